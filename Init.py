@@ -1,0 +1,5 @@
+# HOMesh workbench: initialisation without GUI (FreeCAD and freecadcmd). FreeCAD puts this Mod
+# folder on sys.path, which makes the `homesh` package importable.
+import FreeCAD
+
+FreeCAD.addExportType("HOMesh curved mesh (*.msh *.vtu)", "homesh.freecad.exporter")

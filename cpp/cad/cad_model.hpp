@@ -1,0 +1,124 @@
+// The CAD model: one OpenCASCADE shape, its numbered sub-shapes and geometric queries.
+//
+// Numbering follows FreeCAD: FaceN is the N-th entry (1-based) of TopExp::MapShapes(shape, FACE),
+// and likewise for vertices, edges and solids. All queries take these 1-based indices.
+// Every OCCT failure is converted to CadError naming the entity ("Face3", "Edge7").
+//
+// Thread safety: loading and const queries may not run concurrently on one CadModel, because
+// OCCT's adaptors cache B-spline evaluation state; give each thread its own copy via clone().
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace homesh {
+
+struct CurveDerivatives {
+  Eigen::Vector3d point, d1, d2;
+};
+
+struct SurfaceDerivatives {
+  Eigen::Vector3d point, du, dv, duu, duv, dvv;
+};
+
+struct CurveProjection {
+  double t = 0.0;
+  Eigen::Vector3d point;
+  double distance = 0.0;
+};
+
+struct SurfaceProjection {
+  double u = 0.0, v = 0.0;
+  Eigen::Vector3d point;
+  double distance = 0.0;
+};
+
+struct PrincipalCurvatures {
+  bool defined = false;       // false at umbilic-free singular points (e.g. a cone apex)
+  double kMin = 0.0, kMax = 0.0;  // signed, relative to the face's outward normal, kMin <= kMax
+  Eigen::Vector3d dirMin, dirMax;
+};
+
+struct ParameterRange {
+  double first = 0.0, last = 0.0;
+};
+
+struct SurfaceBounds {
+  double uMin = 0.0, uMax = 0.0, vMin = 0.0, vMax = 0.0;
+};
+
+class CadModel {
+ public:
+  // Loads .step/.stp, .iges/.igs or .brep/.brp (case-insensitive extension).
+  // Throws IoError (missing or unreadable file) or CadError (no usable shape).
+  static CadModel fromFile(const std::string& path);
+
+  // Loads a shape written by BRepTools::Write (FreeCAD's Shape.exportBrepToString()).
+  static CadModel fromBrepText(const std::string& text);
+
+  CadModel(CadModel&&) noexcept;
+  CadModel& operator=(CadModel&&) noexcept;
+  ~CadModel();
+
+  // A copy sharing the (immutable) shape with fresh evaluation caches, for another thread.
+  CadModel clone() const;
+
+  // Sub-shape counts; degenerated edges (sphere poles) are counted as edges.
+  int numVertices() const;
+  int numEdges() const;
+  int numFaces() const;
+  int numSolids() const;
+
+  // Sorted 1-based indices of the sub-shapes of dimension subDim < dim of entity (dim, index):
+  // the vertices of an edge, the edges of a face, the faces of a solid, ...
+  std::vector<int> subShapeIndices(int dim, int index, int subDim) const;
+
+  // Where the shape came from ("part.step", "BRep text") for messages.
+  const std::string& sourceName() const;
+
+  // Axis-aligned bounding box diagonal length (a length scale for tolerances).
+  double boundingDiagonal() const;
+
+  Eigen::Vector3d vertexPoint(int vertex) const;
+
+  bool isDegenerated(int edge) const;
+  ParameterRange edgeRange(int edge) const;
+  CurveDerivatives evaluateCurve(int edge, double t) const;
+  // Parameter of a vertex on an edge it bounds. For a closed edge both ends qualify; the one
+  // nearer `near` is returned when given, else the first.
+  double vertexParameter(int vertex, int edge, std::optional<double> near = std::nullopt) const;
+  // Closest point on the edge's curve within its parameter range.
+  CurveProjection projectOnCurve(int edge, const Eigen::Vector3d& p) const;
+
+  SurfaceBounds faceBounds(int face) const;
+  SurfaceDerivatives evaluateSurface(int face, double u, double v) const;
+  // Closest point on the face's underlying surface; `guess` speeds up and disambiguates.
+  SurfaceProjection projectOnSurface(int face, const Eigen::Vector3d& p,
+                                     std::optional<std::array<double, 2>> guess = {}) const;
+  PrincipalCurvatures curvature(int face, double u, double v) const;
+  // Plane of a planar face: a point and the unit normal oriented like the face.
+  bool isPlanar(int face) const;
+  std::pair<Eigen::Vector3d, Eigen::Vector3d> plane(int face) const;
+  // Parameters (u,v) of the point of an edge at parameter t on a face containing the edge
+  // (via the edge's p-curve on that face).
+  std::array<double, 2> edgeParameterOnFace(int edge, int face, double t) const;
+
+  // Implementation detail shared with the components that hand the shape to OCCT-based tools
+  // (see cad/occt_access.hpp).
+  struct Impl;
+  const Impl& impl() const { return *impl_; }
+
+ private:
+  explicit CadModel(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+// "Face3", "Edge12", ...: the FreeCAD name of sub-shape `index` of dimension `dim` (0..3).
+std::string cadEntityName(int dim, int index);
+
+}  // namespace homesh

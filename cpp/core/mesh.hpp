@@ -1,0 +1,66 @@
+// The flat mesh that flows through the pipeline.
+//
+// Layout (kept flat so that stages, writers, bindings and a future MPI partitioner can share it):
+//   - nodes: xyz[3*i .. 3*i+2] for node i (0-based).
+//   - per node, where it lies on the CAD: nodeCadDim[i] in {0 vertex, 1 curve, 2 face, 3 solid},
+//     nodeCadIndex[i] the 1-based index of that entity in TopExp::MapShapes order of its dimension
+//     (FreeCAD's VertexN / EdgeN / FaceN / SolidN), nodeCadParam[2*i..2*i+1] its curve parameter t
+//     (second slot NaN) or face parameters (u, v); NaN where there is no parameter (vertex, solid).
+//     A mesh read from a file without CAD has nodeCadIndex 0 everywhere.
+//   - elements in blocks of one cell type and order; connectivity is element-major with the node
+//     order of Gmsh's convention for that type (see element/node_ordering.hpp), 0-based node ids.
+//     Each element records the CAD entity it lies on (its solid for volume elements, its face for
+//     boundary triangles, ...), 1-based like nodeCadIndex.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/cell_type.hpp"
+
+namespace homesh {
+
+struct ElementBlock {
+  CellType type = CellType::Tetrahedron;
+  int order = 1;
+  std::vector<std::int64_t> nodes;  // size() == count() * nodesPerElement()
+  std::vector<std::int32_t> entity;  // size() == count()
+
+  int nodesPerElement() const { return cellNumNodes(type, order); }
+  std::size_t count() const { return entity.size(); }
+  const std::int64_t* element(std::size_t e) const {
+    return nodes.data() + e * static_cast<std::size_t>(nodesPerElement());
+  }
+};
+
+struct Mesh {
+  int dim = 3;    // 3: volume mesh; 2: planar mesh (its elements are triangles in a plane)
+  int order = 1;  // polynomial order of every block
+  // For dim == 2: the unit normal of the mesh plane; 2D elements are oriented counter-clockwise
+  // around it (positive Jacobian).
+  std::array<double, 3> planeNormal{0.0, 0.0, 1.0};
+
+  std::vector<double> xyz;
+  std::vector<std::int8_t> nodeCadDim;
+  std::vector<std::int32_t> nodeCadIndex;
+  std::vector<double> nodeCadParam;
+
+  // Blocks whose cells have dimension `dim` (the elements), then those of lower dimension
+  // (the boundary: triangles on CAD faces in 3D, lines on CAD curves in 2D).
+  std::vector<ElementBlock> blocks;
+
+  std::size_t numNodes() const { return xyz.size() / 3; }
+
+  // Appends a node and returns its id.
+  std::int64_t addNode(const double p[3], int cadDim, int cadIndex, double param0, double param1);
+
+  // Number of cells of dimension `dim` (the elements the report counts).
+  std::size_t numElements() const;
+
+  // Throws Error if array sizes disagree or a connectivity entry is out of range.
+  void checkConsistency() const;
+};
+
+}  // namespace homesh

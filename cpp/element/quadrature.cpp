@@ -1,0 +1,97 @@
+#include "element/quadrature.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <string>
+
+#include "core/error.hpp"
+
+namespace homesh {
+
+void gaussJacobi(int n, double alpha, double beta, std::vector<double>& x, std::vector<double>& w) {
+  if (n < 1) throw ParameterError("Gauss-Jacobi rule needs at least one point");
+  // Symmetric tridiagonal Jacobi matrix of the recurrence of the orthonormal Jacobi polynomials.
+  Eigen::MatrixXd jm = Eigen::MatrixXd::Zero(n, n);
+  const double ab = alpha + beta;
+  for (int k = 0; k < n; ++k) {
+    const double s = 2.0 * k + ab;
+    jm(k, k) = (k == 0) ? (beta - alpha) / (ab + 2.0) : (beta * beta - alpha * alpha) / (s * (s + 2.0));
+    if (k + 1 < n) {
+      const double m = k + 1.0;
+      const double t = 2.0 * m + ab;
+      const double b = std::sqrt(4.0 * m * (m + alpha) * (m + beta) * (m + ab) /
+                                 (t * t * (t + 1.0) * (t - 1.0)));
+      jm(k, k + 1) = b;
+      jm(k + 1, k) = b;
+    }
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(jm);
+  const double mu0 = std::pow(2.0, ab + 1.0) * std::tgamma(alpha + 1.0) * std::tgamma(beta + 1.0) /
+                     std::tgamma(ab + 2.0);
+  x.resize(n);
+  w.resize(n);
+  for (int k = 0; k < n; ++k) {
+    x[k] = eig.eigenvalues()(k);
+    const double v0 = eig.eigenvectors()(0, k);
+    w[k] = mu0 * v0 * v0;
+  }
+}
+
+namespace {
+
+// n-point Gauss-Jacobi rule for the weight (1-q)^alpha on [0, 1].
+void unitGaussJacobi(int n, double alpha, std::vector<double>& q, std::vector<double>& w) {
+  gaussJacobi(n, alpha, 0.0, q, w);
+  const double scale = std::pow(0.5, alpha + 1.0);
+  for (int k = 0; k < n; ++k) {
+    q[k] = 0.5 * (q[k] + 1.0);
+    w[k] *= scale;
+  }
+}
+
+}  // namespace
+
+QuadratureRule simplexQuadrature(CellType type, int degree) {
+  if (degree < 0) throw ParameterError("quadrature degree must be >= 0");
+  const int n = degree / 2 + 1;  // n-point Gauss rules are exact to degree 2n-1 >= degree
+  QuadratureRule rule;
+  rule.degree = degree;
+  std::vector<double> p, wp, q, wq, r, wr;
+  unitGaussJacobi(n, 0.0, p, wp);
+  switch (type) {
+    case CellType::Line:
+      rule.dim = 1;
+      rule.points = p;
+      rule.weights = wp;
+      return rule;
+    case CellType::Triangle:
+      // x = p (1 - q), y = q; the Jacobian (1 - q) is the Jacobi weight in q.
+      rule.dim = 2;
+      unitGaussJacobi(n, 1.0, q, wq);
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          rule.points.push_back(p[i] * (1.0 - q[j]));
+          rule.points.push_back(q[j]);
+          rule.weights.push_back(wp[i] * wq[j]);
+        }
+      return rule;
+    case CellType::Tetrahedron:
+      // x = p (1-q)(1-r), y = q (1-r), z = r; Jacobian (1-q)(1-r)^2.
+      rule.dim = 3;
+      unitGaussJacobi(n, 1.0, q, wq);
+      unitGaussJacobi(n, 2.0, r, wr);
+      for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+          for (int i = 0; i < n; ++i) {
+            rule.points.push_back(p[i] * (1.0 - q[j]) * (1.0 - r[k]));
+            rule.points.push_back(q[j] * (1.0 - r[k]));
+            rule.points.push_back(r[k]);
+            rule.weights.push_back(wp[i] * wq[j] * wr[k]);
+          }
+      return rule;
+    default:
+      throw ParameterError("no quadrature rule for " + cellShortName(type) + " yet");
+  }
+}
+
+}  // namespace homesh

@@ -1,0 +1,114 @@
+#include "io/json_writer.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/error.hpp"
+
+namespace homesh {
+
+std::string jsonQuote(const std::string& s) {
+  std::string q = "\"";
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    switch (c) {
+      case '"':
+        q += "\\\"";
+        break;
+      case '\\':
+        q += "\\\\";
+        break;
+      case '\n':
+        q += "\\n";
+        break;
+      case '\t':
+        q += "\\t";
+        break;
+      case '\r':
+        q += "\\r";
+        break;
+      default:
+        if (c < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          q += buf;
+        } else {
+          q += ch;
+        }
+    }
+  }
+  return q + "\"";
+}
+
+void JsonWriter::prefix(const std::string& key) {
+  if (!first_.empty()) {
+    if (!first_.back()) out_ += ",";
+    first_.back() = false;
+    out_ += "\n" + std::string(2 * first_.size(), ' ');
+  }
+  if (!key.empty()) out_ += jsonQuote(key) + ": ";
+}
+
+void JsonWriter::raw(const std::string& key, const std::string& text) {
+  prefix(key);
+  out_ += text;
+}
+
+JsonWriter& JsonWriter::beginObject(const std::string& key) {
+  raw(key, "{");
+  first_.push_back(true);
+  return *this;
+}
+
+JsonWriter& JsonWriter::endObject() {
+  if (first_.empty()) throw Error("JsonWriter: endObject without beginObject");
+  const bool empty = first_.back();
+  first_.pop_back();
+  if (!empty) out_ += "\n" + std::string(2 * first_.size(), ' ');
+  out_ += "}";
+  if (first_.empty()) out_ += "\n";
+  return *this;
+}
+
+JsonWriter& JsonWriter::beginArray(const std::string& key) {
+  raw(key, "[");
+  first_.push_back(true);
+  return *this;
+}
+
+JsonWriter& JsonWriter::endArray() {
+  if (first_.empty()) throw Error("JsonWriter: endArray without beginArray");
+  const bool empty = first_.back();
+  first_.pop_back();
+  if (!empty) out_ += "\n" + std::string(2 * first_.size(), ' ');
+  out_ += "]";
+  return *this;
+}
+
+JsonWriter& JsonWriter::value(const std::string& key, double v) {
+  if (!std::isfinite(v)) {
+    raw(key, "null");
+    return *this;
+  }
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.15g", v);
+  raw(key, buf);
+  return *this;
+}
+
+JsonWriter& JsonWriter::value(const std::string& key, long long v) {
+  raw(key, std::to_string(v));
+  return *this;
+}
+
+JsonWriter& JsonWriter::value(const std::string& key, bool v) {
+  raw(key, v ? "true" : "false");
+  return *this;
+}
+
+JsonWriter& JsonWriter::value(const std::string& key, const std::string& v) {
+  raw(key, jsonQuote(v));
+  return *this;
+}
+
+}  // namespace homesh

@@ -1,0 +1,48 @@
+// Exclusive, exception-safe use of the in-process Gmsh library.
+//
+// Gmsh keeps global state, so one GmshSession at a time may exist in the process (others wait).
+// The constructor initialises Gmsh without reading the user's configuration files; the destructor
+// finalises it, also when a job fails. withGmshErrors converts Gmsh's throws (std::string in
+// Gmsh 4.8, sometimes int) and OCCT failures raised inside Gmsh into MeshingError.
+#pragma once
+
+#include <mutex>
+#include <string>
+
+#include <Standard_Failure.hxx>
+
+#include "core/error.hpp"
+
+namespace homesh {
+
+class GmshSession {
+ public:
+  // verbosity 0: silent; 1: Gmsh's errors and warnings on stderr; 2: and its information.
+  explicit GmshSession(int verbosity = 0, int threads = 1);
+  ~GmshSession();
+  GmshSession(const GmshSession&) = delete;
+  GmshSession& operator=(const GmshSession&) = delete;
+
+ private:
+  std::unique_lock<std::mutex> lock_;
+};
+
+// The last error Gmsh logged, or "" (to explain a failure that produced no exception).
+std::string gmshLastError();
+
+template <class F>
+auto withGmshErrors(const std::string& what, F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const std::string& message) {
+    throw MeshingError(what + ": Gmsh failed: " + message);
+  } catch (const Standard_Failure& failure) {
+    throw MeshingError(what + ": Gmsh failed in OpenCASCADE: " + failure.DynamicType()->Name());
+  } catch (int code) {
+    const std::string last = gmshLastError();
+    throw MeshingError(what + ": Gmsh failed (code " + std::to_string(code) + ")" +
+                       (last.empty() ? "" : ": " + last));
+  }
+}
+
+}  // namespace homesh

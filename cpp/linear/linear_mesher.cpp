@@ -1,0 +1,236 @@
+#include "linear/linear_mesher.hpp"
+
+#include <gmsh.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cad/occt_access.hpp"
+#include "core/error.hpp"
+#include "core/format.hpp"
+#include "linear/gmsh_entity_map.hpp"
+#include "linear/gmsh_session.hpp"
+
+namespace homesh {
+namespace {
+
+constexpr double kMaxEstimatedElements = 5e7;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Gmsh element type codes of the linear cells we request.
+constexpr int kGmshLine = 1, kGmshTriangle = 2, kGmshTetrahedron = 4, kGmshPoint = 15;
+
+void checkSize(const CadModel& cad, double size, int dim) {
+  if (!(size > 0.0) || !std::isfinite(size))
+    throw ParameterError("mesh size must be a positive number, got " + formatNumber(size));
+  // The bounding box bounds the domain; an absurd element count means a typo in the size.
+  const double d = cad.boundingDiagonal();
+  const double estimate = dim == 3 ? 8.5 * std::pow(d / std::sqrt(3.0) / size, 3)
+                                   : 2.3 * std::pow(d / std::sqrt(2.0) / size, 2);
+  if (estimate > kMaxEstimatedElements) {
+    std::ostringstream msg;
+    msg << "mesh size " << size << " is too small for " << cad.sourceName()
+        << " (bounding-box diagonal " << d << "): it could make about " << std::scientific
+        << std::setprecision(1) << estimate << " elements";
+    throw ParameterError(msg.str());
+  }
+}
+
+// 3 for a model with solids; 2 for planar faces in one plane; CadError otherwise.
+int meshDimension(const CadModel& cad, Eigen::Vector3d& normal) {
+  if (cad.numSolids() > 0) return 3;
+  for (int f = 1; f <= cad.numFaces(); ++f)
+    if (!cad.isPlanar(f))
+      throw CadError(cadEntityName(2, f) + " of " + cad.sourceName() +
+                     " is not planar and belongs to no solid: HOMesh meshes solids, or planar "
+                     "faces in one plane (2D)");
+  const auto [origin, n] = cad.plane(1);
+  const double tol = 1e-7 * cad.boundingDiagonal();
+  for (int f = 2; f <= cad.numFaces(); ++f) {
+    const auto [o, m] = cad.plane(f);
+    if (std::abs(n.dot(m)) < 1.0 - 1e-9 || std::abs(n.dot(o - origin)) > tol)
+      throw CadError(cadEntityName(2, f) + " is not in the plane of Face1: a 2D mesh needs all "
+                     "faces in one plane");
+  }
+  normal = n;
+  return 2;
+}
+
+struct NodeTable {
+  std::vector<std::int64_t> byTag;  // gmsh tag -> mesh node id, -1 if none
+
+  std::int64_t at(std::size_t tag) const {
+    if (tag >= byTag.size() || byTag[tag] < 0)
+      throw MeshingError("Gmsh element refers to unknown node " + std::to_string(tag));
+    return byTag[tag];
+  }
+};
+
+void readNodes(const GmshEntityMap& entities, Mesh& mesh, NodeTable& table) {
+  struct EntityNodes {
+    int dim, cadIndex;
+    std::vector<std::size_t> tags;
+    std::vector<double> coord, param;
+  };
+  std::vector<EntityNodes> all;
+  std::size_t maxTag = 0;
+  gmsh::vectorpair dimTags;
+  gmsh::model::getEntities(dimTags);
+  for (const auto& [dim, tag] : dimTags) {
+    EntityNodes en{dim, entities.cadIndex(dim, tag), {}, {}, {}};
+    gmsh::model::mesh::getNodes(en.tags, en.coord, en.param, dim, tag, false, true);
+    for (const std::size_t t : en.tags) maxTag = std::max(maxTag, t);
+    all.push_back(std::move(en));
+  }
+  table.byTag.assign(maxTag + 1, -1);
+  for (const EntityNodes& en : all) {
+    const int dim = en.dim;
+    const bool hasParam = (dim == 1 || dim == 2) && en.param.size() == en.tags.size() * dim;
+    for (std::size_t i = 0; i < en.tags.size(); ++i) {
+      double u = kNaN, v = kNaN;
+      if (hasParam) {
+        u = en.param[i * dim];
+        if (dim == 2) v = en.param[i * dim + 1];
+      }
+      if (table.byTag[en.tags[i]] >= 0)
+        throw MeshingError("Gmsh returned node " + std::to_string(en.tags[i]) + " twice");
+      table.byTag[en.tags[i]] = mesh.addNode(&en.coord[3 * i], dim, en.cadIndex, u, v);
+    }
+  }
+}
+
+// Appends the elements of Gmsh entity (dim, tag), which must all be of type `gmshType`.
+void readElements(const GmshEntityMap& entities, const NodeTable& table, int dim, int tag,
+                  int gmshType, ElementBlock& block) {
+  std::vector<int> types;
+  std::vector<std::vector<std::size_t>> elementTags, nodeTags;
+  gmsh::model::mesh::getElements(types, elementTags, nodeTags, dim, tag);
+  const int cadIndex = entities.cadIndex(dim, tag);
+  const int nv = cellNumVertices(block.type);
+  for (std::size_t k = 0; k < types.size(); ++k) {
+    if (types[k] == kGmshPoint) continue;
+    if (types[k] != gmshType)
+      throw MeshingError("Gmsh made elements of type " + std::to_string(types[k]) + " on " +
+                         cadEntityName(dim, cadIndex) + " where only " +
+                         cellShortName(block.type) + "s were expected");
+    for (const std::size_t nodeTag : nodeTags[k]) block.nodes.push_back(table.at(nodeTag));
+    block.entity.insert(block.entity.end(), nodeTags[k].size() / nv, cadIndex);
+  }
+}
+
+Eigen::Vector3d point(const Mesh& mesh, std::int64_t i) {
+  return {mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]};
+}
+
+// Makes every tetrahedron positively oriented and every boundary triangle that bounds exactly one
+// tetrahedron point out of it.
+void orientVolumeMesh(Mesh& mesh, ElementBlock& tets, ElementBlock& tris) {
+  using Face = std::array<std::int64_t, 3>;
+  std::map<Face, std::vector<std::int64_t>> opposite;  // sorted face -> opposite vertices
+  for (std::size_t e = 0; e < tets.count(); ++e) {
+    std::int64_t* t = tets.nodes.data() + 4 * e;
+    const Eigen::Vector3d a = point(mesh, t[0]);
+    const double volume =
+        (point(mesh, t[1]) - a).cross(point(mesh, t[2]) - a).dot(point(mesh, t[3]) - a);
+    if (volume < 0.0) std::swap(t[1], t[2]);
+    for (int skip = 0; skip < 4; ++skip) {
+      Face f;
+      int n = 0;
+      for (int k = 0; k < 4; ++k)
+        if (k != skip) f[n++] = t[k];
+      std::sort(f.begin(), f.end());
+      opposite[f].push_back(t[skip]);
+    }
+  }
+  for (std::size_t e = 0; e < tris.count(); ++e) {
+    std::int64_t* t = tris.nodes.data() + 3 * e;
+    Face f{t[0], t[1], t[2]};
+    std::sort(f.begin(), f.end());
+    const auto it = opposite.find(f);
+    if (it == opposite.end() || it->second.size() != 1) continue;
+    const Eigen::Vector3d a = point(mesh, t[0]);
+    const Eigen::Vector3d n = (point(mesh, t[1]) - a).cross(point(mesh, t[2]) - a);
+    if (n.dot(point(mesh, it->second[0]) - a) > 0.0) std::swap(t[1], t[2]);
+  }
+}
+
+void orientPlanarMesh(Mesh& mesh, ElementBlock& tris) {
+  const Eigen::Vector3d normal(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
+  for (std::size_t e = 0; e < tris.count(); ++e) {
+    std::int64_t* t = tris.nodes.data() + 3 * e;
+    const Eigen::Vector3d a = point(mesh, t[0]);
+    if ((point(mesh, t[1]) - a).cross(point(mesh, t[2]) - a).dot(normal) < 0.0)
+      std::swap(t[1], t[2]);
+  }
+}
+
+}  // namespace
+
+Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
+  Eigen::Vector3d normal(0.0, 0.0, 1.0);
+  const int dim = meshDimension(cad, normal);
+  checkSize(cad, options.size, dim);
+
+  Mesh mesh;
+  mesh.dim = dim;
+  mesh.order = 1;
+  mesh.planeNormal = {normal.x(), normal.y(), normal.z()};
+
+  GmshSession session(options.verbosity, options.threads);
+  withGmshErrors("meshing " + cad.sourceName(), [&] {
+    gmsh::model::add("homesh");
+    gmsh::vectorpair imported;
+    gmsh::model::occ::importShapesNativePointer(&occtShape(cad), imported, false);
+    gmsh::model::occ::synchronize();
+    const GmshEntityMap entities = GmshEntityMap::build(cad);
+
+    const double size = options.size;
+    gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
+    gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+    gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", size);
+    gmsh::option::setNumber("Mesh.ElementOrder", 1);
+    gmsh::model::mesh::setSizeCallback(
+        [size](int, int, double, double, double) { return size; });
+    gmsh::model::mesh::generate(dim);
+
+    NodeTable table;
+    readNodes(entities, mesh, table);
+
+    ElementBlock cells, faces, lines;
+    cells.type = dim == 3 ? CellType::Tetrahedron : CellType::Triangle;
+    faces.type = CellType::Triangle;
+    lines.type = CellType::Line;
+    gmsh::vectorpair dimTags;
+    gmsh::model::getEntities(dimTags);
+    for (const auto& [d, tag] : dimTags) {
+      if (d == 3) readElements(entities, table, d, tag, kGmshTetrahedron, cells);
+      if (d == 2) readElements(entities, table, d, tag, kGmshTriangle, dim == 3 ? faces : cells);
+      if (d == 1) readElements(entities, table, d, tag, kGmshLine, lines);
+    }
+    if (cells.count() == 0) {
+      const std::string last = gmshLastError();
+      throw MeshingError("Gmsh made no " + cellShortName(cells.type) + "s for " +
+                         cad.sourceName() + (last.empty() ? "" : ": " + last));
+    }
+    if (dim == 3) {
+      orientVolumeMesh(mesh, cells, faces);
+      mesh.blocks = {std::move(cells), std::move(faces), std::move(lines)};
+    } else {
+      orientPlanarMesh(mesh, cells);
+      mesh.blocks = {std::move(cells), std::move(lines)};
+    }
+    gmsh::model::mesh::removeSizeCallback();
+  });
+  mesh.checkConsistency();
+  return mesh;
+}
+
+}  // namespace homesh

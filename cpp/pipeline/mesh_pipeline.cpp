@@ -1,0 +1,146 @@
+#include "pipeline/mesh_pipeline.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "core/error.hpp"
+#include "core/format.hpp"
+#include "curving/order_elevation.hpp"
+#include "io/json_writer.hpp"
+#include "linear/linear_mesher.hpp"
+
+namespace homesh {
+
+void MeshingOptions::validate() const {
+  if (order < 1 || order > 10)
+    throw ParameterError("order must be an integer from 1 to 10, got " + std::to_string(order));
+  if (size && (!(*size > 0.0) || !std::isfinite(*size)))
+    throw ParameterError("size must be a positive length, got " + formatNumber(*size));
+  if (threads < 1) throw ParameterError("threads must be >= 1, got " + std::to_string(threads));
+}
+
+double defaultMeshSize(const CadModel& cad) { return cad.boundingDiagonal() / 20.0; }
+
+CadModel CadSource::load() const {
+  return kind == Kind::File ? CadModel::fromFile(value) : CadModel::fromBrepText(value);
+}
+
+void StageTimings::add(const std::string& stage, double s) { seconds.emplace_back(stage, s); }
+
+double StageTimings::total() const {
+  double t = 0.0;
+  for (const auto& [stage, s] : seconds) t += s;
+  return t;
+}
+
+namespace {
+
+class StageClock {
+ public:
+  StageClock(const std::string& stage, StageTimings& timings, PipelineObserver* observer)
+      : stage_(stage), timings_(timings), observer_(observer) {
+    if (observer_) {
+      if (observer_->cancelRequested()) throw CancelledError("cancelled before " + stage);
+      observer_->stageStarted(stage);
+    }
+    start_ = std::chrono::steady_clock::now();
+  }
+  void done() {
+    const double s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    timings_.add(stage_, s);
+    if (observer_) observer_->stageFinished(stage_, s);
+  }
+
+ private:
+  std::string stage_;
+  StageTimings& timings_;
+  PipelineObserver* observer_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace
+
+MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
+                           PipelineObserver* observer) {
+  options.validate();  // before the (possibly slow) CAD import
+
+  MeshResult result;
+  StageClock cad("cad", result.timings, observer);
+  result.cad = std::make_shared<const CadModel>(source.load());
+  cad.done();
+  if (!options.size) options.size = defaultMeshSize(*result.cad);
+  result.options = options;
+
+  StageClock linear("linear", result.timings, observer);
+  const Mesh linearMesh =
+      generateLinearMesh(*result.cad, {*options.size, options.threads, options.verbosity});
+  linear.done();
+
+  StageClock highOrder("high_order", result.timings, observer);
+  result.mesh = elevateOrder(linearMesh, options.order, result.cad.get());
+  highOrder.done();
+
+  StageClock quality("quality", result.timings, observer);
+  result.quality = evaluateQuality(result.mesh);
+  quality.done();
+  return result;
+}
+
+std::vector<CellField> qualityFields(const QualitySummary& quality) {
+  CellField field{"scaled_jacobian", quality.scaledJacobian};
+  field.values.insert(field.values.end(), quality.boundaryScaledJacobian.begin(),
+                      quality.boundaryScaledJacobian.end());
+  return {field};
+}
+
+void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,
+                      PipelineObserver* observer) {
+  StageClock output("output", result.timings, observer);
+  const std::vector<CellField> fields = qualityFields(result.quality);
+  for (const std::string& path : paths) writeMesh(result.mesh, path, fields);
+  output.done();
+}
+
+std::string meshReportJson(const MeshResult& result, const std::string& input) {
+  const Mesh& mesh = result.mesh;
+  std::map<std::string, std::size_t> elements = {{"tet", 0}, {"prism", 0}, {"pyramid", 0},
+                                                 {"hex", 0}, {"tri", 0},   {"quad", 0}};
+  std::map<std::string, std::size_t> boundary;
+  for (const ElementBlock& block : mesh.blocks) {
+    if (cellDimension(block.type) == mesh.dim)
+      elements[cellShortName(block.type)] += block.count();
+    else
+      boundary[cellShortName(block.type)] += block.count();
+  }
+  JsonWriter json;
+  json.beginObject();
+  json.value("input", input);
+  json.value("dimension", mesh.dim);
+  json.value("order", mesh.order);
+  json.value("size", result.options.size.value_or(0.0));
+  json.value("nodes", mesh.numNodes());
+  json.beginObject("elements");
+  for (const char* name : {"tet", "prism", "pyramid", "hex", "tri", "quad"})
+    json.value(name, elements[name]);
+  json.endObject();
+  json.beginObject("boundary");
+  for (const auto& [name, count] : boundary) json.value(name, count);
+  json.endObject();
+  json.beginObject("quality");
+  json.beginObject("scaled_jacobian");
+  json.value("min", result.quality.min);
+  json.value("mean", result.quality.mean);
+  json.endObject();
+  json.value("invalid_elements", result.quality.invalid);
+  json.value("sampling", "quadrature points of degree 2P+2 and nodes");
+  json.endObject();
+  json.beginObject("timings_s");
+  for (const auto& [stage, s] : result.timings.seconds) json.value(stage, s);
+  json.endObject();
+  json.endObject();
+  return json.str();
+}
+
+}  // namespace homesh

@@ -1,0 +1,83 @@
+// CAD in, curved mesh out: the stages in order, with timings and progress.
+//
+//   CAD model -> linear mesh (Gmsh, uniform size) -> order elevation with boundary nodes on the
+//   CAD -> quality.
+//
+// The command line, the Python module and the tests all drive meshing through this one entry
+// point, so they validate parameters and report identically.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cad/cad_model.hpp"
+#include "core/mesh.hpp"
+#include "io/mesh_writers.hpp"
+#include "quality/jacobian_quality.hpp"
+
+namespace homesh {
+
+struct MeshingOptions {
+  int order = 4;       // polynomial order, 1..10
+  std::optional<double> size;  // target edge length (> 0); unset: defaultMeshSize(cad)
+  int threads = 1;     // threads the stages may use
+  int verbosity = 0;   // 0 silent; 1 Gmsh's warnings; 2 Gmsh's information
+
+  // Throws ParameterError naming the offending parameter.
+  void validate() const;
+};
+
+// A uniform size giving a coarse mesh: a twentieth of the bounding-box diagonal.
+double defaultMeshSize(const CadModel& cad);
+
+// Where the CAD comes from.
+struct CadSource {
+  enum class Kind { File, BrepText } kind = Kind::File;
+  std::string value;  // a path, or BRep text
+  static CadSource file(std::string path) { return {Kind::File, std::move(path)}; }
+  static CadSource brepText(std::string text) { return {Kind::BrepText, std::move(text)}; }
+  CadModel load() const;
+};
+
+// Wall-clock seconds per stage, in the order the stages ran.
+struct StageTimings {
+  std::vector<std::pair<std::string, double>> seconds;
+  void add(const std::string& stage, double s);
+  double total() const;
+};
+
+// Receives progress; may ask to stop between stages (the run then throws CancelledError).
+class PipelineObserver {
+ public:
+  virtual ~PipelineObserver() = default;
+  virtual void stageStarted(const std::string& /*stage*/) {}
+  virtual void stageFinished(const std::string& /*stage*/, double /*seconds*/) {}
+  virtual bool cancelRequested() { return false; }
+};
+
+struct MeshResult {
+  std::shared_ptr<const CadModel> cad;
+  Mesh mesh;
+  QualitySummary quality;
+  StageTimings timings;
+  MeshingOptions options;
+};
+
+// Runs every stage. Throws ParameterError, IoError, CadError, MeshingError or CancelledError.
+MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
+                           PipelineObserver* observer = nullptr);
+
+// The per-element quality fields written beside the mesh.
+std::vector<CellField> qualityFields(const QualitySummary& quality);
+
+// Writes the mesh to each path (format from the extension) and records the "output" timing.
+void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,
+                      PipelineObserver* observer = nullptr);
+
+// The JSON report (schema in README.md): order, counts, quality, timings and the inputs.
+std::string meshReportJson(const MeshResult& result, const std::string& input);
+
+}  // namespace homesh

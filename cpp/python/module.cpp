@@ -1,0 +1,336 @@
+// The Python extension homesh._core (Boost.Python). The pure-Python package `homesh` wraps it;
+// see homesh/__init__.py for the public API.
+//
+// Every C++ exception becomes a Python exception (homesh errors to their Python classes, other
+// std::exceptions to RuntimeError), so a failing job never takes FreeCAD down. Long calls release
+// the GIL; the progress callback re-acquires it.
+#include <Python.h>
+
+#include <boost/python.hpp>
+#include <boost/python/numpy.hpp>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/version.hpp"
+#include "element/reference_element.hpp"
+#include "pipeline/mesh_pipeline.hpp"
+
+namespace bp = boost::python;
+namespace np = boost::python::numpy;
+
+namespace homesh {
+namespace {
+
+PyObject* gBaseError = nullptr;
+PyObject* gParameterError = nullptr;
+PyObject* gCadError = nullptr;
+PyObject* gMeshingError = nullptr;
+PyObject* gFileError = nullptr;
+PyObject* gCancelledError = nullptr;
+
+PyObject* makeException(const char* name, PyObject* bases, const char* doc) {
+  const std::string qualified = std::string("homesh._core.") + name;
+  PyObject* type = PyErr_NewExceptionWithDoc(qualified.c_str(), doc, bases, nullptr);
+  if (!type) bp::throw_error_already_set();
+  bp::scope().attr(name) = bp::handle<>(bp::borrowed(type));
+  return type;
+}
+
+template <class E>
+void registerTranslator(PyObject* pyType) {
+  bp::register_exception_translator<E>(
+      [pyType](const E& e) { PyErr_SetString(pyType, e.what()); });
+}
+
+class ReleaseGil {
+ public:
+  ReleaseGil() : state_(PyEval_SaveThread()) {}
+  ~ReleaseGil() { PyEval_RestoreThread(state_); }
+  ReleaseGil(const ReleaseGil&) = delete;
+  ReleaseGil& operator=(const ReleaseGil&) = delete;
+
+ private:
+  PyThreadState* state_;
+};
+
+// Calls progress(stage, seconds_or_None); an exception in the callback cancels the job.
+class PythonProgress : public PipelineObserver {
+ public:
+  explicit PythonProgress(bp::object callback) : callback_(std::move(callback)) {}
+  void stageStarted(const std::string& stage) override { call(stage, nullptr); }
+  void stageFinished(const std::string& stage, double seconds) override { call(stage, &seconds); }
+  bool cancelRequested() override { return !failure_.empty(); }
+  const std::string& failure() const { return failure_; }
+
+ private:
+  void call(const std::string& stage, const double* seconds) {
+    if (callback_.is_none() || !failure_.empty()) return;
+    const PyGILState_STATE gil = PyGILState_Ensure();
+    try {
+      callback_(stage, seconds ? bp::object(*seconds) : bp::object());
+    } catch (const bp::error_already_set&) {
+      PyObject *type = nullptr, *value = nullptr, *trace = nullptr;
+      PyErr_Fetch(&type, &value, &trace);
+      failure_ = "progress callback raised an exception";
+      if (value) {
+        PyObject* text = PyObject_Str(value);
+        if (text) {
+          failure_ += std::string(": ") + PyUnicode_AsUTF8(text);
+          Py_DECREF(text);
+        }
+      }
+      PyErr_Clear();
+      Py_XDECREF(type);
+      Py_XDECREF(value);
+      Py_XDECREF(trace);
+    }
+    PyGILState_Release(gil);
+  }
+  bp::object callback_;
+  std::string failure_;
+};
+
+template <class T>
+np::ndarray toArray(const std::vector<T>& values, std::size_t rows, std::size_t cols) {
+  const bp::tuple shape =
+      cols == 0 ? bp::make_tuple(rows) : bp::make_tuple(rows, cols);
+  np::ndarray a = np::empty(shape, np::dtype::get_builtin<T>());
+  if (!values.empty()) std::memcpy(a.get_data(), values.data(), values.size() * sizeof(T));
+  return a;
+}
+
+// Copies a contiguous numpy array of dtype T (any shape) into a vector.
+template <class T>
+std::vector<T> fromArray(const bp::object& object, const char* what) {
+  np::ndarray a = np::from_object(object, np::dtype::get_builtin<T>(), np::ndarray::C_CONTIGUOUS);
+  std::size_t n = 1;
+  for (int k = 0; k < a.get_nd(); ++k) n *= static_cast<std::size_t>(a.shape(k));
+  if (a.get_nd() == 0) throw ParameterError(std::string(what) + " must be an array");
+  std::vector<T> v(n);
+  if (n) std::memcpy(v.data(), a.get_data(), n * sizeof(T));
+  return v;
+}
+
+CellType cellTypeFromName(const std::string& name) {
+  for (CellType t : {CellType::Line, CellType::Triangle, CellType::Quadrilateral,
+                     CellType::Tetrahedron, CellType::Prism, CellType::Pyramid,
+                     CellType::Hexahedron})
+    if (cellShortName(t) == name) return t;
+  throw ParameterError("unknown element type '" + name + "'");
+}
+
+// The Python-visible mesh: a pipeline result (or a mesh rebuilt from saved arrays).
+class PyMesh {
+ public:
+  explicit PyMesh(MeshResult result) : result_(std::make_shared<MeshResult>(std::move(result))) {}
+
+  int order() const { return result_->mesh.order; }
+  int dim() const { return result_->mesh.dim; }
+  std::size_t numNodes() const { return result_->mesh.numNodes(); }
+  std::size_t numElements() const { return result_->mesh.numElements(); }
+  bool hasCad() const { return static_cast<bool>(result_->cad); }
+
+  np::ndarray nodes() const { return toArray(result_->mesh.xyz, numNodes(), 3); }
+  np::ndarray nodeCadDim() const { return toArray(result_->mesh.nodeCadDim, numNodes(), 0); }
+  np::ndarray nodeCadIndex() const { return toArray(result_->mesh.nodeCadIndex, numNodes(), 0); }
+  np::ndarray nodeCadParams() const { return toArray(result_->mesh.nodeCadParam, numNodes(), 2); }
+  bp::tuple planeNormal() const {
+    const auto& n = result_->mesh.planeNormal;
+    return bp::make_tuple(n[0], n[1], n[2]);
+  }
+
+  // [(type name, order, connectivity (E, npe) int64, entity (E,) int32), ...]
+  bp::list blocks() const {
+    bp::list out;
+    for (const ElementBlock& b : result_->mesh.blocks)
+      out.append(bp::make_tuple(cellShortName(b.type), b.order,
+                                toArray(b.nodes, b.count(), b.nodesPerElement()),
+                                toArray(b.entity, b.count(), 0)));
+    return out;
+  }
+
+  np::ndarray scaledJacobian() const {
+    return toArray(result_->quality.scaledJacobian, result_->quality.scaledJacobian.size(), 0);
+  }
+
+  bp::dict qualitySummary() const {
+    const QualitySummary& q = result_->quality;
+    bp::dict d;
+    d["min"] = q.min;
+    d["mean"] = q.mean;
+    d["invalid_elements"] = q.invalid;
+    bp::dict byType;
+    for (const auto& [type, t] : q.byType) {
+      bp::dict e;
+      e["count"] = t.count;
+      e["min"] = t.min;
+      e["mean"] = t.mean;
+      e["invalid_elements"] = t.invalid;
+      byType[cellShortName(type)] = e;
+    }
+    d["by_type"] = byType;
+    return d;
+  }
+
+  bp::dict timings() const {
+    bp::dict d;
+    for (const auto& [stage, s] : result_->timings.seconds) d[stage] = s;
+    return d;
+  }
+
+  void write(const std::string& path) {
+    const ReleaseGil nogil;
+    writeMeshOutputs(*result_, {path});
+  }
+
+  std::string reportJson(const std::string& input) const {
+    return meshReportJson(*result_, input);
+  }
+
+  std::shared_ptr<MeshResult> result_;
+};
+
+MeshingOptions makeOptions(int order, bp::object size, int threads, int verbosity) {
+  MeshingOptions options;
+  options.order = order;
+  if (!size.is_none()) options.size = bp::extract<double>(size);
+  options.threads = threads;
+  options.verbosity = verbosity;
+  return options;
+}
+
+PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::object progress) {
+  PythonProgress observer(progress);
+  std::unique_ptr<MeshResult> result;
+  try {
+    const ReleaseGil nogil;
+    result = std::make_unique<MeshResult>(runMeshPipeline(source, options, &observer));
+  } catch (const CancelledError&) {
+    if (!observer.failure().empty()) throw CancelledError(observer.failure());
+    throw;
+  }
+  return PyMesh(std::move(*result));
+}
+
+PyMesh meshFile(const std::string& path, int order, bp::object size, int threads, int verbosity,
+                bp::object progress) {
+  return runPipeline(CadSource::file(path), makeOptions(order, size, threads, verbosity), progress);
+}
+
+PyMesh meshBrep(const std::string& text, int order, bp::object size, int threads, int verbosity,
+                bp::object progress) {
+  return runPipeline(CadSource::brepText(text), makeOptions(order, size, threads, verbosity),
+                     progress);
+}
+
+// Rebuilds a mesh (without CAD) from the arrays PyMesh exposes, and evaluates its quality.
+// blocks: [(type name, order, connectivity, entity), ...] as returned by PyMesh.blocks().
+PyMesh meshFromArrays(int dim, int order, bp::object nodes, bp::object cadDim, bp::object cadIndex,
+                      bp::object cadParams, bp::list blocks, bp::tuple normal) {
+  MeshResult result;
+  Mesh& mesh = result.mesh;
+  mesh.dim = dim;
+  mesh.order = order;
+  if (dim != 2 && dim != 3) throw ParameterError("dim must be 2 or 3");
+  if (bp::len(normal) != 3) throw ParameterError("plane normal needs 3 components");
+  for (int k = 0; k < 3; ++k) mesh.planeNormal[k] = bp::extract<double>(normal[k]);
+  mesh.xyz = fromArray<double>(nodes, "nodes");
+  mesh.nodeCadDim = fromArray<std::int8_t>(cadDim, "node_cad_dim");
+  mesh.nodeCadIndex = fromArray<std::int32_t>(cadIndex, "node_cad_index");
+  mesh.nodeCadParam = fromArray<double>(cadParams, "node_cad_params");
+  for (bp::ssize_t i = 0; i < bp::len(blocks); ++i) {
+    const bp::tuple b = bp::extract<bp::tuple>(blocks[i]);
+    ElementBlock block;
+    block.type = cellTypeFromName(bp::extract<std::string>(b[0]));
+    block.order = bp::extract<int>(b[1]);
+    block.nodes = fromArray<std::int64_t>(b[2], "connectivity");
+    block.entity = fromArray<std::int32_t>(b[3], "entity");
+    mesh.blocks.push_back(std::move(block));
+  }
+  mesh.checkConsistency();
+  result.quality = evaluateQuality(mesh);
+  result.options.order = order;
+  return PyMesh(std::move(result));
+}
+
+// Values of the Lagrange basis of (type, order) at reference points (npts x dim):
+// returns (npts x numNodes), nodes in Gmsh order. Used to draw curved elements.
+np::ndarray lagrangeBasis(const std::string& type, int order, bp::object points) {
+  const ReferenceElement& ref = ReferenceElement::get(cellTypeFromName(type), order);
+  const std::vector<double> xi = fromArray<double>(points, "points");
+  const std::size_t dim = static_cast<std::size_t>(ref.dim());
+  if (xi.size() % dim != 0)
+    throw ParameterError("points must have " + std::to_string(dim) + " coordinates each");
+  const std::size_t npts = xi.size() / dim;
+  std::vector<double> out(npts * ref.numNodes());
+  Eigen::VectorXd values;
+  Eigen::MatrixXd gradients;
+  for (std::size_t i = 0; i < npts; ++i) {
+    ref.evaluate(&xi[i * dim], values, gradients);
+    for (int n = 0; n < ref.numNodes(); ++n) out[i * ref.numNodes() + n] = values(n);
+  }
+  return toArray(out, npts, ref.numNodes());
+}
+
+}  // namespace
+}  // namespace homesh
+
+BOOST_PYTHON_MODULE(_core) {
+  using namespace homesh;
+  np::initialize();
+  bp::scope().attr("__version__") = kVersion;
+
+  gBaseError = makeException("HOMeshError", PyExc_RuntimeError, "Base of all HOMesh errors.");
+  gParameterError = makeException(
+      "ParameterError", bp::make_tuple(bp::handle<>(bp::borrowed(gBaseError)),
+                                       bp::handle<>(bp::borrowed(PyExc_ValueError)))
+                            .ptr(),
+      "A parameter is out of range (order, size, ...).");
+  gCadError = makeException("CadError", gBaseError, "The CAD model cannot be read or meshed.");
+  gMeshingError = makeException("MeshingError", gBaseError, "The mesher failed.");
+  gFileError = makeException("FileError",
+                             bp::make_tuple(bp::handle<>(bp::borrowed(gBaseError)),
+                                            bp::handle<>(bp::borrowed(PyExc_OSError)))
+                                 .ptr(),
+                             "A file is missing, unreadable or cannot be written.");
+  gCancelledError = makeException("CancelledError", gBaseError, "The job was cancelled.");
+  registerTranslator<Error>(gBaseError);
+  registerTranslator<ParameterError>(gParameterError);
+  registerTranslator<CadError>(gCadError);
+  registerTranslator<MeshingError>(gMeshingError);
+  registerTranslator<IoError>(gFileError);
+  registerTranslator<CancelledError>(gCancelledError);
+
+  bp::class_<PyMesh>("Mesh", bp::no_init)
+      .add_property("order", &PyMesh::order)
+      .add_property("dim", &PyMesh::dim)
+      .add_property("num_nodes", &PyMesh::numNodes)
+      .add_property("num_elements", &PyMesh::numElements)
+      .add_property("has_cad", &PyMesh::hasCad)
+      .add_property("plane_normal", &PyMesh::planeNormal)
+      .def("nodes", &PyMesh::nodes)
+      .def("node_cad_dim", &PyMesh::nodeCadDim)
+      .def("node_cad_index", &PyMesh::nodeCadIndex)
+      .def("node_cad_params", &PyMesh::nodeCadParams)
+      .def("blocks", &PyMesh::blocks)
+      .def("scaled_jacobian", &PyMesh::scaledJacobian)
+      .def("quality_summary", &PyMesh::qualitySummary)
+      .def("timings", &PyMesh::timings)
+      .def("write", &PyMesh::write)
+      .def("report_json", &PyMesh::reportJson);
+
+  bp::def("mesh_file", &meshFile,
+          (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
+           bp::arg("verbosity"), bp::arg("progress")));
+  bp::def("mesh_brep", &meshBrep,
+          (bp::arg("text"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
+           bp::arg("verbosity"), bp::arg("progress")));
+  bp::def("lagrange_basis", &lagrangeBasis, (bp::arg("type"), bp::arg("order"), bp::arg("points")));
+  bp::def("mesh_from_arrays", &meshFromArrays,
+          (bp::arg("dim"), bp::arg("order"), bp::arg("nodes"), bp::arg("node_cad_dim"),
+           bp::arg("node_cad_index"), bp::arg("node_cad_params"), bp::arg("blocks"),
+           bp::arg("plane_normal")));
+}

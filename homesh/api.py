@@ -1,0 +1,198 @@
+"""The Python face of the meshing core: :func:`mesh`, :func:`load` and :class:`HighOrderMesh`."""
+
+import json
+import numbers
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _core
+from ._core import FileError, ParameterError
+
+_NPZ_FORMAT = 1
+
+
+@dataclass(frozen=True)
+class BoundaryBlock:
+    """Lower-dimensional cells: triangles on CAD faces (3D) or lines on CAD edges.
+
+    ``elements`` is (count, nodes per cell) int64 in Gmsh order; ``cad_entity`` gives the
+    1-based FreeCAD index of the face (``FaceN``) or edge (``EdgeN``) each cell lies on.
+    """
+
+    element_type: str
+    order: int
+    elements: np.ndarray
+    cad_entity: np.ndarray
+
+
+class HighOrderMesh:
+    """A curved mesh: flat arrays of nodes and connectivity, with quality and writers.
+
+    Attributes (numpy arrays, copied from the core once):
+      nodes            (N, 3) float64
+      elements         (E, k) int64: cells of dimension ``dim`` (tetrahedra, or triangles in 2D)
+      element_type     "tet" or "tri"
+      element_entity   (E,) int32: the solid (3D) or face (2D) each element belongs to
+      boundary         list of :class:`BoundaryBlock`
+      node_cad_dim     (N,) int8: 0 vertex, 1 edge, 2 face, 3 solid interior
+      node_cad_index   (N,) int32: 1-based FreeCAD index of that entity (VertexN, EdgeN, ...)
+      node_cad_params  (N, 2) float64: t on an edge (second column NaN) or (u, v) on a face
+    """
+
+    def __init__(self, core):
+        self._core = core
+        self.order = core.order
+        self.dim = core.dim
+        self.plane_normal = tuple(core.plane_normal)
+        self.nodes = core.nodes()
+        self.node_cad_dim = core.node_cad_dim()
+        self.node_cad_index = core.node_cad_index()
+        self.node_cad_params = core.node_cad_params()
+        self._blocks = core.blocks()
+        cells = [b for b in self._blocks if _cell_dim(b[0]) == self.dim]
+        if len(cells) != 1:
+            raise _core.HOMeshError("expected one element block, found %d" % len(cells))
+        self.element_type, _, self.elements, self.element_entity = cells[0]
+        self.boundary = [
+            BoundaryBlock(t, o, conn, ent)
+            for t, o, conn, ent in self._blocks
+            if _cell_dim(t) != self.dim
+        ]
+
+    def __repr__(self):
+        return "<HighOrderMesh order %d: %d nodes, %d %s>" % (
+            self.order, len(self.nodes), len(self.elements), self.element_type)
+
+    @property
+    def num_nodes(self):
+        return len(self.nodes)
+
+    @property
+    def num_elements(self):
+        return len(self.elements)
+
+    def quality(self):
+        """Scaled Jacobian (min J / max J, sampled) per element plus its summary.
+
+        Returns a dict: ``scaled_jacobian`` (E,) array, ``min``, ``mean``, ``invalid_elements``
+        and ``by_type``.
+        """
+        summary = dict(self._core.quality_summary())
+        summary["scaled_jacobian"] = self._core.scaled_jacobian()
+        return summary
+
+    def report(self, input_name=""):
+        """The JSON report of ``homesh mesh --report`` as a dict."""
+        return json.loads(self._core.report_json(str(input_name)))
+
+    def timings(self):
+        """Seconds spent in each pipeline stage."""
+        return dict(self._core.timings())
+
+    def write(self, path):
+        """Writes .msh (Gmsh 4.1), .vtu (VTK Lagrange cells) or .npz (this object's arrays)."""
+        path = os.fspath(path)
+        if path.lower().endswith(".npz"):
+            self._save_npz(path)
+        else:
+            self._core.write(path)
+
+    def _save_npz(self, path):
+        arrays = {
+            "format": np.array([_NPZ_FORMAT]),
+            "dim": np.array([self.dim]),
+            "order": np.array([self.order]),
+            "plane_normal": np.array(self.plane_normal),
+            "nodes": self.nodes,
+            "node_cad_dim": self.node_cad_dim,
+            "node_cad_index": self.node_cad_index,
+            "node_cad_params": self.node_cad_params,
+            "block_types": np.array([b[0] for b in self._blocks]),
+            "block_orders": np.array([b[1] for b in self._blocks]),
+        }
+        for i, (_, _, conn, ent) in enumerate(self._blocks):
+            arrays["block%d_elements" % i] = conn
+            arrays["block%d_entity" % i] = ent
+        try:
+            with open(path, "wb") as f:
+                np.savez_compressed(f, **arrays)
+        except OSError as e:
+            raise FileError("cannot write '%s': %s" % (path, e.strerror)) from None
+
+
+def load(path):
+    """Reads a mesh saved with ``write('....npz')`` and recomputes its quality."""
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise FileError("mesh file '%s' does not exist" % path)
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            if int(data["format"][0]) != _NPZ_FORMAT:
+                raise FileError("'%s' has an unknown HOMesh array format" % path)
+            blocks = [
+                (str(t), int(o), data["block%d_elements" % i], data["block%d_entity" % i])
+                for i, (t, o) in enumerate(zip(data["block_types"], data["block_orders"]))
+            ]
+            core = _core.mesh_from_arrays(
+                int(data["dim"][0]), int(data["order"][0]), data["nodes"],
+                data["node_cad_dim"], data["node_cad_index"], data["node_cad_params"],
+                blocks, tuple(float(x) for x in data["plane_normal"]))
+    except (KeyError, ValueError, OSError) as e:
+        raise FileError("'%s' is not a HOMesh array file: %s" % (path, e)) from None
+    return HighOrderMesh(core)
+
+
+def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None):
+    """Meshes a CAD shape with curved elements of the given order.
+
+    shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
+              a .step/.stp/.iges/.igs/.brep/.brp file, or BRep text.
+    order     polynomial order, 1..10.
+    size      target element size (a positive length); None: bounding-box diagonal / 20.
+    threads   threads the core may use.
+    progress  optional ``callable(stage, seconds)``: called with ``seconds=None`` when a stage
+              starts and with its duration when it ends. Raising inside it cancels the job
+              (:class:`CancelledError`).
+
+    Raises ParameterError, FileError, CadError, MeshingError or CancelledError.
+    """
+    order = _check_int("order", order)
+    threads = _check_int("threads", threads)
+    verbosity = _check_int("verbosity", verbosity)
+    if size is not None:
+        if isinstance(size, bool) or not isinstance(size, numbers.Real):
+            raise ParameterError("size must be a positive number, got %r" % (size,))
+        size = float(size)
+        if not size > 0.0:
+            raise ParameterError("size must be a positive length, got %g" % size)
+    if progress is not None and not callable(progress):
+        raise ParameterError("progress must be callable")
+
+    if hasattr(shape, "exportBrepToString"):
+        if shape.isNull():
+            raise ParameterError("the shape is null (empty)")
+        core = _core.mesh_brep(shape.exportBrepToString(), order, size, threads, verbosity,
+                               progress)
+    elif isinstance(shape, (str, os.PathLike)):
+        text = os.fspath(shape)
+        if "\n" in text and "CASCADE Topology" in text[:200]:
+            core = _core.mesh_brep(text, order, size, threads, verbosity, progress)
+        else:
+            core = _core.mesh_file(text, order, size, threads, verbosity, progress)
+    else:
+        raise ParameterError(
+            "shape must be a Part.Shape, a CAD file path or BRep text, got %s"
+            % type(shape).__name__)
+    return HighOrderMesh(core)
+
+
+def _check_int(name, value):
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ParameterError("%s must be an integer, got %r" % (name, value))
+    return int(value)
+
+
+def _cell_dim(element_type):
+    return {"line": 1, "tri": 2, "quad": 2}.get(element_type, 3)

@@ -1,0 +1,19 @@
+"""File > Export of HighOrderMesh objects (registered in Init.py): .msh and .vtu."""
+
+import FreeCAD
+
+
+def export(objects, filename):
+    from .objects import TYPE_HIGH_ORDER_MESH, get_mesh
+    meshes = [o for o in objects
+              if getattr(getattr(o, "Proxy", None), "Type", None) == TYPE_HIGH_ORDER_MESH]
+    if len(meshes) != 1:
+        FreeCAD.Console.PrintError("HOMesh: select exactly one high-order mesh to export\n")
+        return
+    mesh = get_mesh(meshes[0])
+    if mesh is None:
+        FreeCAD.Console.PrintError("HOMesh: %s has no mesh yet: recompute it first\n"
+                                   % meshes[0].Label)
+        return
+    mesh.write(filename)
+    FreeCAD.Console.PrintMessage("HOMesh: wrote %s\n" % filename)
