@@ -144,7 +144,7 @@ def load(path):
     return HighOrderMesh(core)
 
 
-def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None):
+def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None):
     """Meshes a CAD shape with curved elements of the given order.
 
     shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
@@ -155,6 +155,8 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None):
     progress  optional ``callable(stage, seconds)``: called with ``seconds=None`` when a stage
               starts and with its duration when it ends. Raising inside it cancels the job
               (:class:`CancelledError`).
+    name      how error messages call a shape given as an object or BRep text (for example
+              the FreeCAD object's label); default "the shape".
 
     Raises ParameterError, FileError, CadError, MeshingError or CancelledError.
     """
@@ -170,15 +172,16 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None):
     if progress is not None and not callable(progress):
         raise ParameterError("progress must be callable")
 
+    label = str(name) if name else "the shape"
     if hasattr(shape, "exportBrepToString"):
         if shape.isNull():
-            raise ParameterError("the shape is null (empty)")
-        core = _core.mesh_brep(shape.exportBrepToString(), order, size, threads, verbosity,
-                               progress)
+            raise ParameterError("%s is null (empty)" % label)
+        core = _core.mesh_brep(shape.exportBrepToString(), label, order, size, threads,
+                               verbosity, progress)
     elif isinstance(shape, (str, os.PathLike)):
         text = os.fspath(shape)
         if "\n" in text and "CASCADE Topology" in text[:200]:
-            core = _core.mesh_brep(text, order, size, threads, verbosity, progress)
+            core = _core.mesh_brep(text, label, order, size, threads, verbosity, progress)
         else:
             core = _core.mesh_file(text, order, size, threads, verbosity, progress)
     else:

@@ -51,8 +51,8 @@ struct CadModel::Impl {
     curves.resize(edges.Extent() + 1);
     surfaces.resize(faces.Extent() + 1);
     analysers.resize(faces.Extent() + 1);
-    Bnd_Box box;
-    BRepBndLib::Add(shape, box);
+    Bnd_Box box;  // the geometric box, not enlarged by the shape's tolerances
+    BRepBndLib::AddOptimal(shape, box, false, false);
     if (!box.IsVoid()) {
       double x0, y0, z0, x1, y1, z1;
       box.Get(x0, y0, z0, x1, y1, z1);
@@ -170,9 +170,9 @@ CadModel CadModel::fromFile(const std::string& path) {
   return CadModel(std::move(impl));
 }
 
-CadModel CadModel::fromBrepText(const std::string& text) {
+CadModel CadModel::fromBrepText(const std::string& text, const std::string& name) {
   auto impl = std::make_unique<Impl>();
-  impl->source = "the BRep text";
+  impl->source = name;
   impl->shape = withOcctErrors("reading BRep text", [&] {
     TopoDS_Shape shape;
     BRep_Builder builder;
@@ -180,7 +180,7 @@ CadModel CadModel::fromBrepText(const std::string& text) {
     BRepTools::Read(shape, stream, builder);
     return shape;
   });
-  if (impl->shape.IsNull()) throw CadError("the BRep text does not describe a shape");
+  if (impl->shape.IsNull()) throw CadError(name + " is not a valid BRep shape");
   return CadModel(std::move(impl));
 }
 

@@ -58,8 +58,9 @@ class CadModel {
   // Throws IoError (missing or unreadable file) or CadError (no usable shape).
   static CadModel fromFile(const std::string& path);
 
-  // Loads a shape written by BRepTools::Write (FreeCAD's Shape.exportBrepToString()).
-  static CadModel fromBrepText(const std::string& text);
+  // Loads a shape written by BRepTools::Write (FreeCAD's Shape.exportBrepToString()); `name`
+  // is how messages refer to it (a FreeCAD object's label, say).
+  static CadModel fromBrepText(const std::string& text, const std::string& name = "the shape");
 
   CadModel(CadModel&&) noexcept;
   CadModel& operator=(CadModel&&) noexcept;

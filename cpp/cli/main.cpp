@@ -11,6 +11,7 @@
 #include "cli/arguments.hpp"
 #include "core/error.hpp"
 #include "core/version.hpp"
+#include "io/mesh_writers.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 
 namespace {
@@ -46,6 +47,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
   options.size = cmd.size;
   options.threads = cmd.threads;
   options.verbosity = cmd.verbosity;
+  for (const std::string& path : cmd.outputs) homesh::checkMeshOutputPath(path);
   StderrProgress progress;
   homesh::PipelineObserver* observer = cmd.quiet ? nullptr : &progress;
   homesh::MeshResult result =

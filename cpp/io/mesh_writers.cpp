@@ -288,14 +288,30 @@ void writeVtu(const Mesh& mesh, const std::string& path, const std::vector<CellF
   file.commit();
 }
 
-void writeMesh(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields) {
+namespace {
+std::string lowerExtension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (ext == ".msh") return writeMsh41(mesh, path, fields);
-  if (ext == ".vtu") return writeVtu(mesh, path, fields);
-  throw IoError("cannot write '" + path + "': unknown mesh format '" + ext +
-                "' (use .msh or .vtu)");
+  return ext;
+}
+}  // namespace
+
+void checkMeshOutputPath(const std::string& path) {
+  const std::string ext = lowerExtension(path);
+  if (ext != ".msh" && ext != ".vtu")
+    throw IoError("cannot write '" + path + "': unknown mesh format '" + ext +
+                  "' (use .msh or .vtu)");
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
+    throw IoError("cannot write '" + path + "': folder '" + parent.string() + "' does not exist");
+}
+
+void writeMesh(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields) {
+  checkMeshOutputPath(path);
+  if (lowerExtension(path) == ".msh") return writeMsh41(mesh, path, fields);
+  return writeVtu(mesh, path, fields);
 }
 
 }  // namespace homesh

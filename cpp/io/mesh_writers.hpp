@@ -28,6 +28,10 @@ struct CellField {
 void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields);
 void writeVtu(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields);
 
+// Throws IoError unless `path` has a supported extension and its folder exists: lets callers
+// reject a bad output path before spending time on meshing.
+void checkMeshOutputPath(const std::string& path);
+
 // Chooses the format from the extension (.msh, .vtu); throws IoError for others.
 void writeMesh(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields);
 

@@ -23,7 +23,7 @@ void MeshingOptions::validate() const {
 double defaultMeshSize(const CadModel& cad) { return cad.boundingDiagonal() / 20.0; }
 
 CadModel CadSource::load() const {
-  return kind == Kind::File ? CadModel::fromFile(value) : CadModel::fromBrepText(value);
+  return kind == Kind::File ? CadModel::fromFile(value) : CadModel::fromBrepText(value, name);
 }
 
 void StageTimings::add(const std::string& stage, double s) { seconds.emplace_back(stage, s); }

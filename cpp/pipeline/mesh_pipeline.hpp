@@ -37,8 +37,11 @@ double defaultMeshSize(const CadModel& cad);
 struct CadSource {
   enum class Kind { File, BrepText } kind = Kind::File;
   std::string value;  // a path, or BRep text
-  static CadSource file(std::string path) { return {Kind::File, std::move(path)}; }
-  static CadSource brepText(std::string text) { return {Kind::BrepText, std::move(text)}; }
+  std::string name;   // for BRep text: what to call it in messages (e.g. the FreeCAD label)
+  static CadSource file(std::string path) { return {Kind::File, std::move(path), {}}; }
+  static CadSource brepText(std::string text, std::string name = "the shape") {
+    return {Kind::BrepText, std::move(text), std::move(name)};
+  }
   CadModel load() const;
 };
 

@@ -220,10 +220,10 @@ PyMesh meshFile(const std::string& path, int order, bp::object size, int threads
   return runPipeline(CadSource::file(path), makeOptions(order, size, threads, verbosity), progress);
 }
 
-PyMesh meshBrep(const std::string& text, int order, bp::object size, int threads, int verbosity,
-                bp::object progress) {
-  return runPipeline(CadSource::brepText(text), makeOptions(order, size, threads, verbosity),
-                     progress);
+PyMesh meshBrep(const std::string& text, const std::string& name, int order, bp::object size,
+                int threads, int verbosity, bp::object progress) {
+  return runPipeline(CadSource::brepText(text, name),
+                     makeOptions(order, size, threads, verbosity), progress);
 }
 
 // Rebuilds a mesh (without CAD) from the arrays PyMesh exposes, and evaluates its quality.
@@ -326,7 +326,7 @@ BOOST_PYTHON_MODULE(_core) {
           (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
            bp::arg("verbosity"), bp::arg("progress")));
   bp::def("mesh_brep", &meshBrep,
-          (bp::arg("text"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
+          (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
            bp::arg("verbosity"), bp::arg("progress")));
   bp::def("lagrange_basis", &lagrangeBasis, (bp::arg("type"), bp::arg("order"), bp::arg("points")));
   bp::def("mesh_from_arrays", &meshFromArrays,

@@ -100,7 +100,8 @@ class HighOrderMeshProxy:
         size = obj.Size.Value if obj.Size.Value > 0 else None
         progress = _Progress(obj.Label)
         try:
-            mesh = homesh.mesh(shape, order=obj.Order, size=size, progress=progress)
+            mesh = homesh.mesh(shape, order=obj.Order, size=size, progress=progress,
+                               name=obj.Part.Label)
         except homesh.HOMeshError as e:
             FreeCAD.Console.PrintError("HOMesh: %s: %s\n" % (obj.Label, e))
             raise

@@ -62,7 +62,7 @@ class ViewProviderHighOrderMesh:
     def rebuild(self):
         """Rebuilds the scene from the object's mesh (after a recompute or a reload)."""
         from .objects import get_mesh
-        from .tessellation import surface_and_edges
+        from ..tessellation import surface_and_edges
         obj = self.Object
         mesh = get_mesh(obj)
         if mesh is None:

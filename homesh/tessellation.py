@@ -3,7 +3,7 @@ elements' own Lagrange maps (pure numpy plus the core's basis; no FreeCAD needed
 
 import numpy as np
 
-from .. import _core
+from . import _core
 
 
 def triangle_lattice(level):

@@ -1,0 +1,202 @@
+// CadModel against analytic shapes: loading, FreeCAD numbering, evaluation, projection and
+// curvature on a sphere, a cylinder and a torus.
+#include <gtest/gtest.h>
+
+#include <BRep_Tool.hxx>
+#include <STEPControl_Writer.hxx>
+#include <TopExp.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
+#include <cmath>
+#include <fstream>
+
+#include "cad/cad_model.hpp"
+#include "core/error.hpp"
+#include "test_support.hpp"
+
+namespace homesh {
+namespace {
+
+using test::toModel;
+
+// The first face of the given kind (OCCT's primitive makers put the lateral face first).
+int lateralFace(const CadModel& cad) {
+  for (int f = 1; f <= cad.numFaces(); ++f)
+    if (!cad.isPlanar(f)) return f;
+  return 0;
+}
+
+TEST(CadModel, LoadsStepIgesAndBrepFilesWithTheSameTopology) {
+  const auto dir = test::tempDir();
+  const TopoDS_Shape shape = test::boxWithHole();
+  const std::string brep = (dir / "part.brep").string();
+  ASSERT_TRUE(BRepTools::Write(shape, brep.c_str()));
+  STEPControl_Writer writer;
+  writer.Transfer(shape, STEPControl_AsIs);
+  const std::string step = (dir / "part.STEP").string();  // upper-case extension on purpose
+  ASSERT_EQ(writer.Write(step.c_str()), IFSelect_RetDone);
+
+  for (const std::string& path : {brep, step}) {
+    const CadModel cad = CadModel::fromFile(path);
+    EXPECT_EQ(cad.numSolids(), 1) << path;
+    EXPECT_EQ(cad.numFaces(), 7) << path;
+    EXPECT_EQ(cad.numEdges(), 15) << path;
+    EXPECT_EQ(cad.numVertices(), 10) << path;
+  }
+}
+
+TEST(CadModel, NumberingIsTopExpMapShapes) {
+  const TopoDS_Shape shape = test::boxWithHole();
+  const CadModel cad = toModel(shape);
+  // BRep text keeps sub-shape order, so the model's FaceN is the N-th MapShapes entry of the
+  // original shape: compare by geometry.
+  TopTools_IndexedMapOfShape vertices;
+  TopExp::MapShapes(shape, TopAbs_VERTEX, vertices);
+  ASSERT_EQ(vertices.Extent(), cad.numVertices());
+  for (int v = 1; v <= vertices.Extent(); ++v) {
+    const gp_Pnt p = BRep_Tool::Pnt(TopoDS::Vertex(vertices(v)));
+    EXPECT_NEAR((cad.vertexPoint(v) - Eigen::Vector3d(p.X(), p.Y(), p.Z())).norm(), 0.0, 1e-12);
+  }
+  const std::vector<int> faceEdges = cad.subShapeIndices(2, 1, 1);
+  EXPECT_FALSE(faceEdges.empty());
+  EXPECT_EQ(cad.subShapeIndices(3, 1, 2).size(), 7u);
+}
+
+TEST(CadModel, SphereEvaluationProjectionAndCurvature) {
+  const double r = 2.0;
+  const CadModel cad = toModel(test::sphere(r));
+  ASSERT_EQ(cad.numFaces(), 1);
+  const SurfaceBounds b = cad.faceBounds(1);
+  EXPECT_NEAR(b.uMax - b.uMin, 2 * M_PI, 1e-9);
+  // OCCT's sphere: P(u, v) = r (cos v cos u, cos v sin u, sin v).
+  const double u = 0.7, v = 0.3;
+  const SurfaceDerivatives d = cad.evaluateSurface(1, u, v);
+  EXPECT_NEAR((d.point - r * Eigen::Vector3d(std::cos(v) * std::cos(u), std::cos(v) * std::sin(u),
+                                             std::sin(v)))
+                  .norm(),
+              0.0, 1e-12);
+  // First and second derivatives against central differences.
+  const double h = 1e-5;
+  const auto p = [&](double uu, double vv) { return cad.evaluateSurface(1, uu, vv).point; };
+  EXPECT_NEAR((d.du - (p(u + h, v) - p(u - h, v)) / (2 * h)).norm(), 0.0, 1e-8);
+  EXPECT_NEAR((d.dv - (p(u, v + h) - p(u, v - h)) / (2 * h)).norm(), 0.0, 1e-8);
+  EXPECT_NEAR((d.duu - (p(u + h, v) - 2 * d.point + p(u - h, v)) / (h * h)).norm(), 0.0, 1e-4);
+  EXPECT_NEAR((d.dvv - (p(u, v + h) - 2 * d.point + p(u, v - h)) / (h * h)).norm(), 0.0, 1e-4);
+  EXPECT_NEAR((d.duv - (p(u + h, v + h) - p(u + h, v - h) - p(u - h, v + h) + p(u - h, v - h)) /
+                           (4 * h * h))
+                  .norm(),
+              0.0, 1e-4);
+
+  for (const Eigen::Vector3d& q : {Eigen::Vector3d(3, 1, -2), Eigen::Vector3d(0.1, -0.2, 0.3),
+                                   Eigen::Vector3d(-1, 4, 0.5)}) {
+    const SurfaceProjection proj = cad.projectOnSurface(1, q);
+    EXPECT_NEAR(proj.distance, std::abs(q.norm() - r), 1e-9);
+    EXPECT_NEAR((proj.point - r * q.normalized()).norm(), 0.0, 1e-9);
+    EXPECT_NEAR((cad.evaluateSurface(1, proj.u, proj.v).point - proj.point).norm(), 0.0, 1e-12);
+  }
+
+  const PrincipalCurvatures k = cad.curvature(1, u, v);
+  ASSERT_TRUE(k.defined);
+  EXPECT_NEAR(std::abs(k.kMin), 1.0 / r, 1e-9);
+  EXPECT_NEAR(std::abs(k.kMax), 1.0 / r, 1e-9);
+}
+
+TEST(CadModel, CylinderCurvesAndCurvature) {
+  const double r = 1.5, height = 3.0;
+  const CadModel cad = toModel(test::cylinder(r, height));
+  const int lateral = lateralFace(cad);
+  ASSERT_GT(lateral, 0);
+  const SurfaceBounds b = cad.faceBounds(lateral);
+  const PrincipalCurvatures k = cad.curvature(lateral, 0.5 * (b.uMin + b.uMax),
+                                              0.5 * (b.vMin + b.vMax));
+  ASSERT_TRUE(k.defined);
+  const double small = std::min(std::abs(k.kMin), std::abs(k.kMax));
+  const double large = std::max(std::abs(k.kMin), std::abs(k.kMax));
+  EXPECT_NEAR(small, 0.0, 1e-12);
+  EXPECT_NEAR(large, 1.0 / r, 1e-9);
+
+  // The circular edges: radius r around the axis, |c'| = r, c'' points to the axis with |c''| = r.
+  int circles = 0;
+  for (int e = 1; e <= cad.numEdges(); ++e) {
+    if (cad.isDegenerated(e)) continue;
+    const ParameterRange range = cad.edgeRange(e);
+    const double t = 0.3 * range.first + 0.7 * range.last;
+    const CurveDerivatives c = cad.evaluateCurve(e, t);
+    const Eigen::Vector2d radial(c.point.x(), c.point.y());
+    if (std::abs(radial.norm() - r) > 1e-9 || std::abs(c.d1.z()) > 1e-12) continue;  // the seam
+    ++circles;
+    EXPECT_NEAR(c.d1.norm(), r, 1e-9);
+    EXPECT_NEAR(c.d2.norm(), r, 1e-9);
+    EXPECT_NEAR(c.d2.head<2>().normalized().dot(-radial.normalized()), 1.0, 1e-9);
+    // Projection of a point off the circle.
+    const Eigen::Vector3d q(3.0, -1.0, c.point.z() + 0.5);
+    const CurveProjection proj = cad.projectOnCurve(e, q);
+    const Eigen::Vector3d expected =
+        Eigen::Vector3d(r * q.x() / std::hypot(q.x(), q.y()), r * q.y() / std::hypot(q.x(), q.y()),
+                        c.point.z());
+    EXPECT_NEAR((proj.point - expected).norm(), 0.0, 1e-9);
+    EXPECT_NEAR((cad.evaluateCurve(e, proj.t).point - proj.point).norm(), 0.0, 1e-12);
+    // Each circle is closed at one vertex: both parameters are valid, `near` picks one.
+    const std::vector<int> ends = cad.subShapeIndices(1, e, 0);
+    ASSERT_EQ(ends.size(), 1u);
+    EXPECT_NEAR(cad.vertexParameter(ends[0], e, range.last - 0.1), range.last, 1e-12);
+    EXPECT_NEAR(cad.vertexParameter(ends[0], e, range.first + 0.1), range.first, 1e-12);
+  }
+  EXPECT_EQ(circles, 2);
+}
+
+TEST(CadModel, TorusPrincipalCurvatures) {
+  const double major = 3.0, minor = 1.0;
+  const CadModel cad = toModel(test::torus(major, minor));
+  ASSERT_EQ(cad.numFaces(), 1);
+  // OCCT's torus: P(u, v) = ((R + r cos v) cos u, (R + r cos v) sin u, r sin v).
+  for (const double v : {0.0, M_PI}) {
+    const PrincipalCurvatures k = cad.curvature(1, 0.4, v);
+    ASSERT_TRUE(k.defined);
+    const double distance = major + minor * std::cos(v);  // from the axis
+    double expected[2] = {1.0 / minor, std::cos(v) / distance};
+    double got[2] = {k.kMin, k.kMax};
+    // Compare magnitudes and the product's sign (Gaussian curvature: + outside, - inside).
+    std::sort(expected, expected + 2, [](double a, double b) { return std::abs(a) < std::abs(b); });
+    std::sort(got, got + 2, [](double a, double b) { return std::abs(a) < std::abs(b); });
+    EXPECT_NEAR(std::abs(got[0]), std::abs(expected[0]), 1e-9) << "v = " << v;
+    EXPECT_NEAR(std::abs(got[1]), std::abs(expected[1]), 1e-9) << "v = " << v;
+    EXPECT_GT(got[0] * got[1] * expected[0] * expected[1], 0.0) << "v = " << v;
+  }
+}
+
+TEST(CadModel, ClearErrorsNameTheProblem) {
+  const auto dir = test::tempDir();
+  try {
+    CadModel::fromFile((dir / "missing.step").string());
+    FAIL();
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.step"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos);
+  }
+  const std::string fake = (dir / "notes.step").string();
+  std::ofstream(fake) << "this is not a STEP file\n";
+  EXPECT_THROW(CadModel::fromFile(fake), IoError);
+  const std::string odd = (dir / "part.obj").string();
+  std::ofstream(odd) << "v 0 0 0\n";
+  try {
+    CadModel::fromFile(odd);
+    FAIL();
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("unsupported CAD format"), std::string::npos);
+  }
+  EXPECT_THROW(CadModel::fromFile(dir.string()), IoError);
+  EXPECT_THROW(CadModel::fromBrepText("garbage"), CadError);
+  EXPECT_THROW(CadModel::fromBrepText(""), CadError);
+
+  const CadModel cad = toModel(test::box(1, 1, 1));
+  try {
+    cad.faceBounds(9);
+    FAIL();
+  } catch (const CadError& e) {
+    EXPECT_NE(std::string(e.what()).find("Face9"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace homesh

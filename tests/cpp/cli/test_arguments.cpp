@@ -1,0 +1,65 @@
+// Command-line parsing: accepted forms and the error for each bad one.
+#include <gtest/gtest.h>
+
+#include "cli/arguments.hpp"
+
+namespace homesh {
+namespace {
+
+ParsedCommand parse(std::vector<std::string> args) { return parseCommandLine(args); }
+
+std::string usageError(std::vector<std::string> args) {
+  try {
+    parseCommandLine(args);
+  } catch (const UsageError& e) {
+    return e.message;
+  }
+  return "";
+}
+
+TEST(Arguments, MeshWithEveryOption) {
+  const ParsedCommand p = parse({"mesh", "part.step", "--order", "5", "--size", "0.25", "-o",
+                                 "a.msh", "-o", "b.vtu", "--report", "r.json", "-j", "2", "-v"});
+  ASSERT_EQ(p.kind, ParsedCommand::Kind::Mesh);
+  EXPECT_EQ(p.mesh.input, "part.step");
+  EXPECT_EQ(p.mesh.order, 5);
+  ASSERT_TRUE(p.mesh.size.has_value());
+  EXPECT_DOUBLE_EQ(*p.mesh.size, 0.25);
+  EXPECT_EQ(p.mesh.outputs, (std::vector<std::string>{"a.msh", "b.vtu"}));
+  EXPECT_EQ(p.mesh.report.value_or(""), "r.json");
+  EXPECT_EQ(p.mesh.threads, 2);
+  EXPECT_EQ(p.mesh.verbosity, 1);
+}
+
+TEST(Arguments, Defaults) {
+  const ParsedCommand p = parse({"mesh", "part.brep"});
+  EXPECT_EQ(p.mesh.order, 4);
+  EXPECT_FALSE(p.mesh.size.has_value());
+  EXPECT_TRUE(p.mesh.outputs.empty());
+}
+
+TEST(Arguments, HelpAndVersion) {
+  EXPECT_EQ(parse({"--help"}).kind, ParsedCommand::Kind::Help);
+  EXPECT_EQ(parse({"mesh", "--help"}).helpTopic, "mesh");
+  EXPECT_EQ(parse({"--version"}).kind, ParsedCommand::Kind::Version);
+  EXPECT_NE(usageText("mesh").find("--order"), std::string::npos);
+}
+
+TEST(Arguments, BadCommandLinesNameTheProblem) {
+  EXPECT_NE(usageError({}).find("no command"), std::string::npos);
+  EXPECT_NE(usageError({"frobnicate"}).find("frobnicate"), std::string::npos);
+  EXPECT_NE(usageError({"mesh"}).find("INPUT"), std::string::npos);
+  EXPECT_NE(usageError({"mesh", "a.step", "--order", "0"}).find("--order"), std::string::npos);
+  EXPECT_NE(usageError({"mesh", "a.step", "--order", "11"}).find("--order"), std::string::npos);
+  EXPECT_NE(usageError({"mesh", "a.step", "--order", "two"}).find("integer"), std::string::npos);
+  EXPECT_NE(usageError({"mesh", "a.step", "--size", "-1"}).find("positive"), std::string::npos);
+  EXPECT_NE(usageError({"mesh", "a.step", "--size", "0"}).find("positive"), std::string::npos);
+  EXPECT_NE(usageError({"mesh", "a.step", "--size", "1x"}).find("number"), std::string::npos);
+  EXPECT_NE(usageError({"mesh", "a.step", "--size"}).find("needs a value"), std::string::npos);
+  EXPECT_NE(usageError({"mesh", "a.step", "--bogus"}).find("--bogus"), std::string::npos);
+  EXPECT_NE(usageError({"mesh", "a.step", "b.step"}).find("b.step"), std::string::npos);
+  EXPECT_NE(usageError({"mesh", "a.step", "-j", "0"}).find("--threads"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace homesh

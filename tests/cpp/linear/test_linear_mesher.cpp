@@ -1,0 +1,158 @@
+// The Gmsh-driven linear mesher: valid tetrahedra, CAD classification of every node, the
+// Gmsh-to-FreeCAD entity numbering on compounds, planar (2D) meshes, and its errors.
+#include <gtest/gtest.h>
+
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepGProp.hxx>
+#include <BRep_Builder.hxx>
+#include <GProp_GProps.hxx>
+#include <TopExp.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Compound.hxx>
+#include <gp_Pln.hxx>
+#include <map>
+#include <set>
+
+#include "core/error.hpp"
+#include "linear/linear_mesher.hpp"
+#include "test_support.hpp"
+
+namespace homesh {
+namespace {
+
+using test::nodePoint;
+
+// Every node on a CAD curve or face sits where its recorded parameters say.
+void expectParametersReproduceNodes(const Mesh& mesh, const CadModel& cad, double tol) {
+  std::size_t onCurves = 0, onFaces = 0;
+  for (std::size_t i = 0; i < mesh.numNodes(); ++i) {
+    const int dim = mesh.nodeCadDim[i];
+    const int index = mesh.nodeCadIndex[i];
+    const double* param = &mesh.nodeCadParam[2 * i];
+    if (dim == 1) {
+      ++onCurves;
+      EXPECT_NEAR((cad.evaluateCurve(index, param[0]).point - nodePoint(mesh, i)).norm(), 0.0, tol)
+          << "node " << i << " on Edge" << index;
+    } else if (dim == 2) {
+      ++onFaces;
+      EXPECT_NEAR((cad.evaluateSurface(index, param[0], param[1]).point - nodePoint(mesh, i)).norm(),
+                  0.0, tol)
+          << "node " << i << " on Face" << index;
+    } else if (dim == 0) {
+      EXPECT_NEAR((cad.vertexPoint(index) - nodePoint(mesh, i)).norm(), 0.0, tol);
+    }
+  }
+  EXPECT_GT(onCurves, 0u);
+  EXPECT_GT(onFaces, 0u);
+}
+
+TEST(LinearMesher, BoxWithHoleGivesPositiveTetsFillingTheVolume) {
+  const CadModel cad = test::toModel(test::boxWithHole());
+  const Mesh mesh = generateLinearMesh(cad, {0.5, 1, 0});
+  ASSERT_EQ(mesh.dim, 3);
+  const ElementBlock& tets = mesh.blocks[0];
+  ASSERT_EQ(tets.type, CellType::Tetrahedron);
+  EXPECT_GT(tets.count(), 200u);
+  double volume = 0.0;
+  for (std::size_t e = 0; e < tets.count(); ++e) {
+    const double v = test::tetVolume(mesh, tets.element(e));
+    EXPECT_GT(v, 0.0);
+    volume += v;
+  }
+  // The straight-sided mesh of the hole is a polygonal prism, inscribed in the cylinder and
+  // (with at least 6 sides) larger than the hexagonal one.
+  EXPECT_GT(volume, 32.0 - 2.0 * M_PI);
+  EXPECT_LT(volume, 32.0 - 2.0 * (1.5 * std::sqrt(3.0)));
+  expectParametersReproduceNodes(mesh, cad, 1e-9);
+
+  // Boundary triangles cover all seven faces, lines all fifteen edges but the seam-free ones.
+  std::set<int> faces, curves;
+  for (const ElementBlock& b : mesh.blocks) {
+    if (b.type == CellType::Triangle) faces.insert(b.entity.begin(), b.entity.end());
+    if (b.type == CellType::Line) curves.insert(b.entity.begin(), b.entity.end());
+  }
+  EXPECT_EQ(faces.size(), 7u);
+  EXPECT_EQ(curves.size(), 15u);
+}
+
+TEST(LinearMesher, CompoundNumberingFollowsFreeCad) {
+  // Three disjoint boxes of different volumes in one compound: Gmsh binds them in its own
+  // order; each tetrahedron must still record the solid it fills (by MapShapes index).
+  BRep_Builder builder;
+  TopoDS_Compound compound;
+  builder.MakeCompound(compound);
+  const double sides[3] = {1.0, 2.0, 1.5};
+  for (int k = 0; k < 3; ++k) {
+    const TopoDS_Shape b =
+        BRepPrimAPI_MakeBox(gp_Pnt(5.0 * k, 0, 0), sides[k], sides[k], sides[k]).Shape();
+    builder.Add(compound, b);
+  }
+  const CadModel cad = test::toModel(compound);
+  ASSERT_EQ(cad.numSolids(), 3);
+  const Mesh mesh = generateLinearMesh(cad, {0.4, 1, 0});
+  std::map<int, double> volumeBySolid;
+  const ElementBlock& tets = mesh.blocks[0];
+  for (std::size_t e = 0; e < tets.count(); ++e)
+    volumeBySolid[tets.entity[e]] += test::tetVolume(mesh, tets.element(e));
+  TopTools_IndexedMapOfShape solids;
+  TopExp::MapShapes(compound, TopAbs_SOLID, solids);
+  ASSERT_EQ(volumeBySolid.size(), 3u);
+  for (int s = 1; s <= 3; ++s) {
+    GProp_GProps props;
+    BRepGProp::VolumeProperties(solids(s), props);
+    EXPECT_NEAR(volumeBySolid[s], props.Mass(), 1e-9) << "Solid" << s;
+  }
+  expectParametersReproduceNodes(mesh, cad, 1e-9);
+}
+
+TEST(LinearMesher, PlanarFaceGivesOrientedTriangles) {
+  // A 4 x 2 rectangle in a tilted plane.
+  const gp_Pln plane(gp_Pnt(1, 2, 3), gp_Dir(1, 1, 1));
+  const TopoDS_Shape face = BRepBuilderAPI_MakeFace(plane, -2.0, 2.0, -1.0, 1.0).Shape();
+  const CadModel cad = test::toModel(face);
+  const Mesh mesh = generateLinearMesh(cad, {0.25, 1, 0});
+  ASSERT_EQ(mesh.dim, 2);
+  const Eigen::Vector3d n(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
+  EXPECT_NEAR(std::abs(n.dot(Eigen::Vector3d(1, 1, 1).normalized())), 1.0, 1e-12);
+  const ElementBlock& tris = mesh.blocks[0];
+  ASSERT_EQ(tris.type, CellType::Triangle);
+  double area = 0.0;
+  for (std::size_t e = 0; e < tris.count(); ++e) {
+    const std::int64_t* t = tris.element(e);
+    const Eigen::Vector3d a = nodePoint(mesh, t[0]);
+    const double signedArea =
+        0.5 * (nodePoint(mesh, t[1]) - a).cross(nodePoint(mesh, t[2]) - a).dot(n);
+    EXPECT_GT(signedArea, 0.0);
+    area += signedArea;
+  }
+  EXPECT_NEAR(area, 8.0, 1e-9);
+  EXPECT_EQ(mesh.blocks[1].type, CellType::Line);
+  expectParametersReproduceNodes(mesh, cad, 1e-9);
+}
+
+TEST(LinearMesher, RejectsWhatItCannotMesh) {
+  // A lone cylindrical face: not planar and in no solid.
+  TopTools_IndexedMapOfShape faces;
+  TopExp::MapShapes(test::cylinder(1, 2), TopAbs_FACE, faces);
+  int lateral = 0;
+  for (int f = 1; f <= faces.Extent() && !lateral; ++f) {
+    const CadModel one = test::toModel(faces(f));
+    if (!one.isPlanar(1)) lateral = f;
+  }
+  ASSERT_GT(lateral, 0);
+  const CadModel curved = test::toModel(faces(lateral));
+  try {
+    generateLinearMesh(curved, {0.5, 1, 0});
+    FAIL();
+  } catch (const CadError& e) {
+    EXPECT_NE(std::string(e.what()).find("Face1"), std::string::npos);
+  }
+  const CadModel cube = test::toModel(test::box(1, 1, 1));
+  EXPECT_THROW(generateLinearMesh(cube, {0.0, 1, 0}), ParameterError);
+  EXPECT_THROW(generateLinearMesh(cube, {-1.0, 1, 0}), ParameterError);
+  EXPECT_THROW(generateLinearMesh(cube, {1e-5, 1, 0}), ParameterError);  // ~1e16 elements
+}
+
+}  // namespace
+}  // namespace homesh

@@ -1,0 +1,79 @@
+// The pipeline end to end: stages, timings, report, parameter checks before CAD import, cancel.
+#include <gtest/gtest.h>
+
+#include <BRepTools.hxx>
+
+#include "core/error.hpp"
+#include "pipeline/mesh_pipeline.hpp"
+#include "test_support.hpp"
+
+namespace homesh {
+namespace {
+
+class CountingObserver : public PipelineObserver {
+ public:
+  explicit CountingObserver(int cancelAfter = -1) : cancelAfter_(cancelAfter) {}
+  void stageStarted(const std::string& stage) override { started.push_back(stage); }
+  void stageFinished(const std::string&, double seconds) override {
+    EXPECT_GE(seconds, 0.0);
+    ++finished;
+  }
+  bool cancelRequested() override { return cancelAfter_ >= 0 && finished >= cancelAfter_; }
+  std::vector<std::string> started;
+  int finished = 0;
+
+ private:
+  int cancelAfter_;
+};
+
+TEST(MeshPipeline, RunsEveryStageAndReports) {
+  MeshingOptions options;
+  options.order = 3;
+  options.size = 0.5;
+  CountingObserver observer;
+  const MeshResult result =
+      runMeshPipeline(CadSource::brepText(test::brepText(test::sphere(1.0))), options, &observer);
+  EXPECT_EQ(observer.started,
+            (std::vector<std::string>{"cad", "linear", "high_order", "quality"}));
+  EXPECT_EQ(result.mesh.order, 3);
+  EXPECT_EQ(result.quality.scaledJacobian.size(), result.mesh.numElements());
+  const std::string json = meshReportJson(result, "sphere");
+  for (const char* key : {"\"order\": 3", "\"nodes\": ", "\"tet\": ", "\"invalid_elements\"",
+                          "\"scaled_jacobian\"", "\"timings_s\"", "\"high_order\""})
+    EXPECT_NE(json.find(key), std::string::npos) << key;
+  EXPECT_NE(json.find("\"tet\": " + std::to_string(result.mesh.numElements())), std::string::npos);
+}
+
+TEST(MeshPipeline, DefaultSizeIsATwentiethOfTheDiagonal) {
+  MeshingOptions options;
+  options.order = 1;
+  const MeshResult result =
+      runMeshPipeline(CadSource::brepText(test::brepText(test::box(2, 2, 1))), options);
+  ASSERT_TRUE(result.options.size.has_value());
+  EXPECT_NEAR(*result.options.size, 3.0 / 20.0, 1e-12);
+}
+
+TEST(MeshPipeline, BadParametersFailBeforeReadingTheCad) {
+  MeshingOptions options;
+  options.order = 0;
+  // The file does not exist: the parameter error must come first.
+  EXPECT_THROW(runMeshPipeline(CadSource::file("/nonexistent.step"), options), ParameterError);
+  options.order = 2;
+  options.size = -1.0;
+  EXPECT_THROW(runMeshPipeline(CadSource::file("/nonexistent.step"), options), ParameterError);
+  options.size = 1.0;
+  EXPECT_THROW(runMeshPipeline(CadSource::file("/nonexistent.step"), options), IoError);
+}
+
+TEST(MeshPipeline, ObserverCanCancelBetweenStages) {
+  MeshingOptions options;
+  options.size = 0.5;
+  CountingObserver observer(2);
+  EXPECT_THROW(
+      runMeshPipeline(CadSource::brepText(test::brepText(test::sphere(1.0))), options, &observer),
+      CancelledError);
+  EXPECT_EQ(observer.finished, 2);
+}
+
+}  // namespace
+}  // namespace homesh

@@ -1,0 +1,99 @@
+"""The HighOrderMesh document object: creation, recompute, properties, save and reopen without
+recomputing, export, and invalid input."""
+
+import os
+import tempfile
+import unittest
+
+import FreeCAD
+import numpy as np
+
+import homesh
+import homesh.freecad
+from homesh.freecad import exporter
+
+
+def box_with_hole(doc):
+    box = doc.addObject("Part::Box", "Box")
+    box.Length, box.Width, box.Height = 4, 4, 2
+    cyl = doc.addObject("Part::Cylinder", "Cylinder")
+    cyl.Radius, cyl.Height = 1, 2
+    cyl.Placement.Base = FreeCAD.Vector(2, 2, 0)
+    cut = doc.addObject("Part::Cut", "Cut")
+    cut.Base, cut.Tool = box, cyl
+    doc.recompute()
+    return cut
+
+
+class HighOrderMeshObject(unittest.TestCase):
+    def setUp(self):
+        self.doc = FreeCAD.newDocument("HOMeshTest")
+        self.folder = tempfile.mkdtemp()
+
+    def tearDown(self):
+        FreeCAD.closeDocument(self.doc.Name)
+
+    def test_recompute_save_reopen_without_recompute(self):
+        part = box_with_hole(self.doc)
+        obj = homesh.freecad.make_high_order_mesh(self.doc, part, order=3, size=0.8)
+        self.doc.recompute()
+        self.assertTrue(obj.isValid())
+        self.assertEqual(obj.Proxy.Type, homesh.freecad.TYPE_HIGH_ORDER_MESH)
+        mesh = homesh.freecad.get_mesh(obj)
+        self.assertEqual(obj.NumNodes, mesh.num_nodes)
+        self.assertEqual(obj.NumElements, mesh.num_elements)
+        self.assertEqual(obj.InvalidElements, 0)
+        self.assertGreater(obj.MinScaledJacobian, 0.0)
+        nodes = mesh.nodes.copy()
+        name = obj.Name
+
+        path = os.path.join(self.folder, "mesh.FCStd")
+        self.doc.saveAs(path)
+        FreeCAD.closeDocument(self.doc.Name)
+
+        original = homesh.mesh
+        calls = []
+        homesh.mesh = lambda *a, **k: calls.append(a) or original(*a, **k)
+        try:
+            self.doc = FreeCAD.openDocument(path)
+            restored = self.doc.getObject(name)
+            self.assertNotIn("Touched", restored.State)
+            self.assertEqual(restored.NumNodes, len(nodes))
+            back = homesh.freecad.get_mesh(restored)
+            np.testing.assert_array_equal(back.nodes, nodes)
+            self.assertEqual(back.quality()["invalid_elements"], 0)
+            self.assertEqual(calls, [], "reopening must not re-mesh")
+        finally:
+            homesh.mesh = original
+
+        out = os.path.join(self.folder, "export.msh")
+        exporter.export([restored], out)
+        self.assertGreater(os.path.getsize(out), 0)
+
+    def test_changing_the_order_recomputes(self):
+        part = box_with_hole(self.doc)
+        obj = homesh.freecad.make_high_order_mesh(self.doc, part, order=2, size=1.0)
+        self.doc.recompute()
+        n2 = obj.NumNodes
+        obj.Order = 4
+        self.doc.recompute()
+        self.assertTrue(obj.isValid())
+        self.assertGreater(obj.NumNodes, n2)
+        self.assertEqual(homesh.freecad.get_mesh(obj).order, 4)
+
+    def test_order_is_constrained(self):
+        part = box_with_hole(self.doc)
+        obj = homesh.freecad.make_high_order_mesh(self.doc, part)
+        obj.Order = 50
+        self.assertEqual(obj.Order, 10)
+
+    def test_missing_shape_fails_cleanly(self):
+        obj = homesh.freecad.make_high_order_mesh(self.doc, None)
+        self.doc.recompute()
+        self.assertFalse(obj.isValid())
+        # A wire cannot be meshed: the object is invalid, FreeCAD keeps running.
+        wire = self.doc.addObject("Part::Circle", "Circle")
+        obj.Part = wire
+        self.doc.recompute()
+        self.assertFalse(obj.isValid())
+        self.assertIsNone(homesh.freecad.get_mesh(obj))

@@ -1,0 +1,79 @@
+"""GUI smoke test, run by FreeCAD itself under Xvfb (see tests/CMakeLists.txt):
+
+activates the HOMesh workbench, selects a box-minus-cylinder, runs the toolbar command
+"High-order mesh", and saves two screenshots to $HOMESH_SCREENSHOT_DIR: the 3D view rendered
+off-screen (view.png) and the whole main window (window.png). It checks that the command made a
+valid mesh object and that the rendered view shows it (pixels in the quality colour map).
+FreeCAD's GUI never exits by itself, so the script ends with os._exit(status).
+"""
+
+import os
+import sys
+import traceback
+
+status = 1
+try:
+    import FreeCAD
+    import FreeCADGui
+    from PySide2 import QtGui, QtWidgets
+
+    out = os.environ.get("HOMESH_SCREENSHOT_DIR", os.getcwd())
+    os.makedirs(out, exist_ok=True)
+
+    assert "HOMeshWorkbench" in FreeCADGui.listWorkbenches(), "workbench not registered"
+    FreeCADGui.activateWorkbench("HOMeshWorkbench")
+
+    doc = FreeCAD.newDocument("Smoke")
+    box = doc.addObject("Part::Box", "Box")
+    box.Length, box.Width, box.Height = 4, 4, 2
+    cyl = doc.addObject("Part::Cylinder", "Cylinder")
+    cyl.Radius, cyl.Height = 1, 2
+    cyl.Placement.Base = FreeCAD.Vector(2, 2, 0)
+    cut = doc.addObject("Part::Cut", "Cut")
+    cut.Base, cut.Tool = box, cyl
+    doc.recompute()
+
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(cut)
+    FreeCADGui.runCommand("HOMesh_HighOrderMesh")
+    meshes = [o for o in doc.Objects if getattr(o, "Proxy", None) is not None
+              and getattr(o.Proxy, "Type", "") == "HOMesh::HighOrderMesh"]
+    assert len(meshes) == 1, "the command made %d mesh objects" % len(meshes)
+    mesh = meshes[0]
+    assert mesh.isValid(), "the mesh object failed to recompute"
+    assert mesh.NumElements > 0 and mesh.Order == 4
+    assert not cut.ViewObject.Visibility, "the meshed shape should be hidden"
+    print("HOMesh GUI smoke: %d nodes, %d elements, worst scaled Jacobian %.3f"
+          % (mesh.NumNodes, mesh.NumElements, mesh.MinScaledJacobian))
+
+    view = FreeCADGui.ActiveDocument.ActiveView
+    view.viewIsometric()
+    view.fitAll()
+    for _ in range(10):
+        QtWidgets.QApplication.processEvents()
+    view_png = os.path.join(out, "view.png")
+    view.saveImage(view_png, 800, 600, "White")
+    window = FreeCADGui.getMainWindow()
+    QtWidgets.QApplication.primaryScreen().grabWindow(window.winId()).save(
+        os.path.join(out, "window.png"))
+
+    # The rendered view must show the mesh: many pixels of the colour map (green to yellow,
+    # little blue), none of which a white background or black edges have.
+    image = QtGui.QImage(view_png)
+    coloured = total = 0
+    for y in range(0, image.height(), 4):
+        for x in range(0, image.width(), 4):
+            c = QtGui.QColor(image.pixel(x, y))
+            total += 1
+            if c.green() > 60 and c.green() > c.blue() + 40:
+                coloured += 1
+    fraction = coloured / float(total)
+    print("HOMesh GUI smoke: %.0f %% of the view shows the mesh" % (100 * fraction))
+    assert fraction > 0.15, "the mesh is not visible in the 3D view"
+    status = 0
+except Exception:
+    traceback.print_exc()
+finally:
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(status)

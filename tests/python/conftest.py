@@ -1,0 +1,35 @@
+"""Shared fixtures of the Python tests (run by CTest with Debian's /usr/bin/python3.11).
+
+HOMESH_BUILD_DIR points at the CMake build tree; its staged workbench folder Mod/HOMesh holds
+the `homesh` package with the compiled core.
+"""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+BUILD = Path(os.environ.get("HOMESH_BUILD_DIR", ROOT / "build"))
+sys.path.insert(0, str(BUILD / "Mod" / "HOMesh"))
+DATA = ROOT / "tests" / "data"
+
+
+@pytest.fixture(scope="session")
+def homesh_bin():
+    path = BUILD / "bin" / "homesh"
+    assert path.is_file(), "build the project first: %s is missing" % path
+    return str(path)
+
+
+@pytest.fixture(scope="session")
+def data():
+    return DATA
+
+
+def run(args, **kwargs):
+    """Runs a command, returning the CompletedProcess (text mode, never raises on failure)."""
+    return subprocess.run([str(a) for a in args], capture_output=True, text=True, timeout=600,
+                          **kwargs)

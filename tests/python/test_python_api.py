@@ -1,0 +1,133 @@
+"""The `homesh` Python package outside FreeCAD: arrays, quality, writers, persistence, errors,
+progress and cancel."""
+
+import json
+
+import numpy as np
+import pytest
+
+import homesh
+from homesh import tessellation
+
+
+@pytest.fixture(scope="module")
+def sphere(data):
+    return homesh.mesh(str(data / "sphere.brep"), order=3, size=0.4)
+
+
+def test_arrays_have_the_documented_layout(sphere):
+    m = sphere
+    assert m.order == 3 and m.dim == 3 and m.element_type == "tet"
+    assert m.nodes.shape == (m.num_nodes, 3) and m.nodes.dtype == np.float64
+    assert m.elements.shape == (m.num_elements, 20) and m.elements.dtype == np.int64
+    assert m.elements.min() >= 0 and m.elements.max() < m.num_nodes
+    assert m.node_cad_params.shape == (m.num_nodes, 2)
+    on_face = m.node_cad_dim == 2
+    assert np.all(m.node_cad_index[on_face] == 1)
+    assert np.allclose(np.linalg.norm(m.nodes[on_face], axis=1), 1.0, atol=1e-9)
+    (tris,) = [b for b in m.boundary if b.element_type == "tri"]
+    assert tris.elements.shape[1] == 10 and np.all(tris.cad_entity == 1)
+
+
+def test_quality_and_report(sphere):
+    q = sphere.quality()
+    assert q["scaled_jacobian"].shape == (sphere.num_elements,)
+    assert q["invalid_elements"] == 0
+    assert q["min"] == pytest.approx(q["scaled_jacobian"].min())
+    report = sphere.report("sphere.brep")
+    assert report["elements"]["tet"] == sphere.num_elements
+    assert report["nodes"] == sphere.num_nodes
+    json.dumps(report)
+
+
+def test_npz_round_trip_keeps_everything(sphere, tmp_path):
+    path = tmp_path / "m.npz"
+    sphere.write(path)
+    back = homesh.load(path)
+    assert np.array_equal(back.nodes, sphere.nodes)
+    assert np.array_equal(back.elements, sphere.elements)
+    assert np.array_equal(back.node_cad_dim, sphere.node_cad_dim)
+    np.testing.assert_array_equal(back.quality()["scaled_jacobian"],
+                                  sphere.quality()["scaled_jacobian"])
+    back.write(tmp_path / "again.msh")
+    assert (tmp_path / "again.msh").stat().st_size > 0
+
+
+def test_brep_text_input(data):
+    text = (data / "sphere.brep").read_text()
+    m = homesh.mesh(text, order=2, size=0.5)
+    assert m.num_elements > 0
+
+
+def test_planar_face_gives_a_2d_mesh(tmp_path):
+    # A unit square face as BRep text written by OCCT (FreeCAD's Part.makePlane(1, 1)).
+    import subprocess
+    square = tmp_path / "square.brep"
+    subprocess.run(["freecadcmd", "-c",
+                    "import Part; Part.makePlane(2, 1).exportBrep(%r)" % str(square)],
+                   check=True, capture_output=True, timeout=120)
+    m = homesh.mesh(str(square), order=4, size=0.3)
+    assert m.dim == 2 and m.element_type == "tri"
+    assert m.quality()["invalid_elements"] == 0
+    assert all(b.element_type == "line" for b in m.boundary)
+
+
+@pytest.mark.parametrize("kwargs, error", [
+    (dict(order=0), homesh.ParameterError),
+    (dict(order=11), homesh.ParameterError),
+    (dict(order=2.5), homesh.ParameterError),
+    (dict(order=True), homesh.ParameterError),
+    (dict(size=-1), homesh.ParameterError),
+    (dict(size=0), homesh.ParameterError),
+    (dict(size="big"), homesh.ParameterError),
+    (dict(threads=0), homesh.ParameterError),
+])
+def test_bad_parameters_raise(data, kwargs, error):
+    with pytest.raises(error):
+        homesh.mesh(str(data / "sphere.brep"), **kwargs)
+
+
+def test_bad_inputs_raise_named_errors(tmp_path):
+    with pytest.raises(homesh.FileError, match="does not exist"):
+        homesh.mesh(str(tmp_path / "nope.step"))
+    fake = tmp_path / "fake.step"
+    fake.write_text("not a step file")
+    with pytest.raises(homesh.FileError, match="fake.step"):
+        homesh.mesh(str(fake))
+    with pytest.raises(homesh.CadError):
+        homesh.mesh("\nCASCADE Topology V1, garbage\nnot really\n")
+    with pytest.raises(homesh.ParameterError):
+        homesh.mesh(42)
+    # The errors are ordinary Python exceptions with the standard bases.
+    assert issubclass(homesh.ParameterError, ValueError)
+    assert issubclass(homesh.FileError, OSError)
+    assert issubclass(homesh.HOMeshError, RuntimeError)
+
+
+def test_progress_reports_stages_and_can_cancel(data):
+    seen = []
+    homesh.mesh(str(data / "sphere.brep"), order=2, size=0.5,
+                progress=lambda stage, seconds: seen.append((stage, seconds)))
+    assert [s for s, t in seen if t is None] == ["cad", "linear", "high_order", "quality"]
+    assert all(t >= 0 for s, t in seen if t is not None)
+
+    def stop(stage, seconds):
+        if stage == "linear" and seconds is not None:
+            raise RuntimeError("user pressed cancel")
+
+    with pytest.raises(homesh.CancelledError, match="user pressed cancel"):
+        homesh.mesh(str(data / "sphere.brep"), order=2, size=0.5, progress=stop)
+
+
+def test_tessellation_follows_the_curved_surface(sphere):
+    geometry = tessellation.surface_and_edges(sphere, level=6)
+    pts = geometry["points"]
+    assert len(geometry["triangles"]) == len(geometry["colors"])
+    assert geometry["triangles"].max() < len(pts)
+    # Points sampled inside curved boundary triangles are on (or extremely near) the sphere:
+    # far closer than the straight-sided chords would be.
+    radius = np.linalg.norm(pts, axis=1)
+    assert np.max(np.abs(radius - 1.0)) < 2e-3
+    edge_radius = np.linalg.norm(geometry["edge_points"], axis=1)
+    assert np.max(np.abs(edge_radius - 1.0)) < 2e-3
+    assert geometry["edge_polylines"].shape[1] == 7
