@@ -36,7 +36,7 @@ class HighOrderMesh:
       element_type     "tet" or "tri"
       element_entity   (E,) int32: the solid (3D) or face (2D) each element belongs to
       boundary         list of :class:`BoundaryBlock`
-      node_cad_dim     (N,) int8: 0 vertex, 1 edge, 2 face, 3 solid interior
+      node_cad_dim     (N,) uint8: 0 vertex, 1 edge, 2 face, 3 solid interior
       node_cad_index   (N,) int32: 1-based FreeCAD index of that entity (VertexN, EdgeN, ...)
       node_cad_params  (N, 2) float64: t on an edge (second column NaN) or (u, v) on a face
     """

@@ -1,7 +1,6 @@
 #include "cad/cad_model.hpp"
 
 #include <BRepAdaptor_Curve.hxx>
-#include <Eigen/Geometry>
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepBndLib.hxx>
 #include <BRepLProp_SLProps.hxx>
@@ -9,8 +8,9 @@
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
-#include <GeomLib_IsPlanarSurface.hxx>
+#include <Eigen/Geometry>
 #include <Geom2d_Curve.hxx>
+#include <GeomLib_IsPlanarSurface.hxx>
 #include <Geom_Surface.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESControl_Reader.hxx>
@@ -103,10 +103,18 @@ struct CadModel::Impl {
 
 namespace {
 
-Eigen::Vector3d toEigen(const gp_Pnt& p) { return {p.X(), p.Y(), p.Z()}; }
-Eigen::Vector3d toEigen(const gp_Vec& v) { return {v.X(), v.Y(), v.Z()}; }
-Eigen::Vector3d toEigen(const gp_Dir& d) { return {d.X(), d.Y(), d.Z()}; }
-gp_Pnt toGp(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
+Eigen::Vector3d toEigen(const gp_Pnt& p) {
+  return {p.X(), p.Y(), p.Z()};
+}
+Eigen::Vector3d toEigen(const gp_Vec& v) {
+  return {v.X(), v.Y(), v.Z()};
+}
+Eigen::Vector3d toEigen(const gp_Dir& d) {
+  return {d.X(), d.Y(), d.Z()};
+}
+gp_Pnt toGp(const Eigen::Vector3d& p) {
+  return {p.x(), p.y(), p.z()};
+}
 
 std::string lowerExtension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -191,12 +199,24 @@ CadModel CadModel::clone() const {
   return CadModel(std::move(impl));
 }
 
-int CadModel::numVertices() const { return impl_->vertices.Extent(); }
-int CadModel::numEdges() const { return impl_->edges.Extent(); }
-int CadModel::numFaces() const { return impl_->faces.Extent(); }
-int CadModel::numSolids() const { return impl_->solids.Extent(); }
-const std::string& CadModel::sourceName() const { return impl_->source; }
-double CadModel::boundingDiagonal() const { return impl_->diagonal; }
+int CadModel::numVertices() const {
+  return impl_->vertices.Extent();
+}
+int CadModel::numEdges() const {
+  return impl_->edges.Extent();
+}
+int CadModel::numFaces() const {
+  return impl_->faces.Extent();
+}
+int CadModel::numSolids() const {
+  return impl_->solids.Extent();
+}
+const std::string& CadModel::sourceName() const {
+  return impl_->source;
+}
+double CadModel::boundingDiagonal() const {
+  return impl_->diagonal;
+}
 
 std::vector<int> CadModel::subShapeIndices(int dim, int index, int subDim) const {
   static const TopAbs_ShapeEnum types[] = {TopAbs_VERTEX, TopAbs_EDGE, TopAbs_FACE, TopAbs_SOLID};
@@ -290,9 +310,9 @@ SurfaceProjection CadModel::projectOnSurface(int face, const Eigen::Vector3d& p,
   ShapeAnalysis_Surface& analyser = impl_->analyser(face);
   return withOcctErrors("projecting onto " + cadEntityName(2, face), [&] {
     const double precision = 1e-9 * impl_->diagonal;
-    const gp_Pnt2d uv = guess ? analyser.NextValueOfUV(gp_Pnt2d((*guess)[0], (*guess)[1]),
-                                                       toGp(p), precision)
-                              : analyser.ValueOfUV(toGp(p), precision);
+    const gp_Pnt2d uv =
+        guess ? analyser.NextValueOfUV(gp_Pnt2d((*guess)[0], (*guess)[1]), toGp(p), precision)
+              : analyser.ValueOfUV(toGp(p), precision);
     const gp_Pnt q = analyser.Value(uv);
     return SurfaceProjection{uv.X(), uv.Y(), toEigen(q), q.Distance(toGp(p))};
   });
@@ -325,15 +345,16 @@ PrincipalCurvatures CadModel::curvature(int face, double u, double v) const {
 bool CadModel::isPlanar(int face) const {
   const TopoDS_Face f = occtFace(*this, face);
   return withOcctErrors(cadEntityName(2, face), [&] {
-    return static_cast<bool>(GeomLib_IsPlanarSurface(BRep_Tool::Surface(f), 1e-9 * impl_->diagonal)
-                                 .IsPlanar());
+    return static_cast<bool>(
+        GeomLib_IsPlanarSurface(BRep_Tool::Surface(f), 1e-9 * impl_->diagonal).IsPlanar());
   });
 }
 
 std::pair<Eigen::Vector3d, Eigen::Vector3d> CadModel::plane(int face) const {
   if (!isPlanar(face)) throw CadError(cadEntityName(2, face) + " is not planar");
   const SurfaceBounds b = faceBounds(face);
-  const SurfaceDerivatives d = evaluateSurface(face, 0.5 * (b.uMin + b.uMax), 0.5 * (b.vMin + b.vMax));
+  const SurfaceDerivatives d =
+      evaluateSurface(face, 0.5 * (b.uMin + b.uMax), 0.5 * (b.vMin + b.vMax));
   Eigen::Vector3d normal = d.du.cross(d.dv);
   if (!(normal.norm() > 0.0))
     throw CadError(cadEntityName(2, face) + " has a singular parametrisation at its centre");
@@ -362,7 +383,9 @@ std::string cadEntityName(int dim, int index) {
   return names[dim] + std::to_string(index);
 }
 
-const TopoDS_Shape& occtShape(const CadModel& cad) { return cad.impl().shape; }
+const TopoDS_Shape& occtShape(const CadModel& cad) {
+  return cad.impl().shape;
+}
 
 TopoDS_Vertex occtVertex(const CadModel& cad, int index) {
   cad.impl().checkIndex(0, index, cad.numVertices());

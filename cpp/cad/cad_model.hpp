@@ -39,7 +39,7 @@ struct SurfaceProjection {
 };
 
 struct PrincipalCurvatures {
-  bool defined = false;       // false at umbilic-free singular points (e.g. a cone apex)
+  bool defined = false;           // false at umbilic-free singular points (e.g. a cone apex)
   double kMin = 0.0, kMax = 0.0;  // signed, relative to the face's outward normal, kMin <= kMax
   Eigen::Vector3d dirMin, dirMax;
 };
@@ -62,8 +62,8 @@ class CadModel {
   // is how messages refer to it (a FreeCAD object's label, say).
   static CadModel fromBrepText(const std::string& text, const std::string& name = "the shape");
 
-  CadModel(CadModel&&) noexcept;
-  CadModel& operator=(CadModel&&) noexcept;
+  CadModel(CadModel&& other) noexcept;
+  CadModel& operator=(CadModel&& other) noexcept;
   ~CadModel();
 
   // A copy sharing the (immutable) shape with fresh evaluation caches, for another thread.

@@ -5,7 +5,16 @@
 
 namespace homesh {
 
-enum class CellType { Point, Line, Triangle, Quadrilateral, Tetrahedron, Prism, Pyramid, Hexahedron };
+enum class CellType {
+  Point,
+  Line,
+  Triangle,
+  Quadrilateral,
+  Tetrahedron,
+  Prism,
+  Pyramid,
+  Hexahedron
+};
 
 // Topological dimension of the shape (0 for a point, 3 for a tetrahedron).
 int cellDimension(CellType type);

@@ -10,7 +10,7 @@ std::int64_t Mesh::addNode(const double p[3], int cadDim, int cadIndex, double p
                            double param1) {
   const auto id = static_cast<std::int64_t>(numNodes());
   xyz.insert(xyz.end(), p, p + 3);
-  nodeCadDim.push_back(static_cast<std::int8_t>(cadDim));
+  nodeCadDim.push_back(static_cast<std::uint8_t>(cadDim));
   nodeCadIndex.push_back(cadIndex);
   nodeCadParam.push_back(param0);
   nodeCadParam.push_back(param1);

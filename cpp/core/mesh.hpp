@@ -25,7 +25,7 @@ namespace homesh {
 struct ElementBlock {
   CellType type = CellType::Tetrahedron;
   int order = 1;
-  std::vector<std::int64_t> nodes;  // size() == count() * nodesPerElement()
+  std::vector<std::int64_t> nodes;   // size() == count() * nodesPerElement()
   std::vector<std::int32_t> entity;  // size() == count()
 
   int nodesPerElement() const { return cellNumNodes(type, order); }
@@ -43,7 +43,7 @@ struct Mesh {
   std::array<double, 3> planeNormal{0.0, 0.0, 1.0};
 
   std::vector<double> xyz;
-  std::vector<std::int8_t> nodeCadDim;
+  std::vector<std::uint8_t> nodeCadDim;
   std::vector<std::int32_t> nodeCadIndex;
   std::vector<double> nodeCadParam;
 

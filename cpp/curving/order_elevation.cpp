@@ -30,7 +30,7 @@ struct NodeKey {
 
 struct NodeKeyHash {
   std::size_t operator()(const NodeKey& k) const {
-    std::size_t h = static_cast<std::size_t>(k.size);
+    auto h = static_cast<std::size_t>(k.size);
     for (int i = 0; i < k.size; ++i) {
       h = h * 1000003u ^ static_cast<std::size_t>(k.vertex[i]);
       h = h * 1000003u ^ static_cast<std::size_t>(k.index[i]);
@@ -152,9 +152,9 @@ struct Elevator {
 
 // Moves the nodes created by elevation (ids >= firstNew) that lie on a CAD curve or face onto it.
 void projectNewNodes(Mesh& mesh, std::size_t firstNew, const CadModel& cad) {
-  for (auto id = static_cast<std::int64_t>(firstNew); id < static_cast<std::int64_t>(mesh.numNodes());
-       ++id) {
-    const int dim = mesh.nodeCadDim[id];
+  for (auto id = static_cast<std::int64_t>(firstNew);
+       id < static_cast<std::int64_t>(mesh.numNodes()); ++id) {
+    const int dim = static_cast<int>(mesh.nodeCadDim[id]);
     const int entity = mesh.nodeCadIndex[id];
     if (dim != 1 && dim != 2) continue;
     double* x = &mesh.xyz[3 * id];
@@ -182,7 +182,7 @@ Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad) {
     throw ParameterError("order must be between 1 and 10, got " + std::to_string(order));
   Elevator elevator(linear, order);
   for (const ElementBlock& block : linear.blocks) elevator.elevateBlock(block);
-  if (cad) projectNewNodes(elevator.out, linear.numNodes(), *cad);
+  if (cad != nullptr) projectNewNodes(elevator.out, linear.numNodes(), *cad);
   elevator.out.checkConsistency();
   return std::move(elevator.out);
 }

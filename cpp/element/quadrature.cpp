@@ -15,7 +15,8 @@ void gaussJacobi(int n, double alpha, double beta, std::vector<double>& x, std::
   const double ab = alpha + beta;
   for (int k = 0; k < n; ++k) {
     const double s = 2.0 * k + ab;
-    jm(k, k) = (k == 0) ? (beta - alpha) / (ab + 2.0) : (beta * beta - alpha * alpha) / (s * (s + 2.0));
+    jm(k, k) =
+        (k == 0) ? (beta - alpha) / (ab + 2.0) : (beta * beta - alpha * alpha) / (s * (s + 2.0));
     if (k + 1 < n) {
       const double m = k + 1.0;
       const double t = 2.0 * m + ab;

@@ -42,7 +42,9 @@ void checkFields(const Mesh& mesh, const std::vector<CellField>& fields) {
 }
 
 // Gmsh entity tags must be positive; meshes without CAD have index 0.
-int entityTag(int cadIndex) { return std::max(1, cadIndex); }
+int entityTag(int cadIndex) {
+  return std::max(1, cadIndex);
+}
 
 struct Box {
   double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
@@ -63,8 +65,8 @@ void writeMshEntities(std::ostream& os, const std::map<EntityKey, Box>& entities
                       const std::set<EntityKey>& physical) {
   std::array<int, 4> counts{0, 0, 0, 0};
   for (const auto& [key, box] : entities) ++counts[key.first];
-  os << "$Entities\n" << counts[0] << " " << counts[1] << " " << counts[2] << " " << counts[3]
-     << "\n";
+  os << "$Entities\n"
+     << counts[0] << " " << counts[1] << " " << counts[2] << " " << counts[3] << "\n";
   for (const auto& [key, box] : entities) {
     const auto [dim, tag] = key;
     os << tag;
@@ -73,7 +75,7 @@ void writeMshEntities(std::ostream& os, const std::map<EntityKey, Box>& entities
       const double* b = k == 0 ? box.lo : box.hi;
       os << " " << b[0] << " " << b[1] << " " << b[2];
     }
-    if (physical.count(key))
+    if (physical.count(key) > 0)
       os << " 1 " << tag;
     else
       os << " 0";

@@ -42,7 +42,7 @@ Eigen::Vector3d gmshValue(int dim, int tag, const std::vector<double>& param) {
 
 IndexSet cadBoundary(const CadModel& cad, int dim, int index) {
   const std::vector<int> sub = cad.subShapeIndices(dim, index, dim - 1);
-  return IndexSet(sub.begin(), sub.end());
+  return {sub.begin(), sub.end()};
 }
 
 [[noreturn]] void fail(int dim, int tag, const std::string& why) {
@@ -96,17 +96,17 @@ GmshEntityMap GmshEntityMap::build(const CadModel& cad) {
       for (int e = 1; e <= cad.numEdges() && match == 0; ++e) {
         if (used[e] || cadBoundary(cad, 1, e) != ends) continue;
         // A degenerated edge (a sphere's pole) is a point: Gmsh evaluates it at its vertex.
-        const Eigen::Vector3d q = cad.isDegenerated(e) ? cad.vertexPoint(*ends.begin())
-                                                       : cad.evaluateCurve(e, tm).point;
+        const Eigen::Vector3d q =
+            cad.isDegenerated(e) ? cad.vertexPoint(*ends.begin()) : cad.evaluateCurve(e, tm).point;
         if ((q - p).norm() <= tol) match = e;
       }
-      if (match == 0) fail(1, tag, "no CAD edge with the same vertices passes through its midpoint");
+      if (match == 0)
+        fail(1, tag, "no CAD edge with the same vertices passes through its midpoint");
       used[match] = true;
       map.toCad_[{1, tag}] = match;
     }
     for (int e = 1; e <= cad.numEdges(); ++e)
-      if (!used[e])
-        throw MeshingError(cadEntityName(1, e) + " was not imported by Gmsh");
+      if (!used[e]) throw MeshingError(cadEntityName(1, e) + " was not imported by Gmsh");
 
     // Surfaces: same boundary curves and the same point at the parametric centre.
     used.assign(cad.numFaces() + 1, false);

@@ -56,7 +56,8 @@ int meshDimension(const CadModel& cad, Eigen::Vector3d& normal) {
   for (int f = 2; f <= cad.numFaces(); ++f) {
     const auto [o, m] = cad.plane(f);
     if (std::abs(n.dot(m)) < 1.0 - 1e-9 || std::abs(n.dot(o - origin)) > tol)
-      throw CadError(cadEntityName(2, f) + " is not in the plane of Face1: a 2D mesh needs all "
+      throw CadError(cadEntityName(2, f) +
+                     " is not in the plane of Face1: a 2D mesh needs all "
                      "faces in one plane");
   }
   normal = n;
@@ -118,8 +119,8 @@ void readElements(const GmshEntityMap& entities, const NodeTable& table, int dim
     if (types[k] == kGmshPoint) continue;
     if (types[k] != gmshType)
       throw MeshingError("Gmsh made elements of type " + std::to_string(types[k]) + " on " +
-                         cadEntityName(dim, cadIndex) + " where only " +
-                         cellShortName(block.type) + "s were expected");
+                         cadEntityName(dim, cadIndex) + " where only " + cellShortName(block.type) +
+                         "s were expected");
     for (const std::size_t nodeTag : nodeTags[k]) block.nodes.push_back(table.at(nodeTag));
     block.entity.insert(block.entity.end(), nodeTags[k].size() / nv, cadIndex);
   }
@@ -197,8 +198,7 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
     gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
     gmsh::option::setNumber("Mesh.MeshSizeMax", size);
     gmsh::option::setNumber("Mesh.ElementOrder", 1);
-    gmsh::model::mesh::setSizeCallback(
-        [size](int, int, double, double, double) { return size; });
+    gmsh::model::mesh::setSizeCallback([size](int, int, double, double, double) { return size; });
     gmsh::model::mesh::generate(dim);
 
     NodeTable table;
@@ -217,8 +217,8 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
     }
     if (cells.count() == 0) {
       const std::string last = gmshLastError();
-      throw MeshingError("Gmsh made no " + cellShortName(cells.type) + "s for " +
-                         cad.sourceName() + (last.empty() ? "" : ": " + last));
+      throw MeshingError("Gmsh made no " + cellShortName(cells.type) + "s for " + cad.sourceName() +
+                         (last.empty() ? "" : ": " + last));
     }
     if (dim == 3) {
       orientVolumeMesh(mesh, cells, faces);

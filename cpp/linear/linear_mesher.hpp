@@ -14,9 +14,9 @@
 namespace homesh {
 
 struct LinearMeshOptions {
-  double size = 0.0;   // target edge length, uniform for now (> 0)
-  int threads = 1;     // threads Gmsh may use
-  int verbosity = 0;   // 0 silent, 1 Gmsh's warnings, 2 Gmsh's information
+  double size = 0.0;  // target edge length, uniform for now (> 0)
+  int threads = 1;    // threads Gmsh may use
+  int verbosity = 0;  // 0 silent, 1 Gmsh's warnings, 2 Gmsh's information
 };
 
 // Throws ParameterError (bad size), CadError (nothing meshable) or MeshingError.

@@ -20,13 +20,17 @@ void MeshingOptions::validate() const {
   if (threads < 1) throw ParameterError("threads must be >= 1, got " + std::to_string(threads));
 }
 
-double defaultMeshSize(const CadModel& cad) { return cad.boundingDiagonal() / 20.0; }
+double defaultMeshSize(const CadModel& cad) {
+  return cad.boundingDiagonal() / 20.0;
+}
 
 CadModel CadSource::load() const {
   return kind == Kind::File ? CadModel::fromFile(value) : CadModel::fromBrepText(value, name);
 }
 
-void StageTimings::add(const std::string& stage, double s) { seconds.emplace_back(stage, s); }
+void StageTimings::add(const std::string& stage, double s) {
+  seconds.emplace_back(stage, s);
+}
 
 double StageTimings::total() const {
   double t = 0.0;
@@ -40,7 +44,7 @@ class StageClock {
  public:
   StageClock(const std::string& stage, StageTimings& timings, PipelineObserver* observer)
       : stage_(stage), timings_(timings), observer_(observer) {
-    if (observer_) {
+    if (observer_ != nullptr) {
       if (observer_->cancelRequested()) throw CancelledError("cancelled before " + stage);
       observer_->stageStarted(stage);
     }
@@ -50,7 +54,7 @@ class StageClock {
     const double s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     timings_.add(stage_, s);
-    if (observer_) observer_->stageFinished(stage_, s);
+    if (observer_ != nullptr) observer_->stageFinished(stage_, s);
   }
 
  private:

@@ -21,10 +21,10 @@
 namespace homesh {
 
 struct MeshingOptions {
-  int order = 4;       // polynomial order, 1..10
+  int order = 4;               // polynomial order, 1..10
   std::optional<double> size;  // target edge length (> 0); unset: defaultMeshSize(cad)
-  int threads = 1;     // threads the stages may use
-  int verbosity = 0;   // 0 silent; 1 Gmsh's warnings; 2 Gmsh's information
+  int threads = 1;             // threads the stages may use
+  int verbosity = 0;           // 0 silent; 1 Gmsh's warnings; 2 Gmsh's information
 
   // Throws ParameterError naming the offending parameter.
   void validate() const;

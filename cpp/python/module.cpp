@@ -34,15 +34,14 @@ PyObject* gCancelledError = nullptr;
 PyObject* makeException(const char* name, PyObject* bases, const char* doc) {
   const std::string qualified = std::string("homesh._core.") + name;
   PyObject* type = PyErr_NewExceptionWithDoc(qualified.c_str(), doc, bases, nullptr);
-  if (!type) bp::throw_error_already_set();
+  if (type == nullptr) bp::throw_error_already_set();
   bp::scope().attr(name) = bp::handle<>(bp::borrowed(type));
   return type;
 }
 
 template <class E>
 void registerTranslator(PyObject* pyType) {
-  bp::register_exception_translator<E>(
-      [pyType](const E& e) { PyErr_SetString(pyType, e.what()); });
+  bp::register_exception_translator<E>([pyType](const E& e) { PyErr_SetString(pyType, e.what()); });
 }
 
 class ReleaseGil {
@@ -67,17 +66,21 @@ class PythonProgress : public PipelineObserver {
 
  private:
   void call(const std::string& stage, const double* seconds) {
-    if (callback_.is_none() || !failure_.empty()) return;
+    if (!failure_.empty()) return;
     const PyGILState_STATE gil = PyGILState_Ensure();
+    if (callback_.is_none()) {
+      PyGILState_Release(gil);
+      return;
+    }
     try {
-      callback_(stage, seconds ? bp::object(*seconds) : bp::object());
+      callback_(stage, seconds != nullptr ? bp::object(*seconds) : bp::object());
     } catch (const bp::error_already_set&) {
       PyObject *type = nullptr, *value = nullptr, *trace = nullptr;
       PyErr_Fetch(&type, &value, &trace);
       failure_ = "progress callback raised an exception";
-      if (value) {
+      if (value != nullptr) {
         PyObject* text = PyObject_Str(value);
-        if (text) {
+        if (text != nullptr) {
           failure_ += std::string(": ") + PyUnicode_AsUTF8(text);
           Py_DECREF(text);
         }
@@ -95,8 +98,7 @@ class PythonProgress : public PipelineObserver {
 
 template <class T>
 np::ndarray toArray(const std::vector<T>& values, std::size_t rows, std::size_t cols) {
-  const bp::tuple shape =
-      cols == 0 ? bp::make_tuple(rows) : bp::make_tuple(rows, cols);
+  const bp::tuple shape = cols == 0 ? bp::make_tuple(rows) : bp::make_tuple(rows, cols);
   np::ndarray a = np::empty(shape, np::dtype::get_builtin<T>());
   if (!values.empty()) std::memcpy(a.get_data(), values.data(), values.size() * sizeof(T));
   return a;
@@ -115,9 +117,9 @@ std::vector<T> fromArray(const bp::object& object, const char* what) {
 }
 
 CellType cellTypeFromName(const std::string& name) {
-  for (CellType t : {CellType::Line, CellType::Triangle, CellType::Quadrilateral,
-                     CellType::Tetrahedron, CellType::Prism, CellType::Pyramid,
-                     CellType::Hexahedron})
+  for (CellType t :
+       {CellType::Line, CellType::Triangle, CellType::Quadrilateral, CellType::Tetrahedron,
+        CellType::Prism, CellType::Pyramid, CellType::Hexahedron})
     if (cellShortName(t) == name) return t;
   throw ParameterError("unknown element type '" + name + "'");
 }
@@ -186,14 +188,12 @@ class PyMesh {
     writeMeshOutputs(*result_, {path});
   }
 
-  std::string reportJson(const std::string& input) const {
-    return meshReportJson(*result_, input);
-  }
+  std::string reportJson(const std::string& input) const { return meshReportJson(*result_, input); }
 
   std::shared_ptr<MeshResult> result_;
 };
 
-MeshingOptions makeOptions(int order, bp::object size, int threads, int verbosity) {
+MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity) {
   MeshingOptions options;
   options.order = order;
   if (!size.is_none()) options.size = bp::extract<double>(size);
@@ -203,7 +203,7 @@ MeshingOptions makeOptions(int order, bp::object size, int threads, int verbosit
 }
 
 PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::object progress) {
-  PythonProgress observer(progress);
+  PythonProgress observer(std::move(progress));
   std::unique_ptr<MeshResult> result;
   try {
     const ReleaseGil nogil;
@@ -215,21 +215,23 @@ PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::o
   return PyMesh(std::move(*result));
 }
 
-PyMesh meshFile(const std::string& path, int order, bp::object size, int threads, int verbosity,
-                bp::object progress) {
-  return runPipeline(CadSource::file(path), makeOptions(order, size, threads, verbosity), progress);
+PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
+                int verbosity, bp::object progress) {
+  return runPipeline(CadSource::file(path), makeOptions(order, size, threads, verbosity),
+                     std::move(progress));
 }
 
-PyMesh meshBrep(const std::string& text, const std::string& name, int order, bp::object size,
+PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
                 int threads, int verbosity, bp::object progress) {
-  return runPipeline(CadSource::brepText(text, name),
-                     makeOptions(order, size, threads, verbosity), progress);
+  return runPipeline(CadSource::brepText(text, name), makeOptions(order, size, threads, verbosity),
+                     std::move(progress));
 }
 
 // Rebuilds a mesh (without CAD) from the arrays PyMesh exposes, and evaluates its quality.
 // blocks: [(type name, order, connectivity, entity), ...] as returned by PyMesh.blocks().
-PyMesh meshFromArrays(int dim, int order, bp::object nodes, bp::object cadDim, bp::object cadIndex,
-                      bp::object cadParams, bp::list blocks, bp::tuple normal) {
+PyMesh meshFromArrays(int dim, int order, const bp::object& nodes, const bp::object& cadDim,
+                      const bp::object& cadIndex, const bp::object& cadParams,
+                      const bp::list& blocks, const bp::tuple& normal) {
   MeshResult result;
   Mesh& mesh = result.mesh;
   mesh.dim = dim;
@@ -238,7 +240,7 @@ PyMesh meshFromArrays(int dim, int order, bp::object nodes, bp::object cadDim, b
   if (bp::len(normal) != 3) throw ParameterError("plane normal needs 3 components");
   for (int k = 0; k < 3; ++k) mesh.planeNormal[k] = bp::extract<double>(normal[k]);
   mesh.xyz = fromArray<double>(nodes, "nodes");
-  mesh.nodeCadDim = fromArray<std::int8_t>(cadDim, "node_cad_dim");
+  mesh.nodeCadDim = fromArray<std::uint8_t>(cadDim, "node_cad_dim");
   mesh.nodeCadIndex = fromArray<std::int32_t>(cadIndex, "node_cad_index");
   mesh.nodeCadParam = fromArray<double>(cadParams, "node_cad_params");
   for (bp::ssize_t i = 0; i < bp::len(blocks); ++i) {
@@ -258,10 +260,10 @@ PyMesh meshFromArrays(int dim, int order, bp::object nodes, bp::object cadDim, b
 
 // Values of the Lagrange basis of (type, order) at reference points (npts x dim):
 // returns (npts x numNodes), nodes in Gmsh order. Used to draw curved elements.
-np::ndarray lagrangeBasis(const std::string& type, int order, bp::object points) {
+np::ndarray lagrangeBasis(const std::string& type, int order, const bp::object& points) {
   const ReferenceElement& ref = ReferenceElement::get(cellTypeFromName(type), order);
   const std::vector<double> xi = fromArray<double>(points, "points");
-  const std::size_t dim = static_cast<std::size_t>(ref.dim());
+  const auto dim = static_cast<std::size_t>(ref.dim());
   if (xi.size() % dim != 0)
     throw ParameterError("points must have " + std::to_string(dim) + " coordinates each");
   const std::size_t npts = xi.size() / dim;
@@ -284,11 +286,11 @@ BOOST_PYTHON_MODULE(_core) {
   bp::scope().attr("__version__") = kVersion;
 
   gBaseError = makeException("HOMeshError", PyExc_RuntimeError, "Base of all HOMesh errors.");
-  gParameterError = makeException(
-      "ParameterError", bp::make_tuple(bp::handle<>(bp::borrowed(gBaseError)),
-                                       bp::handle<>(bp::borrowed(PyExc_ValueError)))
-                            .ptr(),
-      "A parameter is out of range (order, size, ...).");
+  gParameterError = makeException("ParameterError",
+                                  bp::make_tuple(bp::handle<>(bp::borrowed(gBaseError)),
+                                                 bp::handle<>(bp::borrowed(PyExc_ValueError)))
+                                      .ptr(),
+                                  "A parameter is out of range (order, size, ...).");
   gCadError = makeException("CadError", gBaseError, "The CAD model cannot be read or meshed.");
   gMeshingError = makeException("MeshingError", gBaseError, "The mesher failed.");
   gFileError = makeException("FileError",

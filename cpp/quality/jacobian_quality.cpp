@@ -41,7 +41,7 @@ void JacobianSampler::sample(const Eigen::Matrix<double, Eigen::Dynamic, 3>& x,
   if (dim_ == 2) {
     for (int s = 0; s < samples; ++s) {
       const Eigen::RowVector3d n = a.row(s).cross(b.row(s));
-      jacobians(s) = normal ? n.dot(normal->transpose()) : n.norm();
+      jacobians(s) = normal != nullptr ? n.dot(normal->transpose()) : n.norm();
     }
     return;
   }
@@ -49,7 +49,9 @@ void JacobianSampler::sample(const Eigen::Matrix<double, Eigen::Dynamic, 3>& x,
   for (int s = 0; s < samples; ++s) jacobians(s) = a.row(s).cross(b.row(s)).dot(c.row(s));
 }
 
-double scaledJacobian(double minJ, double maxJ) { return maxJ > 0.0 ? minJ / maxJ : -1.0; }
+double scaledJacobian(double minJ, double maxJ) {
+  return maxJ > 0.0 ? minJ / maxJ : -1.0;
+}
 
 QualitySummary evaluateQuality(const Mesh& mesh) {
   QualitySummary summary;

@@ -43,9 +43,9 @@ struct TypeQuality {
 };
 
 struct QualitySummary {
-  std::vector<double> scaledJacobian;  // per element of dimension mesh.dim, in block order
+  std::vector<double> scaledJacobian;          // per element of dimension mesh.dim, in block order
   std::vector<double> boundaryScaledJacobian;  // per lower-dimensional cell, in block order
-  std::size_t invalid = 0;             // elements with scaled Jacobian <= 0
+  std::size_t invalid = 0;                     // elements with scaled Jacobian <= 0
   double min = 1.0;
   double mean = 0.0;
   std::map<CellType, TypeQuality> byType;

@@ -22,8 +22,7 @@ namespace homesh::test {
 // A fresh temporary folder per call, removed by the OS's tmp cleaning (tests stay hermetic).
 inline std::filesystem::path tempDir() {
   static std::mt19937_64 rng(std::random_device{}());
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("homesh-test-" + std::to_string(rng()));
+  auto dir = std::filesystem::temp_directory_path() / ("homesh-test-" + std::to_string(rng()));
   std::filesystem::create_directories(dir);
   return dir;
 }
@@ -34,20 +33,28 @@ inline std::string brepText(const TopoDS_Shape& shape) {
   return out.str();
 }
 
-inline CadModel toModel(const TopoDS_Shape& shape) { return CadModel::fromBrepText(brepText(shape)); }
+inline CadModel toModel(const TopoDS_Shape& shape) {
+  return CadModel::fromBrepText(brepText(shape));
+}
 
-inline TopoDS_Shape sphere(double r) { return BRepPrimAPI_MakeSphere(r).Shape(); }
-inline TopoDS_Shape cylinder(double r, double h) { return BRepPrimAPI_MakeCylinder(r, h).Shape(); }
+inline TopoDS_Shape sphere(double r) {
+  return BRepPrimAPI_MakeSphere(r).Shape();
+}
+inline TopoDS_Shape cylinder(double r, double h) {
+  return BRepPrimAPI_MakeCylinder(r, h).Shape();
+}
 inline TopoDS_Shape torus(double major, double minor) {
   return BRepPrimAPI_MakeTorus(major, minor).Shape();
 }
-inline TopoDS_Shape box(double x, double y, double z) { return BRepPrimAPI_MakeBox(x, y, z).Shape(); }
+inline TopoDS_Shape box(double x, double y, double z) {
+  return BRepPrimAPI_MakeBox(x, y, z).Shape();
+}
 
 // A 4 x 4 x 2 box with a vertical hole of radius 1 through its centre (7 faces).
 inline TopoDS_Shape boxWithHole() {
   const TopoDS_Shape b = BRepPrimAPI_MakeBox(4.0, 4.0, 2.0).Shape();
-  const TopoDS_Shape c = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(2, 2, -1), gp_Dir(0, 0, 1)), 1.0, 4.0)
-                             .Shape();
+  const TopoDS_Shape c =
+      BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(2, 2, -1), gp_Dir(0, 0, 1)), 1.0, 4.0).Shape();
   return BRepAlgoAPI_Cut(b, c).Shape();
 }
 
@@ -58,7 +65,9 @@ inline Eigen::Vector3d nodePoint(const Mesh& mesh, std::int64_t i) {
 // Signed volume of a linear tetrahedron given by its first four nodes.
 inline double tetVolume(const Mesh& mesh, const std::int64_t* t) {
   const Eigen::Vector3d a = nodePoint(mesh, t[0]);
-  return (nodePoint(mesh, t[1]) - a).cross(nodePoint(mesh, t[2]) - a).dot(nodePoint(mesh, t[3]) - a) /
+  return (nodePoint(mesh, t[1]) - a)
+             .cross(nodePoint(mesh, t[2]) - a)
+             .dot(nodePoint(mesh, t[3]) - a) /
          6.0;
 }
 

@@ -87,8 +87,8 @@ TEST(CadModel, SphereEvaluationProjectionAndCurvature) {
                   .norm(),
               0.0, 1e-4);
 
-  for (const Eigen::Vector3d& q : {Eigen::Vector3d(3, 1, -2), Eigen::Vector3d(0.1, -0.2, 0.3),
-                                   Eigen::Vector3d(-1, 4, 0.5)}) {
+  for (const Eigen::Vector3d& q :
+       {Eigen::Vector3d(3, 1, -2), Eigen::Vector3d(0.1, -0.2, 0.3), Eigen::Vector3d(-1, 4, 0.5)}) {
     const SurfaceProjection proj = cad.projectOnSurface(1, q);
     EXPECT_NEAR(proj.distance, std::abs(q.norm() - r), 1e-9);
     EXPECT_NEAR((proj.point - r * q.normalized()).norm(), 0.0, 1e-9);
@@ -107,8 +107,8 @@ TEST(CadModel, CylinderCurvesAndCurvature) {
   const int lateral = lateralFace(cad);
   ASSERT_GT(lateral, 0);
   const SurfaceBounds b = cad.faceBounds(lateral);
-  const PrincipalCurvatures k = cad.curvature(lateral, 0.5 * (b.uMin + b.uMax),
-                                              0.5 * (b.vMin + b.vMax));
+  const PrincipalCurvatures k =
+      cad.curvature(lateral, 0.5 * (b.uMin + b.uMax), 0.5 * (b.vMin + b.vMax));
   ASSERT_TRUE(k.defined);
   const double small = std::min(std::abs(k.kMin), std::abs(k.kMax));
   const double large = std::max(std::abs(k.kMin), std::abs(k.kMax));
@@ -131,9 +131,8 @@ TEST(CadModel, CylinderCurvesAndCurvature) {
     // Projection of a point off the circle.
     const Eigen::Vector3d q(3.0, -1.0, c.point.z() + 0.5);
     const CurveProjection proj = cad.projectOnCurve(e, q);
-    const Eigen::Vector3d expected =
-        Eigen::Vector3d(r * q.x() / std::hypot(q.x(), q.y()), r * q.y() / std::hypot(q.x(), q.y()),
-                        c.point.z());
+    const Eigen::Vector3d expected = Eigen::Vector3d(
+        r * q.x() / std::hypot(q.x(), q.y()), r * q.y() / std::hypot(q.x(), q.y()), c.point.z());
     EXPECT_NEAR((proj.point - expected).norm(), 0.0, 1e-9);
     EXPECT_NEAR((cad.evaluateCurve(e, proj.t).point - proj.point).norm(), 0.0, 1e-12);
     // Each circle is closed at one vertex: both parameters are valid, `near` picks one.

@@ -6,9 +6,11 @@
 namespace homesh {
 namespace {
 
-ParsedCommand parse(std::vector<std::string> args) { return parseCommandLine(args); }
+ParsedCommand parse(const std::vector<std::string>& args) {
+  return parseCommandLine(args);
+}
 
-std::string usageError(std::vector<std::string> args) {
+std::string usageError(const std::vector<std::string>& args) {
   try {
     parseCommandLine(args);
   } catch (const UsageError& e) {

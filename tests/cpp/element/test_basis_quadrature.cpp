@@ -11,7 +11,9 @@
 namespace homesh {
 namespace {
 
-double factorial(int n) { return std::tgamma(n + 1.0); }
+double factorial(int n) {
+  return std::tgamma(n + 1.0);
+}
 
 // Exact integral of x^a y^b z^c over the unit simplex of dimension dim.
 double monomialIntegral(int dim, int a, int b, int c) {
@@ -37,7 +39,8 @@ TEST_P(SimplexShapes, QuadratureIsExactToItsDegree) {
         for (int c = 0; a + b + c <= degree && (dim > 2 || c == 0); ++c) {
           double sum = 0.0;
           for (int q = 0; q < rule.size(); ++q)
-            sum += rule.weights[q] * monomial(&rule.points[q * dim], dim, a, b, c);
+            sum += rule.weights[q] *
+                   monomial(&rule.points[static_cast<std::size_t>(q) * dim], dim, a, b, c);
           EXPECT_NEAR(sum, monomialIntegral(dim, a, b, c), 1e-13)
               << "degree " << degree << " monomial " << a << b << c;
         }

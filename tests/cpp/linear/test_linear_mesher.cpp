@@ -27,7 +27,7 @@ using test::nodePoint;
 void expectParametersReproduceNodes(const Mesh& mesh, const CadModel& cad, double tol) {
   std::size_t onCurves = 0, onFaces = 0;
   for (std::size_t i = 0; i < mesh.numNodes(); ++i) {
-    const int dim = mesh.nodeCadDim[i];
+    const int dim = static_cast<int>(mesh.nodeCadDim[i]);
     const int index = mesh.nodeCadIndex[i];
     const double* param = &mesh.nodeCadParam[2 * i];
     if (dim == 1) {
@@ -36,8 +36,9 @@ void expectParametersReproduceNodes(const Mesh& mesh, const CadModel& cad, doubl
           << "node " << i << " on Edge" << index;
     } else if (dim == 2) {
       ++onFaces;
-      EXPECT_NEAR((cad.evaluateSurface(index, param[0], param[1]).point - nodePoint(mesh, i)).norm(),
-                  0.0, tol)
+      EXPECT_NEAR(
+          (cad.evaluateSurface(index, param[0], param[1]).point - nodePoint(mesh, i)).norm(), 0.0,
+          tol)
           << "node " << i << " on Face" << index;
     } else if (dim == 0) {
       EXPECT_NEAR((cad.vertexPoint(index) - nodePoint(mesh, i)).norm(), 0.0, tol);
@@ -136,7 +137,7 @@ TEST(LinearMesher, RejectsWhatItCannotMesh) {
   TopTools_IndexedMapOfShape faces;
   TopExp::MapShapes(test::cylinder(1, 2), TopAbs_FACE, faces);
   int lateral = 0;
-  for (int f = 1; f <= faces.Extent() && !lateral; ++f) {
+  for (int f = 1; f <= faces.Extent() && lateral == 0; ++f) {
     const CadModel one = test::toModel(faces(f));
     if (!one.isPlanar(1)) lateral = f;
   }

@@ -14,7 +14,7 @@ class CountingObserver : public PipelineObserver {
  public:
   explicit CountingObserver(int cancelAfter = -1) : cancelAfter_(cancelAfter) {}
   void stageStarted(const std::string& stage) override { started.push_back(stage); }
-  void stageFinished(const std::string&, double seconds) override {
+  void stageFinished(const std::string& /*stage*/, double seconds) override {
     EXPECT_GE(seconds, 0.0);
     ++finished;
   }
@@ -33,8 +33,7 @@ TEST(MeshPipeline, RunsEveryStageAndReports) {
   CountingObserver observer;
   const MeshResult result =
       runMeshPipeline(CadSource::brepText(test::brepText(test::sphere(1.0))), options, &observer);
-  EXPECT_EQ(observer.started,
-            (std::vector<std::string>{"cad", "linear", "high_order", "quality"}));
+  EXPECT_EQ(observer.started, (std::vector<std::string>{"cad", "linear", "high_order", "quality"}));
   EXPECT_EQ(result.mesh.order, 3);
   EXPECT_EQ(result.quality.scaledJacobian.size(), result.mesh.numElements());
   const std::string json = meshReportJson(result, "sphere");
