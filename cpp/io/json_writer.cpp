@@ -54,35 +54,33 @@ void JsonWriter::raw(const std::string& key, const std::string& text) {
   out_ += text;
 }
 
-JsonWriter& JsonWriter::beginObject(const std::string& key) {
-  raw(key, "{");
+JsonWriter& JsonWriter::open(const std::string& key, char bracket) {
+  raw(key, std::string(1, bracket));
   first_.push_back(true);
   return *this;
 }
 
-JsonWriter& JsonWriter::endObject() {
-  if (first_.empty()) throw Error("JsonWriter: endObject without beginObject");
+JsonWriter& JsonWriter::close(char bracket) {
+  if (first_.empty()) throw Error(std::string("JsonWriter: '") + bracket + "' closes nothing");
   const bool empty = first_.back();
   first_.pop_back();
   if (!empty) out_ += "\n" + std::string(2 * first_.size(), ' ');
-  out_ += "}";
+  out_ += bracket;
   if (first_.empty()) out_ += "\n";
   return *this;
 }
 
-JsonWriter& JsonWriter::beginArray(const std::string& key) {
-  raw(key, "[");
-  first_.push_back(true);
-  return *this;
+JsonWriter& JsonWriter::beginObject(const std::string& key) {
+  return open(key, '{');
 }
-
+JsonWriter& JsonWriter::endObject() {
+  return close('}');
+}
+JsonWriter& JsonWriter::beginArray(const std::string& key) {
+  return open(key, '[');
+}
 JsonWriter& JsonWriter::endArray() {
-  if (first_.empty()) throw Error("JsonWriter: endArray without beginArray");
-  const bool empty = first_.back();
-  first_.pop_back();
-  if (!empty) out_ += "\n" + std::string(2 * first_.size(), ' ');
-  out_ += "]";
-  return *this;
+  return close(']');
 }
 
 JsonWriter& JsonWriter::value(const std::string& key, double v) {

@@ -27,6 +27,8 @@ class JsonWriter {
   const std::string& str() const { return out_; }
 
  private:
+  JsonWriter& open(const std::string& key, char bracket);
+  JsonWriter& close(char bracket);
   void prefix(const std::string& key);
   void raw(const std::string& key, const std::string& text);
   std::string out_;

@@ -12,17 +12,7 @@ import homesh
 import homesh.freecad
 from homesh.freecad import exporter
 
-
-def box_with_hole(doc):
-    box = doc.addObject("Part::Box", "Box")
-    box.Length, box.Width, box.Height = 4, 4, 2
-    cyl = doc.addObject("Part::Cylinder", "Cylinder")
-    cyl.Radius, cyl.Height = 1, 2
-    cyl.Placement.Base = FreeCAD.Vector(2, 2, 0)
-    cut = doc.addObject("Part::Cut", "Cut")
-    cut.Base, cut.Tool = box, cyl
-    doc.recompute()
-    return cut
+from fixtures import box_with_hole
 
 
 class HighOrderMeshObject(unittest.TestCase):

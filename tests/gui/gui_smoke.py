@@ -23,15 +23,11 @@ try:
     assert "HOMeshWorkbench" in FreeCADGui.listWorkbenches(), "workbench not registered"
     FreeCADGui.activateWorkbench("HOMeshWorkbench")
 
+    sys.path.insert(0, os.path.join(os.environ["HOMESH_TESTS_DIR"], "freecad"))
+    from fixtures import box_with_hole
+
     doc = FreeCAD.newDocument("Smoke")
-    box = doc.addObject("Part::Box", "Box")
-    box.Length, box.Width, box.Height = 4, 4, 2
-    cyl = doc.addObject("Part::Cylinder", "Cylinder")
-    cyl.Radius, cyl.Height = 1, 2
-    cyl.Placement.Base = FreeCAD.Vector(2, 2, 0)
-    cut = doc.addObject("Part::Cut", "Cut")
-    cut.Base, cut.Tool = box, cyl
-    doc.recompute()
+    cut = box_with_hole(doc)
 
     FreeCADGui.Selection.clearSelection()
     FreeCADGui.Selection.addSelection(cut)
