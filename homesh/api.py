@@ -3,12 +3,13 @@
 import json
 import numbers
 import os
+import zipfile
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import _core
-from ._core import FileError, ParameterError
+from ._core import FileError, HOMeshError, ParameterError
 
 _NPZ_FORMAT = 1
 
@@ -139,7 +140,9 @@ def load(path):
                 int(data["dim"][0]), int(data["order"][0]), data["nodes"],
                 data["node_cad_dim"], data["node_cad_index"], data["node_cad_params"],
                 blocks, tuple(float(x) for x in data["plane_normal"]))
-    except (KeyError, ValueError, OSError) as e:
+    except HOMeshError:
+        raise
+    except (KeyError, ValueError, TypeError, OSError, zipfile.BadZipFile) as e:
         raise FileError("'%s' is not a HOMesh array file: %s" % (path, e)) from None
     return HighOrderMesh(core)
 
@@ -191,9 +194,14 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     return HighOrderMesh(core)
 
 
+_INT32_MAX = 2**31 - 1
+
+
 def _check_int(name, value):
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise ParameterError("%s must be an integer, got %r" % (name, value))
+    if not -_INT32_MAX <= value <= _INT32_MAX:
+        raise ParameterError("%s is out of range: %d" % (name, value))
     return int(value)
 
 

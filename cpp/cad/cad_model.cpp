@@ -25,6 +25,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <mutex>
 #include <sstream>
 #include <vector>
 
@@ -123,7 +124,15 @@ std::string lowerExtension(const std::string& path) {
   return ext;
 }
 
+// OCCT's STEP and IGES readers share process-wide state (the XSControl session, static
+// parameters): two threads reading at once corrupt each other. Reads are serialised.
+std::mutex& dataExchangeMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
 TopoDS_Shape readStep(const std::string& path) {
+  const std::lock_guard<std::mutex> lock(dataExchangeMutex());
   STEPControl_Reader reader;
   if (reader.ReadFile(path.c_str()) != IFSelect_RetDone)
     throw IoError("'" + path + "' is not a readable STEP file");
@@ -132,6 +141,7 @@ TopoDS_Shape readStep(const std::string& path) {
 }
 
 TopoDS_Shape readIges(const std::string& path) {
+  const std::lock_guard<std::mutex> lock(dataExchangeMutex());
   IGESControl_Reader reader;
   if (reader.ReadFile(path.c_str()) != IFSelect_RetDone)
     throw IoError("'" + path + "' is not a readable IGES file");

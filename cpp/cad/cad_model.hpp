@@ -39,8 +39,10 @@ struct SurfaceProjection {
 };
 
 struct PrincipalCurvatures {
-  bool defined = false;           // false at umbilic-free singular points (e.g. a cone apex)
-  double kMin = 0.0, kMax = 0.0;  // signed, relative to the face's outward normal, kMin <= kMax
+  bool defined = false;  // false at umbilic-free singular points (e.g. a cone apex)
+  // Signed against the face's normal (outward for a solid's face): negative where the surface
+  // bends away from the normal (a sphere), positive where it bends towards it (a hole's wall).
+  double kMin = 0.0, kMax = 0.0;  // kMin <= kMax
   Eigen::Vector3d dirMin, dirMax;
 };
 

@@ -1,25 +1,30 @@
 #include "cli/arguments.hpp"
 
+#include <charconv>
 #include <cmath>
-#include <cstdlib>
+
+#include "pipeline/mesh_pipeline.hpp"
 
 namespace homesh {
 namespace {
 
+// Decimal only (no hexadecimal, no "inf"), and the whole text must be the number.
 double parseNumber(const std::string& option, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !std::isfinite(v))
+  double v = 0.0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, v, std::chars_format::general);
+  if (text.empty() || ec != std::errc() || ptr != end || !std::isfinite(v))
     throw UsageError{option + " expects a number, got '" + text + "'"};
   return v;
 }
 
 int parseInteger(const std::string& option, const std::string& text) {
-  char* end = nullptr;
-  const long v = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || v < -1000000 || v > 1000000)
+  int v = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+  if (text.empty() || ec != std::errc() || ptr != end)
     throw UsageError{option + " expects an integer, got '" + text + "'"};
-  return static_cast<int>(v);
+  return v;
 }
 
 MeshCommand parseMesh(const std::vector<std::string>& args, std::size_t i) {
@@ -39,7 +44,9 @@ MeshCommand parseMesh(const std::vector<std::string>& args, std::size_t i) {
       if (!(*cmd.size > 0.0)) throw UsageError{"--size must be a positive length, got " + args[i]};
     } else if (a == "--threads" || a == "-j") {
       cmd.threads = parseInteger(a, next(a));
-      if (cmd.threads < 1) throw UsageError{"--threads must be >= 1, got " + args[i]};
+      if (cmd.threads < 1 || cmd.threads > kMaxThreads)
+        throw UsageError{"--threads must be from 1 to " + std::to_string(kMaxThreads) + ", got " +
+                         args[i]};
     } else if (a == "-o" || a == "--output") {
       cmd.outputs.push_back(next(a));
     } else if (a == "--report") {

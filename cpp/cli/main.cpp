@@ -3,7 +3,6 @@
 #include <Message_Messenger.hxx>
 #include <Message_PrinterOStream.hxx>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -11,6 +10,7 @@
 #include "cli/arguments.hpp"
 #include "core/error.hpp"
 #include "core/version.hpp"
+#include "io/atomic_file.hpp"
 #include "io/mesh_writers.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 
@@ -30,15 +30,12 @@ void silenceOcct() {
   messenger->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
 }
 
-void writeText(const std::string& path, const std::string& text) {
+void writeReport(const std::string& path, const std::string& text) {
   if (path == "-") {
     std::cout << text << std::flush;
     return;
   }
-  std::ofstream out(path);
-  out << text;
-  out.close();
-  if (!out) throw homesh::IoError("cannot write report '" + path + "'");
+  homesh::writeFileAtomically(path, text);
 }
 
 int runMesh(const homesh::MeshCommand& cmd) {
@@ -47,7 +44,9 @@ int runMesh(const homesh::MeshCommand& cmd) {
   options.size = cmd.size;
   options.threads = cmd.threads;
   options.verbosity = cmd.verbosity;
+  // Refuse bad output paths before spending time on meshing.
   for (const std::string& path : cmd.outputs) homesh::checkMeshOutputPath(path);
+  if (cmd.report && *cmd.report != "-") homesh::checkParentFolder(*cmd.report);
   StderrProgress progress;
   homesh::PipelineObserver* observer = cmd.quiet ? nullptr : &progress;
   homesh::MeshResult result =
@@ -62,7 +61,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
     for (const std::string& path : cmd.outputs)
       std::fprintf(stderr, "homesh: wrote %s\n", path.c_str());
   }
-  if (cmd.report) writeText(*cmd.report, homesh::meshReportJson(result, cmd.input));
+  if (cmd.report) writeReport(*cmd.report, homesh::meshReportJson(result, cmd.input));
   return 0;
 }
 

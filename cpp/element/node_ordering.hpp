@@ -8,8 +8,10 @@
 // Both Gmsh and VTK order nodes as: vertices, edge interiors (edge by edge, from the edge's first
 // vertex to its second), face interiors (each a recursively ordered triangle of order P-3 whose
 // vertices are the face's vertices in the listed order), then the cell interior (recursively, a
-// simplex of order P-4 for a tetrahedron). They differ only in the edge and face lists. The tests
-// check both against Gmsh's getElementProperties and VTK's vtkLagrange*::GetParametricCoords.
+// simplex of order P-4 for a tetrahedron). They differ only in the edge and face lists. The C++
+// tests check the Gmsh order against Gmsh's getElementProperties up to order 10; the Python
+// tests (tests/python/test_vtk_reading.py) check the VTK order by letting VTK interpolate our
+// VTU cells.
 #pragma once
 
 #include <array>

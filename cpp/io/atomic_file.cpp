@@ -9,12 +9,22 @@
 
 namespace homesh {
 
-AtomicFile::AtomicFile(const std::string& path, bool binary)
-    : path_(path), temporary_(path + ".part") {
+void checkParentFolder(const std::string& path) {
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   std::error_code ec;
   if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
     throw IoError("cannot write '" + path + "': folder '" + parent.string() + "' does not exist");
+}
+
+void writeFileAtomically(const std::string& path, const std::string& contents) {
+  AtomicFile file(path, true);
+  file.stream() << contents;
+  file.commit();
+}
+
+AtomicFile::AtomicFile(const std::string& path, bool binary)
+    : path_(path), temporary_(path + ".part") {
+  checkParentFolder(path);
   stream_.open(temporary_, binary ? std::ios::out | std::ios::binary : std::ios::out);
   if (!stream_) throw IoError("cannot write '" + path + "': " + std::strerror(errno));
 }

@@ -7,6 +7,12 @@
 
 namespace homesh {
 
+// Throws IoError unless the folder `path` would be written in exists.
+void checkParentFolder(const std::string& path);
+
+// Writes `contents` to `path` through an AtomicFile.
+void writeFileAtomically(const std::string& path, const std::string& contents);
+
 class AtomicFile {
  public:
   // Throws IoError if the file cannot be created.

@@ -304,10 +304,7 @@ void checkMeshOutputPath(const std::string& path) {
   if (ext != ".msh" && ext != ".vtu")
     throw IoError("cannot write '" + path + "': unknown mesh format '" + ext +
                   "' (use .msh or .vtu)");
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  std::error_code ec;
-  if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
-    throw IoError("cannot write '" + path + "': folder '" + parent.string() + "' does not exist");
+  checkParentFolder(path);
 }
 
 void writeMesh(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields) {

@@ -3,7 +3,10 @@
 #include <gmsh.h>
 
 #include <algorithm>
-#include <set>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,43 +16,175 @@
 namespace homesh {
 namespace {
 
-using IndexSet = std::set<int>;
+struct GmshEntity {
+  int dim = 0, tag = 0;
+  std::vector<int> boundary;   // tags of dimension dim - 1, unique
+  std::vector<double> lo, hi;  // parametrisation bounds (curves and surfaces)
+  Eigen::Vector3d probe;       // the point at the parametric centre (a point's position)
+};
 
-std::vector<int> gmshEntities(int dim) {
-  gmsh::vectorpair dimTags;
-  gmsh::model::getEntities(dimTags, dim);
-  std::vector<int> tags;
-  for (const auto& dt : dimTags) tags.push_back(dt.second);
-  return tags;
-}
-
-std::vector<int> gmshBoundaryTags(int dim, int tag) {
-  gmsh::vectorpair out;
-  gmsh::model::getBoundary({{dim, tag}}, out, false, false, false);
-  std::vector<int> tags;
-  for (const auto& dt : out) tags.push_back(std::abs(dt.second));
-  return tags;
-}
-
-Eigen::Vector3d gmshValue(int dim, int tag, const std::vector<double>& param) {
-  std::vector<double> xyz;
-  gmsh::model::getValue(dim, tag, param, xyz);
-  if (xyz.size() < 3)
-    throw MeshingError("Gmsh returned no point for entity (" + std::to_string(dim) + ", " +
-                       std::to_string(tag) + ")");
-  return {xyz[0], xyz[1], xyz[2]};
-}
-
-IndexSet cadBoundary(const CadModel& cad, int dim, int index) {
-  const std::vector<int> sub = cad.subShapeIndices(dim, index, dim - 1);
-  return {sub.begin(), sub.end()};
-}
-
-[[noreturn]] void fail(int dim, int tag, const std::string& why) {
+std::string gmshName(int dim, int tag) {
   static const char* kinds[] = {"point", "curve", "surface", "volume"};
-  throw MeshingError("cannot match Gmsh " + std::string(kinds[dim]) + " " + std::to_string(tag) +
-                     " to a CAD entity: " + why);
+  return std::string("Gmsh ") + kinds[dim] + " " + std::to_string(tag);
 }
+
+GmshEntity readGmshEntity(int dim, int tag) {
+  GmshEntity g;
+  g.dim = dim;
+  g.tag = tag;
+  if (dim > 0) {
+    gmsh::vectorpair out;
+    gmsh::model::getBoundary({{dim, tag}}, out, false, false, false);
+    for (const auto& dt : out) g.boundary.push_back(std::abs(dt.second));
+    std::sort(g.boundary.begin(), g.boundary.end());
+    g.boundary.erase(std::unique(g.boundary.begin(), g.boundary.end()), g.boundary.end());
+  }
+  std::vector<double> centre;
+  if (dim == 1 || dim == 2) {
+    gmsh::model::getParametrizationBounds(dim, tag, g.lo, g.hi);
+    for (std::size_t k = 0; k < g.lo.size(); ++k) centre.push_back(0.5 * (g.lo[k] + g.hi[k]));
+  }
+  if (dim <= 2) {
+    std::vector<double> xyz;
+    gmsh::model::getValue(dim, tag, centre, xyz);
+    if (xyz.size() < 3) throw MeshingError(gmshName(dim, tag) + " has no point to evaluate");
+    g.probe = {xyz[0], xyz[1], xyz[2]};
+  }
+  return g;
+}
+
+class Matcher {
+ public:
+  explicit Matcher(const CadModel& cad) : cad_(cad), tol_(1e-7 * cad.boundingDiagonal()) {
+    const int counts[4] = {cad.numVertices(), cad.numEdges(), cad.numFaces(), cad.numSolids()};
+    for (int dim = 0; dim <= 3; ++dim) {
+      gmsh::vectorpair dimTags;
+      gmsh::model::getEntities(dimTags, dim);
+      for (const auto& dt : dimTags) entities_[dim].push_back(readGmshEntity(dim, dt.second));
+      used_[dim].assign(counts[dim] + 1, false);
+    }
+  }
+
+  std::map<std::pair<int, int>, int> run() {
+    for (const GmshEntity& volume : entities_[3]) matchFree(volume);
+    for (int dim = 2; dim >= 0; --dim) {
+      for (const GmshEntity& parent : entities_[dim + 1]) {
+        const int cadParent = map_.at({dim + 1, parent.tag});
+        const std::vector<int> cadChildren = cad_.subShapeIndices(dim + 1, cadParent, dim);
+        for (const int child : parent.boundary) matchWithin(entity(dim, child), cadChildren);
+      }
+      for (const GmshEntity& g : entities_[dim])
+        if (map_.count({dim, g.tag}) == 0) matchFree(g);
+    }
+    for (int dim = 0; dim <= 3; ++dim)
+      for (std::size_t c = 1; c < used_[dim].size(); ++c)
+        if (!used_[dim][c])
+          throw MeshingError(cadEntityName(dim, static_cast<int>(c)) +
+                             " has no counterpart in the model Gmsh imported");
+    return map_;
+  }
+
+ private:
+  const GmshEntity& entity(int dim, int tag) const {
+    for (const GmshEntity& g : entities_[dim])
+      if (g.tag == tag) return g;
+    throw MeshingError(gmshName(dim, tag) + " is not in the Gmsh model");
+  }
+
+  // How well CAD entity c fits Gmsh entity g: nullopt if the geometry differs, else a mismatch
+  // of parameter ranges (0 for a perfect fit), to choose between pieces of one curve/surface.
+  std::optional<double> score(const GmshEntity& g, int c) const {
+    switch (g.dim) {
+      case 0: {
+        const double d = (cad_.vertexPoint(c) - g.probe).norm();
+        return d <= tol_ ? std::optional<double>(d) : std::nullopt;
+      }
+      case 1: {
+        if (cad_.isDegenerated(c)) {
+          const std::vector<int> v = cad_.subShapeIndices(1, c, 0);
+          if (v.empty() || (cad_.vertexPoint(v[0]) - g.probe).norm() > tol_) return std::nullopt;
+          return 0.0;
+        }
+        const double tm = 0.5 * (g.lo.at(0) + g.hi.at(0));
+        if ((cad_.evaluateCurve(c, tm).point - g.probe).norm() > tol_) return std::nullopt;
+        const ParameterRange r = cad_.edgeRange(c);
+        return std::abs(r.first - g.lo[0]) + std::abs(r.last - g.hi[0]);
+      }
+      case 2: {
+        const double um = 0.5 * (g.lo.at(0) + g.hi.at(0)), vm = 0.5 * (g.lo.at(1) + g.hi.at(1));
+        if ((cad_.evaluateSurface(c, um, vm).point - g.probe).norm() > tol_) return std::nullopt;
+        const SurfaceBounds b = cad_.faceBounds(c);
+        return std::abs(b.uMin - g.lo[0]) + std::abs(b.uMax - g.hi[0]) +
+               std::abs(b.vMin - g.lo[1]) + std::abs(b.vMax - g.hi[1]);
+      }
+      default: {  // a solid fits if each Gmsh boundary surface fits one of its faces
+        const std::vector<int> faces = cad_.subShapeIndices(3, c, 2);
+        if (faces.size() != g.boundary.size()) return std::nullopt;
+        double total = 0.0;
+        for (const int tag : g.boundary) {
+          const GmshEntity& surface = entity(2, tag);
+          double bestFace = std::numeric_limits<double>::infinity();
+          for (const int f : faces)
+            if (const auto s = score(surface, f)) bestFace = std::min(bestFace, *s);
+          if (!std::isfinite(bestFace)) return std::nullopt;
+          total += bestFace;
+        }
+        return total;
+      }
+    }
+  }
+
+  int best(const GmshEntity& g, const std::vector<int>& candidates) const {
+    int chosen = 0;
+    double chosenScore = std::numeric_limits<double>::infinity();
+    for (const int c : candidates) {
+      if (used_[g.dim][c]) continue;
+      if (const auto s = score(g, c); s && *s < chosenScore) {
+        chosen = c;
+        chosenScore = *s;
+      }
+    }
+    return chosen;
+  }
+
+  void assign(const GmshEntity& g, int c) {
+    map_[{g.dim, g.tag}] = c;
+    used_[g.dim][c] = true;
+  }
+
+  void matchFree(const GmshEntity& g) {
+    std::vector<int> all(used_[g.dim].size() - 1);
+    for (std::size_t c = 0; c < all.size(); ++c) all[c] = static_cast<int>(c) + 1;
+    const int c = best(g, all);
+    if (c == 0)
+      throw MeshingError("cannot match " + gmshName(g.dim, g.tag) +
+                         " to a CAD entity: no unmatched one has its geometry");
+    assign(g, c);
+  }
+
+  // Matches g among the CAD boundary entities of its parent's counterpart, or checks that an
+  // earlier match (through another parent sharing it) is one of them.
+  void matchWithin(const GmshEntity& g, const std::vector<int>& candidates) {
+    if (const auto it = map_.find({g.dim, g.tag}); it != map_.end()) {
+      if (std::find(candidates.begin(), candidates.end(), it->second) == candidates.end())
+        throw MeshingError(gmshName(g.dim, g.tag) + " was matched to " +
+                           cadEntityName(g.dim, it->second) +
+                           ", which does not bound the CAD entity of another of its parents");
+      return;
+    }
+    const int c = best(g, candidates);
+    if (c == 0)
+      throw MeshingError("cannot match " + gmshName(g.dim, g.tag) +
+                         " to a CAD entity bounding its parent's counterpart");
+    assign(g, c);
+  }
+
+  const CadModel& cad_;
+  double tol_;
+  std::array<std::vector<GmshEntity>, 4> entities_;
+  std::array<std::vector<bool>, 4> used_;
+  std::map<std::pair<int, int>, int> map_;
+};
 
 }  // namespace
 
@@ -63,88 +198,7 @@ int GmshEntityMap::cadIndex(int dim, int tag) const {
 
 GmshEntityMap GmshEntityMap::build(const CadModel& cad) {
   GmshEntityMap map;
-  const double tol = 1e-7 * cad.boundingDiagonal();
-  withGmshErrors("matching Gmsh entities to the CAD", [&] {
-    // Vertices: by position.
-    std::vector<bool> used(cad.numVertices() + 1, false);
-    for (const int tag : gmshEntities(0)) {
-      const Eigen::Vector3d p = gmshValue(0, tag, {});
-      int best = 0;
-      double bestDistance = tol;
-      for (int v = 1; v <= cad.numVertices(); ++v) {
-        const double d = (cad.vertexPoint(v) - p).norm();
-        if (!used[v] && d <= bestDistance) {
-          best = v;
-          bestDistance = d;
-        }
-      }
-      if (best == 0) fail(0, tag, "no unmatched CAD vertex at its position");
-      used[best] = true;
-      map.toCad_[{0, tag}] = best;
-    }
-
-    // Curves: same end vertices and the same point at the mid parameter.
-    used.assign(cad.numEdges() + 1, false);
-    for (const int tag : gmshEntities(1)) {
-      IndexSet ends;
-      for (const int b : gmshBoundaryTags(1, tag)) ends.insert(map.cadIndex(0, b));
-      std::vector<double> lo, hi;
-      gmsh::model::getParametrizationBounds(1, tag, lo, hi);
-      const double tm = 0.5 * (lo.at(0) + hi.at(0));
-      const Eigen::Vector3d p = gmshValue(1, tag, {tm});
-      int match = 0;
-      for (int e = 1; e <= cad.numEdges() && match == 0; ++e) {
-        if (used[e] || cadBoundary(cad, 1, e) != ends) continue;
-        // A degenerated edge (a sphere's pole) is a point: Gmsh evaluates it at its vertex.
-        const Eigen::Vector3d q =
-            cad.isDegenerated(e) ? cad.vertexPoint(*ends.begin()) : cad.evaluateCurve(e, tm).point;
-        if ((q - p).norm() <= tol) match = e;
-      }
-      if (match == 0)
-        fail(1, tag, "no CAD edge with the same vertices passes through its midpoint");
-      used[match] = true;
-      map.toCad_[{1, tag}] = match;
-    }
-    for (int e = 1; e <= cad.numEdges(); ++e)
-      if (!used[e]) throw MeshingError(cadEntityName(1, e) + " was not imported by Gmsh");
-
-    // Surfaces: same boundary curves and the same point at the parametric centre.
-    used.assign(cad.numFaces() + 1, false);
-    for (const int tag : gmshEntities(2)) {
-      IndexSet curves;
-      for (const int b : gmshBoundaryTags(2, tag)) curves.insert(map.cadIndex(1, b));
-      std::vector<double> lo, hi;
-      gmsh::model::getParametrizationBounds(2, tag, lo, hi);
-      const double um = 0.5 * (lo.at(0) + hi.at(0)), vm = 0.5 * (lo.at(1) + hi.at(1));
-      const Eigen::Vector3d p = gmshValue(2, tag, {um, vm});
-      int match = 0;
-      for (int f = 1; f <= cad.numFaces() && match == 0; ++f) {
-        if (used[f]) continue;
-        if (cadBoundary(cad, 2, f) != curves) continue;
-        if ((cad.evaluateSurface(f, um, vm).point - p).norm() <= tol) match = f;
-      }
-      if (match == 0) fail(2, tag, "no CAD face with the same edges passes through its centre");
-      used[match] = true;
-      map.toCad_[{2, tag}] = match;
-    }
-    for (int f = 1; f <= cad.numFaces(); ++f)
-      if (!used[f]) throw MeshingError(cadEntityName(2, f) + " was not imported by Gmsh");
-
-    // Volumes: same boundary surfaces.
-    used.assign(cad.numSolids() + 1, false);
-    for (const int tag : gmshEntities(3)) {
-      IndexSet surfaces;
-      for (const int b : gmshBoundaryTags(3, tag)) surfaces.insert(map.cadIndex(2, b));
-      int match = 0;
-      for (int s = 1; s <= cad.numSolids() && match == 0; ++s)
-        if (!used[s] && cadBoundary(cad, 3, s) == surfaces) match = s;
-      if (match == 0) fail(3, tag, "no CAD solid has the same faces");
-      used[match] = true;
-      map.toCad_[{3, tag}] = match;
-    }
-    for (int s = 1; s <= cad.numSolids(); ++s)
-      if (!used[s]) throw MeshingError(cadEntityName(3, s) + " was not imported by Gmsh");
-  });
+  withGmshErrors("matching Gmsh entities to the CAD", [&] { map.toCad_ = Matcher(cad).run(); });
   return map;
 }
 

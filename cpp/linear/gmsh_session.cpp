@@ -2,6 +2,9 @@
 
 #include <gmsh.h>
 
+#include <cstdio>
+#include <vector>
+
 namespace homesh {
 namespace {
 std::mutex& gmshMutex() {
@@ -10,11 +13,12 @@ std::mutex& gmshMutex() {
 }
 }  // namespace
 
-GmshSession::GmshSession(int verbosity, int threads) : lock_(gmshMutex()) {
+GmshSession::GmshSession(int verbosity, int threads) : lock_(gmshMutex()), verbosity_(verbosity) {
   withGmshErrors("starting Gmsh", [&] {
     gmsh::initialize(0, nullptr, false);
-    gmsh::option::setNumber("General.Terminal", verbosity > 0 ? 1 : 0);
-    gmsh::option::setNumber("General.Verbosity", verbosity >= 2 ? 5 : (verbosity == 1 ? 2 : 0));
+    gmsh::option::setNumber("General.Terminal", 0);
+    // Errors are always logged (gmshLastError explains failures).
+    gmsh::option::setNumber("General.Verbosity", verbosity >= 2 ? 5 : (verbosity == 1 ? 2 : 1));
     gmsh::option::setNumber("General.NumThreads", threads);
     gmsh::logger::start();
   });
@@ -22,6 +26,11 @@ GmshSession::GmshSession(int verbosity, int threads) : lock_(gmshMutex()) {
 
 GmshSession::~GmshSession() {
   try {
+    if (verbosity_ > 0) {
+      std::vector<std::string> log;
+      gmsh::logger::get(log);
+      for (const std::string& line : log) std::fprintf(stderr, "gmsh: %s\n", line.c_str());
+    }
     gmsh::logger::stop();
     gmsh::finalize();
   } catch (...) {  // never throw from a destructor; Gmsh is unusable anyway if this fails

@@ -17,7 +17,9 @@ namespace homesh {
 
 class GmshSession {
  public:
-  // verbosity 0: silent; 1: Gmsh's errors and warnings on stderr; 2: and its information.
+  // verbosity 0: silent; 1: Gmsh's errors and warnings; 2: and its information. Gmsh's own
+  // terminal output (stdout) stays off: its messages are collected and written to stderr when
+  // the session ends, so that stdout stays clean for a report.
   explicit GmshSession(int verbosity = 0, int threads = 1);
   ~GmshSession();
   GmshSession(const GmshSession&) = delete;
@@ -25,6 +27,7 @@ class GmshSession {
 
  private:
   std::unique_lock<std::mutex> lock_;
+  int verbosity_;
 };
 
 // The last error Gmsh logged, or "" (to explain a failure that produced no exception).

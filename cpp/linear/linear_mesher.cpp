@@ -32,6 +32,10 @@ void checkSize(const CadModel& cad, double size, int dim) {
     throw ParameterError("mesh size must be a positive number, got " + formatNumber(size));
   // The bounding box bounds the domain; an absurd element count means a typo in the size.
   const double d = cad.boundingDiagonal();
+  if (size >= d)
+    throw ParameterError("mesh size " + formatNumber(size) + " is not smaller than " +
+                         cad.sourceName() + " itself (bounding-box diagonal " + formatNumber(d) +
+                         ")");
   const double estimate = dim == 3 ? 8.5 * std::pow(d / std::sqrt(3.0) / size, 3)
                                    : 2.3 * std::pow(d / std::sqrt(2.0) / size, 2);
   if (estimate > kMaxEstimatedElements) {
@@ -46,19 +50,20 @@ void checkSize(const CadModel& cad, double size, int dim) {
 // 3 for a model with solids; 2 for planar faces in one plane; CadError otherwise.
 int meshDimension(const CadModel& cad, Eigen::Vector3d& normal) {
   if (cad.numSolids() > 0) return 3;
+  const std::string hint =
+      ": HOMesh meshes solids, or planar faces in one plane (2D); a closed shell must be made a "
+      "solid first (FreeCAD: Part > Convert to solid)";
   for (int f = 1; f <= cad.numFaces(); ++f)
     if (!cad.isPlanar(f))
-      throw CadError(cadEntityName(2, f) + " of " + cad.sourceName() +
-                     " is not planar and belongs to no solid: HOMesh meshes solids, or planar "
-                     "faces in one plane (2D)");
+      throw CadError(cad.sourceName() + " has no solid and " + cadEntityName(2, f) +
+                     " is not planar" + hint);
   const auto [origin, n] = cad.plane(1);
   const double tol = 1e-7 * cad.boundingDiagonal();
   for (int f = 2; f <= cad.numFaces(); ++f) {
     const auto [o, m] = cad.plane(f);
     if (std::abs(n.dot(m)) < 1.0 - 1e-9 || std::abs(n.dot(o - origin)) > tol)
-      throw CadError(cadEntityName(2, f) +
-                     " is not in the plane of Face1: a 2D mesh needs all "
-                     "faces in one plane");
+      throw CadError(cad.sourceName() + " has no solid and its faces are not in one plane (" +
+                     cadEntityName(2, f) + " is not in the plane of Face1)" + hint);
   }
   normal = n;
   return 2;
@@ -199,7 +204,15 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
     gmsh::option::setNumber("Mesh.MeshSizeMax", size);
     gmsh::option::setNumber("Mesh.ElementOrder", 1);
     gmsh::model::mesh::setSizeCallback([size](int, int, double, double, double) { return size; });
-    gmsh::model::mesh::generate(dim);
+    try {
+      gmsh::model::mesh::generate(dim);
+    } catch (const std::string& message) {
+      throw MeshingError("Gmsh could not mesh " + cad.sourceName() + " with size " +
+                         formatNumber(size) + ": " + message +
+                         (message.find("No elements") != std::string::npos
+                              ? " (the size may be too large for a thin part)"
+                              : ""));
+    }
 
     NodeTable table;
     readNodes(entities, mesh, table);

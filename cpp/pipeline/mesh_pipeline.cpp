@@ -3,6 +3,9 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <sstream>
+
+#include <unistd.h>
 
 #include "core/error.hpp"
 #include "core/format.hpp"
@@ -17,7 +20,9 @@ void MeshingOptions::validate() const {
     throw ParameterError("order must be an integer from 1 to 10, got " + std::to_string(order));
   if (size && (!(*size > 0.0) || !std::isfinite(*size)))
     throw ParameterError("size must be a positive length, got " + formatNumber(*size));
-  if (threads < 1) throw ParameterError("threads must be >= 1, got " + std::to_string(threads));
+  if (threads < 1 || threads > kMaxThreads)
+    throw ParameterError("threads must be from 1 to " + std::to_string(kMaxThreads) + ", got " +
+                         std::to_string(threads));
 }
 
 double defaultMeshSize(const CadModel& cad) {
@@ -54,7 +59,10 @@ class StageClock {
     const double s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     timings_.add(stage_, s);
-    if (observer_ != nullptr) observer_->stageFinished(stage_, s);
+    if (observer_ != nullptr) {
+      observer_->stageFinished(stage_, s);
+      if (observer_->cancelRequested()) throw CancelledError("cancelled after " + stage_);
+    }
   }
 
  private:
@@ -63,6 +71,26 @@ class StageClock {
   PipelineObserver* observer_;
   std::chrono::steady_clock::time_point start_;
 };
+
+// Refuses an order that would make the high-order mesh need more than half the machine's memory
+// (connectivity plus nodes, whose count is about a fifth of the element-node slots for
+// tetrahedra), before elevation starts allocating it.
+void checkHighOrderMemory(const Mesh& linear, int order) {
+  double slots = 0.0;
+  for (const ElementBlock& b : linear.blocks)
+    slots += static_cast<double>(b.count()) * cellNumNodes(b.type, order);
+  const double bytes = slots * sizeof(std::int64_t) + 0.2 * slots * 48.0;
+  const double physical =
+      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  if (physical > 0.0 && bytes > 0.5 * physical) {
+    std::ostringstream msg;
+    msg.precision(3);
+    msg << "order " << order << " on " << linear.numElements() << " elements would need about "
+        << bytes / 1e9 << " GB of memory (this machine has " << physical / 1e9
+        << " GB): use a larger size or a lower order";
+    throw ParameterError(msg.str());
+  }
+}
 
 }  // namespace
 
@@ -82,6 +110,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       generateLinearMesh(*result.cad, {*options.size, options.threads, options.verbosity});
   linear.done();
 
+  checkHighOrderMemory(linearMesh, options.order);
   StageClock highOrder("high_order", result.timings, observer);
   result.mesh = elevateOrder(linearMesh, options.order, result.cad.get());
   highOrder.done();
@@ -99,11 +128,15 @@ std::vector<CellField> qualityFields(const QualitySummary& quality) {
   return {field};
 }
 
+void writeMeshFiles(const MeshResult& result, const std::vector<std::string>& paths) {
+  const std::vector<CellField> fields = qualityFields(result.quality);
+  for (const std::string& path : paths) writeMesh(result.mesh, path, fields);
+}
+
 void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,
                       PipelineObserver* observer) {
   StageClock output("output", result.timings, observer);
-  const std::vector<CellField> fields = qualityFields(result.quality);
-  for (const std::string& path : paths) writeMesh(result.mesh, path, fields);
+  writeMeshFiles(result, paths);
   output.done();
 }
 

@@ -20,10 +20,12 @@
 
 namespace homesh {
 
+inline constexpr int kMaxThreads = 1024;
+
 struct MeshingOptions {
   int order = 4;               // polynomial order, 1..10
   std::optional<double> size;  // target edge length (> 0); unset: defaultMeshSize(cad)
-  int threads = 1;             // threads the stages may use
+  int threads = 1;             // threads the stages may use, 1..kMaxThreads
   int verbosity = 0;           // 0 silent; 1 Gmsh's warnings; 2 Gmsh's information
 
   // Throws ParameterError naming the offending parameter.
@@ -52,7 +54,8 @@ struct StageTimings {
   double total() const;
 };
 
-// Receives progress; may ask to stop between stages (the run then throws CancelledError).
+// Receives progress; may ask to stop, which is honoured when a stage starts or ends (the run
+// then throws CancelledError and returns nothing).
 class PipelineObserver {
  public:
   virtual ~PipelineObserver() = default;
@@ -77,6 +80,10 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
 std::vector<CellField> qualityFields(const QualitySummary& quality);
 
 // Writes the mesh to each path (format from the extension) and records the "output" timing.
+// Writes the mesh and its quality fields to each path (format from the extension).
+void writeMeshFiles(const MeshResult& result, const std::vector<std::string>& paths);
+
+// writeMeshFiles as the pipeline's last stage: records its "output" timing in the result.
 void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,
                       PipelineObserver* observer = nullptr);
 

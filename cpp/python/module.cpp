@@ -56,6 +56,38 @@ class ReleaseGil {
 };
 
 // Calls progress(stage, seconds_or_None); an exception in the callback cancels the job.
+// Holds the GIL for its lifetime (from a thread that released it).
+class AcquireGil {
+ public:
+  AcquireGil() : state_(PyGILState_Ensure()) {}
+  ~AcquireGil() { PyGILState_Release(state_); }
+  AcquireGil(const AcquireGil&) = delete;
+  AcquireGil& operator=(const AcquireGil&) = delete;
+
+ private:
+  PyGILState_STATE state_;
+};
+
+// The text of the pending Python exception (which is cleared); never fails.
+std::string takePythonError() {
+  PyObject *type = nullptr, *value = nullptr, *trace = nullptr;
+  PyErr_Fetch(&type, &value, &trace);
+  std::string text;
+  if (value != nullptr) {
+    PyObject* str = PyObject_Str(value);
+    const char* utf8 = str != nullptr ? PyUnicode_AsUTF8(str) : nullptr;
+    if (utf8 != nullptr) text = utf8;
+    Py_XDECREF(str);
+  }
+  PyErr_Clear();  // also whatever PyObject_Str or PyUnicode_AsUTF8 may have raised
+  Py_XDECREF(type);
+  Py_XDECREF(value);
+  Py_XDECREF(trace);
+  return text;
+}
+
+// Calls progress(stage, seconds_or_None); an exception in the callback cancels the job.
+// Called with the GIL released; never lets an exception escape into the pipeline.
 class PythonProgress : public PipelineObserver {
  public:
   explicit PythonProgress(bp::object callback) : callback_(std::move(callback)) {}
@@ -65,32 +97,19 @@ class PythonProgress : public PipelineObserver {
   const std::string& failure() const { return failure_; }
 
  private:
-  void call(const std::string& stage, const double* seconds) {
+  void call(const std::string& stage, const double* seconds) noexcept {
     if (!failure_.empty()) return;
-    const PyGILState_STATE gil = PyGILState_Ensure();
-    if (callback_.is_none()) {
-      PyGILState_Release(gil);
-      return;
-    }
+    const AcquireGil gil;
+    if (callback_.is_none()) return;
     try {
       callback_(stage, seconds != nullptr ? bp::object(*seconds) : bp::object());
     } catch (const bp::error_already_set&) {
-      PyObject *type = nullptr, *value = nullptr, *trace = nullptr;
-      PyErr_Fetch(&type, &value, &trace);
-      failure_ = "progress callback raised an exception";
-      if (value != nullptr) {
-        PyObject* text = PyObject_Str(value);
-        if (text != nullptr) {
-          failure_ += std::string(": ") + PyUnicode_AsUTF8(text);
-          Py_DECREF(text);
-        }
-      }
+      const std::string text = takePythonError();
+      failure_ = "progress callback raised an exception" + (text.empty() ? "" : ": " + text);
+    } catch (...) {
       PyErr_Clear();
-      Py_XDECREF(type);
-      Py_XDECREF(value);
-      Py_XDECREF(trace);
+      failure_ = "progress callback failed";
     }
-    PyGILState_Release(gil);
   }
   bp::object callback_;
   std::string failure_;
@@ -185,12 +204,12 @@ class PyMesh {
 
   void write(const std::string& path) {
     const ReleaseGil nogil;
-    writeMeshOutputs(*result_, {path});
+    writeMeshFiles(*result_, {path});
   }
 
   std::string reportJson(const std::string& input) const { return meshReportJson(*result_, input); }
 
-  std::shared_ptr<MeshResult> result_;
+  std::shared_ptr<const MeshResult> result_;  // immutable: safe to read without the GIL
 };
 
 MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity) {

@@ -12,8 +12,9 @@ def export(objects, filename):
         return
     mesh = get_mesh(meshes[0])
     if mesh is None:
-        FreeCAD.Console.PrintError("HOMesh: %s has no mesh yet: recompute it first\n"
-                                   % meshes[0].Label)
+        FreeCAD.Console.PrintError(
+            "HOMesh: %s has no valid mesh (never computed, or its last recompute failed): "
+            "nothing exported\n" % meshes[0].Label)
         return
     mesh.write(filename)
     FreeCAD.Console.PrintMessage("HOMesh: wrote %s\n" % filename)

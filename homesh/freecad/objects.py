@@ -6,6 +6,7 @@ document shows and exports the mesh without recomputing it.
 """
 
 import os
+import shutil
 import tempfile
 
 import FreeCAD
@@ -33,7 +34,10 @@ def make_high_order_mesh(doc, part, order=4, size=0.0, name="HighOrderMesh"):
 
 def get_mesh(obj):
     """The :class:`homesh.HighOrderMesh` of a HighOrderMesh object (from the last recompute,
-    or read back from the document), or None if it has none yet."""
+    or read back from the document), or None if it has none or its last recompute failed (the
+    view then still shows the last good mesh, as FreeCAD does for failed features)."""
+    if not obj.isValid():
+        return None
     proxy = getattr(obj, "Proxy", None)
     cached = getattr(proxy, "mesh", None)
     if cached is not None:
@@ -92,6 +96,7 @@ class HighOrderMeshProxy:
 
     def execute(self, obj):
         import homesh
+        self.mesh = None
         if obj.Part is None:
             raise ValueError("%s: no shape to mesh (set its Part property)" % obj.Label)
         shape = getattr(obj.Part, "Shape", None)
@@ -108,10 +113,13 @@ class HighOrderMeshProxy:
         finally:
             progress.stop()
         folder = tempfile.mkdtemp(prefix="homesh-")
-        path = os.path.join(folder, "mesh.npz")
-        mesh.write(path)
+        try:
+            path = os.path.join(folder, "mesh.npz")
+            mesh.write(path)
+            obj.MeshData = path  # FreeCAD copies the file into the document
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
         self.mesh = mesh
-        obj.MeshData = path
         quality = mesh.quality()
         obj.NumNodes = mesh.num_nodes
         obj.NumElements = mesh.num_elements

@@ -77,6 +77,30 @@ class HighOrderMeshObject(unittest.TestCase):
         obj.Order = 50
         self.assertEqual(obj.Order, 10)
 
+    def test_a_failed_recompute_exports_nothing_stale(self):
+        part = box_with_hole(self.doc)
+        obj = homesh.freecad.make_high_order_mesh(self.doc, part, order=2, size=1.0)
+        self.doc.recompute()
+        self.assertIsNotNone(homesh.freecad.get_mesh(obj))
+        obj.Part = self.doc.addObject("Part::Circle", "Circle")  # a wire: cannot be meshed
+        self.doc.recompute()
+        self.assertFalse(obj.isValid())
+        self.assertIsNone(homesh.freecad.get_mesh(obj))
+        out = os.path.join(self.folder, "stale.msh")
+        exporter.export([obj], out)
+        self.assertFalse(os.path.exists(out))
+
+    def test_recompute_leaves_no_temporary_folders(self):
+        before = set(os.listdir(tempfile.gettempdir()))
+        part = box_with_hole(self.doc)
+        obj = homesh.freecad.make_high_order_mesh(self.doc, part, order=2, size=1.0)
+        for order in (2, 3):
+            obj.Order = order
+            self.doc.recompute()
+        leaked = [d for d in set(os.listdir(tempfile.gettempdir())) - before
+                  if d.startswith("homesh-")]
+        self.assertEqual(leaked, [])
+
     def test_missing_shape_fails_cleanly(self):
         obj = homesh.freecad.make_high_order_mesh(self.doc, None)
         self.doc.recompute()

@@ -111,6 +111,32 @@ def test_bad_inputs_give_one_line_errors(homesh_bin, data, tmp_path):
     assert not (tmp_path / "x.stl").exists()
 
 
+def test_verbose_gmsh_output_stays_off_stdout(homesh_bin, data):
+    result = run([homesh_bin, "mesh", data / "sphere.brep", "--size", "0.5", "--order", "2",
+                  "-vv", "--report", "-"])
+    assert result.returncode == 0, result.stderr
+    assert json.loads(result.stdout)["order"] == 2
+    assert "gmsh: " in result.stderr
+
+
+def test_bad_report_path_fails_before_meshing(homesh_bin, data, tmp_path):
+    out = tmp_path / "mesh.msh"
+    result = run([homesh_bin, "mesh", data / "sphere.brep", "-o", out,
+                  "--report", tmp_path / "nowhere" / "r.json"])
+    _expect_failure(result, 1, "nowhere")
+    assert not out.exists()
+
+
+def test_numbers_are_strict_and_sizes_sane(homesh_bin, data):
+    _expect_failure(run([homesh_bin, "mesh", data / "sphere.brep", "--size", "0x10"]), 2,
+                    "--size")
+    _expect_failure(run([homesh_bin, "mesh", data / "sphere.brep", "--size", "inf"]), 2, "--size")
+    _expect_failure(run([homesh_bin, "mesh", data / "sphere.brep", "-j", "100000"]), 2,
+                    "--threads")
+    _expect_failure(run([homesh_bin, "mesh", data / "sphere.brep", "--size", "5"]), 2,
+                    "not smaller than")
+
+
 def test_help_and_version(homesh_bin):
     assert run([homesh_bin, "--help"]).returncode == 0
     assert "--order" in run([homesh_bin, "mesh", "--help"]).stdout

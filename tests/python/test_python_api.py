@@ -81,6 +81,9 @@ def test_planar_face_gives_a_2d_mesh(tmp_path):
     (dict(size=0), homesh.ParameterError),
     (dict(size="big"), homesh.ParameterError),
     (dict(threads=0), homesh.ParameterError),
+    (dict(threads=100000), homesh.ParameterError),
+    (dict(order=2**40), homesh.ParameterError),
+    (dict(verbosity=2**40), homesh.ParameterError),
 ])
 def test_bad_parameters_raise(data, kwargs, error):
     with pytest.raises(error):
@@ -104,6 +107,41 @@ def test_bad_inputs_raise_named_errors(tmp_path):
     assert issubclass(homesh.HOMeshError, RuntimeError)
 
 
+def test_load_rejects_files_that_are_not_ours(tmp_path):
+    bad = tmp_path / "bad.npz"
+    bad.write_bytes(b"PK\x03\x04 not really a zip")
+    with pytest.raises(homesh.FileError):
+        homesh.load(bad)
+    np.savez(tmp_path / "other.npz", x=np.arange(3))
+    with pytest.raises(homesh.FileError):
+        homesh.load(tmp_path / "other.npz")
+    with pytest.raises(homesh.FileError):
+        homesh.load(tmp_path / "missing.npz")
+
+
+def test_writing_twice_keeps_the_report_consistent(sphere, tmp_path):
+    sphere.write(tmp_path / "a.msh")
+    sphere.write(tmp_path / "a.vtu")
+    def unique_keys(pairs):
+        keys = [k for k, _ in pairs]
+        assert len(keys) == len(set(keys)), keys
+        return dict(pairs)
+
+    report = json.loads(sphere._core.report_json("x"), object_pairs_hook=unique_keys)
+    assert "output" not in report["timings_s"]
+
+
+def test_concurrent_jobs_in_threads(data):
+    """The core runs without the GIL: jobs from several threads must not disturb each other
+    (OCCT's STEP reader and Gmsh have process-wide state)."""
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(4) as pool:
+        meshes = list(pool.map(lambda _: homesh.mesh(str(data / "box_hole.step"), order=2,
+                                                     size=1.0), range(8)))
+    counts = {m.num_elements for m in meshes}
+    assert len(counts) == 1 and counts.pop() > 0
+
+
 def test_progress_reports_stages_and_can_cancel(data):
     seen = []
     homesh.mesh(str(data / "sphere.brep"), order=2, size=0.5,
@@ -117,6 +155,19 @@ def test_progress_reports_stages_and_can_cancel(data):
 
     with pytest.raises(homesh.CancelledError, match="user pressed cancel"):
         homesh.mesh(str(data / "sphere.brep"), order=2, size=0.5, progress=stop)
+
+    def stop_at_the_end(stage, seconds):
+        if stage == "quality" and seconds is not None:
+            raise KeyboardInterrupt
+
+    with pytest.raises(homesh.CancelledError):
+        homesh.mesh(str(data / "sphere.brep"), order=2, size=0.5, progress=stop_at_the_end)
+
+    def unprintable(stage, seconds):
+        raise ValueError("\udcff")  # str() of it cannot be encoded to UTF-8
+
+    with pytest.raises(homesh.CancelledError):
+        homesh.mesh(str(data / "sphere.brep"), order=2, size=0.5, progress=unprintable)
 
 
 def test_tessellation_follows_the_curved_surface(sphere):

@@ -95,10 +95,33 @@ TEST(CadModel, SphereEvaluationProjectionAndCurvature) {
     EXPECT_NEAR((cad.evaluateSurface(1, proj.u, proj.v).point - proj.point).norm(), 0.0, 1e-12);
   }
 
+  // Convex: both principal curvatures are -1/r against the outward normal.
   const PrincipalCurvatures k = cad.curvature(1, u, v);
   ASSERT_TRUE(k.defined);
-  EXPECT_NEAR(std::abs(k.kMin), 1.0 / r, 1e-9);
-  EXPECT_NEAR(std::abs(k.kMax), 1.0 / r, 1e-9);
+  EXPECT_NEAR(k.kMin, -1.0 / r, 1e-9);
+  EXPECT_NEAR(k.kMax, -1.0 / r, 1e-9);
+}
+
+TEST(CadModel, CurvatureSignFollowsTheOutwardNormal) {
+  // The wall of a hole bends towards the solid's outward normal (+1/r); a cylinder's side
+  // bends away from it (-1/r). Both have a zero curvature along the axis.
+  const CadModel holed = toModel(test::boxWithHole());
+  const CadModel solid = toModel(test::cylinder(1.0, 2.0));
+  for (const auto* model : {&holed, &solid}) {
+    const int f = lateralFace(*model);
+    ASSERT_GT(f, 0);
+    const SurfaceBounds b = model->faceBounds(f);
+    const PrincipalCurvatures k =
+        model->curvature(f, 0.5 * (b.uMin + b.uMax), 0.5 * (b.vMin + b.vMax));
+    ASSERT_TRUE(k.defined);
+    if (model == &holed) {
+      EXPECT_NEAR(k.kMin, 0.0, 1e-12);
+      EXPECT_NEAR(k.kMax, 1.0, 1e-9);
+    } else {
+      EXPECT_NEAR(k.kMin, -1.0, 1e-9);
+      EXPECT_NEAR(k.kMax, 0.0, 1e-12);
+    }
+  }
 }
 
 TEST(CadModel, CylinderCurvesAndCurvature) {

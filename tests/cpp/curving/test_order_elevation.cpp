@@ -71,9 +71,26 @@ TEST_P(SphereOrders, NodesAreSharedAndBoundaryNodesLieOnTheSphere) {
                                            mesh.nodeCadParam[2 * i + 1]);
         EXPECT_NEAR((s.point - nodePoint(mesh, i)).norm(), 0.0, 1e-9);
       }
-    } else {
-      EXPECT_LT(r, radius + 1e-12);
     }
+  }
+  // Nodes inside the solid stay where the straight-sided element puts them.
+  const ElementBlock& tets = mesh.blocks[0];
+  const ReferenceElement& ref = ReferenceElement::get(CellType::Tetrahedron, order);
+  std::size_t interior = 0;
+  for (std::size_t e = 0; e < tets.count(); ++e) {
+    const std::int64_t* t = tets.element(e);
+    const Eigen::Vector3d x0 = nodePoint(mesh, t[0]);
+    Eigen::Matrix3d a;
+    for (int k = 0; k < 3; ++k) a.col(k) = nodePoint(mesh, t[k + 1]) - x0;
+    for (int n = 0; n < ref.numNodes(); ++n) {
+      if (mesh.nodeCadDim[t[n]] != 3) continue;
+      ++interior;
+      EXPECT_NEAR((nodePoint(mesh, t[n]) - (x0 + a * ref.nodes().row(n).transpose())).norm(), 0.0,
+                  1e-12);
+    }
+  }
+  if (order >= 2) {
+    EXPECT_GT(interior, 0u);
   }
   // Every node of every boundary triangle is on the sphere.
   std::size_t boundaryNodes = 0;

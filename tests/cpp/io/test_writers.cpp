@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "curving/order_elevation.hpp"
+#include "io/atomic_file.hpp"
 #include "io/json_writer.hpp"
 #include "io/mesh_writers.hpp"
 #include "linear/linear_mesher.hpp"
@@ -112,6 +113,34 @@ TEST(Writers, FailuresLeaveNoPartialFileAndNameThePath) {
   EXPECT_THROW(writeMesh(mesh, (dir / "out.msh").string(), {wrong}), Error);
   // Nothing was left behind, not even the temporary ".part" file.
   EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
+TEST(AtomicFile, UncommittedOrFailedWritesLeaveNothingBehind) {
+  const auto dir = test::tempDir();
+  const std::string path = (dir / "out.txt").string();
+  {
+    AtomicFile file(path, false);
+    file.stream() << "half a file";
+    EXPECT_TRUE(std::filesystem::exists(path + ".part"));
+  }  // destroyed without commit, as when a writer throws half-way
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+
+  // The final rename fails (the target is a folder): IoError, and no ".part" is left.
+  std::filesystem::create_directory(dir / "taken");
+  const std::string taken = (dir / "taken").string();
+  {
+    AtomicFile file(taken, false);
+    file.stream() << "data";
+    EXPECT_THROW(file.commit(), IoError);
+  }
+  EXPECT_FALSE(std::filesystem::exists(taken + ".part"));
+
+  // A committed file replaces the old one completely.
+  writeFileAtomically(path, "first version, long");
+  writeFileAtomically(path, "second");
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, "second");
 }
 
 TEST(JsonWriter, NestsAndEscapes) {

@@ -2,12 +2,14 @@
 // Gmsh-to-FreeCAD entity numbering on compounds, planar (2D) meshes, and its errors.
 #include <gtest/gtest.h>
 
+#include <BRepAlgoAPI_BuilderAlgo.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepGProp.hxx>
 #include <BRep_Builder.hxx>
 #include <GProp_GProps.hxx>
 #include <TopExp.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
+#include <TopTools_ListOfShape.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
 #include <gp_Pln.hxx>
@@ -46,6 +48,26 @@ void expectParametersReproduceNodes(const Mesh& mesh, const CadModel& cad, doubl
   }
   EXPECT_GT(onCurves, 0u);
   EXPECT_GT(onFaces, 0u);
+}
+
+// Sum of tetrahedron volumes per solid equals each solid's own volume (so every tetrahedron
+// records the right SolidN), and every node's parameters reproduce it.
+void expectSolidsFilled(const TopoDS_Shape& shape, double size) {
+  const CadModel cad = test::toModel(shape);
+  const Mesh mesh = generateLinearMesh(cad, {size, 1, 0});
+  std::map<int, double> volumeBySolid;
+  const ElementBlock& tets = mesh.blocks[0];
+  for (std::size_t e = 0; e < tets.count(); ++e)
+    volumeBySolid[tets.entity[e]] += test::tetVolume(mesh, tets.element(e));
+  TopTools_IndexedMapOfShape solids;
+  TopExp::MapShapes(shape, TopAbs_SOLID, solids);
+  ASSERT_EQ(static_cast<int>(volumeBySolid.size()), solids.Extent());
+  for (int s = 1; s <= solids.Extent(); ++s) {
+    GProp_GProps props;
+    BRepGProp::VolumeProperties(solids(s), props);
+    EXPECT_NEAR(volumeBySolid[s], props.Mass(), 1e-9) << "Solid" << s;
+  }
+  expectParametersReproduceNodes(mesh, cad, 1e-9);
 }
 
 TEST(LinearMesher, BoxWithHoleGivesPositiveTetsFillingTheVolume) {
@@ -89,22 +111,34 @@ TEST(LinearMesher, CompoundNumberingFollowsFreeCad) {
         BRepPrimAPI_MakeBox(gp_Pnt(5.0 * k, 0, 0), sides[k], sides[k], sides[k]).Shape();
     builder.Add(compound, b);
   }
-  const CadModel cad = test::toModel(compound);
-  ASSERT_EQ(cad.numSolids(), 3);
-  const Mesh mesh = generateLinearMesh(cad, {0.4, 1, 0});
-  std::map<int, double> volumeBySolid;
-  const ElementBlock& tets = mesh.blocks[0];
-  for (std::size_t e = 0; e < tets.count(); ++e)
-    volumeBySolid[tets.entity[e]] += test::tetVolume(mesh, tets.element(e));
-  TopTools_IndexedMapOfShape solids;
-  TopExp::MapShapes(compound, TopAbs_SOLID, solids);
-  ASSERT_EQ(volumeBySolid.size(), 3u);
-  for (int s = 1; s <= 3; ++s) {
-    GProp_GProps props;
-    BRepGProp::VolumeProperties(solids(s), props);
-    EXPECT_NEAR(volumeBySolid[s], props.Mass(), 1e-9) << "Solid" << s;
-  }
-  expectParametersReproduceNodes(mesh, cad, 1e-9);
+  ASSERT_EQ(test::toModel(compound).numSolids(), 3);
+  expectSolidsFilled(compound, 0.4);
+}
+
+TEST(LinearMesher, SolidsSharingAFace) {
+  // Two boxes fragmented so that they share their common face (FreeCAD's BooleanFragments).
+  TopTools_ListOfShape arguments;
+  arguments.Append(BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 1.0, 1.0, 1.0).Shape());
+  arguments.Append(BRepPrimAPI_MakeBox(gp_Pnt(1, 0, 0), 2.0, 1.0, 1.0).Shape());
+  BRepAlgoAPI_BuilderAlgo fragments;
+  fragments.SetArguments(arguments);
+  fragments.Build();
+  ASSERT_TRUE(fragments.IsDone());
+  const TopoDS_Shape shared = fragments.Shape();
+  EXPECT_EQ(test::toModel(shared).numFaces(), 11);
+  expectSolidsFilled(shared, 0.3);
+}
+
+TEST(LinearMesher, TouchingSolidsWithoutSharedTopology) {
+  // The same two boxes in a plain compound: their common face exists twice, at the same place,
+  // as do its edges and vertices. The numbering must still tell them apart.
+  BRep_Builder builder;
+  TopoDS_Compound compound;
+  builder.MakeCompound(compound);
+  builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 1.0, 1.0, 1.0).Shape());
+  builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(1, 0, 0), 2.0, 1.0, 1.0).Shape());
+  EXPECT_EQ(test::toModel(compound).numFaces(), 12);
+  expectSolidsFilled(compound, 0.3);
 }
 
 TEST(LinearMesher, PlanarFaceGivesOrientedTriangles) {
