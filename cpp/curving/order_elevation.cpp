@@ -120,6 +120,10 @@ struct Elevator {
   }
 
   void elevateBlock(const ElementBlock& block) {
+    if (block.type != CellType::Line && block.type != CellType::Triangle &&
+        block.type != CellType::Tetrahedron)
+      throw ParameterError("order elevation supports lines, triangles and tetrahedra, not " +
+                           cellShortName(block.type));
     const ReferenceElement& ref = ReferenceElement::get(block.type, order);
     const int nv = cellNumVertices(block.type);
     ElementBlock high;
@@ -129,7 +133,8 @@ struct Elevator {
     high.nodes.reserve(block.count() * ref.numNodes());
     for (std::size_t e = 0; e < block.count(); ++e) {
       const std::int64_t* v = block.element(e);
-      for (const Lattice& a : ref.lattice()) {
+      for (const LatticePoint& point : ref.lattice()) {
+        const std::array<int, 4> a = simplexBarycentric(point, ref.dim(), order);
         std::array<std::pair<std::int64_t, int>, 4> support{};
         int n = 0;
         for (int k = 0; k < nv; ++k)

@@ -9,87 +9,306 @@
 namespace homesh {
 namespace {
 
-struct SimplexTopology {
-  std::vector<std::pair<int, int>> edges;
-  std::vector<std::array<int, 3>> faces;  // only for tetrahedra
-};
+using P3 = LatticePoint;
+using Nodes = std::vector<P3>;
 
-SimplexTopology topologyOf(int dim, NodeConvention convention) {
-  if (dim == 1) return {{{0, 1}}, {}};
-  if (dim == 2) return {{{0, 1}, {1, 2}, {2, 0}}, {}};
-  if (convention == NodeConvention::Gmsh)
-    return {{{0, 1}, {1, 2}, {2, 0}, {3, 0}, {3, 2}, {3, 1}},
-            {{{0, 2, 1}}, {{0, 1, 3}}, {{0, 3, 2}}, {{3, 1, 2}}}};
-  return {{{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}},
-          {{{0, 1, 3}}, {{2, 3, 1}}, {{0, 3, 2}}, {{0, 2, 1}}}};
+P3 operator+(P3 a, const P3& b) {
+  for (int k = 0; k < 3; ++k) a[k] += b[k];
+  return a;
+}
+P3 operator-(P3 a, const P3& b) {
+  for (int k = 0; k < 3; ++k) a[k] -= b[k];
+  return a;
+}
+// a + (b - a) * t / n, exact: corner differences are multiples of n by construction.
+P3 along(const P3& a, const P3& b, int t, int n) {
+  P3 r = a;
+  for (int k = 0; k < 3; ++k) r[k] += (b[k] - a[k]) / n * t;
+  return r;
 }
 
-// Recursive ordering of a dim-simplex of order p >= 0 (order 0: the single centre node).
-std::vector<Lattice> orderSimplex(int dim, int p, NodeConvention convention) {
-  std::vector<Lattice> nodes;
-  if (p == 0) {
-    nodes.push_back({0, 0, 0, 0});
-    return nodes;
+void edge(Nodes& out, const P3& a, const P3& b, int n) {
+  for (int t = 1; t < n; ++t) out.push_back(along(a, b, t, n));
+}
+
+// Corners moved one lattice step towards the given neighbours: the corners of the interior
+// sub-element (order n - 3 for simplices' faces, n - 4 tetrahedron, n - 2 tensor shapes).
+P3 inward(const P3& corner, const std::vector<P3>& neighbours, int n) {
+  P3 r = corner;
+  for (const P3& b : neighbours) r = r + along(P3{0, 0, 0}, b - corner, 1, n);
+  return r;
+}
+
+// Recursive triangle (Gmsh and VTK): vertices, edges ab, bc, ca, interior of order n - 3.
+void triangle(Nodes& out, const P3& a, const P3& b, const P3& c, int n) {
+  if (n == 0) {
+    out.push_back(a);
+    return;
   }
-  for (int k = 0; k <= dim; ++k) {
-    Lattice a{0, 0, 0, 0};
-    a[k] = p;
-    nodes.push_back(a);
+  out.insert(out.end(), {a, b, c});
+  edge(out, a, b, n);
+  edge(out, b, c, n);
+  edge(out, c, a, n);
+  if (n >= 3)
+    triangle(out, inward(a, {b, c}, n), inward(b, {a, c}, n), inward(c, {a, b}, n), n - 3);
+}
+
+// Interior of a triangle face, ordered as a recursive triangle of order n - 3.
+void triangleInterior(Nodes& out, const P3& a, const P3& b, const P3& c, int n) {
+  if (n >= 3)
+    triangle(out, inward(a, {b, c}, n), inward(b, {a, c}, n), inward(c, {a, b}, n), n - 3);
+}
+
+// Recursive quadrilateral (Gmsh): vertices, edges ab, bc, cd, da, interior of order n - 2.
+void quadrilateral(Nodes& out, const P3& a, const P3& b, const P3& c, const P3& d, int n) {
+  if (n == 0) {
+    out.push_back(a);
+    return;
   }
-  const SimplexTopology topo = topologyOf(dim, convention);
-  for (const auto& [v0, v1] : topo.edges) {
-    for (int i = 1; i < p; ++i) {
-      Lattice a{0, 0, 0, 0};
-      a[v0] = p - i;
-      a[v1] = i;
-      nodes.push_back(a);
+  out.insert(out.end(), {a, b, c, d});
+  edge(out, a, b, n);
+  edge(out, b, c, n);
+  edge(out, c, d, n);
+  edge(out, d, a, n);
+  if (n >= 2)
+    quadrilateral(out, inward(a, {b, d}, n), inward(b, {a, c}, n), inward(c, {b, d}, n),
+                  inward(d, {a, c}, n), n - 2);
+}
+
+void quadrilateralInterior(Nodes& out, const P3& a, const P3& b, const P3& c, const P3& d, int n) {
+  if (n >= 2)
+    quadrilateral(out, inward(a, {b, d}, n), inward(b, {a, c}, n), inward(c, {b, d}, n),
+                  inward(d, {a, c}, n), n - 2);
+}
+
+using Edges = std::vector<std::pair<int, int>>;
+using Faces = std::vector<std::vector<int>>;
+
+void corners(Nodes& out, const std::vector<P3>& v) {
+  out.insert(out.end(), v.begin(), v.end());
+}
+void edges(Nodes& out, const std::vector<P3>& v, const Edges& list, int n) {
+  for (const auto& [a, b] : list) edge(out, v[a], v[b], n);
+}
+
+void tetrahedron(Nodes& out, const std::vector<P3>& v, int n, NodeConvention convention) {
+  if (n == 0) {
+    out.push_back(v[0]);
+    return;
+  }
+  const bool gmsh = convention == NodeConvention::Gmsh;
+  const Edges edgeList = gmsh ? Edges{{0, 1}, {1, 2}, {2, 0}, {3, 0}, {3, 2}, {3, 1}}
+                              : Edges{{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+  const Faces faceList = gmsh ? Faces{{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {3, 1, 2}}
+                              : Faces{{0, 1, 3}, {2, 3, 1}, {0, 3, 2}, {0, 2, 1}};
+  corners(out, v);
+  edges(out, v, edgeList, n);
+  for (const auto& f : faceList) triangleInterior(out, v[f[0]], v[f[1]], v[f[2]], n);
+  if (n >= 4) {
+    std::vector<P3> inner;
+    for (int i = 0; i < 4; ++i) {
+      std::vector<P3> others;
+      for (int j = 0; j < 4; ++j)
+        if (j != i) others.push_back(v[j]);
+      inner.push_back(inward(v[i], others, n));
     }
+    tetrahedron(out, inner, n - 4, convention);
   }
-  if (dim == 2 && p >= 3) {
-    for (const Lattice& c : orderSimplex(2, p - 3, convention))
-      nodes.push_back({c[0] + 1, c[1] + 1, c[2] + 1, 0});
+}
+
+void gmshHexahedron(Nodes& out, const std::vector<P3>& v, int n) {
+  if (n == 0) {
+    out.push_back(v[0]);
+    return;
   }
-  if (dim == 3) {
-    if (p >= 3) {
-      for (const auto& face : topo.faces) {
-        for (const Lattice& c : orderSimplex(2, p - 3, convention)) {
-          Lattice a{0, 0, 0, 0};
-          for (int k = 0; k < 3; ++k) a[face[k]] = c[k] + 1;
-          nodes.push_back(a);
+  corners(out, v);
+  edges(out, v,
+        {{0, 1},
+         {0, 3},
+         {0, 4},
+         {1, 2},
+         {1, 5},
+         {2, 3},
+         {2, 6},
+         {3, 7},
+         {4, 5},
+         {4, 7},
+         {5, 6},
+         {6, 7}},
+        n);
+  for (const auto& f :
+       Faces{{0, 3, 2, 1}, {0, 1, 5, 4}, {0, 4, 7, 3}, {1, 2, 6, 5}, {2, 3, 7, 6}, {4, 5, 6, 7}})
+    quadrilateralInterior(out, v[f[0]], v[f[1]], v[f[2]], v[f[3]], n);
+  if (n >= 2) {
+    // Each corner's three neighbours along hexahedron edges.
+    static const int adjacent[8][3] = {{1, 3, 4}, {0, 2, 5}, {1, 3, 6}, {0, 2, 7},
+                                       {0, 5, 7}, {1, 4, 6}, {2, 5, 7}, {3, 4, 6}};
+    std::vector<P3> inner;
+    for (int i = 0; i < 8; ++i)
+      inner.push_back(inward(v[i], {v[adjacent[i][0]], v[adjacent[i][1]], v[adjacent[i][2]]}, n));
+    gmshHexahedron(out, inner, n - 2);
+  }
+}
+
+// Gmsh's line of order n between lattice coordinates lo and hi (vertices first).
+std::vector<int> gmshLine(int lo, int hi, int n) {
+  std::vector<int> k{lo};
+  if (n == 0) return k;
+  k.push_back(hi);
+  for (int t = 1; t < n; ++t) k.push_back(lo + (hi - lo) / n * t);
+  return k;
+}
+
+void gmshPrism(Nodes& out, const std::vector<P3>& v, int n) {
+  corners(out, v);
+  edges(out, v, {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 4}, {2, 5}, {3, 4}, {3, 5}, {4, 5}}, n);
+  triangleInterior(out, v[0], v[2], v[1], n);
+  triangleInterior(out, v[3], v[4], v[5], n);
+  for (const auto& f : Faces{{0, 1, 4, 3}, {0, 3, 5, 2}, {1, 2, 5, 4}})
+    quadrilateralInterior(out, v[f[0]], v[f[1]], v[f[2]], v[f[3]], n);
+  if (n >= 3) {
+    Nodes tri;
+    triangleInterior(tri, v[0], v[1], v[2], n);
+    const std::vector<int> ks = gmshLine(1, n - 1, n - 2);
+    for (const P3& p : tri)
+      for (const int k : ks) out.push_back({p[0], p[1], k});
+  }
+}
+
+void vtkQuadrilateral(Nodes& out, int n) {
+  // (push_back rather than insert of a list: GCC 12 warns falsely about the latter here)
+  for (const P3& corner : {P3{0, 0, 0}, P3{n, 0, 0}, P3{n, n, 0}, P3{0, n, 0}})
+    out.push_back(corner);
+  edge(out, {0, 0, 0}, {n, 0, 0}, n);
+  edge(out, {n, 0, 0}, {n, n, 0}, n);
+  edge(out, {0, n, 0}, {n, n, 0}, n);
+  edge(out, {0, 0, 0}, {0, n, 0}, n);
+  for (int j = 1; j < n; ++j)
+    for (int i = 1; i < n; ++i) out.push_back({i, j, 0});
+}
+
+void vtkHexahedron(Nodes& out, const std::vector<P3>& v, int n) {
+  corners(out, v);
+  edges(out, v,
+        {{0, 1},
+         {1, 2},
+         {3, 2},
+         {0, 3},
+         {4, 5},
+         {5, 6},
+         {7, 6},
+         {4, 7},
+         {0, 4},
+         {1, 5},
+         {2, 6},
+         {3, 7}},
+        n);
+  // Faces x = 0, x = n, y = 0, y = n, z = 0, z = n; each row-major in its two free axes.
+  for (int axis = 0; axis < 3; ++axis) {
+    const int a = axis == 0 ? 1 : 0, b = axis == 2 ? 1 : 2;
+    for (const int side : {0, n})
+      for (int q = 1; q < n; ++q)
+        for (int p = 1; p < n; ++p) {
+          P3 c{0, 0, 0};
+          c[axis] = side;
+          c[a] = p;
+          c[b] = q;
+          out.push_back(c);
         }
-      }
-    }
-    if (p >= 4) {
-      for (const Lattice& c : orderSimplex(3, p - 4, convention))
-        nodes.push_back({c[0] + 1, c[1] + 1, c[2] + 1, c[3] + 1});
-    }
   }
-  return nodes;
+  for (int k = 1; k < n; ++k)
+    for (int j = 1; j < n; ++j)
+      for (int i = 1; i < n; ++i) out.push_back({i, j, k});
+}
+
+void vtkWedge(Nodes& out, const std::vector<P3>& v, int n) {
+  corners(out, v);
+  edges(out, v, {{0, 1}, {1, 2}, {2, 0}, {3, 4}, {4, 5}, {5, 3}, {0, 3}, {1, 4}, {2, 5}}, n);
+  for (const int k : {0, n})
+    for (int j = 1; j < n; ++j)
+      for (int i = 1; i + j < n; ++i) out.push_back({i, j, k});
+  for (int k = 1; k < n; ++k)
+    for (int i = 1; i < n; ++i) out.push_back({i, 0, k});
+  for (int k = 1; k < n; ++k)
+    for (int j = 1; j < n; ++j) out.push_back({n - j, j, k});
+  for (int k = 1; k < n; ++k)
+    for (int j = n - 1; j >= 1; --j) out.push_back({0, j, k});
+  for (int k = 1; k < n; ++k)
+    for (int j = 1; j < n; ++j)
+      for (int i = 1; i + j < n; ++i) out.push_back({i, j, k});
 }
 
 }  // namespace
 
-std::vector<Lattice> simplexLattice(CellType type, int order, NodeConvention convention) {
+std::vector<LatticePoint> latticeOrder(CellType type, int order, NodeConvention convention) {
   if (order < 1) throw ParameterError("element order must be >= 1, got " + std::to_string(order));
+  const int n = order;
+  const bool gmsh = convention == NodeConvention::Gmsh;
+  Nodes out;
   switch (type) {
     case CellType::Line:
+      out = {{0, 0, 0}, {n, 0, 0}};
+      edge(out, {0, 0, 0}, {n, 0, 0}, n);
+      break;
     case CellType::Triangle:
+      triangle(out, {0, 0, 0}, {n, 0, 0}, {0, n, 0}, n);
+      break;
+    case CellType::Quadrilateral:
+      if (gmsh)
+        quadrilateral(out, {0, 0, 0}, {n, 0, 0}, {n, n, 0}, {0, n, 0}, n);
+      else
+        vtkQuadrilateral(out, n);
+      break;
     case CellType::Tetrahedron:
-      return orderSimplex(cellDimension(type), order, convention);
+      tetrahedron(out, {{0, 0, 0}, {n, 0, 0}, {0, n, 0}, {0, 0, n}}, n, convention);
+      break;
+    case CellType::Prism: {
+      const std::vector<P3> v{{0, 0, 0}, {n, 0, 0}, {0, n, 0}, {0, 0, n}, {n, 0, n}, {0, n, n}};
+      if (gmsh)
+        gmshPrism(out, v, n);
+      else
+        vtkWedge(out, v, n);
+      break;
+    }
+    case CellType::Hexahedron: {
+      const std::vector<P3> v{{0, 0, 0}, {n, 0, 0}, {n, n, 0}, {0, n, 0},
+                              {0, 0, n}, {n, 0, n}, {n, n, n}, {0, n, n}};
+      if (gmsh)
+        gmshHexahedron(out, v, n);
+      else
+        vtkHexahedron(out, v, n);
+      break;
+    }
     default:
-      throw ParameterError("no simplex lattice for " + cellShortName(type));
+      throw ParameterError("no node ordering for " + cellShortName(type));
   }
+  if (static_cast<int>(out.size()) != cellNumNodes(type, order))
+    throw Error("node ordering of " + cellShortName(type) + " order " + std::to_string(order) +
+                " produced " + std::to_string(out.size()) + " nodes");
+  return out;
 }
 
 std::vector<int> nodePermutationFromGmsh(CellType type, int order, NodeConvention convention) {
-  const std::vector<Lattice> gmsh = simplexLattice(type, order, NodeConvention::Gmsh);
-  const std::vector<Lattice> other = simplexLattice(type, order, convention);
-  std::map<Lattice, int> gmshIndex;
+  const std::vector<LatticePoint> gmsh = latticeOrder(type, order, NodeConvention::Gmsh);
+  const std::vector<LatticePoint> other = latticeOrder(type, order, convention);
+  std::map<LatticePoint, int> gmshIndex;
   for (int i = 0; i < static_cast<int>(gmsh.size()); ++i) gmshIndex[gmsh[i]] = i;
+  if (gmshIndex.size() != gmsh.size())
+    throw Error("node ordering of " + cellShortName(type) + " repeats a lattice point");
   std::vector<int> perm;
   perm.reserve(other.size());
-  for (const Lattice& a : other) perm.push_back(gmshIndex.at(a));
+  for (const LatticePoint& c : other) perm.push_back(gmshIndex.at(c));
   return perm;
+}
+
+std::array<int, 4> simplexBarycentric(const LatticePoint& c, int dim, int order) {
+  std::array<int, 4> a{0, 0, 0, 0};
+  a[0] = order;
+  for (int k = 0; k < dim; ++k) {
+    a[k + 1] = c[k];
+    a[0] -= c[k];
+  }
+  return a;
 }
 
 }  // namespace homesh

@@ -1,15 +1,19 @@
-// Node orderings of complete Lagrange simplices (line, triangle, tetrahedron).
+// Node orderings of complete Lagrange elements (line, triangle, quadrilateral, tetrahedron,
+// prism, hexahedron) in Gmsh's and VTK's conventions.
 //
-// A node of an order-P simplex is named by its integer barycentric coordinates (a_0, ..., a_d),
-// a_k >= 0, sum a_k = P: node position = sum_k (a_k / P) * vertex_k for equispaced nodes, and the
-// same lattice index names the corresponding node of any symmetric node set. Vertex k of the
-// reference simplex is the origin for k = 0 and the k-th unit vector otherwise.
+// A node of an order-P element is named by its integer lattice point c = (i, j, k): its
+// equispaced reference position is c / P (unused coordinates are 0). Vertices are at the
+// corners: triangle (0,0) (P,0) (0,P); quadrilateral (0,0) (P,0) (P,P) (0,P); tetrahedron the
+// origin and P times the unit vectors; prism the triangle at k = 0 then at k = P; hexahedron the
+// quadrilateral at k = 0 then at k = P. Any node set (equispaced, GLL, warp & blend) names its
+// nodes by the same lattice points, so connectivity does not depend on the node set.
 //
-// Both Gmsh and VTK order nodes as: vertices, edge interiors (edge by edge, from the edge's first
-// vertex to its second), face interiors (each a recursively ordered triangle of order P-3 whose
-// vertices are the face's vertices in the listed order), then the cell interior (recursively, a
-// simplex of order P-4 for a tetrahedron). They differ only in the edge and face lists. The C++
-// tests check the Gmsh order against Gmsh's getElementProperties up to order 10; the Python
+// Gmsh orders nodes as vertices, edge interiors (edge by edge, from its first vertex to its
+// second), face interiors (each a recursively ordered triangle or quadrilateral on the face's
+// vertices in Gmsh's face order) and the cell interior (recursively; for prisms, triangle
+// interior by line interior). VTK uses the same recursion for triangles and tetrahedra with
+// other edge/face lists, and row-major (i fastest) interiors for quadrilaterals, hexahedra and
+// wedges. The C++ tests check the Gmsh order against Gmsh's getElementProperties; the Python
 // tests (tests/python/test_vtk_reading.py) check the VTK order by letting VTK interpolate our
 // VTU cells.
 #pragma once
@@ -23,14 +27,17 @@ namespace homesh {
 
 enum class NodeConvention { Gmsh, Vtk };
 
-// Integer barycentric coordinates; entries beyond the simplex dimension are zero.
-using Lattice = std::array<int, 4>;
+using LatticePoint = std::array<int, 3>;
 
-// The lattice of every node of a Line, Triangle or Tetrahedron of the given order, in the node
-// order of `convention`. Throws ParameterError for other shapes or order < 1.
-std::vector<Lattice> simplexLattice(CellType type, int order, NodeConvention convention);
+// The lattice point of every node of a shape of the given order, in `convention`'s order.
+// Throws ParameterError for unsupported shapes or order < 1.
+std::vector<LatticePoint> latticeOrder(CellType type, int order, NodeConvention convention);
 
 // perm[i] = index, in Gmsh order, of the i-th node in `convention` order.
 std::vector<int> nodePermutationFromGmsh(CellType type, int order, NodeConvention convention);
+
+// Integer barycentric coordinates (a0, a1, ..., ad) of a simplex lattice point: a_k = c_{k-1}
+// for k >= 1 and a0 = P - sum. For simplices only.
+std::array<int, 4> simplexBarycentric(const LatticePoint& c, int dim, int order);
 
 }  // namespace homesh

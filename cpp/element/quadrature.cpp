@@ -52,7 +52,7 @@ void unitGaussJacobi(int n, double alpha, std::vector<double>& q, std::vector<do
 
 }  // namespace
 
-QuadratureRule simplexQuadrature(CellType type, int degree) {
+QuadratureRule quadratureRule(CellType type, int degree) {
   if (degree < 0) throw ParameterError("quadrature degree must be >= 0");
   const int n = degree / 2 + 1;  // n-point Gauss rules are exact to degree 2n-1 >= degree
   QuadratureRule rule;
@@ -90,8 +90,35 @@ QuadratureRule simplexQuadrature(CellType type, int degree) {
             rule.weights.push_back(wp[i] * wq[j] * wr[k]);
           }
       return rule;
+    case CellType::Quadrilateral:
+      rule.dim = 2;
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          rule.points.insert(rule.points.end(), {p[i], p[j]});
+          rule.weights.push_back(wp[i] * wp[j]);
+        }
+      return rule;
+    case CellType::Hexahedron:
+      rule.dim = 3;
+      for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+          for (int i = 0; i < n; ++i) {
+            rule.points.insert(rule.points.end(), {p[i], p[j], p[k]});
+            rule.weights.push_back(wp[i] * wp[j] * wp[k]);
+          }
+      return rule;
+    case CellType::Prism: {
+      rule.dim = 3;
+      const QuadratureRule tri = quadratureRule(CellType::Triangle, degree);
+      for (int k = 0; k < n; ++k)
+        for (int t = 0; t < tri.size(); ++t) {
+          rule.points.insert(rule.points.end(), {tri.points[2 * t], tri.points[2 * t + 1], p[k]});
+          rule.weights.push_back(tri.weights[t] * wp[k]);
+        }
+      return rule;
+    }
     default:
-      throw ParameterError("no quadrature rule for " + cellShortName(type) + " yet");
+      throw ParameterError("no quadrature rule for " + cellShortName(type));
   }
 }
 

@@ -1,51 +1,50 @@
 #include "element/reference_element.hpp"
 
 #include <Eigen/LU>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <string>
-#include <utility>
+#include <tuple>
 
 #include "core/error.hpp"
-#include "element/simplex_basis.hpp"
+#include "element/orthogonal_basis.hpp"
 
 namespace homesh {
 
-namespace {
-constexpr int kMaxOrder = 10;
-}
-
-const ReferenceElement& ReferenceElement::get(CellType type, int order) {
+const ReferenceElement& ReferenceElement::get(CellType type, int order, NodeSet set) {
   static std::mutex mutex;
-  static std::map<std::pair<CellType, int>, std::unique_ptr<ReferenceElement>> cache;
+  static std::map<std::tuple<CellType, int, NodeSet>, std::unique_ptr<ReferenceElement>> cache;
   const std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[{type, order}];
-  if (!slot) slot = std::make_unique<ReferenceElement>(type, order);
+  auto& slot = cache[{type, order, set}];
+  if (!slot) slot = std::make_unique<ReferenceElement>(type, order, set);
   return *slot;
 }
 
-ReferenceElement::ReferenceElement(CellType type, int order)
-    : type_(type), order_(order), dim_(cellDimension(type)) {
+ReferenceElement::ReferenceElement(CellType type, int order, NodeSet set)
+    : type_(type), order_(order), set_(set), dim_(cellDimension(type)) {
   if (order < 1 || order > kMaxOrder)
     throw ParameterError("element order must be in 1.." + std::to_string(kMaxOrder) + ", got " +
                          std::to_string(order));
-  lattice_ = simplexLattice(type, order, NodeConvention::Gmsh);
+  lattice_ = latticeOrder(type, order, NodeConvention::Gmsh);
+  nodes_ = nodeCoordinates(type, order, set, lattice_);
   const int n = numNodes();
-  nodes_.resize(n, dim_);
-  for (int i = 0; i < n; ++i)
-    for (int k = 0; k < dim_; ++k) nodes_(i, k) = static_cast<double>(lattice_[i][k + 1]) / order;
-
   Eigen::MatrixXd vandermonde(n, n);
   Eigen::VectorXd psi;
   Eigen::MatrixXd dpsi;
   for (int i = 0; i < n; ++i) {
     const Eigen::VectorXd xi = nodes_.row(i).transpose();
-    simplexBasis(type, order, xi.data(), psi, dpsi);
+    orthogonalBasis(type, order, xi.data(), psi, dpsi);
+    if (psi.size() != n)
+      throw Error("reference element: basis size " + std::to_string(psi.size()) + " for " +
+                  std::to_string(n) + " nodes of " + cellShortName(type));
     vandermonde.row(i) = psi.transpose();
   }
-  const Eigen::FullPivLU<Eigen::MatrixXd> lu(vandermonde);
-  if (!lu.isInvertible())
+  // The orthogonal basis keeps V well conditioned; partial pivoting is enough and much faster
+  // than full pivoting for the 1331 x 1331 matrix of the order-10 hexahedron.
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(vandermonde);
+  if (!(std::abs(lu.determinant()) > 0.0))
     throw Error("reference element: singular Vandermonde matrix for " + cellShortName(type) +
                 " of order " + std::to_string(order));
   inverseVandermonde_ = lu.inverse();
@@ -55,9 +54,41 @@ void ReferenceElement::evaluate(const double* xi, Eigen::VectorXd& values,
                                 Eigen::MatrixXd& gradients) const {
   Eigen::VectorXd psi;
   Eigen::MatrixXd dpsi;
-  simplexBasis(type_, order_, xi, psi, dpsi);
+  orthogonalBasis(type_, order_, xi, psi, dpsi);
   values.noalias() = inverseVandermonde_.transpose() * psi;
   gradients.noalias() = inverseVandermonde_.transpose() * dpsi;
+}
+
+Eigen::MatrixXd ReferenceElement::valuesAt(const Eigen::MatrixXd& points) const {
+  Eigen::MatrixXd out(points.rows(), numNodes());
+  Eigen::VectorXd values;
+  Eigen::MatrixXd gradients;
+  for (Eigen::Index r = 0; r < points.rows(); ++r) {
+    const Eigen::VectorXd xi = points.row(r).transpose();
+    evaluate(xi.data(), values, gradients);
+    out.row(r) = values.transpose();
+  }
+  return out;
+}
+
+double ReferenceElement::lebesgueConstant(int samples) const {
+  const std::vector<LatticePoint> lattice = samplingLattice(type_, samples);
+  Eigen::MatrixXd points = nodeCoordinates(type_, samples, NodeSet::Equispaced, lattice);
+  return valuesAt(points).cwiseAbs().rowwise().sum().maxCoeff();
+}
+
+std::vector<LatticePoint> samplingLattice(CellType type, int n) {
+  std::vector<LatticePoint> points;
+  const int dim = cellDimension(type);
+  for (int k = 0; k <= (dim > 2 ? n : 0); ++k)
+    for (int j = 0; j <= (dim > 1 ? n : 0); ++j)
+      for (int i = 0; i <= n; ++i) {
+        const bool inside = (type == CellType::Triangle || type == CellType::Prism)
+                                ? i + j <= n
+                                : (type == CellType::Tetrahedron ? i + j + k <= n : true);
+        if (inside) points.push_back({i, j, k});
+      }
+  return points;
 }
 
 }  // namespace homesh

@@ -1,10 +1,9 @@
 // Reference Lagrange elements: node positions and the nodal basis with its derivatives.
 //
-// Nodes are in Gmsh's order (element/node_ordering.hpp) on the unit reference simplex. The
-// nodal basis is l(xi)^T = psi(xi)^T V^{-1} with psi the orthogonal simplex basis and
-// V_ij = psi_j(node_i), which stays well conditioned at high order. Node sets are equispaced for
-// now; the lattice indices let a better-conditioned symmetric set replace them without changing
-// connectivity.
+// Nodes are in Gmsh's order (element/node_ordering.hpp) on the unit reference shape, placed by
+// a node set (element/node_sets.hpp). The nodal basis is l(xi)^T = psi(xi)^T V^{-1} with psi
+// the orthogonal basis of the shape (element/orthogonal_basis.hpp) and V_ij = psi_j(node_i),
+// which stays well conditioned at high order.
 #pragma once
 
 #include <Eigen/Core>
@@ -12,24 +11,28 @@
 
 #include "core/cell_type.hpp"
 #include "element/node_ordering.hpp"
+#include "element/node_sets.hpp"
 
 namespace homesh {
 
+inline constexpr int kMaxOrder = 10;
+
 class ReferenceElement {
  public:
-  // The shared, immutable element for a shape and order (built on first use; thread-safe).
-  // Throws ParameterError for shapes or orders the library does not provide.
-  static const ReferenceElement& get(CellType type, int order);
+  // The shared, immutable element for a shape, order and node set (built on first use;
+  // thread-safe). Throws ParameterError for shapes or orders the library does not provide.
+  static const ReferenceElement& get(CellType type, int order, NodeSet set = NodeSet::Equispaced);
 
-  ReferenceElement(CellType type, int order);
+  ReferenceElement(CellType type, int order, NodeSet set);
 
   CellType type() const { return type_; }
   int order() const { return order_; }
+  NodeSet nodeSet() const { return set_; }
   int dim() const { return dim_; }
   int numNodes() const { return static_cast<int>(lattice_.size()); }
 
-  // Integer barycentric index of each node (Gmsh order).
-  const std::vector<Lattice>& lattice() const { return lattice_; }
+  // Lattice point of each node (Gmsh order).
+  const std::vector<LatticePoint>& lattice() const { return lattice_; }
   // Reference coordinates, numNodes() x dim().
   const Eigen::MatrixXd& nodes() const { return nodes_; }
 
@@ -37,13 +40,25 @@ class ReferenceElement {
   // gradients (numNodes() x dim()).
   void evaluate(const double* xi, Eigen::VectorXd& values, Eigen::MatrixXd& gradients) const;
 
+  // Values of the basis at many points (rows of `points`): (points x numNodes()).
+  Eigen::MatrixXd valuesAt(const Eigen::MatrixXd& points) const;
+
+  // Lebesgue constant max_xi sum_n |l_n(xi)|, estimated on a lattice of `samples` points per
+  // edge (a measure of how well the node set interpolates; 1 is ideal).
+  double lebesgueConstant(int samples) const;
+
  private:
   CellType type_;
   int order_;
+  NodeSet set_;
   int dim_;
-  std::vector<Lattice> lattice_;
+  std::vector<LatticePoint> lattice_;
   Eigen::MatrixXd nodes_;
   Eigen::MatrixXd inverseVandermonde_;
 };
+
+// Lattice points of a shape at a sampling resolution (reference coordinates = point / n), used
+// to sample elements uniformly.
+std::vector<LatticePoint> samplingLattice(CellType type, int n);
 
 }  // namespace homesh

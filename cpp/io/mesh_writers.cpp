@@ -14,21 +14,9 @@
 #include "core/error.hpp"
 #include "element/node_ordering.hpp"
 #include "io/atomic_file.hpp"
+#include "io/gmsh_element_types.hpp"
 
 namespace homesh {
-
-int gmshElementType(CellType type, int order) {
-  static const std::map<CellType, std::array<int, 10>> codes = {
-      {CellType::Line, {1, 8, 26, 27, 28, 62, 63, 64, 65, 66}},
-      {CellType::Triangle, {2, 9, 21, 23, 25, 42, 43, 44, 45, 46}},
-      {CellType::Tetrahedron, {4, 11, 29, 30, 31, 71, 72, 73, 74, 75}},
-  };
-  const auto it = codes.find(type);
-  if (it == codes.end() || order < 1 || order > 10)
-    throw ParameterError("no Gmsh element type for " + cellShortName(type) + " of order " +
-                         std::to_string(order));
-  return it->second[order - 1];
-}
 
 namespace {
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/mesh.hpp"
+#include "io/gmsh_element_types.hpp"
 
 namespace homesh {
 
@@ -34,8 +35,5 @@ void checkMeshOutputPath(const std::string& path);
 
 // Chooses the format from the extension (.msh, .vtu); throws IoError for others.
 void writeMesh(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields);
-
-// Gmsh's element type code for a shape and order (1..10); throws ParameterError otherwise.
-int gmshElementType(CellType type, int order);
 
 }  // namespace homesh

@@ -12,7 +12,7 @@ namespace homesh {
 JacobianSampler::JacobianSampler(CellType type, int order) : dim_(cellDimension(type)) {
   if (dim_ < 1) throw Error("Jacobian sampling needs a 1D, 2D or 3D cell");
   const ReferenceElement& ref = ReferenceElement::get(type, order);
-  const QuadratureRule rule = simplexQuadrature(type, 2 * order + 2);
+  const QuadratureRule rule = quadratureRule(type, 2 * order + 2);
   const int n = ref.numNodes();
   const int samples = rule.size() + n;
   dxi_.assign(dim_, Eigen::MatrixXd(samples, n));

@@ -1,99 +1,201 @@
-// The nodal basis reproduces polynomials; quadrature integrates monomials exactly.
+// The element library on every shape and order 1..10, with both node sets: the nodal basis
+// reproduces the polynomials of its space and differentiates them exactly, quadrature is exact
+// to its degree, and the optimal node sets interpolate well (Lebesgue constants).
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
 #include <cmath>
 #include <random>
 
+#include "element/node_sets.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 
 namespace homesh {
 namespace {
 
+const CellType kShapes[] = {CellType::Line,        CellType::Triangle, CellType::Quadrilateral,
+                            CellType::Tetrahedron, CellType::Prism,    CellType::Hexahedron};
+
 double factorial(int n) {
   return std::tgamma(n + 1.0);
 }
 
-// Exact integral of x^a y^b z^c over the unit simplex of dimension dim.
-double monomialIntegral(int dim, int a, int b, int c) {
-  return factorial(a) * factorial(b) * factorial(c) / factorial(a + b + c + dim);
+struct Monomial {
+  int e[3];
+};
+
+// The monomials x^a y^b z^c spanning the shape's polynomial space of degree p.
+std::vector<Monomial> monomials(CellType type, int p) {
+  const int dim = cellDimension(type);
+  std::vector<Monomial> out;
+  for (int c = 0; c <= (dim > 2 ? p : 0); ++c)
+    for (int b = 0; b <= (dim > 1 ? p : 0); ++b)
+      for (int a = 0; a <= p; ++a) {
+        const bool simplex =
+            type == CellType::Triangle || type == CellType::Tetrahedron || type == CellType::Line;
+        if (simplex && a + b + c > p) continue;
+        if (type == CellType::Prism && a + b > p) continue;
+        out.push_back({{a, b, c}});
+      }
+  return out;
 }
 
-double monomial(const double* x, int dim, int a, int b, int c) {
-  double v = std::pow(x[0], a);
-  if (dim > 1) v *= std::pow(x[1], b);
-  if (dim > 2) v *= std::pow(x[2], c);
+double evaluate(const Monomial& m, const double* x, int dim) {
+  double v = 1.0;
+  for (int k = 0; k < dim; ++k) v *= std::pow(x[k], m.e[k]);
   return v;
 }
 
-class SimplexShapes : public ::testing::TestWithParam<CellType> {};
-
-TEST_P(SimplexShapes, QuadratureIsExactToItsDegree) {
-  const CellType type = GetParam();
-  const int dim = cellDimension(type);
-  for (int degree = 0; degree <= 22; ++degree) {
-    const QuadratureRule rule = simplexQuadrature(type, degree);
-    for (int a = 0; a <= degree; ++a)
-      for (int b = 0; a + b <= degree && (dim > 1 || b == 0); ++b)
-        for (int c = 0; a + b + c <= degree && (dim > 2 || c == 0); ++c) {
-          double sum = 0.0;
-          for (int q = 0; q < rule.size(); ++q)
-            sum += rule.weights[q] *
-                   monomial(&rule.points[static_cast<std::size_t>(q) * dim], dim, a, b, c);
-          EXPECT_NEAR(sum, monomialIntegral(dim, a, b, c), 1e-13)
-              << "degree " << degree << " monomial " << a << b << c;
-        }
+double exactIntegral(CellType type, const Monomial& m) {
+  const int a = m.e[0], b = m.e[1], c = m.e[2];
+  switch (type) {
+    case CellType::Line:
+      return 1.0 / (a + 1);
+    case CellType::Triangle:
+      return factorial(a) * factorial(b) / factorial(a + b + 2);
+    case CellType::Tetrahedron:
+      return factorial(a) * factorial(b) * factorial(c) / factorial(a + b + c + 3);
+    case CellType::Quadrilateral:
+      return 1.0 / ((a + 1) * (b + 1));
+    case CellType::Hexahedron:
+      return 1.0 / ((a + 1) * (b + 1) * (c + 1));
+    case CellType::Prism:
+      return factorial(a) * factorial(b) / factorial(a + b + 2) / (c + 1);
+    default:
+      return 0.0;
   }
 }
 
-TEST_P(SimplexShapes, BasisReproducesPolynomialsAndDerivatives) {
+// A random point inside the reference shape.
+std::vector<double> randomPoint(CellType type, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<double> x(cellDimension(type));
+  for (double& v : x) v = u(rng);
+  const int simplexDims = type == CellType::Triangle || type == CellType::Prism     ? 2
+                          : type == CellType::Tetrahedron || type == CellType::Line ? x.size()
+                                                                                    : 0;
+  double s = 0.0;
+  for (int k = 0; k < simplexDims; ++k) s += x[k];
+  if (s > 1.0)
+    for (int k = 0; k < simplexDims; ++k) x[k] /= s + 1e-3;
+  return x;
+}
+
+std::string shapeName(const ::testing::TestParamInfo<CellType>& param) {
+  return cellShortName(param.param);
+}
+
+class Shapes : public ::testing::TestWithParam<CellType> {};
+
+TEST_P(Shapes, QuadratureIsExactToItsDegree) {
   const CellType type = GetParam();
   const int dim = cellDimension(type);
-  std::mt19937 rng(42);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  for (int p = 1; p <= 10; ++p) {
-    const ReferenceElement& ref = ReferenceElement::get(type, p);
-    Eigen::VectorXd values;
-    Eigen::MatrixXd gradients;
-    for (int trial = 0; trial < 5; ++trial) {
-      double xi[3] = {uniform(rng), uniform(rng), uniform(rng)};
-      double s = 0.0;
-      for (int k = 0; k < dim; ++k) s += xi[k];
-      if (s > 1.0)
-        for (int k = 0; k < dim; ++k) xi[k] /= (s + 1e-3);
-      ref.evaluate(xi, values, gradients);
-      // Every monomial of total degree <= p, interpolated at the nodes.
-      for (int a = 0; a <= p; ++a)
-        for (int b = 0; a + b <= p && (dim > 1 || b == 0); ++b)
-          for (int c = 0; a + b + c <= p && (dim > 2 || c == 0); ++c) {
-            double f = 0.0, df[3] = {0.0, 0.0, 0.0};
-            for (int n = 0; n < ref.numNodes(); ++n) {
-              const Eigen::VectorXd node = ref.nodes().row(n).transpose();
-              const double fn = monomial(node.data(), dim, a, b, c);
-              f += values(n) * fn;
-              for (int k = 0; k < dim; ++k) df[k] += gradients(n, k) * fn;
-            }
-            EXPECT_NEAR(f, monomial(xi, dim, a, b, c), 1e-10) << "order " << p;
-            const int e[3] = {a, b, c};
-            for (int k = 0; k < dim; ++k) {
-              if (e[k] == 0) {
-                EXPECT_NEAR(df[k], 0.0, 1e-9) << "order " << p;
-                continue;
-              }
-              int ee[3] = {a, b, c};
-              ee[k] -= 1;
-              const double exact = e[k] * monomial(xi, dim, ee[0], ee[1], ee[2]);
-              EXPECT_NEAR(df[k], exact, 1e-9) << "order " << p;
-            }
-          }
+  for (int degree = 0; degree <= 22; ++degree) {
+    const QuadratureRule rule = quadratureRule(type, degree);
+    for (const Monomial& m : monomials(type, degree)) {
+      double sum = 0.0;
+      for (int q = 0; q < rule.size(); ++q)
+        sum += rule.weights[q] * evaluate(m, &rule.points[static_cast<std::size_t>(q) * dim], dim);
+      ASSERT_NEAR(sum, exactIntegral(type, m), 1e-13)
+          << "degree " << degree << " monomial " << m.e[0] << m.e[1] << m.e[2];
     }
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(All, SimplexShapes,
-                         ::testing::Values(CellType::Line, CellType::Triangle,
-                                           CellType::Tetrahedron));
+TEST_P(Shapes, BasisReproducesItsPolynomialsAndTheirDerivatives) {
+  const CellType type = GetParam();
+  const int dim = cellDimension(type);
+  std::mt19937 rng(7);
+  for (const NodeSet set : {NodeSet::Equispaced, NodeSet::Optimal})
+    for (int p = 1; p <= 10; ++p) {
+      const ReferenceElement& ref = ReferenceElement::get(type, p, set);
+      const std::vector<Monomial> space = monomials(type, p);
+      ASSERT_EQ(space.size(), static_cast<std::size_t>(ref.numNodes()));
+      // Nodal values of every monomial: (nodes x monomials).
+      Eigen::MatrixXd nodal(ref.numNodes(), space.size());
+      for (int n = 0; n < ref.numNodes(); ++n) {
+        const Eigen::VectorXd x = ref.nodes().row(n).transpose();
+        for (std::size_t m = 0; m < space.size(); ++m)
+          nodal(n, m) = evaluate(space[m], x.data(), dim);
+      }
+      Eigen::VectorXd values;
+      Eigen::MatrixXd gradients;
+      for (int trial = 0; trial < 3; ++trial) {
+        const std::vector<double> xi = randomPoint(type, rng);
+        ref.evaluate(xi.data(), values, gradients);
+        const Eigen::VectorXd f = nodal.transpose() * values;
+        const Eigen::MatrixXd df = nodal.transpose() * gradients;  // monomials x dim
+        for (std::size_t m = 0; m < space.size(); ++m) {
+          ASSERT_NEAR(f(m), evaluate(space[m], xi.data(), dim), 1e-10)
+              << cellShortName(type) << " order " << p;
+          for (int k = 0; k < dim; ++k) {
+            Monomial d = space[m];
+            const double factor = d.e[k];
+            double exact = 0.0;
+            if (factor > 0) {
+              d.e[k] -= 1;
+              exact = factor * evaluate(d, xi.data(), dim);
+            }
+            ASSERT_NEAR(df(m, k), exact, 1e-9) << cellShortName(type) << " order " << p;
+          }
+        }
+      }
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(All, Shapes, ::testing::ValuesIn(kShapes),
+                         shapeName);
+
+TEST(NodeSets, OptimalSetsPutGllPointsOnEdgesAndTriangleNodesOnTetrahedronFaces) {
+  for (int p = 1; p <= 10; ++p) {
+    const std::vector<double> gll = gllPoints(p);
+    const ReferenceElement& tri = ReferenceElement::get(CellType::Triangle, p, NodeSet::Optimal);
+    const ReferenceElement& tet = ReferenceElement::get(CellType::Tetrahedron, p, NodeSet::Optimal);
+    // Edge (0, 0)-(P, 0) of the triangle: x = GLL point, y = 0.
+    for (int n = 0; n < tri.numNodes(); ++n)
+      if (tri.lattice()[n][1] == 0) {
+        EXPECT_NEAR(tri.nodes()(n, 0), gll[tri.lattice()[n][0]], 1e-13);
+        EXPECT_NEAR(tri.nodes()(n, 1), 0.0, 1e-13);
+      }
+    // The tetrahedron's face z = 0 carries exactly the triangle's nodes.
+    for (int n = 0; n < tet.numNodes(); ++n) {
+      if (tet.lattice()[n][2] != 0) continue;
+      for (int m = 0; m < tri.numNodes(); ++m)
+        if (tri.lattice()[m][0] == tet.lattice()[n][0] &&
+            tri.lattice()[m][1] == tet.lattice()[n][1]) {
+          EXPECT_NEAR(tet.nodes()(n, 0), tri.nodes()(m, 0), 1e-12) << "order " << p;
+          EXPECT_NEAR(tet.nodes()(n, 1), tri.nodes()(m, 1), 1e-12) << "order " << p;
+          EXPECT_NEAR(tet.nodes()(n, 2), 0.0, 1e-12);
+        }
+    }
+  }
+}
+
+TEST(NodeSets, TriangleLebesgueConstantAtOrderTen) {
+  const double optimal =
+      ReferenceElement::get(CellType::Triangle, 10, NodeSet::Optimal).lebesgueConstant(200);
+  const double equispaced =
+      ReferenceElement::get(CellType::Triangle, 10, NodeSet::Equispaced).lebesgueConstant(200);
+  std::printf("Lebesgue constant, order-10 triangle: warp & blend %.3f, equispaced %.3f\n", optimal,
+              equispaced);
+  RecordProperty("lebesgue_triangle_p10_warp_blend", std::to_string(optimal));
+  RecordProperty("lebesgue_triangle_p10_equispaced", std::to_string(equispaced));
+  EXPECT_LT(optimal, 10.0);
+  EXPECT_GT(equispaced, 4.0 * optimal);
+}
+
+TEST(NodeSets, TetrahedronOptimalSetInterpolatesBetterThanEquispaced) {
+  for (const int p : {6, 8, 10}) {
+    const double optimal =
+        ReferenceElement::get(CellType::Tetrahedron, p, NodeSet::Optimal).lebesgueConstant(40);
+    const double equispaced =
+        ReferenceElement::get(CellType::Tetrahedron, p, NodeSet::Equispaced).lebesgueConstant(40);
+    std::printf("Lebesgue constant, order-%d tetrahedron: warp & blend %.3f, equispaced %.3f\n", p,
+                optimal, equispaced);
+    EXPECT_LT(optimal, equispaced) << "order " << p;
+  }
+}
 
 }  // namespace
 }  // namespace homesh

@@ -1,4 +1,4 @@
-#include "element/simplex_basis.hpp"
+#include "element/orthogonal_basis.hpp"
 
 #include <array>
 #include <string>
@@ -136,21 +136,60 @@ void tetrahedronBasis(int p, const double* xi, Eigen::VectorXd& values, Eigen::M
   store<3>(funcs, values, grads);
 }
 
-}  // namespace
-
-int simplexBasisSize(CellType type, int order) {
-  switch (type) {
-    case CellType::Line:
-    case CellType::Triangle:
-    case CellType::Tetrahedron:
-      return cellNumNodes(type, order);
-    default:
-      throw ParameterError("no simplex basis for " + cellShortName(type));
-  }
+void quadrilateralBasis(int p, const double* xi, Eigen::VectorXd& values, Eigen::MatrixXd& grads) {
+  using D2 = Dual<2>;
+  D2 x = D2::affine(-1.0, {2.0, 0.0});
+  D2 y = D2::affine(-1.0, {0.0, 2.0});
+  x.at(xi);
+  y.at(xi);
+  const auto px = scaledJacobi<2>(p, 0.0, x, D2::constant(1.0));
+  const auto py = scaledJacobi<2>(p, 0.0, y, D2::constant(1.0));
+  std::vector<D2> funcs;
+  for (int j = 0; j <= p; ++j)
+    for (int i = 0; i <= p; ++i) funcs.push_back(px[i] * py[j]);
+  store<2>(funcs, values, grads);
 }
 
-void simplexBasis(CellType type, int order, const double* xi, Eigen::VectorXd& values,
-                  Eigen::MatrixXd& gradients) {
+void hexahedronBasis(int p, const double* xi, Eigen::VectorXd& values, Eigen::MatrixXd& grads) {
+  using D3 = Dual<3>;
+  D3 x = D3::affine(-1.0, {2.0, 0.0, 0.0});
+  D3 y = D3::affine(-1.0, {0.0, 2.0, 0.0});
+  D3 z = D3::affine(-1.0, {0.0, 0.0, 2.0});
+  for (D3* d : {&x, &y, &z}) d->at(xi);
+  const auto px = scaledJacobi<3>(p, 0.0, x, D3::constant(1.0));
+  const auto py = scaledJacobi<3>(p, 0.0, y, D3::constant(1.0));
+  const auto pz = scaledJacobi<3>(p, 0.0, z, D3::constant(1.0));
+  std::vector<D3> funcs;
+  for (int k = 0; k <= p; ++k)
+    for (int j = 0; j <= p; ++j) {
+      const D3 yz = py[j] * pz[k];
+      for (int i = 0; i <= p; ++i) funcs.push_back(px[i] * yz);
+    }
+  store<3>(funcs, values, grads);
+}
+
+void prismBasis(int p, const double* xi, Eigen::VectorXd& values, Eigen::MatrixXd& grads) {
+  using D3 = Dual<3>;
+  D3 au = D3::affine(-1.0, {2.0, 1.0, 0.0});  // a u = 2x + y - 1 (triangle factor)
+  D3 u = D3::affine(1.0, {0.0, -1.0, 0.0});   // u = 1 - y
+  D3 b = D3::affine(-1.0, {0.0, 2.0, 0.0});   // b = 2y - 1
+  D3 z = D3::affine(-1.0, {0.0, 0.0, 2.0});
+  for (D3* d : {&au, &u, &b, &z}) d->at(xi);
+  const auto qi = scaledJacobi<3>(p, 0.0, au, u);
+  const auto pz = scaledJacobi<3>(p, 0.0, z, D3::constant(1.0));
+  std::vector<D3> funcs;
+  for (int k = 0; k <= p; ++k)
+    for (int i = 0; i <= p; ++i) {
+      const auto rj = scaledJacobi<3>(p - i, 2.0 * i + 1.0, b, D3::constant(1.0));
+      for (int j = 0; i + j <= p; ++j) funcs.push_back(qi[i] * rj[j] * pz[k]);
+    }
+  store<3>(funcs, values, grads);
+}
+
+}  // namespace
+
+void orthogonalBasis(CellType type, int order, const double* xi, Eigen::VectorXd& values,
+                     Eigen::MatrixXd& gradients) {
   if (order < 0) throw ParameterError("basis order must be >= 0");
   switch (type) {
     case CellType::Line:
@@ -159,8 +198,14 @@ void simplexBasis(CellType type, int order, const double* xi, Eigen::VectorXd& v
       return triangleBasis(order, xi, values, gradients);
     case CellType::Tetrahedron:
       return tetrahedronBasis(order, xi, values, gradients);
+    case CellType::Quadrilateral:
+      return quadrilateralBasis(order, xi, values, gradients);
+    case CellType::Hexahedron:
+      return hexahedronBasis(order, xi, values, gradients);
+    case CellType::Prism:
+      return prismBasis(order, xi, values, gradients);
     default:
-      throw ParameterError("no simplex basis for " + cellShortName(type));
+      throw ParameterError("no polynomial basis for " + cellShortName(type));
   }
 }
 
