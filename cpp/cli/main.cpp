@@ -13,6 +13,7 @@
 #include "io/atomic_file.hpp"
 #include "io/mesh_writers.hpp"
 #include "pipeline/mesh_pipeline.hpp"
+#include "pipeline/report.hpp"
 
 namespace {
 
@@ -57,7 +58,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
                  "homesh: %zu nodes, %zu elements of order %d; scaled Jacobian min %.4f mean "
                  "%.4f; %zu invalid\n",
                  result.mesh.numNodes(), result.mesh.numElements(), result.mesh.order,
-                 result.quality.min, result.quality.mean, result.quality.invalid);
+                 result.quality.scaled.min, result.quality.scaled.mean, result.quality.invalid);
     for (const std::string& path : cmd.outputs)
       std::fprintf(stderr, "homesh: wrote %s\n", path.c_str());
   }

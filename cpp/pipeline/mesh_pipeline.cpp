@@ -10,7 +10,6 @@
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "curving/order_elevation.hpp"
-#include "io/json_writer.hpp"
 #include "linear/linear_mesher.hpp"
 
 namespace homesh {
@@ -116,7 +115,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   highOrder.done();
 
   StageClock quality("quality", result.timings, observer);
-  result.quality = evaluateQuality(result.mesh);
+  result.quality = evaluateQuality(result.mesh, options.threads);
   quality.done();
   return result;
 }
@@ -138,46 +137,6 @@ void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,
   StageClock output("output", result.timings, observer);
   writeMeshFiles(result, paths);
   output.done();
-}
-
-std::string meshReportJson(const MeshResult& result, const std::string& input) {
-  const Mesh& mesh = result.mesh;
-  std::map<std::string, std::size_t> elements = {{"tet", 0}, {"prism", 0}, {"pyramid", 0},
-                                                 {"hex", 0}, {"tri", 0},   {"quad", 0}};
-  std::map<std::string, std::size_t> boundary;
-  for (const ElementBlock& block : mesh.blocks) {
-    if (cellDimension(block.type) == mesh.dim)
-      elements[cellShortName(block.type)] += block.count();
-    else
-      boundary[cellShortName(block.type)] += block.count();
-  }
-  JsonWriter json;
-  json.beginObject();
-  json.value("input", input);
-  json.value("dimension", mesh.dim);
-  json.value("order", mesh.order);
-  json.value("size", result.options.size.value_or(0.0));
-  json.value("nodes", mesh.numNodes());
-  json.beginObject("elements");
-  for (const char* name : {"tet", "prism", "pyramid", "hex", "tri", "quad"})
-    json.value(name, elements[name]);
-  json.endObject();
-  json.beginObject("boundary");
-  for (const auto& [name, count] : boundary) json.value(name, count);
-  json.endObject();
-  json.beginObject("quality");
-  json.beginObject("scaled_jacobian");
-  json.value("min", result.quality.min);
-  json.value("mean", result.quality.mean);
-  json.endObject();
-  json.value("invalid_elements", result.quality.invalid);
-  json.value("sampling", "quadrature points of degree 2P+2 and nodes");
-  json.endObject();
-  json.beginObject("timings_s");
-  for (const auto& [stage, s] : result.timings.seconds) json.value(stage, s);
-  json.endObject();
-  json.endObject();
-  return json.str();
 }
 
 }  // namespace homesh

@@ -16,7 +16,7 @@
 #include "cad/cad_model.hpp"
 #include "core/mesh.hpp"
 #include "io/mesh_writers.hpp"
-#include "quality/jacobian_quality.hpp"
+#include "quality/mesh_quality.hpp"
 
 namespace homesh {
 
@@ -86,8 +86,5 @@ void writeMeshFiles(const MeshResult& result, const std::vector<std::string>& pa
 // writeMeshFiles as the pipeline's last stage: records its "output" timing in the result.
 void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,
                       PipelineObserver* observer = nullptr);
-
-// The JSON report (schema in README.md): order, counts, quality, timings and the inputs.
-std::string meshReportJson(const MeshResult& result, const std::string& input);
 
 }  // namespace homesh

@@ -17,6 +17,7 @@
 #include "core/version.hpp"
 #include "element/reference_element.hpp"
 #include "pipeline/mesh_pipeline.hpp"
+#include "pipeline/report.hpp"
 
 namespace bp = boost::python;
 namespace np = boost::python::numpy;
@@ -180,20 +181,28 @@ class PyMesh {
   bp::dict qualitySummary() const {
     const QualitySummary& q = result_->quality;
     bp::dict d;
-    d["min"] = q.min;
-    d["mean"] = q.mean;
+    d["min"] = q.scaled.min;
+    d["mean"] = q.scaled.mean;
+    d["distortion_min"] = q.distortionSummary.min;
+    d["distortion_mean"] = q.distortionSummary.mean;
     d["invalid_elements"] = q.invalid;
+    d["undecided_elements"] = q.undecided;
+    d["certified"] = q.certified;
     bp::dict byType;
     for (const auto& [type, t] : q.byType) {
       bp::dict e;
       e["count"] = t.count;
-      e["min"] = t.min;
-      e["mean"] = t.mean;
+      e["min"] = t.scaledJacobian.min;
+      e["mean"] = t.scaledJacobian.mean;
       e["invalid_elements"] = t.invalid;
       byType[cellShortName(type)] = e;
     }
     d["by_type"] = byType;
     return d;
+  }
+
+  np::ndarray distortion() const {
+    return toArray(result_->quality.distortion, result_->quality.distortion.size(), 0);
   }
 
   bp::dict timings() const {
@@ -338,6 +347,7 @@ BOOST_PYTHON_MODULE(_core) {
       .def("node_cad_params", &PyMesh::nodeCadParams)
       .def("blocks", &PyMesh::blocks)
       .def("scaled_jacobian", &PyMesh::scaledJacobian)
+      .def("distortion", &PyMesh::distortion)
       .def("quality_summary", &PyMesh::qualitySummary)
       .def("timings", &PyMesh::timings)
       .def("write", &PyMesh::write)

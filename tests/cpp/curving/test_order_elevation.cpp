@@ -9,7 +9,7 @@
 #include "curving/order_elevation.hpp"
 #include "element/reference_element.hpp"
 #include "linear/linear_mesher.hpp"
-#include "quality/jacobian_quality.hpp"
+#include "quality/mesh_quality.hpp"
 #include "test_support.hpp"
 
 namespace homesh {
@@ -125,7 +125,7 @@ TEST(OrderElevation, WithoutCadTheElementsStayStraight) {
     }
   }
   const QualitySummary q = evaluateQuality(mesh);
-  EXPECT_NEAR(q.min, 1.0, 1e-9);
+  EXPECT_NEAR(q.scaled.min, 1.0, 1e-9);
   EXPECT_EQ(q.invalid, 0u);
 }
 

@@ -14,7 +14,7 @@
 #include "io/json_writer.hpp"
 #include "io/mesh_writers.hpp"
 #include "linear/linear_mesher.hpp"
-#include "quality/jacobian_quality.hpp"
+#include "quality/mesh_quality.hpp"
 #include "test_support.hpp"
 
 namespace homesh {

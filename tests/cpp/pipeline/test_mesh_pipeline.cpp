@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "pipeline/mesh_pipeline.hpp"
+#include "pipeline/report.hpp"
 #include "test_support.hpp"
 
 namespace homesh {

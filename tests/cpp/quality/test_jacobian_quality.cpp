@@ -1,70 +1,177 @@
-// Sampled scaled Jacobian: exact for straight elements, detects a fold, 2D orientation.
+// Quality measures: exact on straight elements of every shape, certified validity (Bezier
+// bounds) that catches a negative Jacobian hidden between sample points, distortion, and the
+// mesh-wide summary.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "core/error.hpp"
+#include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
-#include "quality/jacobian_quality.hpp"
+#include "quality/bezier_jacobian.hpp"
+#include "quality/distortion.hpp"
+#include "quality/mesh_quality.hpp"
 
 namespace homesh {
 namespace {
 
-// One straight tetrahedron of order p on the reference vertices scaled and sheared.
-Mesh straightTet(int p) {
-  Mesh mesh;
-  mesh.dim = 3;
-  mesh.order = p;
-  const ReferenceElement& ref = ReferenceElement::get(CellType::Tetrahedron, p);
+const CellType kVolumeShapes[] = {CellType::Tetrahedron, CellType::Prism, CellType::Hexahedron};
+
+// One element of the given shape and order: the reference element mapped by an affine map
+// (sheared and scaled), optionally with node i moved by `shift`.
+NodeCoordinates affineElement(CellType type, int order) {
+  const ReferenceElement& ref = ReferenceElement::get(type, order);
   Eigen::Matrix3d a;
   a << 2.0, 0.3, 0.1, 0.0, 1.5, -0.2, 0.0, 0.0, 0.7;
-  ElementBlock block;
-  block.type = CellType::Tetrahedron;
-  block.order = p;
+  NodeCoordinates x(ref.numNodes(), 3);
   for (int n = 0; n < ref.numNodes(); ++n) {
-    const Eigen::Vector3d x = a * ref.nodes().row(n).transpose() + Eigen::Vector3d(1, 2, 3);
-    block.nodes.push_back(mesh.addNode(x.data(), 3, 1, NAN, NAN));
+    Eigen::Vector3d xi = Eigen::Vector3d::Zero();
+    xi.head(ref.dim()) = ref.nodes().row(n).transpose();
+    x.row(n) = (a * xi + Eigen::Vector3d(1, 2, 3)).transpose();
+  }
+  return x;
+}
+
+Mesh singleElementMesh(CellType type, int order, const NodeCoordinates& x) {
+  Mesh mesh;
+  mesh.dim = cellDimension(type);
+  mesh.order = order;
+  ElementBlock block;
+  block.type = type;
+  block.order = order;
+  for (int n = 0; n < x.rows(); ++n) {
+    const Eigen::Vector3d p = x.row(n).transpose();
+    block.nodes.push_back(mesh.addNode(p.data(), 3, 1, NAN, NAN));
   }
   block.entity.push_back(1);
   mesh.blocks.push_back(block);
   return mesh;
 }
 
-TEST(JacobianQuality, StraightElementsScoreOne) {
-  for (int p = 1; p <= 10; ++p) {
-    const QualitySummary q = evaluateQuality(straightTet(p));
-    ASSERT_EQ(q.scaledJacobian.size(), 1u);
-    EXPECT_NEAR(q.scaledJacobian[0], 1.0, 1e-9) << "order " << p;
-    EXPECT_EQ(q.invalid, 0u);
+TEST(Quality, StraightElementsScoreOneAndAreCertifiedValid) {
+  // An affine map keeps J constant: min J / max J = 1 exactly.
+  for (const CellType type : {CellType::Tetrahedron, CellType::Prism, CellType::Hexahedron,
+                              CellType::Triangle, CellType::Quadrilateral})
+    for (int p = 1; p <= 5; ++p) {
+      const NodeCoordinates x = affineElement(type, p);
+      const Eigen::Vector3d normal(0, 0, 1);
+      const JacobianBounds b =
+          boundJacobian(type, p, x, cellDimension(type) == 2 ? &normal : nullptr);
+      EXPECT_EQ(b.validity, Validity::Valid) << cellShortName(type) << " order " << p;
+      EXPECT_TRUE(b.certified);
+      EXPECT_NEAR(b.scaledJacobian(), 1.0, 1e-9) << cellShortName(type) << " order " << p;
+      EXPECT_NEAR(b.minLower, b.maxUpper, 1e-9 * std::abs(b.maxUpper));
+      EXPECT_NEAR(elementDistortion(type, p, x), 1.0, 1e-9);
+    }
+}
+
+TEST(Quality, HexahedronBoundsEncloseTheSampledJacobian) {
+  // A trilinear hexahedron with one corner pulled out: J varies; the certified bounds must
+  // enclose every value of J on a fine lattice and be tight (1e-4).
+  for (int p = 1; p <= 3; ++p) {
+    NodeCoordinates x = affineElement(CellType::Hexahedron, p);
+    const ReferenceElement& ref = ReferenceElement::get(CellType::Hexahedron, p);
+    for (int n = 0; n < ref.numNodes(); ++n) {
+      const Eigen::Vector3d xi = ref.nodes().row(n).transpose();
+      x.row(n) += 0.4 * xi.x() * xi.y() * xi.z() * Eigen::RowVector3d(1.0, 0.5, 0.8);
+    }
+    const JacobianBounds b = boundJacobian(CellType::Hexahedron, p, x, nullptr);
+    ASSERT_TRUE(b.certified);
+    EXPECT_EQ(b.validity, Validity::Valid);
+    const std::vector<LatticePoint> fine = samplingLattice(CellType::Hexahedron, 12);
+    const JacobianSampler sampler(
+        ref, nodeCoordinates(CellType::Hexahedron, 12, NodeSet::Equispaced, fine));
+    Eigen::VectorXd j;
+    sampler.jacobians(x, nullptr, j);
+    EXPECT_GE(j.minCoeff(), b.minLower - 1e-12);
+    EXPECT_LE(j.maxCoeff(), b.maxUpper + 1e-12);
+    EXPECT_LT(b.minUpper - b.minLower, 1e-4 * b.maxLower + 1e-12);
+    EXPECT_LT(b.maxUpper - b.maxLower, 1e-4 * b.maxLower + 1e-12);
+    EXPECT_LT(b.scaledJacobian(), 1.0);
   }
 }
 
-TEST(JacobianQuality, MovingAnEdgeNodeCurvesAndThenFoldsTheElement) {
-  // Order 2: node 4 is the midpoint of edge (0, 1). Pulling it towards the opposite edge makes
-  // J vary (0 < q < 1); pulling it past the element makes J negative at vertex 0.
-  Mesh mesh = straightTet(2);
-  const std::int64_t mid = mesh.blocks[0].nodes[4];
-  const Eigen::Vector3d start(mesh.xyz[3 * mid], mesh.xyz[3 * mid + 1], mesh.xyz[3 * mid + 2]);
-  const Eigen::Vector3d inward(0.0, 0.5, 0.3);
-  for (int c = 0; c < 3; ++c) mesh.xyz[3 * mid + c] = start[c] + 0.1 * inward[c];
-  const QualitySummary curved = evaluateQuality(mesh);
-  EXPECT_GT(curved.min, 0.0);
-  EXPECT_LT(curved.min, 0.999);
-  for (int c = 0; c < 3; ++c) mesh.xyz[3 * mid + c] = start[c] + 3.0 * inward[c];
-  const QualitySummary folded = evaluateQuality(mesh);
-  EXPECT_LT(folded.min, 0.0);
-  EXPECT_EQ(folded.invalid, 1u);
-  EXPECT_EQ(folded.byType.at(CellType::Tetrahedron).invalid, 1u);
+// J at the nodes and the points of a degree 2P+2 quadrature rule: what sampling checks.
+double sampledMinimum(CellType type, int order, const NodeCoordinates& x) {
+  const ReferenceElement& ref = ReferenceElement::get(type, order);
+  const QuadratureRule rule = quadratureRule(type, 2 * order + 2);
+  Eigen::MatrixXd points(rule.size() + ref.numNodes(), ref.dim());
+  for (int q = 0; q < rule.size(); ++q)
+    for (int k = 0; k < ref.dim(); ++k) points(q, k) = rule.points[q * ref.dim() + k];
+  points.bottomRows(ref.numNodes()) = ref.nodes();
+  Eigen::VectorXd j;
+  JacobianSampler(ref, points).jacobians(x, nullptr, j);
+  return j.minCoeff();
 }
 
-TEST(JacobianQuality, PlanarTrianglesAreSignedAgainstThePlaneNormal) {
+TEST(Quality, CertifiedCheckCatchesANegativeJacobianBetweenSamplePoints) {
+  // Push one face node of an order-3 tetrahedron until the certified minimum of J first
+  // crosses zero (bisection), then a little further: J is then negative in a small region
+  // that, in general position, contains no node and no quadrature point.
+  const CellType type = CellType::Tetrahedron;
+  const int p = 3;
+  const NodeCoordinates straight = affineElement(type, p);
+  bool found = false;
+  for (int node = 4; node < straight.rows() && !found; ++node)
+    for (const Eigen::RowVector3d& dir :
+         {Eigen::RowVector3d(0.3, 0.8, -0.5), Eigen::RowVector3d(-0.7, 0.2, 0.6),
+          Eigen::RowVector3d(0.1, -0.9, 0.4)}) {
+      const auto moved = [&](double t) {
+        NodeCoordinates x = straight;
+        x.row(node) += t * dir;
+        return x;
+      };
+      double lo = 0.0, hi = 4.0;
+      if (boundJacobian(type, p, moved(hi), nullptr).minLower > 0.0) continue;
+      for (int it = 0; it < 60; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (boundJacobian(type, p, moved(mid), nullptr).minLower > 0.0 ? lo : hi) = mid;
+      }
+      const NodeCoordinates x = moved(hi * 1.002);
+      const JacobianBounds b = boundJacobian(type, p, x, nullptr);
+      if (b.validity == Validity::Invalid && sampledMinimum(type, p, x) > 0.0) {
+        found = true;
+        EXPECT_LT(b.minUpper, 0.0);  // an actual point with J < 0 was found
+        const Mesh mesh = singleElementMesh(type, p, x);
+        const QualitySummary q = evaluateQuality(mesh);
+        EXPECT_EQ(q.invalid, 1u);
+        EXPECT_TRUE(q.certified);
+        EXPECT_LT(q.scaledJacobian[0], 0.0);
+        break;
+      }
+    }
+  EXPECT_TRUE(found) << "no element with a negative Jacobian hidden between samples was built";
+}
+
+TEST(Quality, FoldedElementIsCertifiedInvalid) {
+  // Order 2: node 4 is the midpoint of edge (0, 1). Pulled a little towards the element, J
+  // varies (0 < q < 1); pulled far past it, J is negative at vertex 0.
+  NodeCoordinates x = affineElement(CellType::Tetrahedron, 2);
+  const Eigen::RowVector3d inward(0.0, 0.5, 0.3);
+  const Eigen::RowVector3d start = x.row(4);
+  x.row(4) = start + 0.1 * inward;
+  const QualitySummary curved = evaluateQuality(singleElementMesh(CellType::Tetrahedron, 2, x));
+  EXPECT_GT(curved.scaled.min, 0.0);
+  EXPECT_LT(curved.scaled.min, 0.999);
+  EXPECT_GT(curved.distortionSummary.min, 0.0);
+  EXPECT_LT(curved.distortionSummary.min, 1.0);
+  x.row(4) = start + 3.0 * inward;
+  const QualitySummary folded = evaluateQuality(singleElementMesh(CellType::Tetrahedron, 2, x));
+  EXPECT_LT(folded.scaled.min, 0.0);
+  EXPECT_LT(folded.distortionSummary.min, 0.0);
+  EXPECT_EQ(folded.invalid, 1u);
+  EXPECT_EQ(folded.byType.at(CellType::Tetrahedron).invalid, 1u);
+  EXPECT_EQ(folded.scaled.histogram.below, 1u);
+}
+
+TEST(Quality, PlanarTrianglesAreSignedAgainstThePlaneNormal) {
   Mesh mesh;
   mesh.dim = 2;
   mesh.order = 1;
   const double pts[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   ElementBlock tris;
   tris.type = CellType::Triangle;
-  for (const auto& p : pts) tris.nodes.push_back(mesh.addNode(p, 2, 1, 0, 0));
+  for (const auto& pt : pts) tris.nodes.push_back(mesh.addNode(pt, 2, 1, 0, 0));
   tris.nodes.insert(tris.nodes.end(), {0, 2, 1});  // the same triangle, clockwise
   tris.entity = {1, 1};
   mesh.blocks.push_back(tris);
@@ -72,11 +179,25 @@ TEST(JacobianQuality, PlanarTrianglesAreSignedAgainstThePlaneNormal) {
   EXPECT_NEAR(q.scaledJacobian[0], 1.0, 1e-12);
   EXPECT_EQ(q.scaledJacobian[1], -1.0);
   EXPECT_EQ(q.invalid, 1u);
+  EXPECT_EQ(q.scaled.histogram.counts[Histogram::kBins - 1], 1u);
   mesh.planeNormal = {0.0, 0.0, -1.0};
   EXPECT_EQ(evaluateQuality(mesh).scaledJacobian[0], -1.0);
 }
 
-TEST(JacobianQuality, EmptyMeshIsAnError) {
+TEST(Quality, HighOrderBoundsStayExact) {
+  // Order 10: J has degree 27 on a tetrahedron (4060 Bezier coefficients); the exact Bezier
+  // arithmetic keeps a constant J constant to round-off.
+  for (const CellType type : kVolumeShapes) {
+    const int p = type == CellType::Tetrahedron ? 10 : 6;
+    const NodeCoordinates x = affineElement(type, p);
+    const JacobianBounds b = boundJacobian(type, p, x, nullptr);
+    EXPECT_TRUE(b.certified);
+    EXPECT_EQ(b.validity, Validity::Valid);
+    EXPECT_NEAR(b.minLower / b.maxUpper, 1.0, 1e-9) << cellShortName(type);
+  }
+}
+
+TEST(Quality, EmptyMeshIsAnError) {
   Mesh mesh;
   EXPECT_THROW(evaluateQuality(mesh), Error);
 }

@@ -1,0 +1,101 @@
+#include "pipeline/report.hpp"
+
+#include <map>
+
+namespace homesh {
+namespace {
+
+const char* kElementKeys[] = {"tet", "prism", "pyramid", "hex", "tri", "quad"};
+
+void appendMeasure(JsonWriter& json, const std::string& key, const MeasureSummary& m,
+                   bool histogram) {
+  json.beginObject(key);
+  json.value("min", m.min);
+  json.value("mean", m.mean);
+  if (histogram) {
+    json.beginObject("histogram");
+    json.beginArray("edges");
+    for (int k = 0; k <= Histogram::kBins; ++k)
+      json.value("", static_cast<double>(k) / Histogram::kBins);
+    json.endArray();
+    json.beginArray("counts");
+    for (const std::size_t c : m.histogram.counts) json.value("", c);
+    json.endArray();
+    json.value("below_zero", m.histogram.below);
+    json.endObject();
+  }
+  json.endObject();
+}
+
+}  // namespace
+
+void appendCounts(JsonWriter& json, const Mesh& mesh) {
+  std::map<std::string, std::size_t> elements, boundary;
+  for (const char* key : kElementKeys) elements[key] = 0;
+  for (const ElementBlock& block : mesh.blocks)
+    (cellDimension(block.type) == mesh.dim ? elements : boundary)[cellShortName(block.type)] +=
+        block.count();
+  json.beginObject("elements");
+  for (const char* key : kElementKeys) json.value(key, elements[key]);
+  json.endObject();
+  json.beginObject("boundary");
+  for (const auto& [name, count] : boundary) json.value(name, count);
+  json.endObject();
+}
+
+void appendQuality(JsonWriter& json, const QualitySummary& q) {
+  json.beginObject("quality");
+  appendMeasure(json, "scaled_jacobian", q.scaled, true);
+  appendMeasure(json, "distortion", q.distortionSummary, true);
+  json.value("invalid_elements", q.invalid);
+  json.value("undecided_elements", q.undecided);
+  json.value("certified", q.certified);
+  json.value("method",
+             "scaled Jacobian min J / max J from Bezier bounds refined to 1e-4 relative; "
+             "distortion d J^(2/d) / |F|^2 against the straight-sided element, sampled");
+  json.beginObject("by_type");
+  for (const auto& [type, t] : q.byType) {
+    json.beginObject(cellShortName(type));
+    json.value("count", t.count);
+    json.value("invalid_elements", t.invalid);
+    json.value("undecided_elements", t.undecided);
+    appendMeasure(json, "scaled_jacobian", t.scaledJacobian, false);
+    appendMeasure(json, "distortion", t.distortion, false);
+    json.endObject();
+  }
+  json.endObject();
+  json.endObject();
+}
+
+std::string meshReportJson(const MeshResult& result, const std::string& input) {
+  JsonWriter json;
+  json.beginObject();
+  json.value("input", input);
+  json.value("dimension", result.mesh.dim);
+  json.value("order", result.mesh.order);
+  json.value("size", result.options.size.value_or(0.0));
+  json.value("nodes", result.mesh.numNodes());
+  appendCounts(json, result.mesh);
+  appendQuality(json, result.quality);
+  json.beginObject("timings_s");
+  for (const auto& [stage, s] : result.timings.seconds) json.value(stage, s);
+  json.endObject();
+  json.endObject();
+  return json.str();
+}
+
+std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
+                              const std::string& input) {
+  JsonWriter json;
+  json.beginObject();
+  json.value("input", input);
+  json.value("dimension", mesh.dim);
+  json.value("order", mesh.order);
+  json.value("nodes", mesh.numNodes());
+  appendCounts(json, mesh);
+  appendQuality(json, quality);
+  json.endObject();
+  return json.str();
+}
+
+}  // namespace homesh

@@ -1,0 +1,122 @@
+#include "quality/mesh_quality.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "element/quadrature.hpp"
+#include "quality/distortion.hpp"
+
+namespace homesh {
+
+void Histogram::add(double value) {
+  if (value < 0.0) {
+    ++below;
+  } else if (value > 1.0 + 1e-12) {
+    ++above;
+  } else {
+    ++counts[std::min(kBins - 1, static_cast<int>(value * kBins))];
+  }
+}
+
+namespace {
+
+void accumulate(MeasureSummary& s, double value) {
+  s.min = std::min(s.min, value);
+  s.mean += value;
+  s.histogram.add(value);
+}
+
+NodeCoordinates gather(const Mesh& mesh, const std::int64_t* nodes, int n) {
+  NodeCoordinates x(n, 3);
+  for (int i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) x(i, c) = mesh.xyz[3 * nodes[i] + c];
+  return x;
+}
+
+// Area (length) element ratio of a boundary cell, sampled at quadrature points and nodes.
+double boundaryStretch(const JacobianSampler& sampler, const NodeCoordinates& x) {
+  Eigen::VectorXd j;
+  sampler.jacobians(x, nullptr, j);
+  const double hi = j.maxCoeff();
+  return hi > 0.0 ? j.minCoeff() / hi : -1.0;
+}
+
+JacobianSampler boundarySampler(CellType type, int order) {
+  const ReferenceElement& ref = ReferenceElement::get(type, order);
+  const QuadratureRule rule = quadratureRule(type, 2 * order + 2);
+  Eigen::MatrixXd points(rule.size() + ref.numNodes(), ref.dim());
+  for (int q = 0; q < rule.size(); ++q)
+    for (int k = 0; k < ref.dim(); ++k)
+      points(q, k) = rule.points[static_cast<std::size_t>(q) * ref.dim() + k];
+  points.bottomRows(ref.numNodes()) = ref.nodes();
+  return JacobianSampler(ref, points);
+}
+
+}  // namespace
+
+QualitySummary evaluateQuality(const Mesh& mesh, int threads) {
+  QualitySummary summary;
+  const Eigen::Vector3d normal(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
+  for (const ElementBlock& block : mesh.blocks) {
+    const int n = block.nodesPerElement();
+    if (block.count() == 0) continue;
+    if (cellDimension(block.type) != mesh.dim) {
+      const JacobianSampler sampler = boundarySampler(block.type, block.order);
+      for (std::size_t e = 0; e < block.count(); ++e)
+        summary.boundaryScaledJacobian.push_back(
+            boundaryStretch(sampler, gather(mesh, block.element(e), n)));
+      continue;
+    }
+    // Elements are independent: evaluate them in parallel, then summarise in order.
+    const auto count = static_cast<std::int64_t>(block.count());
+    std::vector<JacobianBounds> bounds(block.count());
+    std::vector<double> distortion(block.count());
+    // Warm the shared tables once before the threads need them.
+    boundJacobian(block.type, block.order, gather(mesh, block.element(0), n),
+                  mesh.dim == 2 ? &normal : nullptr);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
+    for (std::int64_t e = 0; e < count; ++e) {
+      const NodeCoordinates x = gather(mesh, block.element(static_cast<std::size_t>(e)), n);
+      bounds[e] = boundJacobian(block.type, block.order, x, mesh.dim == 2 ? &normal : nullptr);
+      distortion[e] = elementDistortion(block.type, block.order, x);
+    }
+    TypeQuality& type = summary.byType[block.type];
+    for (std::size_t e = 0; e < block.count(); ++e) {
+      const double scaled = bounds[e].scaledJacobian();
+      summary.scaledJacobian.push_back(scaled);
+      summary.distortion.push_back(distortion[e]);
+      summary.validity.push_back(bounds[e].validity);
+      ++type.count;
+      accumulate(type.scaledJacobian, scaled);
+      accumulate(type.distortion, distortion[e]);
+      if (bounds[e].validity == Validity::Invalid) ++type.invalid;
+      if (bounds[e].validity == Validity::Undecided) ++type.undecided;
+      if (!bounds[e].certified) summary.certified = false;
+    }
+  }
+  if (summary.scaledJacobian.empty()) throw Error("quality: the mesh has no elements");
+  for (auto& [cell, type] : summary.byType) {
+    for (auto* m : {&type.scaledJacobian, &type.distortion}) {
+      const MeasureSummary typeMeasure = *m;
+      MeasureSummary& total =
+          m == &type.scaledJacobian ? summary.scaled : summary.distortionSummary;
+      total.min = std::min(total.min, typeMeasure.min);
+      total.mean += typeMeasure.mean;  // still a sum here
+      for (int k = 0; k < Histogram::kBins; ++k)
+        total.histogram.counts[k] += typeMeasure.histogram.counts[k];
+      total.histogram.below += typeMeasure.histogram.below;
+      total.histogram.above += typeMeasure.histogram.above;
+      m->mean /= static_cast<double>(type.count);
+    }
+    summary.invalid += type.invalid;
+    summary.undecided += type.undecided;
+  }
+  const auto count = static_cast<double>(summary.scaledJacobian.size());
+  summary.scaled.mean /= count;
+  summary.distortionSummary.mean /= count;
+  if (summary.undecided > 0) summary.certified = false;
+  return summary;
+}
+
+}  // namespace homesh
