@@ -7,7 +7,8 @@ Usable from FreeCAD's Python console, from ``freecadcmd`` and from plain Python 
     m.nodes            # (N, 3) float64
     m.elements         # (E, nodes per element) int64, Gmsh node order
     m.quality()        # per-element scaled Jacobian and summary
-    m.write("out.msh") # .msh (Gmsh 4.1), .vtu (VTK Lagrange cells), .npz (arrays)
+    m.write("out.msh") # .msh (Gmsh 4.1), .vtu (VTK), .xml (Nektar++), .npz (arrays)
+    homesh.read("mesh.msh")  # a mesh file (.msh 2.2/4.1, Nektar++ .xml) with its quality
 
 Every failure raises a subclass of :class:`HOMeshError`; the meshing core never takes the host
 process down.
@@ -22,7 +23,7 @@ from ._core import (  # noqa: F401  (re-exported)
     ParameterError,
     __version__,
 )
-from .api import BoundaryBlock, HighOrderMesh, load, mesh  # noqa: F401
+from .api import BoundaryBlock, HighOrderMesh, load, mesh, read  # noqa: F401
 
 __all__ = [
     "BoundaryBlock",
@@ -35,4 +36,5 @@ __all__ = [
     "ParameterError",
     "load",
     "mesh",
+    "read",
 ]

@@ -16,11 +16,9 @@ _NPZ_FORMAT = 1
 
 @dataclass(frozen=True)
 class BoundaryBlock:
-    """Lower-dimensional cells: triangles on CAD faces (3D) or lines on CAD edges.
-
-    ``elements`` is (count, nodes per cell) int64 in Gmsh order; ``cad_entity`` gives the
-    1-based FreeCAD index of the face (``FaceN``) or edge (``EdgeN``) each cell lies on.
-    """
+    """Cells of one type and order: ``elements`` is (count, nodes per cell) int64 in Gmsh order;
+    ``cad_entity`` gives the 1-based FreeCAD index of the solid, face (``FaceN``) or edge
+    (``EdgeN``) each cell lies on (Gmsh entity tags for meshes read from files)."""
 
     element_type: str
     order: int
@@ -33,10 +31,11 @@ class HighOrderMesh:
 
     Attributes (numpy arrays, copied from the core once):
       nodes            (N, 3) float64
-      elements         (E, k) int64: cells of dimension ``dim`` (tetrahedra, or triangles in 2D)
-      element_type     "tet" or "tri"
-      element_entity   (E,) int32: the solid (3D) or face (2D) each element belongs to
-      boundary         list of :class:`BoundaryBlock`
+      element_blocks   list of :class:`BoundaryBlock`: the cells of dimension ``dim``, one block
+                       per type (a mesh read from a file may mix tetrahedra, prisms, ...)
+      elements         (E, k) int64, element_type ("tet", "tri", ...), element_entity (E,):
+                       the single element block (HOMeshError when types are mixed)
+      boundary         list of :class:`BoundaryBlock`: the lower-dimensional cells
       node_cad_dim     (N,) uint8: 0 vertex, 1 edge, 2 face, 3 solid interior
       node_cad_index   (N,) int32: 1-based FreeCAD index of that entity (VertexN, EdgeN, ...)
       node_cad_params  (N, 2) float64: t on an edge (second column NaN) or (u, v) on a face
@@ -52,19 +51,34 @@ class HighOrderMesh:
         self.node_cad_index = core.node_cad_index()
         self.node_cad_params = core.node_cad_params()
         self._blocks = core.blocks()
-        cells = [b for b in self._blocks if _cell_dim(b[0]) == self.dim]
-        if len(cells) != 1:
-            raise _core.HOMeshError("expected one element block, found %d" % len(cells))
-        self.element_type, _, self.elements, self.element_entity = cells[0]
-        self.boundary = [
-            BoundaryBlock(t, o, conn, ent)
-            for t, o, conn, ent in self._blocks
-            if _cell_dim(t) != self.dim
-        ]
+        self.element_blocks = [BoundaryBlock(t, o, conn, ent)
+                               for t, o, conn, ent in self._blocks if _cell_dim(t) == self.dim]
+        self.boundary = [BoundaryBlock(t, o, conn, ent)
+                         for t, o, conn, ent in self._blocks if _cell_dim(t) != self.dim]
+
+    def _single_block(self):
+        if len(self.element_blocks) != 1:
+            raise _core.HOMeshError(
+                "the mesh mixes %s elements: use element_blocks"
+                % ", ".join(b.element_type for b in self.element_blocks))
+        return self.element_blocks[0]
+
+    @property
+    def elements(self):
+        return self._single_block().elements
+
+    @property
+    def element_type(self):
+        return self._single_block().element_type
+
+    @property
+    def element_entity(self):
+        return self._single_block().cad_entity
 
     def __repr__(self):
-        return "<HighOrderMesh order %d: %d nodes, %d %s>" % (
-            self.order, len(self.nodes), len(self.elements), self.element_type)
+        return "<HighOrderMesh order %d: %d nodes, %s>" % (
+            self.order, len(self.nodes),
+            ", ".join("%d %s" % (len(b.elements), b.element_type) for b in self.element_blocks))
 
     @property
     def num_nodes(self):
@@ -72,17 +86,25 @@ class HighOrderMesh:
 
     @property
     def num_elements(self):
-        return len(self.elements)
+        return sum(len(b.elements) for b in self.element_blocks)
 
     def quality(self):
-        """Scaled Jacobian (min J / max J, sampled) per element plus its summary.
+        """Quality per element (in block order) and its summary.
 
-        Returns a dict: ``scaled_jacobian`` (E,) array, ``min``, ``mean``, ``invalid_elements``
-        and ``by_type``.
+        Returns a dict: ``scaled_jacobian`` (E,) array (certified lower bound of min J / max J,
+        from Bezier bounds), ``distortion`` (E,) array, ``min``/``mean`` of the scaled
+        Jacobian, ``distortion_min``/``distortion_mean``, ``invalid_elements``,
+        ``undecided_elements``, ``certified`` and ``by_type``.
         """
         summary = dict(self._core.quality_summary())
         summary["scaled_jacobian"] = self._core.scaled_jacobian()
+        summary["distortion"] = self._core.distortion()
         return summary
+
+    def element_volumes(self):
+        """Signed volume (area in 2D) of every element, in block order: the exact integral of
+        the Jacobian of each curved element."""
+        return self._core.element_volumes()
 
     def report(self, input_name=""):
         """The JSON report of ``homesh mesh --report`` as a dict."""
@@ -92,13 +114,15 @@ class HighOrderMesh:
         """Seconds spent in each pipeline stage."""
         return dict(self._core.timings())
 
-    def write(self, path):
-        """Writes .msh (Gmsh 4.1), .vtu (VTK Lagrange cells) or .npz (this object's arrays)."""
+    def write(self, path, binary=False, compressed=False):
+        """Writes .msh (Gmsh 4.1), .vtu (VTK Lagrange cells), .xml (Nektar++) or .npz (this
+        object's arrays). ``binary``: binary MSH, raw appended VTU data; ``compressed``:
+        compressed Nektar++ XML (B64Z-LittleEndian)."""
         path = os.fspath(path)
         if path.lower().endswith(".npz"):
             self._save_npz(path)
         else:
-            self._core.write(path)
+            self._core.write(path, bool(binary), bool(compressed))
 
     def _save_npz(self, path):
         arrays = {
@@ -121,6 +145,12 @@ class HighOrderMesh:
                 np.savez_compressed(f, **arrays)
         except OSError as e:
             raise FileError("cannot write '%s': %s" % (path, e.strerror)) from None
+
+
+def read(path, threads=1):
+    """Reads a mesh file: .msh (Gmsh 2.2 or 4.1, ASCII or binary) or .xml (Nektar++, plain or
+    compressed), and evaluates its quality."""
+    return HighOrderMesh(_core.read_mesh(os.fspath(path), _check_int("threads", threads)))
 
 
 def load(path):

@@ -7,7 +7,7 @@ PACKAGES="
   g++ make cmake pkg-config
   freecad
   libocct-modeling-algorithms-dev libocct-data-exchange-dev libocct-foundation-dev libtbb-dev
-  libeigen3-dev libgmsh-dev gmsh
+  libeigen3-dev libgmsh-dev gmsh zlib1g-dev
   libboost-python-dev libboost-numpy-dev python3-dev python3-numpy
   libgtest-dev python3-pytest python3-meshio python3-vtk9
   xvfb xauth

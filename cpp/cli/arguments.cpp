@@ -2,6 +2,8 @@
 
 #include <charconv>
 #include <cmath>
+#include <functional>
+#include <map>
 
 #include "pipeline/mesh_pipeline.hpp"
 
@@ -11,61 +13,119 @@ namespace {
 // Decimal only (no hexadecimal, no "inf"), and the whole text must be the number.
 double parseNumber(const std::string& option, const std::string& text) {
   double v = 0.0;
-  const char* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, v, std::chars_format::general);
-  if (text.empty() || ec != std::errc() || ptr != end || !std::isfinite(v))
+  const std::string digits = !text.empty() && text[0] == '+' ? text.substr(1) : text;
+  const char* end = digits.data() + digits.size();
+  const auto [ptr, ec] = std::from_chars(digits.data(), end, v, std::chars_format::general);
+  if (digits.empty() || ec != std::errc() || ptr != end || !std::isfinite(v))
     throw UsageError{option + " expects a number, got '" + text + "'"};
   return v;
 }
 
 int parseInteger(const std::string& option, const std::string& text) {
   int v = 0;
-  const char* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, v);
-  if (text.empty() || ec != std::errc() || ptr != end)
+  const std::string digits = !text.empty() && text[0] == '+' ? text.substr(1) : text;
+  const char* end = digits.data() + digits.size();
+  const auto [ptr, ec] = std::from_chars(digits.data(), end, v);
+  if (digits.empty() || ec != std::errc() || ptr != end)
     throw UsageError{option + " expects an integer, got '" + text + "'"};
   return v;
 }
 
-MeshCommand parseMesh(const std::vector<std::string>& args, std::size_t i) {
-  MeshCommand cmd;
-  auto next = [&](const std::string& option) -> const std::string& {
-    if (i + 1 >= args.size()) throw UsageError{option + " needs a value"};
-    return args[++i];
-  };
-  for (; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--order" || a == "-p") {
-      cmd.order = parseInteger(a, next(a));
-      if (cmd.order < 1 || cmd.order > 10)
-        throw UsageError{"--order must be from 1 to 10, got " + args[i]};
-    } else if (a == "--size" || a == "-s") {
-      cmd.size = parseNumber(a, next(a));
-      if (!(*cmd.size > 0.0)) throw UsageError{"--size must be a positive length, got " + args[i]};
-    } else if (a == "--threads" || a == "-j") {
-      cmd.threads = parseInteger(a, next(a));
-      if (cmd.threads < 1 || cmd.threads > kMaxThreads)
-        throw UsageError{"--threads must be from 1 to " + std::to_string(kMaxThreads) + ", got " +
-                         args[i]};
-    } else if (a == "-o" || a == "--output") {
-      cmd.outputs.push_back(next(a));
-    } else if (a == "--report") {
-      cmd.report = next(a);
-    } else if (a == "-v" || a == "--verbose") {
-      ++cmd.verbosity;
-    } else if (a == "-vv") {
-      cmd.verbosity += 2;
-    } else if (a == "-q" || a == "--quiet") {
-      cmd.quiet = true;
-    } else if (!a.empty() && a[0] == '-' && a != "-") {
-      throw UsageError{"unknown option '" + a + "' for 'homesh mesh'"};
-    } else if (cmd.input.empty()) {
-      cmd.input = a;
-    } else {
-      throw UsageError{"unexpected argument '" + a + "' (only one INPUT is allowed)"};
-    }
+// Options of one command: flags and options with a value, by every spelling.
+class OptionTable {
+ public:
+  using Handler = std::function<void(const std::string& option, const std::string& value)>;
+  void flag(std::initializer_list<const char*> names, std::function<void()> handler) {
+    for (const char* n : names) flags_[n] = handler;
   }
-  if (cmd.input.empty()) throw UsageError{"'homesh mesh' needs an INPUT CAD file"};
+  void value(std::initializer_list<const char*> names, Handler handler) {
+    for (const char* n : names) values_[n] = handler;
+  }
+  // Parses args[first..]; returns the positional arguments.
+  std::vector<std::string> parse(const std::vector<std::string>& args, std::size_t first,
+                                 const std::string& command) const {
+    std::vector<std::string> positional;
+    for (std::size_t i = first; i < args.size(); ++i) {
+      const std::string& a = args[i];
+      if (const auto f = flags_.find(a); f != flags_.end()) {
+        f->second();
+      } else if (const auto v = values_.find(a); v != values_.end()) {
+        if (i + 1 >= args.size()) throw UsageError{a + " needs a value"};
+        v->second(a, args[++i]);
+      } else if (!a.empty() && a[0] == '-' && a != "-") {
+        throw UsageError{"unknown option '" + a + "' for 'homesh " + command + "'"};
+      } else {
+        positional.push_back(a);
+      }
+    }
+    return positional;
+  }
+
+ private:
+  std::map<std::string, std::function<void()>> flags_;
+  std::map<std::string, Handler> values_;
+};
+
+void addCommon(OptionTable& table, CommonOptions& c, bool outputs, bool report) {
+  table.value({"--threads", "-j"}, [&c](const std::string& o, const std::string& v) {
+    c.threads = parseInteger(o, v);
+    if (c.threads < 1 || c.threads > kMaxThreads)
+      throw UsageError{"--threads must be from 1 to " + std::to_string(kMaxThreads) + ", got " +
+                       v};
+  });
+  table.flag({"--quiet", "-q"}, [&c] { c.quiet = true; });
+  if (outputs) {
+    table.value({"--output", "-o"},
+                [&c](const std::string&, const std::string& v) { c.outputs.push_back(v); });
+    table.flag({"--binary"}, [&c] { c.binary = true; });
+    table.flag({"--compressed"}, [&c] { c.compressed = true; });
+  }
+  if (report)
+    table.value({"--report"}, [&c](const std::string&, const std::string& v) { c.report = v; });
+}
+
+std::string onlyInput(const std::vector<std::string>& positional, const std::string& command,
+                      const char* what) {
+  if (positional.empty()) throw UsageError{"'homesh " + command + "' needs " + what};
+  if (positional.size() > 1)
+    throw UsageError{"unexpected argument '" + positional[1] + "' (only one INPUT is allowed)"};
+  return positional[0];
+}
+
+MeshCommand parseMesh(const std::vector<std::string>& args) {
+  MeshCommand cmd;
+  OptionTable table;
+  addCommon(table, cmd.common, true, true);
+  table.value({"--order", "-p"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.order = parseInteger(o, v);
+    if (cmd.order < 1 || cmd.order > 10)
+      throw UsageError{"--order must be from 1 to 10, got " + v};
+  });
+  table.value({"--size", "-s"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.size = parseNumber(o, v);
+    if (!(*cmd.size > 0.0)) throw UsageError{"--size must be a positive length, got " + v};
+  });
+  table.flag({"--verbose", "-v"}, [&cmd] { ++cmd.verbosity; });
+  table.flag({"-vv"}, [&cmd] { cmd.verbosity += 2; });
+  cmd.input = onlyInput(table.parse(args, 1, "mesh"), "mesh", "an INPUT CAD file");
+  return cmd;
+}
+
+QualityCommand parseQuality(const std::vector<std::string>& args) {
+  QualityCommand cmd;
+  OptionTable table;
+  addCommon(table, cmd.common, false, true);
+  table.flag({"--strict"}, [&cmd] { cmd.strict = true; });
+  cmd.input = onlyInput(table.parse(args, 1, "quality"), "quality", "an INPUT mesh file");
+  return cmd;
+}
+
+ConvertCommand parseConvert(const std::vector<std::string>& args) {
+  ConvertCommand cmd;
+  OptionTable table;
+  addCommon(table, cmd.common, true, false);
+  cmd.input = onlyInput(table.parse(args, 1, "convert"), "convert", "an INPUT mesh file");
+  if (cmd.common.outputs.empty()) throw UsageError{"'homesh convert' needs -o OUTPUT"};
   return cmd;
 }
 
@@ -84,17 +144,24 @@ ParsedCommand parseCommandLine(const std::vector<std::string>& args) {
     parsed.kind = ParsedCommand::Kind::Version;
     return parsed;
   }
+  if (first != "mesh" && first != "quality" && first != "convert")
+    throw UsageError{"unknown command '" + first + "'"};
+  for (std::size_t i = 1; i < args.size(); ++i)
+    if (args[i] == "-h" || args[i] == "--help") {
+      parsed.helpTopic = first;
+      return parsed;
+    }
   if (first == "mesh") {
-    for (std::size_t i = 1; i < args.size(); ++i)
-      if (args[i] == "-h" || args[i] == "--help") {
-        parsed.helpTopic = "mesh";
-        return parsed;
-      }
     parsed.kind = ParsedCommand::Kind::Mesh;
-    parsed.mesh = parseMesh(args, 1);
-    return parsed;
+    parsed.mesh = parseMesh(args);
+  } else if (first == "quality") {
+    parsed.kind = ParsedCommand::Kind::Quality;
+    parsed.quality = parseQuality(args);
+  } else {
+    parsed.kind = ParsedCommand::Kind::Convert;
+    parsed.convert = parseConvert(args);
   }
-  throw UsageError{"unknown command '" + first + "'"};
+  return parsed;
 }
 
 std::string usageText(const std::string& topic) {
@@ -108,7 +175,9 @@ placed on the CAD at order P.
 options:
   -p, --order P       polynomial order, 1..10 (default 4)
   -s, --size H        target element size (default: bounding-box diagonal / 20)
-  -o, --output FILE   write the mesh; .msh (Gmsh 4.1) or .vtu (VTK); repeatable
+  -o, --output FILE   write the mesh: .msh (Gmsh 4.1), .vtu (VTK), .xml (Nektar++); repeatable
+      --binary        binary MSH, raw appended VTU data
+      --compressed    compressed Nektar++ XML (B64Z-LittleEndian)
       --report FILE   write the JSON report ("-" for standard output)
   -j, --threads N     threads (default 1)
   -v, --verbose       show Gmsh's warnings (-vv: and its information)
@@ -116,12 +185,41 @@ options:
 
 exit status: 0 success, 1 failure (file, CAD or meshing), 2 bad command line or parameter
 )";
+  if (topic == "quality")
+    return R"(usage: homesh quality INPUT [options]
+
+Prints the quality of a mesh (.msh 2.2 or 4.1, ASCII or binary; .xml Nektar++): per element
+type, the certified scaled Jacobian (Bezier bounds, as Gmsh's AnalyseMeshQuality) and the
+distortion against the straight-sided elements, worst, mean and histogram, and the number of
+invalid elements.
+
+options:
+      --report FILE   write the JSON report ("-" for standard output)
+      --strict        exit with status 3 if any element is invalid or not proven valid
+  -j, --threads N     threads (default 1)
+  -q, --quiet         print nothing but errors
+)";
+  if (topic == "convert")
+    return R"(usage: homesh convert INPUT -o OUTPUT [options]
+
+Converts a mesh between Gmsh MSH (2.2/4.1 in, 4.1 out), VTU (out) and Nektar++ XML, with
+the quality fields.
+
+options:
+  -o, --output FILE   .msh, .vtu or .xml; repeatable
+      --binary        binary MSH, raw appended VTU data
+      --compressed    compressed Nektar++ XML (B64Z-LittleEndian)
+  -j, --threads N     threads (default 1)
+  -q, --quiet         print nothing but errors
+)";
   return R"(usage: homesh COMMAND [options]
 
 commands:
-  mesh INPUT     CAD file to curved high-order mesh (homesh mesh --help)
-  --version      print the version
-  --help         this text
+  mesh INPUT      CAD file to curved high-order mesh (homesh mesh --help)
+  quality INPUT   certified quality of a mesh file (homesh quality --help)
+  convert INPUT   mesh file to another format (homesh convert --help)
+  --version       print the version
+  --help          this text
 )";
 }
 

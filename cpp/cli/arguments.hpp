@@ -12,21 +12,41 @@ struct UsageError {
   std::string message;
 };
 
+// Options several commands share.
+struct CommonOptions {
+  int threads = 1;
+  bool quiet = false;
+  std::optional<std::string> report;  // "-" is standard output
+  std::vector<std::string> outputs;   // -o, repeatable
+  bool binary = false;                // MSH binary, VTU appended raw data
+  bool compressed = false;            // Nektar++ XML compressed sections
+};
+
 struct MeshCommand {
   std::string input;
   int order = 4;
   std::optional<double> size;
-  int threads = 1;
-  std::vector<std::string> outputs;
-  std::optional<std::string> report;  // "-" is standard output
-  int verbosity = 0;                  // -v: 1, -vv: 2
-  bool quiet = false;
+  int verbosity = 0;  // -v: 1, -vv: 2
+  CommonOptions common;
+};
+
+struct QualityCommand {
+  std::string input;
+  bool strict = false;  // exit status 3 if an element is invalid or undecided
+  CommonOptions common;
+};
+
+struct ConvertCommand {
+  std::string input;
+  CommonOptions common;
 };
 
 struct ParsedCommand {
-  enum class Kind { Help, Version, Mesh } kind = Kind::Help;
+  enum class Kind { Help, Version, Mesh, Quality, Convert } kind = Kind::Help;
   std::string helpTopic;  // "" or a command name
   MeshCommand mesh;
+  QualityCommand quality;
+  ConvertCommand convert;
 };
 
 // argv without the program name. Throws UsageError.

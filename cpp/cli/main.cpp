@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "core/version.hpp"
 #include "io/atomic_file.hpp"
+#include "io/mesh_readers.hpp"
 #include "io/mesh_writers.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
@@ -39,30 +40,90 @@ void writeReport(const std::string& path, const std::string& text) {
   homesh::writeFileAtomically(path, text);
 }
 
+// Refuses bad output and report paths before any time is spent.
+void checkOutputs(const homesh::CommonOptions& c) {
+  for (const std::string& path : c.outputs) homesh::checkMeshOutputPath(path);
+  if (c.report && *c.report != "-") homesh::checkParentFolder(*c.report);
+}
+
+homesh::WriteOptions writeOptions(const homesh::CommonOptions& c) {
+  homesh::WriteOptions w;
+  w.binary = c.binary;
+  w.compressed = c.compressed;
+  return w;
+}
+
 int runMesh(const homesh::MeshCommand& cmd) {
+  const homesh::CommonOptions& c = cmd.common;
   homesh::MeshingOptions options;
   options.order = cmd.order;
   options.size = cmd.size;
-  options.threads = cmd.threads;
+  options.threads = c.threads;
   options.verbosity = cmd.verbosity;
-  // Refuse bad output paths before spending time on meshing.
-  for (const std::string& path : cmd.outputs) homesh::checkMeshOutputPath(path);
-  if (cmd.report && *cmd.report != "-") homesh::checkParentFolder(*cmd.report);
+  checkOutputs(c);
   StderrProgress progress;
-  homesh::PipelineObserver* observer = cmd.quiet ? nullptr : &progress;
+  homesh::PipelineObserver* observer = c.quiet ? nullptr : &progress;
   homesh::MeshResult result =
       homesh::runMeshPipeline(homesh::CadSource::file(cmd.input), options, observer);
-  if (!cmd.outputs.empty()) homesh::writeMeshOutputs(result, cmd.outputs, observer);
-  if (!cmd.quiet) {
+  if (!c.outputs.empty()) homesh::writeMeshOutputs(result, c.outputs, writeOptions(c), observer);
+  if (!c.quiet) {
     std::fprintf(stderr,
                  "homesh: %zu nodes, %zu elements of order %d; scaled Jacobian min %.4f mean "
                  "%.4f; %zu invalid\n",
                  result.mesh.numNodes(), result.mesh.numElements(), result.mesh.order,
                  result.quality.scaled.min, result.quality.scaled.mean, result.quality.invalid);
-    for (const std::string& path : cmd.outputs)
+    for (const std::string& path : c.outputs)
       std::fprintf(stderr, "homesh: wrote %s\n", path.c_str());
   }
-  if (cmd.report) writeReport(*cmd.report, homesh::meshReportJson(result, cmd.input));
+  if (c.report) writeReport(*c.report, homesh::meshReportJson(result, cmd.input));
+  return 0;
+}
+
+// A human-readable quality summary.
+void printQuality(std::FILE* out, const std::string& input, const homesh::Mesh& mesh,
+                  const homesh::QualitySummary& q) {
+  std::fprintf(out, "%s: %zu nodes, order %d\n", input.c_str(), mesh.numNodes(), mesh.order);
+  for (const auto& [type, t] : q.byType)
+    std::fprintf(out,
+                 "  %-5s %8zu elements  scaled Jacobian worst %8.4f mean %6.4f  distortion worst "
+                 "%8.4f mean %6.4f  invalid %zu\n",
+                 homesh::cellShortName(type).c_str(), t.count, t.scaledJacobian.min,
+                 t.scaledJacobian.mean, t.distortion.min, t.distortion.mean, t.invalid);
+  std::fprintf(out, "  scaled Jacobian (certified lower bound, Bezier): worst %.4f mean %.4f\n",
+               q.scaled.min, q.scaled.mean);
+  std::fprintf(out, "  invalid elements %zu, undecided %zu: %s\n", q.invalid, q.undecided,
+               q.invalid > 0      ? "INVALID"
+               : q.undecided > 0 ? "validity not proven"
+                                  : "certified valid");
+  std::fprintf(out, "  histogram of the scaled Jacobian:\n");
+  if (q.scaled.histogram.below > 0)
+    std::fprintf(out, "    < 0          %8zu\n", q.scaled.histogram.below);
+  for (int k = 0; k < homesh::Histogram::kBins; ++k)
+    if (q.scaled.histogram.counts[k] > 0)
+      std::fprintf(out, "    [%.2f, %.2f) %8zu\n", double(k) / homesh::Histogram::kBins,
+                   double(k + 1) / homesh::Histogram::kBins, q.scaled.histogram.counts[k]);
+}
+
+int runQuality(const homesh::QualityCommand& cmd) {
+  checkOutputs(cmd.common);
+  const homesh::Mesh mesh = homesh::readMesh(cmd.input);
+  const homesh::QualitySummary q = homesh::evaluateQuality(mesh, cmd.common.threads);
+  if (!cmd.common.quiet)
+    printQuality(cmd.common.report && *cmd.common.report == "-" ? stderr : stdout, cmd.input, mesh,
+                 q);
+  if (cmd.common.report)
+    writeReport(*cmd.common.report, homesh::qualityReportJson(mesh, q, cmd.input));
+  return cmd.strict && (q.invalid > 0 || q.undecided > 0) ? 3 : 0;
+}
+
+int runConvert(const homesh::ConvertCommand& cmd) {
+  checkOutputs(cmd.common);
+  const homesh::Mesh mesh = homesh::readMesh(cmd.input);
+  const homesh::QualitySummary q = homesh::evaluateQuality(mesh, cmd.common.threads);
+  for (const std::string& path : cmd.common.outputs) {
+    homesh::writeMesh(mesh, path, homesh::qualityFields(q), writeOptions(cmd.common));
+    if (!cmd.common.quiet) std::fprintf(stderr, "homesh: wrote %s\n", path.c_str());
+  }
   return 0;
 }
 
@@ -82,6 +143,10 @@ int main(int argc, char** argv) {
         return 0;
       case homesh::ParsedCommand::Kind::Mesh:
         return runMesh(parsed.mesh);
+      case homesh::ParsedCommand::Kind::Quality:
+        return runQuality(parsed.quality);
+      case homesh::ParsedCommand::Kind::Convert:
+        return runConvert(parsed.convert);
     }
   } catch (const homesh::UsageError& e) {
     std::fprintf(stderr, "homesh: error: %s (see 'homesh --help')\n", e.message.c_str());

@@ -1,11 +1,9 @@
-// Writers of the formats CFD tools read.
+// Writers of the formats CFD tools read, chosen by file extension.
 //
-// - Gmsh MSH 4.1 (ASCII): $Entities for the CAD entities the nodes and elements lie on (tags are
-//   the CAD indices), physical groups "SolidN" / "FaceN" / "EdgeN" named like FreeCAD's
-//   sub-shapes, high-order element types, and one $ElementData section per cell field.
-// - VTU (VTK XML unstructured grid, base64 binary): the cells of the mesh dimension as VTK
-//   Lagrange cells, cell fields plus the CAD entity, point fields with each node's CAD dimension
-//   and index.
+// - Gmsh MSH 4.1 (msh_writer.hpp), ASCII or binary.
+// - VTU, VTK's XML unstructured grid with Lagrange cells (vtu_writer.hpp), base64 inline or raw
+//   appended binary.
+// - Nektar++ XML (nektar_writer.hpp), plain or compressed (B64Z-LittleEndian).
 // Files are written to a temporary name and renamed, so a failed write never leaves a truncated
 // file behind.
 #pragma once
@@ -26,14 +24,20 @@ struct CellField {
   std::vector<double> values;
 };
 
-void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields);
-void writeVtu(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields);
+struct WriteOptions {
+  bool binary = false;      // MSH: binary; VTU: raw appended data (else base64 inline)
+  bool compressed = false;  // Nektar++ XML: B64Z-LittleEndian sections
+};
 
-// Throws IoError unless `path` has a supported extension and its folder exists: lets callers
-// reject a bad output path before spending time on meshing.
+// Throws IoError unless `path` has a supported extension (.msh, .vtu, .xml) and its folder
+// exists: lets callers reject a bad output path before spending time on meshing.
 void checkMeshOutputPath(const std::string& path);
 
-// Chooses the format from the extension (.msh, .vtu); throws IoError for others.
-void writeMesh(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields);
+// Chooses the format from the extension; throws IoError for others.
+void writeMesh(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields,
+               const WriteOptions& options = {});
+
+// Throws Error unless every field has one value per cell.
+void checkCellFields(const Mesh& mesh, const std::vector<CellField>& fields);
 
 }  // namespace homesh

@@ -121,21 +121,25 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
 }
 
 std::vector<CellField> qualityFields(const QualitySummary& quality) {
-  CellField field{"scaled_jacobian", quality.scaledJacobian};
-  field.values.insert(field.values.end(), quality.boundaryScaledJacobian.begin(),
-                      quality.boundaryScaledJacobian.end());
-  return {field};
+  CellField scaled{"scaled_jacobian", quality.scaledJacobian};
+  scaled.values.insert(scaled.values.end(), quality.boundaryScaledJacobian.begin(),
+                       quality.boundaryScaledJacobian.end());
+  CellField distortion{"distortion", quality.distortion};
+  distortion.values.insert(distortion.values.end(), quality.boundaryDistortion.begin(),
+                           quality.boundaryDistortion.end());
+  return {scaled, distortion};
 }
 
-void writeMeshFiles(const MeshResult& result, const std::vector<std::string>& paths) {
+void writeMeshFiles(const MeshResult& result, const std::vector<std::string>& paths,
+                    const WriteOptions& options) {
   const std::vector<CellField> fields = qualityFields(result.quality);
-  for (const std::string& path : paths) writeMesh(result.mesh, path, fields);
+  for (const std::string& path : paths) writeMesh(result.mesh, path, fields, options);
 }
 
 void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,
-                      PipelineObserver* observer) {
+                      const WriteOptions& options, PipelineObserver* observer) {
   StageClock output("output", result.timings, observer);
-  writeMeshFiles(result, paths);
+  writeMeshFiles(result, paths, options);
   output.done();
 }
 

@@ -76,15 +76,17 @@ struct MeshResult {
 MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
                            PipelineObserver* observer = nullptr);
 
-// The per-element quality fields written beside the mesh.
+// The per-cell quality fields written beside the mesh: scaled Jacobian and distortion (for
+// boundary cells, their own measures: see quality/mesh_quality.hpp).
 std::vector<CellField> qualityFields(const QualitySummary& quality);
 
 // Writes the mesh to each path (format from the extension) and records the "output" timing.
 // Writes the mesh and its quality fields to each path (format from the extension).
-void writeMeshFiles(const MeshResult& result, const std::vector<std::string>& paths);
+void writeMeshFiles(const MeshResult& result, const std::vector<std::string>& paths,
+                    const WriteOptions& options = {});
 
 // writeMeshFiles as the pipeline's last stage: records its "output" timing in the result.
 void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,
-                      PipelineObserver* observer = nullptr);
+                      const WriteOptions& options = {}, PipelineObserver* observer = nullptr);
 
 }  // namespace homesh

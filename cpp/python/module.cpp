@@ -15,7 +15,10 @@
 
 #include "core/error.hpp"
 #include "core/version.hpp"
+#include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
+#include "io/mesh_readers.hpp"
+#include "quality/element_measure.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
 
@@ -211,9 +214,17 @@ class PyMesh {
     return d;
   }
 
-  void write(const std::string& path) {
+  void write(const std::string& path, bool binary, bool compressed) {
+    WriteOptions options;
+    options.binary = binary;
+    options.compressed = compressed;
     const ReleaseGil nogil;
-    writeMeshFiles(*result_, {path});
+    writeMeshFiles(*result_, {path}, options);
+  }
+
+  np::ndarray elementVolumes() const {
+    const std::vector<double> v = elementMeasures(result_->mesh);
+    return toArray(v, v.size(), 0);
   }
 
   std::string reportJson(const std::string& input) const { return meshReportJson(*result_, input); }
@@ -286,6 +297,35 @@ PyMesh meshFromArrays(int dim, int order, const bp::object& nodes, const bp::obj
   return PyMesh(std::move(result));
 }
 
+// Reads a mesh file (.msh, .xml) and evaluates its quality.
+PyMesh readMeshFile(const std::string& path, int threads) {
+  std::unique_ptr<MeshResult> result = std::make_unique<MeshResult>();
+  {
+    const ReleaseGil nogil;
+    result->mesh = readMesh(path);
+    result->quality = evaluateQuality(result->mesh, threads);
+  }
+  result->options.order = result->mesh.order;
+  return PyMesh(std::move(*result));
+}
+
+// Reference coordinates (equispaced, Gmsh order) of the nodes of (type, order): (nodes x dim).
+np::ndarray referenceNodes(const std::string& type, int order) {
+  const ReferenceElement& ref = ReferenceElement::get(cellTypeFromName(type), order);
+  std::vector<double> xi;
+  for (int n = 0; n < ref.numNodes(); ++n)
+    for (int k = 0; k < ref.dim(); ++k) xi.push_back(ref.nodes()(n, k));
+  return toArray(xi, static_cast<std::size_t>(ref.numNodes()), static_cast<std::size_t>(ref.dim()));
+}
+
+// A quadrature rule of the given degree on the reference shape: (points (n x dim), weights).
+bp::tuple quadrature(const std::string& type, int degree) {
+  const QuadratureRule rule = quadratureRule(cellTypeFromName(type), degree);
+  return bp::make_tuple(toArray(rule.points, static_cast<std::size_t>(rule.size()),
+                                static_cast<std::size_t>(rule.dim)),
+                        toArray(rule.weights, static_cast<std::size_t>(rule.size()), 0));
+}
+
 // Values of the Lagrange basis of (type, order) at reference points (npts x dim):
 // returns (npts x numNodes), nodes in Gmsh order. Used to draw curved elements.
 np::ndarray lagrangeBasis(const std::string& type, int order, const bp::object& points) {
@@ -350,7 +390,9 @@ BOOST_PYTHON_MODULE(_core) {
       .def("distortion", &PyMesh::distortion)
       .def("quality_summary", &PyMesh::qualitySummary)
       .def("timings", &PyMesh::timings)
-      .def("write", &PyMesh::write)
+      .def("write", &PyMesh::write, (bp::arg("path"), bp::arg("binary") = false,
+                                       bp::arg("compressed") = false))
+      .def("element_volumes", &PyMesh::elementVolumes)
       .def("report_json", &PyMesh::reportJson);
 
   bp::def("mesh_file", &meshFile,
@@ -359,6 +401,9 @@ BOOST_PYTHON_MODULE(_core) {
   bp::def("mesh_brep", &meshBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
            bp::arg("verbosity"), bp::arg("progress")));
+  bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("threads") = 1));
+  bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
+  bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));
   bp::def("lagrange_basis", &lagrangeBasis, (bp::arg("type"), bp::arg("order"), bp::arg("points")));
   bp::def("mesh_from_arrays", &meshFromArrays,
           (bp::arg("dim"), bp::arg("order"), bp::arg("nodes"), bp::arg("node_cad_dim"),

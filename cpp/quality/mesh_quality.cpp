@@ -63,9 +63,12 @@ QualitySummary evaluateQuality(const Mesh& mesh, int threads) {
     if (block.count() == 0) continue;
     if (cellDimension(block.type) != mesh.dim) {
       const JacobianSampler sampler = boundarySampler(block.type, block.order);
-      for (std::size_t e = 0; e < block.count(); ++e)
-        summary.boundaryScaledJacobian.push_back(
-            boundaryStretch(sampler, gather(mesh, block.element(e), n)));
+      for (std::size_t e = 0; e < block.count(); ++e) {
+        const NodeCoordinates x = gather(mesh, block.element(e), n);
+        summary.boundaryScaledJacobian.push_back(boundaryStretch(sampler, x));
+        summary.boundaryDistortion.push_back(
+            block.type == CellType::Line ? 1.0 : elementDistortion(block.type, block.order, x));
+      }
       continue;
     }
     // Elements are independent: evaluate them in parallel, then summarise in order.

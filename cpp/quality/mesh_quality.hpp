@@ -48,8 +48,9 @@ struct QualitySummary {
   std::vector<double> scaledJacobian;
   std::vector<double> distortion;
   std::vector<Validity> validity;
-  // Per lower-dimensional cell, in block order.
+  // Per lower-dimensional cell, in block order (distortion of a line is 1 by definition).
   std::vector<double> boundaryScaledJacobian;
+  std::vector<double> boundaryDistortion;
 
   std::size_t invalid = 0;    // certified invalid (a value of J <= 0 was found)
   std::size_t undecided = 0;  // neither proven valid nor invalid

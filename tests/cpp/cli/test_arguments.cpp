@@ -27,9 +27,9 @@ TEST(Arguments, MeshWithEveryOption) {
   EXPECT_EQ(p.mesh.order, 5);
   ASSERT_TRUE(p.mesh.size.has_value());
   EXPECT_DOUBLE_EQ(*p.mesh.size, 0.25);
-  EXPECT_EQ(p.mesh.outputs, (std::vector<std::string>{"a.msh", "b.vtu"}));
-  EXPECT_EQ(p.mesh.report.value_or(""), "r.json");
-  EXPECT_EQ(p.mesh.threads, 2);
+  EXPECT_EQ(p.mesh.common.outputs, (std::vector<std::string>{"a.msh", "b.vtu"}));
+  EXPECT_EQ(p.mesh.common.report.value_or(""), "r.json");
+  EXPECT_EQ(p.mesh.common.threads, 2);
   EXPECT_EQ(p.mesh.verbosity, 1);
 }
 
@@ -37,13 +37,33 @@ TEST(Arguments, Defaults) {
   const ParsedCommand p = parse({"mesh", "part.brep"});
   EXPECT_EQ(p.mesh.order, 4);
   EXPECT_FALSE(p.mesh.size.has_value());
-  EXPECT_TRUE(p.mesh.outputs.empty());
+  EXPECT_TRUE(p.mesh.common.outputs.empty());
+}
+
+TEST(Arguments, QualityAndConvert) {
+  const ParsedCommand q = parse({"quality", "m.msh", "--report", "-", "--strict", "-j", "2"});
+  ASSERT_EQ(q.kind, ParsedCommand::Kind::Quality);
+  EXPECT_EQ(q.quality.input, "m.msh");
+  EXPECT_TRUE(q.quality.strict);
+  EXPECT_EQ(q.quality.common.report.value_or(""), "-");
+  EXPECT_EQ(q.quality.common.threads, 2);
+  const ParsedCommand c = parse({"convert", "m.msh", "-o", "m.xml", "--compressed", "-o", "m.msh",
+                                 "--binary"});
+  ASSERT_EQ(c.kind, ParsedCommand::Kind::Convert);
+  EXPECT_EQ(c.convert.common.outputs, (std::vector<std::string>{"m.xml", "m.msh"}));
+  EXPECT_TRUE(c.convert.common.compressed);
+  EXPECT_TRUE(c.convert.common.binary);
+  EXPECT_NE(usageError({"convert", "m.msh"}).find("-o"), std::string::npos);
+  EXPECT_NE(usageError({"quality"}).find("INPUT"), std::string::npos);
+  EXPECT_NE(usageError({"quality", "m.msh", "--order", "3"}).find("--order"), std::string::npos);
 }
 
 TEST(Arguments, HelpAndVersion) {
   EXPECT_EQ(parse({"--help"}).kind, ParsedCommand::Kind::Help);
   EXPECT_EQ(parse({"mesh", "--help"}).helpTopic, "mesh");
   EXPECT_EQ(parse({"--version"}).kind, ParsedCommand::Kind::Version);
+  EXPECT_EQ(parse({"quality", "-h"}).helpTopic, "quality");
+  EXPECT_NE(usageText("convert").find("--compressed"), std::string::npos);
   EXPECT_NE(usageText("mesh").find("--order"), std::string::npos);
 }
 

@@ -13,6 +13,8 @@
 #include "io/atomic_file.hpp"
 #include "io/json_writer.hpp"
 #include "io/mesh_writers.hpp"
+#include "io/msh_writer.hpp"
+#include "io/vtu_writer.hpp"
 #include "linear/linear_mesher.hpp"
 #include "quality/mesh_quality.hpp"
 #include "test_support.hpp"
@@ -37,7 +39,7 @@ TEST(MshWriter, GmshReadsBackNodesElementsGroupsAndData) {
   for (const int order : {1, 3, 6}) {
     const Mesh mesh = curvedBoxWithHole(order);
     const std::string path = (dir / ("mesh" + std::to_string(order) + ".msh")).string();
-    writeMsh41(mesh, path, fieldFor(mesh));
+    writeMsh41(mesh, path, fieldFor(mesh), false);
 
     gmsh::initialize(0, nullptr, false);
     gmsh::option::setNumber("General.Terminal", 0);
@@ -86,7 +88,7 @@ TEST(VtuWriter, WritesLagrangeCellsAndFields) {
   const auto dir = test::tempDir();
   const Mesh mesh = curvedBoxWithHole(3);
   const std::string path = (dir / "mesh.vtu").string();
-  writeVtu(mesh, path, fieldFor(mesh));
+  writeVtu(mesh, path, fieldFor(mesh), false);
   std::ifstream in(path);
   std::stringstream text;
   text << in.rdbuf();

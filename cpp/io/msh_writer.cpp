@@ -1,0 +1,225 @@
+#include "io/msh_writer.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <set>
+
+#include "cad/cad_model.hpp"
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+
+namespace homesh {
+namespace {
+
+// Writes numbers as MSH 4.1 ASCII text or as its binary encoding (int: 4 bytes, size_t: 8,
+// double: 8, native little-endian).
+class MshSink {
+ public:
+  MshSink(std::ostream& os, bool binary) : os_(os), binary_(binary) { os_.precision(17); }
+  bool binary() const { return binary_; }
+
+  void size(std::size_t v) { put(static_cast<std::uint64_t>(v)); }
+  void integer(int v) { put(static_cast<std::int32_t>(v)); }
+  void real(double v) { put(v); }
+  // Ends an ASCII line (nothing in binary).
+  void endLine() {
+    if (!binary_) {
+      os_ << '\n';
+      first_ = true;
+    }
+  }
+  std::ostream& text() { return os_; }
+
+ private:
+  template <class T>
+  void put(T v) {
+    if (binary_) {
+      os_.write(reinterpret_cast<const char*>(&v), sizeof v);
+      return;
+    }
+    if (!first_) os_ << ' ';
+    os_ << v;
+    first_ = false;
+  }
+  std::ostream& os_;
+  bool binary_;
+  bool first_ = true;
+};
+
+// Gmsh entity tags must be positive; meshes without CAD have index 0.
+int entityTag(int cadIndex) { return std::max(1, cadIndex); }
+
+struct Box {
+  double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+                  std::numeric_limits<double>::max()};
+  double hi[3] = {std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest(),
+                  std::numeric_limits<double>::lowest()};
+  void add(const double* p) {
+    for (int c = 0; c < 3; ++c) {
+      lo[c] = std::min(lo[c], p[c]);
+      hi[c] = std::max(hi[c], p[c]);
+    }
+  }
+};
+
+using EntityKey = std::pair<int, int>;  // (dim, tag)
+
+void writeEntities(MshSink& out, const std::map<EntityKey, Box>& entities,
+                   const std::set<EntityKey>& physical) {
+  std::array<std::size_t, 4> counts{0, 0, 0, 0};
+  for (const auto& [key, box] : entities) ++counts[key.first];
+  out.text() << "$Entities\n";
+  for (const std::size_t c : counts) out.size(c);
+  out.endLine();
+  for (const auto& [key, box] : entities) {
+    const auto [dim, tag] = key;
+    out.integer(tag);
+    for (int c = 0; c < 3; ++c) out.real(box.lo[c]);
+    if (dim > 0)
+      for (int c = 0; c < 3; ++c) out.real(box.hi[c]);
+    if (physical.count(key) > 0) {
+      out.size(1);
+      out.integer(tag);
+    } else {
+      out.size(0);
+    }
+    if (dim > 0) out.size(0);  // bounding entities are not listed
+    out.endLine();
+  }
+  if (out.binary()) out.text() << '\n';
+  out.text() << "$EndEntities\n";
+}
+
+}  // namespace
+
+void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields,
+                bool binary) {
+  mesh.checkConsistency();
+  checkCellFields(mesh, fields);
+  const std::size_t n = mesh.numNodes();
+
+  // Entities: from node classification and element entities.
+  std::map<EntityKey, Box> entities;
+  std::map<EntityKey, std::vector<std::size_t>> nodesOf;
+  for (std::size_t i = 0; i < n; ++i) {
+    const EntityKey key{mesh.nodeCadDim[i], entityTag(mesh.nodeCadIndex[i])};
+    entities[key].add(&mesh.xyz[3 * i]);
+    nodesOf[key].push_back(i);
+  }
+  std::set<EntityKey> physical;
+  for (const ElementBlock& block : mesh.blocks) {
+    const int dim = cellDimension(block.type);
+    for (std::size_t e = 0; e < block.count(); ++e) {
+      const EntityKey key{dim, entityTag(block.entity[e])};
+      physical.insert(key);
+      Box& box = entities[key];
+      const std::int64_t* nodes = block.element(e);
+      for (int k = 0; k < cellNumVertices(block.type); ++k) box.add(&mesh.xyz[3 * nodes[k]]);
+    }
+  }
+
+  AtomicFile file(path, binary);
+  std::ostream& os = file.stream();
+  MshSink out(os, binary);
+  os << "$MeshFormat\n4.1 " << (binary ? 1 : 0) << " 8\n";
+  if (binary) {
+    const std::int32_t one = 1;  // tells readers the byte order
+    os.write(reinterpret_cast<const char*>(&one), sizeof one);
+    os << '\n';
+  }
+  os << "$EndMeshFormat\n";
+  os << "$PhysicalNames\n" << physical.size() << "\n";
+  for (const auto& [dim, tag] : physical)
+    os << dim << " " << tag << " \"" << cadEntityName(dim, tag) << "\"\n";
+  os << "$EndPhysicalNames\n";
+  writeEntities(out, entities, physical);
+
+  os << "$Nodes\n";
+  out.size(nodesOf.size());
+  out.size(n);
+  out.size(1);
+  out.size(n);
+  out.endLine();
+  for (const auto& [key, ids] : nodesOf) {
+    out.integer(key.first);
+    out.integer(key.second);
+    out.integer(0);  // no parametric coordinates
+    out.size(ids.size());
+    out.endLine();
+    for (const std::size_t i : ids) {
+      out.size(i + 1);
+      out.endLine();
+    }
+    for (const std::size_t i : ids) {
+      for (int c = 0; c < 3; ++c) out.real(mesh.xyz[3 * i + c]);
+      out.endLine();
+    }
+  }
+  if (binary) os << '\n';
+  os << "$EndNodes\n";
+
+  // Element blocks per (entity, type); tags: cells of dimension mesh.dim first, in block order,
+  // so that element tag k+1 carries field value k.
+  struct Group {
+    int dim, tag, type, nodesPerElement;
+    std::vector<std::pair<std::size_t, const std::int64_t*>> elements;  // (tag, nodes)
+  };
+  std::map<std::array<int, 3>, Group> groups;
+  std::size_t total = 0, nextTag = 1;
+  std::vector<const ElementBlock*> ordered;
+  for (const ElementBlock& b : mesh.blocks)
+    if (cellDimension(b.type) == mesh.dim) ordered.push_back(&b);
+  for (const ElementBlock& b : mesh.blocks)
+    if (cellDimension(b.type) != mesh.dim) ordered.push_back(&b);
+  for (const ElementBlock* block : ordered) {
+    const int dim = cellDimension(block->type);
+    const int type = gmshElementType(block->type, block->order);
+    for (std::size_t e = 0; e < block->count(); ++e) {
+      const int tag = entityTag(block->entity[e]);
+      Group& g = groups[{dim, tag, type}];
+      g.dim = dim;
+      g.tag = tag;
+      g.type = type;
+      g.nodesPerElement = block->nodesPerElement();
+      g.elements.emplace_back(nextTag++, block->element(e));
+      ++total;
+    }
+  }
+  os << "$Elements\n";
+  out.size(groups.size());
+  out.size(total);
+  out.size(1);
+  out.size(total);
+  out.endLine();
+  for (const auto& [key, g] : groups) {
+    out.integer(g.dim);
+    out.integer(g.tag);
+    out.integer(g.type);
+    out.size(g.elements.size());
+    out.endLine();
+    for (const auto& [tag, nodes] : g.elements) {
+      out.size(tag);
+      for (int k = 0; k < g.nodesPerElement; ++k) out.size(static_cast<std::size_t>(nodes[k]) + 1);
+      out.endLine();
+    }
+  }
+  if (binary) os << '\n';
+  os << "$EndElements\n";
+
+  for (const CellField& f : fields) {
+    os << "$ElementData\n1\n\"" << f.name << "\"\n1\n0\n3\n0\n1\n" << f.values.size() << "\n";
+    for (std::size_t k = 0; k < f.values.size(); ++k) {
+      out.integer(static_cast<int>(k + 1));
+      out.real(f.values[k]);
+      out.endLine();
+    }
+    if (binary) os << '\n';
+    os << "$EndElementData\n";
+  }
+  file.commit();
+}
+
+}  // namespace homesh

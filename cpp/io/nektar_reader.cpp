@@ -1,0 +1,646 @@
+#include "io/nektar_reader.hpp"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cstring>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "element/reference_element.hpp"
+#include "io/nektar_format.hpp"
+#include "io/xml_document.hpp"
+
+namespace homesh {
+namespace {
+
+using Point = Eigen::Vector3d;
+using Lattice = LatticePoint;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct Face {
+  bool triangle = true;
+  std::vector<int> edges;
+  std::vector<int> vertices;  // own order, from the edge loop
+};
+
+struct Element {
+  CellType type;
+  int id;
+  std::vector<int> ids;  // faces (3D) or edges (2D)
+};
+
+struct Curve {
+  std::vector<Point> points;
+};
+
+class Reader {
+ public:
+  explicit Reader(std::string path) : path_(std::move(path)) {}
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw IoError("'" + path_ + "' is not a valid Nektar++ geometry: " + what);
+  }
+
+  Mesh read();
+
+ private:
+  // Section parsing.
+  void readVertices(const XmlElement& section);
+  void readEdges(const XmlElement& section);
+  void readFaces(const XmlElement& section);
+  void readElements(const XmlElement& section);
+  void readCurves(const XmlElement& section);
+  void readComposites(const XmlElement& section);
+  // Decodes a compressed blob; `tagged`: the element itself carries COMPRESSED (children of a
+  // compressed CURVED do not).
+  template <class Record>
+  std::vector<Record> records(const XmlElement& e, bool tagged = true) const;
+  std::vector<double> numbers(const std::string& text, const std::string& where) const;
+
+  // Topology.
+  int common(int edgeA, int edgeB) const;  // the vertex two edges share
+  int sharedEdge(int faceA, int faceB) const;
+  int otherEnd(int edge, int vertex) const;
+  std::vector<int> loopVertices(const std::vector<int>& edgeIds) const;
+  std::vector<int> elementVertices(const Element& e) const;  // Gmsh local order
+
+  // Nodes.
+  std::int64_t newNode(const Point& p, bool known);
+  std::int64_t edgeNode(int edge, int fromVertex, int t);
+  int edgeBetween(int a, int b) const;
+  std::vector<std::int64_t> interiorNodes(bool triangle, const Curve* curve);
+  std::vector<std::int64_t> polygonNodes(const std::vector<int>& own,
+                                         const std::vector<std::int64_t>& interior);
+  std::vector<std::int64_t> volumeNodes(
+      CellType type, const std::vector<int>& v,
+      const std::map<std::vector<int>, std::vector<std::int64_t>>& faceByVertices);
+  void fill(CellType type, const std::vector<std::int64_t>& nodes);
+
+  std::string path_;
+  int dim_ = 3;
+  int order_ = 1;
+  std::map<int, Point> vertices_;
+  std::map<int, std::array<int, 2>> edges_;
+  std::map<int, Face> faces_;
+  std::vector<Element> elements_;
+  std::map<int, Curve> edgeCurves_, faceCurves_;
+  struct Composite {
+    std::string name;
+    char letter;
+    std::vector<int> ids;
+  };
+  std::vector<Composite> composites_;
+
+  Mesh mesh_;
+  std::map<std::pair<int, int>, int> edgeOf_;  // (smaller, larger vertex) -> edge
+  std::map<int, std::int64_t> vertexNode_;
+  std::map<int, std::vector<std::int64_t>> edgeNodes_;
+  std::vector<bool> known_;  // node position given by the file (else to be filled)
+};
+
+std::vector<int> parseIdList(const std::string& list) {
+  std::vector<int> ids;
+  std::stringstream ss(list);
+  std::string part;
+  while (std::getline(ss, part, ',')) {
+    if (part.empty()) continue;
+    const std::size_t dash = part.find('-');
+    if (dash == std::string::npos) {
+      ids.push_back(std::stoi(part));
+    } else {
+      const int a = std::stoi(part.substr(0, dash)), b = std::stoi(part.substr(dash + 1));
+      for (int i = a; i <= b; ++i) ids.push_back(i);
+    }
+  }
+  return ids;
+}
+
+std::vector<double> Reader::numbers(const std::string& text, const std::string& where) const {
+  std::vector<double> v;
+  const char* p = text.c_str();
+  char* end = nullptr;
+  for (;;) {
+    const double x = std::strtod(p, &end);
+    if (end == p) break;
+    v.push_back(x);
+    p = end;
+  }
+  while (*p != '\0' && std::isspace(static_cast<unsigned char>(*p))) ++p;
+  if (*p != '\0') fail("unexpected text in " + where);
+  return v;
+}
+
+template <class Record>
+std::vector<Record> Reader::records(const XmlElement& e, bool tagged) const {
+  if (tagged && !e.has("COMPRESSED"))
+    fail("<" + e.name + "> is not compressed like the rest of the file");
+  if (tagged && e.attribute("COMPRESSED") != nektar::kCompressed)
+    fail("unsupported compression '" + e.attribute("COMPRESSED") + "'");
+  const std::string bytes = nektar::decode(e.text);
+  std::vector<Record> out(bytes.size() / sizeof(Record));
+  if (!out.empty()) std::memcpy(out.data(), bytes.data(), out.size() * sizeof(Record));
+  return out;
+}
+
+void Reader::readVertices(const XmlElement& section) {
+  if (section.has("COMPRESSED")) {
+    for (const auto& v : records<nektar::Vertex>(section))
+      vertices_[static_cast<int>(v.id)] = {v.x, v.y, v.z};
+    return;
+  }
+  for (const XmlElement* v : section.childrenNamed("V")) {
+    const std::vector<double> x = numbers(v->text, "vertex " + v->attribute("ID"));
+    if (x.size() != 3) fail("vertex " + v->attribute("ID") + " needs 3 coordinates");
+    vertices_[std::stoi(v->attribute("ID"))] = {x[0], x[1], x[2]};
+  }
+}
+
+void Reader::readEdges(const XmlElement& section) {
+  if (section.has("COMPRESSED")) {
+    for (const auto& e : records<nektar::Edge>(section))
+      edges_[static_cast<int>(e.id)] = {static_cast<int>(e.v0), static_cast<int>(e.v1)};
+    return;
+  }
+  for (const XmlElement* e : section.childrenNamed("E")) {
+    const std::vector<double> v = numbers(e->text, "edge " + e->attribute("ID"));
+    if (v.size() != 2) fail("edge " + e->attribute("ID") + " needs 2 vertices");
+    edges_[std::stoi(e->attribute("ID"))] = {static_cast<int>(v[0]), static_cast<int>(v[1])};
+  }
+}
+
+void Reader::readFaces(const XmlElement& section) {
+  for (const auto& child : section.children) {
+    const bool tri = child->name == "T";
+    if (!tri && child->name != "Q") fail("unknown face <" + child->name + ">");
+    const auto add = [&](int id, std::vector<int> edgeIds) {
+      Face f;
+      f.triangle = tri;
+      f.edges = std::move(edgeIds);
+      faces_[id] = f;
+    };
+    if (child->has("COMPRESSED")) {
+      if (tri)
+        for (const auto& r : records<nektar::Entity<3>>(*child))
+          add(static_cast<int>(r.id), {int(r.ids[0]), int(r.ids[1]), int(r.ids[2])});
+      else
+        for (const auto& r : records<nektar::Entity<4>>(*child))
+          add(static_cast<int>(r.id),
+              {int(r.ids[0]), int(r.ids[1]), int(r.ids[2]), int(r.ids[3])});
+    } else {
+      const std::vector<double> v = numbers(child->text, "face " + child->attribute("ID"));
+      if (v.size() != (tri ? 3u : 4u)) fail("face " + child->attribute("ID") + " has wrong size");
+      add(std::stoi(child->attribute("ID")), std::vector<int>(v.begin(), v.end()));
+    }
+  }
+}
+
+void Reader::readElements(const XmlElement& section) {
+  for (const auto& child : section.children) {
+    const std::string& tag = child->name;
+    CellType type;
+    int n = 0;
+    if (dim_ == 3 && tag == "A") { type = CellType::Tetrahedron; n = 4; }
+    else if (dim_ == 3 && tag == "R") { type = CellType::Prism; n = 5; }
+    else if (dim_ == 3 && tag == "H") { type = CellType::Hexahedron; n = 6; }
+    else if (dim_ == 2 && tag == "T") { type = CellType::Triangle; n = 3; }
+    else if (dim_ == 2 && tag == "Q") { type = CellType::Quadrilateral; n = 4; }
+    else fail("element <" + tag + "> is not supported in a " + std::to_string(dim_) + "D mesh");
+    const auto add = [&](int id, std::vector<int> ids) { elements_.push_back({type, id, ids}); };
+    if (child->has("COMPRESSED")) {
+      const auto take = [&](const auto& recs) {
+        for (const auto& r : recs) add(int(r.id), std::vector<int>(r.ids, r.ids + n));
+      };
+      if (n == 3) take(records<nektar::Entity<3>>(*child));
+      if (n == 4) take(records<nektar::Entity<4>>(*child));
+      if (n == 5) take(records<nektar::Entity<5>>(*child));
+      if (n == 6) take(records<nektar::Entity<6>>(*child));
+    } else {
+      const std::vector<double> v = numbers(child->text, "element " + child->attribute("ID"));
+      if (static_cast<int>(v.size()) != n) fail("element " + child->attribute("ID") + " has wrong size");
+      add(std::stoi(child->attribute("ID")), std::vector<int>(v.begin(), v.end()));
+    }
+  }
+  std::sort(elements_.begin(), elements_.end(),
+            [](const Element& a, const Element& b) { return a.id < b.id; });
+}
+
+void Reader::readCurves(const XmlElement& section) {
+  if (section.has("COMPRESSED")) {
+    const XmlElement* data = section.child("DATAPOINTS");
+    if (data == nullptr) fail("compressed CURVED without DATAPOINTS");
+    const XmlElement* indexElement = data->child("INDEX");
+    const XmlElement* pointsElement = data->child("POINTS");
+    if (indexElement == nullptr || pointsElement == nullptr) fail("DATAPOINTS is incomplete");
+    const auto index = records<std::int64_t>(*indexElement, false);
+    const auto points = records<nektar::Vertex>(*pointsElement, false);
+    for (const char* kind : {"E", "F"}) {
+      const XmlElement* info = section.child(kind);
+      if (info == nullptr) continue;
+      for (const auto& c : records<nektar::CurvedInfo>(*info, false)) {
+        Curve curve;
+        for (std::int64_t k = 0; k < c.numPoints; ++k) {
+          const auto at = static_cast<std::size_t>(index.at(static_cast<std::size_t>(c.offset + k)));
+          const auto& v = points.at(at);
+          curve.points.emplace_back(v.x, v.y, v.z);
+        }
+        (kind[0] == 'E' ? edgeCurves_ : faceCurves_)[static_cast<int>(c.entityId)] = curve;
+      }
+    }
+    return;
+  }
+  for (const auto& child : section.children) {
+    const bool edge = child->name == "E";
+    if (!edge && child->name != "F") fail("unknown curve <" + child->name + ">");
+    const std::vector<double> v = numbers(child->text, "a curve");
+    Curve c;
+    for (std::size_t k = 0; k + 2 < v.size(); k += 3) c.points.emplace_back(v[k], v[k + 1], v[k + 2]);
+    const int entity = std::stoi(child->attribute(edge ? "EDGEID" : "FACEID"));
+    (edge ? edgeCurves_ : faceCurves_)[entity] = c;
+  }
+}
+
+void Reader::readComposites(const XmlElement& section) {
+  for (const XmlElement* c : section.childrenNamed("C")) {
+    std::stringstream ss(c->text);
+    std::string token;
+    while (ss >> token) {
+      const std::size_t open = token.find('['), close = token.rfind(']');
+      if (open == std::string::npos || close == std::string::npos || open == 0)
+        fail("composite " + c->attribute("ID") + " is malformed");
+      composites_.push_back(
+          {c->attribute("NAME"), token[0], parseIdList(token.substr(open + 1, close - open - 1))});
+    }
+  }
+}
+
+int Reader::common(int a, int b) const {
+  const auto& ea = edges_.at(a);
+  const auto& eb = edges_.at(b);
+  for (const int v : ea)
+    if (v == eb[0] || v == eb[1]) return v;
+  fail("edges " + std::to_string(a) + " and " + std::to_string(b) + " do not meet");
+}
+
+int Reader::otherEnd(int edge, int vertex) const {
+  const auto& e = edges_.at(edge);
+  if (e[0] == vertex) return e[1];
+  if (e[1] == vertex) return e[0];
+  fail("vertex " + std::to_string(vertex) + " is not on edge " + std::to_string(edge));
+}
+
+int Reader::sharedEdge(int fa, int fb) const {
+  for (const int a : faces_.at(fa).edges)
+    for (const int b : faces_.at(fb).edges)
+      if (a == b) return a;
+  fail("faces " + std::to_string(fa) + " and " + std::to_string(fb) + " share no edge");
+}
+
+// Vertex j of an edge loop: the vertex shared by edges j-1 and j.
+std::vector<int> Reader::loopVertices(const std::vector<int>& e) const {
+  std::vector<int> v;
+  const int n = static_cast<int>(e.size());
+  for (int j = 0; j < n; ++j) v.push_back(common(e[(j + n - 1) % n], e[j]));
+  return v;
+}
+
+std::vector<int> Reader::elementVertices(const Element& e) const {
+  const auto& f = e.ids;
+  switch (e.type) {
+    case CellType::Triangle:
+    case CellType::Quadrilateral:
+      return loopVertices(f);
+    case CellType::Tetrahedron: {
+      // As Nektar++: e0, e1, e2 are face 0's edges that start faces 1, 2, 3.
+      const int e0 = faces_.at(f[1]).edges[0], e1 = faces_.at(f[2]).edges[0];
+      const int e3 = sharedEdge(f[1], f[3]);
+      const int v1 = common(e0, e1), v0 = otherEnd(e0, v1), v2 = otherEnd(e1, v1);
+      return {v0, v1, v2, otherEnd(e3, v0)};
+    }
+    case CellType::Prism: {
+      const int e0 = sharedEdge(f[0], f[1]), e1 = sharedEdge(f[0], f[2]);
+      const int e2 = sharedEdge(f[0], f[3]), e4 = sharedEdge(f[1], f[4]);
+      const int e8 = sharedEdge(f[2], f[4]);
+      const int v1 = common(e0, e1), v0 = otherEnd(e0, v1), v2 = otherEnd(e1, v1);
+      const int v3 = otherEnd(e2, v2), v4 = common(e8, e4), v5 = otherEnd(e8, v4);
+      // Nektar++ (v0..v5) to Gmsh: triangles (v4 v1 v0) and (v5 v2 v3).
+      return {v4, v1, v0, v5, v2, v3};
+    }
+    case CellType::Hexahedron: {
+      const int e0 = sharedEdge(f[0], f[1]), e1 = sharedEdge(f[0], f[2]);
+      const int e2 = sharedEdge(f[0], f[3]);
+      const int e8 = sharedEdge(f[5], f[1]), e9 = sharedEdge(f[5], f[2]);
+      const int e10 = sharedEdge(f[5], f[3]);
+      const int v1 = common(e0, e1), v0 = otherEnd(e0, v1), v2 = otherEnd(e1, v1);
+      const int v3 = otherEnd(e2, v2), v5 = common(e8, e9), v4 = otherEnd(e8, v5);
+      const int v6 = otherEnd(e9, v5), v7 = otherEnd(e10, v6);
+      return {v0, v1, v2, v3, v4, v5, v6, v7};
+    }
+    default:
+      fail("unsupported element");
+  }
+}
+
+std::int64_t Reader::newNode(const Point& p, bool known) {
+  const double xyz[3] = {p.x(), p.y(), p.z()};
+  known_.push_back(known);
+  return mesh_.addNode(xyz, dim_, 0, kNaN, kNaN);
+}
+
+// Interior node t (1..P-1) of `edge` counted from its end `fromVertex`.
+std::int64_t Reader::edgeNode(int edge, int fromVertex, int t) {
+  auto& nodes = edgeNodes_[edge];
+  const auto& ev = edges_.at(edge);
+  if (nodes.empty()) {
+    const auto curve = edgeCurves_.find(edge);
+    const Point a = vertices_.at(ev[0]), b = vertices_.at(ev[1]);
+    for (int k = 1; k < order_; ++k)
+      nodes.push_back(newNode(curve != edgeCurves_.end() ? curve->second.points.at(k)
+                                                         : Point(a + (b - a) * k / order_),
+                              true));
+  }
+  return nodes.at(ev[0] == fromVertex ? t - 1 : order_ - t - 1);
+}
+
+int Reader::edgeBetween(int a, int b) const {
+  const auto it = edgeOf_.find(std::minmax(a, b));
+  if (it == edgeOf_.end())
+    fail("no edge joins vertices " + std::to_string(a) + " and " + std::to_string(b));
+  return it->second;
+}
+
+// Interior nodes of a face (or 2D element) in Nektar++'s order; `points` is its curve, if any.
+std::vector<std::int64_t> Reader::interiorNodes(bool triangle, const Curve* curve) {
+  std::vector<std::int64_t> nodes;
+  const int n = order_ + 1;
+  int k = 3 * order_;
+  for (int i = 1; i < order_; ++i)
+    for (int j = 1; j < order_; ++j) {
+      if (triangle && i + j >= order_) continue;
+      const int at = triangle ? k++ : i * n + j;
+      nodes.push_back(curve != nullptr ? newNode(curve->points.at(at), true)
+                                       : newNode(Point::Zero(), false));
+    }
+  return nodes;
+}
+
+// Nodes of a polygon (face or 2D element) in Gmsh order, given its vertices in the polygon's
+// own Nektar++ order and its stored interior nodes.
+std::vector<std::int64_t> Reader::polygonNodes(const std::vector<int>& own,
+                                               const std::vector<std::int64_t>& interior) {
+  const bool triangle = own.size() == 3;
+  const CellType type = triangle ? CellType::Triangle : CellType::Quadrilateral;
+  const ReferenceElement& ref = ReferenceElement::get(type, order_);
+  std::map<Lattice, std::int64_t> at;
+  const int nv = static_cast<int>(own.size());
+  for (int k = 0; k < nv; ++k) at[ref.lattice()[k]] = vertexNode_.at(own[k]);
+  for (int k = 0; k < nv; ++k) {
+    const Lattice& a = ref.lattice()[k];
+    const Lattice& b = ref.lattice()[(k + 1) % nv];
+    const int edge = edgeBetween(own[k], own[(k + 1) % nv]);
+    for (int t = 1; t < order_; ++t) {
+      Lattice l;
+      for (int c = 0; c < 3; ++c) l[c] = a[c] + (b[c] - a[c]) / order_ * t;
+      at[l] = edgeNode(edge, own[k], t);
+    }
+  }
+  std::size_t k = 0;  // interior rows: i towards vertex 2 (3), j towards vertex 1
+  for (int i = 1; i < order_; ++i)
+    for (int j = 1; j < order_; ++j)
+      if (!triangle || i + j < order_) at[{j, i, 0}] = interior.at(k++);
+  std::vector<std::int64_t> nodes;
+  for (const Lattice& l : ref.lattice()) nodes.push_back(at.at(l));
+  return nodes;
+}
+
+// Fills nodes of unknown position by a discrete harmonic extension on the element's lattice
+// (each unknown node the mean of its lattice neighbours), Gauss-Seidel to convergence.
+void Reader::fill(CellType type, const std::vector<std::int64_t>& nodes) {
+  const ReferenceElement& ref = ReferenceElement::get(type, order_);
+  std::map<Lattice, std::int64_t> at;
+  std::vector<int> unknown;
+  for (int n = 0; n < ref.numNodes(); ++n) {
+    at[ref.lattice()[n]] = nodes[n];
+    if (!known_[nodes[n]]) unknown.push_back(n);
+  }
+  if (unknown.empty()) return;
+  std::vector<Lattice> stencil{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  if (type == CellType::Triangle || type == CellType::Tetrahedron || type == CellType::Prism)
+    stencil.push_back({1, -1, 0});
+  if (type == CellType::Tetrahedron) {
+    stencil.push_back({1, 0, -1});
+    stencil.push_back({0, 1, -1});
+  }
+  double scale = 0.0;
+  for (const std::int64_t n : nodes)
+    if (known_[n]) scale = std::max(scale, Eigen::Map<const Point>(&mesh_.xyz[3 * n]).norm());
+  for (int sweep = 0; sweep < 10000; ++sweep) {
+    double change = 0.0;
+    for (const int u : unknown) {
+      const Lattice& l = ref.lattice()[u];
+      Point sum = Point::Zero();
+      int count = 0;
+      for (const Lattice& d : stencil)
+        for (const int sign : {-1, 1}) {
+          const Lattice m{l[0] + sign * d[0], l[1] + sign * d[1], l[2] + sign * d[2]};
+          const auto it = at.find(m);
+          if (it == at.end()) continue;
+          sum += Eigen::Map<const Point>(&mesh_.xyz[3 * it->second]);
+          ++count;
+        }
+      double* x = &mesh_.xyz[3 * nodes[u]];
+      const Point next = sum / count;
+      change = std::max(change, (next - Eigen::Map<const Point>(x)).norm());
+      for (int c = 0; c < 3; ++c) x[c] = next[c];
+    }
+    if (change <= 1e-15 * std::max(scale, 1.0)) break;
+  }
+  for (const int u : unknown) known_[nodes[u]] = true;
+}
+
+Mesh Reader::read() {
+  std::ifstream in(path_);
+  if (!in) throw IoError("mesh file '" + path_ + "' cannot be read");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const auto root = parseXml(buffer.str(), path_);
+  if (root->name != "NEKTAR") fail("the root element is <" + root->name + ">, not <NEKTAR>");
+  const XmlElement* geometry = root->child("GEOMETRY");
+  if (geometry == nullptr) fail("no <GEOMETRY>");
+  dim_ = std::stoi(geometry->attribute("DIM", "3"));
+  if (dim_ != 2 && dim_ != 3) fail("DIM must be 2 or 3");
+  const auto section = [&](const char* name, bool required) {
+    const XmlElement* s = geometry->child(name);
+    if (s == nullptr && required) fail(std::string("no <") + name + ">");
+    return s;
+  };
+  readVertices(*section("VERTEX", true));
+  readEdges(*section("EDGE", true));
+  if (dim_ == 3) readFaces(*section("FACE", true));
+  readElements(*section("ELEMENT", true));
+  if (const XmlElement* c = section("CURVED", false)) readCurves(*c);
+  if (const XmlElement* c = section("COMPOSITE", false)) readComposites(*c);
+  if (elements_.empty()) fail("no elements");
+  for (const auto& [id, ev] : edges_) edgeOf_[std::minmax(ev[0], ev[1])] = id;
+  for (auto& [id, f] : faces_) f.vertices = loopVertices(f.edges);
+  if (!edgeCurves_.empty())
+    order_ = static_cast<int>(edgeCurves_.begin()->second.points.size()) - 1;
+  for (const auto& [id, c] : edgeCurves_)
+    if (static_cast<int>(c.points.size()) != order_ + 1)
+      fail("curved edges have different numbers of points");
+  if (order_ < 1 || order_ > kMaxOrder) fail("curves of order " + std::to_string(order_));
+  mesh_.dim = dim_;
+  mesh_.order = order_;
+  for (const auto& [id, p] : vertices_) vertexNode_[id] = newNode(p, true);
+
+  // Entities from the composites' names ("Solid3", "Face12", "Edge5").
+  std::map<std::pair<char, int>, int> entityOf;
+  std::map<int, int> boundaryEntity;  // face (3D) or edge (2D) id -> entity
+  for (const Composite& c : composites_) {
+    int index = 0;
+    for (const char* prefix : {"Solid", "Face", "Edge"})
+      if (c.name.rfind(prefix, 0) == 0) index = std::atoi(c.name.c_str() + std::strlen(prefix));
+    for (const int id : c.ids) {
+      if (c.letter == 'F' || (c.letter == 'E' && dim_ == 2))
+        boundaryEntity[id] = index;
+      else
+        entityOf[{c.letter, id}] = index;
+    }
+  }
+
+  // Faces' interior nodes (from their curves, or to be filled), and the faces' Gmsh-ordered
+  // nodes keyed by their vertex set, for the elements to look up.
+  std::map<std::vector<int>, std::vector<std::int64_t>> faceByVertices;
+  std::map<int, std::vector<std::int64_t>> faceGmshNodes;
+  for (const auto& [id, f] : faces_) {
+    const auto curve = faceCurves_.find(id);
+    const std::vector<std::int64_t> interior =
+        interiorNodes(f.triangle, curve != faceCurves_.end() ? &curve->second : nullptr);
+    std::vector<std::int64_t> nodes = polygonNodes(f.vertices, interior);
+    fill(f.triangle ? CellType::Triangle : CellType::Quadrilateral, nodes);
+    std::vector<int> key = f.vertices;
+    std::sort(key.begin(), key.end());
+    faceByVertices[key] = nodes;
+    faceGmshNodes[id] = nodes;
+  }
+
+  std::map<CellType, ElementBlock> blocks;
+  for (const Element& e : elements_) {
+    const std::vector<int> v = elementVertices(e);
+    ElementBlock& block = blocks[e.type];
+    block.type = e.type;
+    block.order = order_;
+    block.entity.push_back(entityOf[{nektar::letter(e.type), e.id}]);
+    std::vector<std::int64_t> nodes;
+    if (dim_ == 2) {
+      const auto curve = faceCurves_.find(e.id);
+      nodes = polygonNodes(v, interiorNodes(e.type == CellType::Triangle,
+                                            curve != faceCurves_.end() ? &curve->second : nullptr));
+    } else {
+      nodes = volumeNodes(e.type, v, faceByVertices);
+    }
+    fill(e.type, nodes);
+    block.nodes.insert(block.nodes.end(), nodes.begin(), nodes.end());
+    for (const std::int64_t n : nodes) mesh_.nodeCadIndex[n] = block.entity.back();
+  }
+  for (auto& [type, block] : blocks) mesh_.blocks.push_back(std::move(block));
+
+  // Boundary cells: the faces (3D) or edges (2D) of the named boundary composites.
+  ElementBlock tris, quads, lines;
+  tris.type = CellType::Triangle;
+  quads.type = CellType::Quadrilateral;
+  lines.type = CellType::Line;
+  for (ElementBlock* b : {&tris, &quads, &lines}) b->order = order_;
+  for (const auto& [id, entity] : boundaryEntity) {
+    std::vector<std::int64_t> nodes;
+    ElementBlock* block = &lines;
+    if (dim_ == 3) {
+      const auto it = faceGmshNodes.find(id);
+      if (it == faceGmshNodes.end()) fail("composite refers to missing face " + std::to_string(id));
+      nodes = it->second;
+      block = faces_.at(id).triangle ? &tris : &quads;
+    } else {
+      const auto& ev = edges_.at(id);
+      nodes = {vertexNode_.at(ev[0]), vertexNode_.at(ev[1])};
+      for (int t = 1; t < order_; ++t) nodes.push_back(edgeNode(id, ev[0], t));
+    }
+    block->nodes.insert(block->nodes.end(), nodes.begin(), nodes.end());
+    block->entity.push_back(entity);
+    for (const std::int64_t n : nodes) {
+      mesh_.nodeCadDim[n] = static_cast<std::uint8_t>(dim_ - 1);
+      mesh_.nodeCadIndex[n] = entity;
+    }
+  }
+  for (ElementBlock* b : {&tris, &quads, &lines})
+    if (b->count() > 0) mesh_.blocks.push_back(std::move(*b));
+  for (const bool k : known_)
+    if (!k) fail("some nodes could not be placed");
+  mesh_.checkConsistency();
+  return std::move(mesh_);
+}
+
+// Nodes of a 3D element in Gmsh order: vertices, edge nodes, the nodes of its faces (looked up
+// by vertex set), and new interior nodes.
+std::vector<std::int64_t> Reader::volumeNodes(
+    CellType type, const std::vector<int>& v,
+    const std::map<std::vector<int>, std::vector<std::int64_t>>& faceByVertices) {
+  const ReferenceElement& ref = ReferenceElement::get(type, order_);
+  const int nv = cellNumVertices(type);
+  std::map<Lattice, std::int64_t> at;
+  for (int k = 0; k < nv; ++k) at[ref.lattice()[k]] = vertexNode_.at(v[k]);
+  // Faces in Gmsh's local numbering: their nodes from the shared face, mapped by lattice.
+  static const std::map<CellType, std::vector<std::vector<int>>> gmshFaces = {
+      {CellType::Tetrahedron, {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}}},
+      {CellType::Prism, {{0, 1, 2}, {3, 4, 5}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}}},
+      {CellType::Hexahedron,
+       {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}}}};
+  for (const std::vector<int>& local : gmshFaces.at(type)) {
+    std::vector<int> key;
+    for (const int k : local) key.push_back(v[k]);
+    std::sort(key.begin(), key.end());
+    const auto it = faceByVertices.find(key);
+    if (it == faceByVertices.end()) fail("an element's face is missing from FACE");
+    // The face's Gmsh-ordered nodes sit on its own lattice; map its vertices to ours.
+    const std::vector<std::int64_t>& faceNodes = it->second;
+    const bool triangle = local.size() == 3;
+    const ReferenceElement& fref =
+        ReferenceElement::get(triangle ? CellType::Triangle : CellType::Quadrilateral, order_);
+    // The face's own vertices, as local vertices of this element (the first nodes are vertices).
+    std::vector<Lattice> corner;
+    for (std::size_t k = 0; k < local.size(); ++k) {
+      const std::int64_t node = faceNodes[k];
+      const int lv = static_cast<int>(
+          std::find_if(local.begin(), local.end(),
+                       [&](int x) { return vertexNode_.at(v[x]) == node; }) - local.begin());
+      corner.push_back(ref.lattice()[local.at(lv)]);
+    }
+    for (int n = 0; n < fref.numNodes(); ++n) {
+      const Lattice& fl = fref.lattice()[n];  // (s, t) on the face's own lattice
+      Lattice l;
+      const Lattice& b = corner[1];
+      const Lattice& c = corner[triangle ? 2 : 3];
+      for (int k = 0; k < 3; ++k)
+        l[k] = corner[0][k] + (b[k] - corner[0][k]) / order_ * fl[0] +
+               (c[k] - corner[0][k]) / order_ * fl[1];
+      at[l] = faceNodes[n];
+    }
+  }
+  // Edges not on any face do not exist in 3D; the rest is interior.
+  std::vector<std::int64_t> nodes;
+  for (const Lattice& l : ref.lattice()) {
+    const auto it = at.find(l);
+    nodes.push_back(it != at.end() ? it->second : newNode(Point::Zero(), false));
+  }
+  return nodes;
+}
+
+}  // namespace
+
+Mesh readNektarXml(const std::string& path) { return Reader(path).read(); }
+
+}  // namespace homesh

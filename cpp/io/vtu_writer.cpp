@@ -1,0 +1,172 @@
+#include "io/vtu_writer.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "element/node_ordering.hpp"
+#include "io/atomic_file.hpp"
+
+namespace homesh {
+
+namespace {
+
+std::string base64(const std::uint8_t* data, std::size_t size) {
+  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((size + 2) / 3 * 4);
+  for (std::size_t i = 0; i < size; i += 3) {
+    const std::uint32_t b0 = data[i];
+    const std::uint32_t b1 = i + 1 < size ? data[i + 1] : 0;
+    const std::uint32_t b2 = i + 2 < size ? data[i + 2] : 0;
+    const std::uint32_t triple = (b0 << 16) | (b1 << 8) | b2;
+    out += table[(triple >> 18) & 63];
+    out += table[(triple >> 12) & 63];
+    out += i + 1 < size ? table[(triple >> 6) & 63] : '=';
+    out += i + 2 < size ? table[triple & 63] : '=';
+  }
+  return out;
+}
+
+// [UInt64 byte count][raw little-endian values]: VTK's layout of one binary data array.
+template <class T>
+std::string withHeader(const std::vector<T>& values) {
+  const std::uint64_t bytes = values.size() * sizeof(T);
+  std::string buffer(sizeof bytes + bytes, '\0');
+  std::memcpy(buffer.data(), &bytes, sizeof bytes);
+  if (bytes > 0) std::memcpy(buffer.data() + sizeof bytes, values.data(), bytes);
+  return buffer;
+}
+
+// Writes DataArray elements, either with their data base64-encoded inline or as references
+// into the raw <AppendedData> block written at the end.
+class DataArrays {
+ public:
+  DataArrays(std::ostream& os, bool appended) : os_(os), appended_(appended) {}
+
+  template <class T>
+  void add(const char* type, const std::string& name, int components,
+           const std::vector<T>& values) {
+    os_ << "        <DataArray type=\"" << type << "\"";
+    if (!name.empty()) os_ << " Name=\"" << name << "\"";
+    if (components > 1) os_ << " NumberOfComponents=\"" << components << "\"";
+    const std::string data = withHeader(values);
+    if (appended_) {
+      os_ << " format=\"appended\" offset=\"" << appendix_.size() << "\"/>\n";
+      appendix_ += data;
+    } else {
+      os_ << " format=\"binary\">\n          "
+          << base64(reinterpret_cast<const std::uint8_t*>(data.data()), data.size())
+          << "\n        </DataArray>\n";
+    }
+  }
+
+  // After </UnstructuredGrid>: the appended data, if any.
+  void finish() {
+    if (!appended_) return;
+    os_ << "  <AppendedData encoding=\"raw\">\n   _";
+    os_.write(appendix_.data(), static_cast<std::streamsize>(appendix_.size()));
+    os_ << "\n  </AppendedData>\n";
+  }
+
+ private:
+  std::ostream& os_;
+  bool appended_;
+  std::string appendix_;
+};
+
+std::uint8_t vtkLagrangeType(CellType type) {
+  switch (type) {
+    case CellType::Line:
+      return 68;
+    case CellType::Triangle:
+      return 69;
+    case CellType::Quadrilateral:
+      return 70;
+    case CellType::Tetrahedron:
+      return 71;
+    case CellType::Hexahedron:
+      return 72;
+    case CellType::Prism:
+      return 73;
+    case CellType::Pyramid:
+      return 74;
+    default:
+      throw ParameterError("no VTK Lagrange cell for " + cellShortName(type));
+  }
+}
+
+// VTK 9 renumbered the Lagrange hexahedron: files older than version 2.2 list the nodes of
+// edges 10 and 11 (the vertical edges through vertices 2-6 and 3-7) the other way round, and
+// VTK's reader swaps them back. We write version 1.0, which every reader (meshio included)
+// accepts, so the hexahedra carry the version-1 numbering.
+void swapToFileVersion1HexEdges(std::vector<int>& perm, int order) {
+  const auto perEdge = static_cast<std::size_t>(order - 1);
+  const std::size_t edge10 = 8 + 10 * perEdge;
+  std::swap_ranges(perm.begin() + static_cast<std::ptrdiff_t>(edge10),
+                   perm.begin() + static_cast<std::ptrdiff_t>(edge10 + perEdge),
+                   perm.begin() + static_cast<std::ptrdiff_t>(edge10 + perEdge));
+}
+
+}  // namespace
+
+void writeVtu(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields,
+              bool appended) {
+  mesh.checkConsistency();
+  checkCellFields(mesh, fields);
+  std::vector<std::int64_t> connectivity, offsets;
+  std::vector<std::uint8_t> types;
+  std::vector<std::int32_t> entity;
+  for (const ElementBlock& block : mesh.blocks) {
+    if (cellDimension(block.type) != mesh.dim) continue;
+    std::vector<int> perm = nodePermutationFromGmsh(block.type, block.order, NodeConvention::Vtk);
+    if (block.type == CellType::Hexahedron) swapToFileVersion1HexEdges(perm, block.order);
+    for (std::size_t e = 0; e < block.count(); ++e) {
+      const std::int64_t* nodes = block.element(e);
+      for (const int k : perm) connectivity.push_back(nodes[k]);
+      offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
+      types.push_back(vtkLagrangeType(block.type));
+      entity.push_back(block.entity[e]);
+    }
+  }
+  std::vector<std::int32_t> cadDim(mesh.nodeCadDim.begin(), mesh.nodeCadDim.end());
+
+  AtomicFile file(path, appended);
+  std::ostream& os = file.stream();
+  DataArrays arrays(os, appended);
+  os << "<?xml version=\"1.0\"?>\n"
+     << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+        "header_type=\"UInt64\">\n"
+     << "  <UnstructuredGrid>\n"
+     << "    <Piece NumberOfPoints=\"" << mesh.numNodes() << "\" NumberOfCells=\"" << types.size()
+     << "\">\n";
+  os << "      <PointData>\n";
+  arrays.add("Int32", "cad_dim", 1, cadDim);
+  arrays.add("Int32", "cad_index", 1, mesh.nodeCadIndex);
+  os << "      </PointData>\n";
+  os << "      <CellData" << (fields.empty() ? "" : " Scalars=\"" + fields[0].name + "\"") << ">\n";
+  for (const CellField& f : fields)
+    arrays.add("Float64", f.name, 1,
+              std::vector<double>(f.values.begin(), f.values.begin() + types.size()));
+  arrays.add("Int32", "cad_entity", 1, entity);
+  os << "      </CellData>\n";
+  os << "      <Points>\n";
+  arrays.add("Float64", "", 3, mesh.xyz);
+  os << "      </Points>\n";
+  os << "      <Cells>\n";
+  arrays.add("Int64", "connectivity", 1, connectivity);
+  arrays.add("Int64", "offsets", 1, offsets);
+  arrays.add("UInt8", "types", 1, types);
+  os << "      </Cells>\n"
+     << "    </Piece>\n"
+     << "  </UnstructuredGrid>\n";
+  arrays.finish();
+  os << "</VTKFile>\n";
+  file.commit();
+}
+
+}  // namespace homesh

@@ -1,0 +1,79 @@
+#include "quality/element_measure.hpp"
+
+#include <map>
+#include <memory>
+#include <mutex>
+
+#include "element/quadrature.hpp"
+
+namespace homesh {
+namespace {
+
+struct MeasureRule {
+  QuadratureRule rule;
+  std::unique_ptr<JacobianSampler> sampler;
+};
+
+// J's degree (per variable for boxes and prisms), so that the rule is exact.
+int jacobianDegree(CellType type, int p) {
+  switch (type) {
+    case CellType::Line:
+      return 4 * p;  // |x'| is not polynomial: over-integrate
+    case CellType::Triangle:
+      return 2 * (p - 1) + 2;
+    case CellType::Quadrilateral:
+      return 2 * p;
+    case CellType::Tetrahedron:
+      return 3 * (p - 1);
+    default:  // prisms and hexahedra
+      return 3 * p;
+  }
+}
+
+const MeasureRule& rule(CellType type, int order) {
+  static std::mutex mutex;
+  static std::map<std::pair<CellType, int>, std::unique_ptr<MeasureRule>> cache;
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[{type, order}];
+  if (!slot) {
+    slot = std::make_unique<MeasureRule>();
+    slot->rule = quadratureRule(type, jacobianDegree(type, order));
+    const int dim = cellDimension(type);
+    Eigen::MatrixXd points(slot->rule.size(), dim);
+    for (int q = 0; q < slot->rule.size(); ++q)
+      for (int k = 0; k < dim; ++k)
+        points(q, k) = slot->rule.points[static_cast<std::size_t>(q) * dim + k];
+    slot->sampler = std::make_unique<JacobianSampler>(ReferenceElement::get(type, order), points);
+  }
+  return *slot;
+}
+
+}  // namespace
+
+double elementMeasure(CellType type, int order, const NodeCoordinates& x,
+                      const Eigen::Vector3d* normal) {
+  const MeasureRule& r = rule(type, order);
+  Eigen::VectorXd j;
+  r.sampler->jacobians(x, normal, j);
+  double sum = 0.0;
+  for (int q = 0; q < r.rule.size(); ++q) sum += r.rule.weights[q] * j(q);
+  return sum;
+}
+
+std::vector<double> elementMeasures(const Mesh& mesh) {
+  std::vector<double> out;
+  const Eigen::Vector3d normal(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
+  for (const ElementBlock& b : mesh.blocks) {
+    if (cellDimension(b.type) != mesh.dim) continue;
+    const int n = b.nodesPerElement();
+    NodeCoordinates x(n, 3);
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      for (int i = 0; i < n; ++i)
+        for (int c = 0; c < 3; ++c) x(i, c) = mesh.xyz[3 * b.element(e)[i] + c];
+      out.push_back(elementMeasure(b.type, b.order, x, mesh.dim == 2 ? &normal : nullptr));
+    }
+  }
+  return out;
+}
+
+}  // namespace homesh

@@ -1,0 +1,358 @@
+// Readers: MSH 2.2 / 4.1 (ASCII and binary, ours and Gmsh's), Nektar++ XML (plain and
+// compressed) round trips, every element type, and the peer meshes' quality against Gmsh's own
+// AnalyseMeshQuality.
+#include <gmsh.h>
+#include <gtest/gtest.h>
+
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <gp_Pln.hxx>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+#include "core/error.hpp"
+#include "curving/order_elevation.hpp"
+#include "element/reference_element.hpp"
+#include "io/mesh_readers.hpp"
+#include "io/mesh_writers.hpp"
+#include "io/msh_reader.hpp"
+#include "linear/linear_mesher.hpp"
+#include "quality/mesh_quality.hpp"
+#include "test_support.hpp"
+
+#ifndef HOMESH_SHARED_DIR
+#error "HOMESH_SHARED_DIR must name the shared data folder"
+#endif
+
+namespace homesh {
+namespace {
+
+Mesh curvedBoxWithHole(int order) {
+  const CadModel cad = test::toModel(test::boxWithHole());
+  return elevateOrder(generateLinearMesh(cad, {0.9, 1, 0}), order, &cad);
+}
+
+Mesh curvedPlate(int order) {  // 2D: a planar face with a hole is not needed, a disc will do
+  const TopoDS_Shape face = BRepBuilderAPI_MakeFace(gp_Pln(gp::Origin(), gp::DZ()), -2, 2, -1, 1);
+  const CadModel cad = test::toModel(face);
+  return elevateOrder(generateLinearMesh(cad, {0.6, 1, 0}), order, &cad);
+}
+
+void expectSameMesh(const Mesh& a, const Mesh& b, double tol) {
+  ASSERT_EQ(a.dim, b.dim);
+  ASSERT_EQ(a.order, b.order);
+  ASSERT_EQ(a.numNodes(), b.numNodes());
+  for (std::size_t i = 0; i < a.xyz.size(); ++i) {
+    if (tol == 0.0)
+      ASSERT_EQ(a.xyz[i], b.xyz[i]) << "coordinate " << i;
+    else
+      ASSERT_NEAR(a.xyz[i], b.xyz[i], tol) << "coordinate " << i;
+  }
+  EXPECT_EQ(a.nodeCadDim, b.nodeCadDim);
+  EXPECT_EQ(a.nodeCadIndex, b.nodeCadIndex);
+  ASSERT_EQ(a.blocks.size(), b.blocks.size());
+  for (std::size_t k = 0; k < a.blocks.size(); ++k) {
+    EXPECT_EQ(a.blocks[k].type, b.blocks[k].type);
+    EXPECT_EQ(a.blocks[k].nodes, b.blocks[k].nodes) << "block " << k;
+    EXPECT_EQ(a.blocks[k].entity, b.blocks[k].entity) << "block " << k;
+  }
+}
+
+TEST(MshReader, RoundTripsOurFilesExactly) {
+  const auto dir = test::tempDir();
+  for (const Mesh& mesh : {curvedBoxWithHole(1), curvedBoxWithHole(3), curvedBoxWithHole(6),
+                           curvedPlate(4)})
+    for (const bool binary : {false, true}) {
+      const std::string path = (dir / (binary ? "b.msh" : "a.msh")).string();
+      writeMesh(mesh, path, {}, {binary, false});
+      // Binary: bit-exact. ASCII: 17 significant digits, exact as well; the spec asks 1e-12.
+      expectSameMesh(mesh, readMsh(path), binary ? 0.0 : 1e-12);
+    }
+}
+
+// The node of `to` nearest each node of `from` (which must be within `tol`), by hashing
+// coordinates on a coarse grid and searching the neighbouring cells.
+std::vector<std::int64_t> matchNodes(const Mesh& from, const Mesh& to, double tol) {
+  const double cell = 1e-6;
+  std::map<std::array<long long, 3>, std::vector<std::int64_t>> grid;
+  const auto key = [&](const double* x) {
+    return std::array<long long, 3>{std::llround(x[0] / cell), std::llround(x[1] / cell),
+                                    std::llround(x[2] / cell)};
+  };
+  for (std::size_t i = 0; i < to.numNodes(); ++i)
+    grid[key(&to.xyz[3 * i])].push_back(static_cast<std::int64_t>(i));
+  std::vector<std::int64_t> match(from.numNodes(), -1);
+  for (std::size_t i = 0; i < from.numNodes(); ++i) {
+    const double* x = &from.xyz[3 * i];
+    const auto k = key(x);
+    double best = tol;
+    for (long long dx = -1; dx <= 1; ++dx)
+      for (long long dy = -1; dy <= 1; ++dy)
+        for (long long dz = -1; dz <= 1; ++dz) {
+          const auto it = grid.find({k[0] + dx, k[1] + dy, k[2] + dz});
+          if (it == grid.end()) continue;
+          for (const std::int64_t j : it->second) {
+            const double* y = &to.xyz[3 * j];
+            const double d = std::hypot(x[0] - y[0], x[1] - y[1], x[2] - y[2]);
+            if (d <= best) {
+              best = d;
+              match[i] = j;
+            }
+          }
+        }
+  }
+  return match;
+}
+
+// The elements of `mesh` as sorted lists of node ids, after renaming nodes by `rename`.
+std::vector<std::vector<std::int64_t>> elementNodeSets(const Mesh& mesh,
+                                                       const std::vector<std::int64_t>& rename) {
+  std::vector<std::vector<std::int64_t>> out;
+  for (const ElementBlock& b : mesh.blocks) {
+    if (cellDimension(b.type) != mesh.dim) continue;
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      std::vector<std::int64_t> ids;
+      for (int k = 0; k < b.nodesPerElement(); ++k)
+        ids.push_back(rename.empty() ? b.element(e)[k] : rename[b.element(e)[k]]);
+      std::sort(ids.begin(), ids.end());
+      out.push_back(ids);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// The same mesh saved by Gmsh itself in every version and encoding it writes.
+TEST(MshReader, ReadsFilesGmshWrote) {
+  const auto dir = test::tempDir();
+  const Mesh mesh = curvedBoxWithHole(4);
+  const std::string ours = (dir / "ours.msh").string();
+  writeMesh(mesh, ours, {}, {});
+  gmsh::initialize(0, nullptr, false);
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::open(ours);
+  for (const double version : {2.2, 4.1})
+    for (const int binary : {0, 1}) {
+      const std::string path = (dir / ("gmsh" + std::to_string(version) + "_" +
+                                       std::to_string(binary) + ".msh"))
+                                   .string();
+      gmsh::option::setNumber("Mesh.MshFileVersion", version);
+      gmsh::option::setNumber("Mesh.Binary", binary);
+      gmsh::option::setNumber("Mesh.SaveAll", 1);
+      gmsh::write(path);
+      const Mesh back = readMsh(path);
+      EXPECT_EQ(back.numNodes(), mesh.numNodes()) << path;
+      EXPECT_EQ(back.order, 4);
+      ASSERT_EQ(back.blocks[0].type, CellType::Tetrahedron);
+      EXPECT_EQ(back.blocks[0].count(), mesh.blocks[0].count()) << path;
+      // Gmsh may renumber nodes and elements: match every node to ours (exactly in binary
+      // files; Gmsh writes ASCII numbers with 16 significant digits), then the elements.
+      const std::vector<std::int64_t> match = matchNodes(back, mesh, binary ? 0.0 : 1e-13);
+      EXPECT_EQ(std::count(match.begin(), match.end(), -1), 0) << path;
+      EXPECT_EQ(elementNodeSets(back, match), elementNodeSets(mesh, {})) << path;
+    }
+  gmsh::finalize();
+  EXPECT_THROW(readMsh((dir / "missing.msh").string()), IoError);
+}
+
+// Element counts per Gmsh type code of a file, as Gmsh reads it.
+std::map<int, std::size_t> gmshCounts(const std::string& path) {
+  gmsh::initialize(0, nullptr, false);
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::open(path);
+  std::vector<int> types;
+  std::vector<std::vector<std::size_t>> tags, nodes;
+  gmsh::model::mesh::getElements(types, tags, nodes);
+  std::map<int, std::size_t> counts;
+  for (std::size_t k = 0; k < types.size(); ++k) counts[types[k]] += tags[k].size();
+  gmsh::finalize();
+  return counts;
+}
+
+std::map<int, std::size_t> ourCounts(const Mesh& mesh) {
+  std::map<int, std::size_t> counts;
+  for (const ElementBlock& b : mesh.blocks) counts[gmshElementType(b.type, b.order)] += b.count();
+  return counts;
+}
+
+// Per element, the sorted coordinates of its nodes that the Nektar++ format stores (all but
+// the interior of 3D elements).
+std::vector<std::vector<std::array<double, 3>>> storedNodes(const Mesh& mesh) {
+  std::vector<std::vector<std::array<double, 3>>> out;
+  for (const ElementBlock& b : mesh.blocks) {
+    if (cellDimension(b.type) != mesh.dim) continue;
+    const ReferenceElement& ref = ReferenceElement::get(b.type, b.order);
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      std::vector<std::array<double, 3>> pts;
+      for (int n = 0; n < ref.numNodes(); ++n) {
+        const LatticePoint& l = ref.lattice()[n];
+        const int p = b.order;
+        const bool tetInside = b.type == CellType::Tetrahedron && l[0] > 0 && l[1] > 0 &&
+                               l[2] > 0 && l[0] + l[1] + l[2] < p;
+        const bool boxInside = b.type == CellType::Hexahedron && l[0] > 0 && l[1] > 0 &&
+                               l[2] > 0 && l[0] < p && l[1] < p && l[2] < p;
+        const bool prismInside = b.type == CellType::Prism && l[0] > 0 && l[1] > 0 &&
+                                 l[0] + l[1] < p && l[2] > 0 && l[2] < p;
+        if (tetInside || boxInside || prismInside) continue;
+        const std::int64_t id = b.element(e)[n];
+        pts.push_back({mesh.xyz[3 * id], mesh.xyz[3 * id + 1], mesh.xyz[3 * id + 2]});
+      }
+      std::sort(pts.begin(), pts.end());
+      out.push_back(pts);
+    }
+  }
+  return out;
+}
+
+// Hexahedra, prisms and quadrilaterals of order p, meshed by Gmsh, read by us.
+Mesh gmshStructuredMesh(bool prisms, int order, const std::string& path) {
+  gmsh::initialize(0, nullptr, false);
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::model::add("structured");
+  const int p1 = gmsh::model::geo::addPoint(0, 0, 0), p2 = gmsh::model::geo::addPoint(1, 0, 0);
+  const int l = gmsh::model::geo::addLine(p1, p2);
+  gmsh::vectorpair out;
+  // A structured square (quadrilaterals, or triangles for prisms) extruded in layers.
+  gmsh::model::geo::extrude({{1, l}}, 0, 1, 0, out, {3}, {}, !prisms);
+  const int surface = out[1].second;
+  gmsh::vectorpair volume;
+  gmsh::model::geo::extrude({{2, surface}}, 0, 0, 1, volume, {2}, {}, true);
+  gmsh::model::geo::synchronize();
+  gmsh::model::mesh::generate(3);
+  gmsh::model::mesh::setOrder(order);
+  // Curve it: move every node by a smooth field so that elements are really curved.
+  std::vector<std::size_t> tags;
+  std::vector<double> coord, param;
+  gmsh::model::mesh::getNodes(tags, coord, param, -1, -1, true, false);
+  for (std::size_t k = 0; k < tags.size(); ++k) {
+    double* x = &coord[3 * k];
+    const std::vector<double> moved{x[0] + 0.05 * std::sin(3 * x[1]), x[1] + 0.05 * std::sin(2 * x[2]),
+                                    x[2] + 0.05 * std::sin(2 * x[0])};
+    gmsh::model::mesh::setNode(tags[k], moved, {});
+  }
+  gmsh::option::setNumber("Mesh.SaveAll", 1);
+  gmsh::write(path);
+  gmsh::finalize();
+  return readMsh(path);
+}
+
+TEST(Readers, HexahedraPrismsAndQuadrilateralsFromGmsh) {
+  const auto dir = test::tempDir();
+  for (const bool prisms : {false, true})
+    for (const int order : {1, 2, 4}) {
+      const Mesh mesh =
+          gmshStructuredMesh(prisms, order, (dir / ("g" + std::to_string(order) + ".msh")).string());
+      ASSERT_EQ(mesh.dim, 3);
+      EXPECT_EQ(mesh.blocks[0].type, prisms ? CellType::Prism : CellType::Hexahedron);
+      const QualitySummary q = evaluateQuality(mesh);
+      EXPECT_EQ(q.invalid, 0u);
+      EXPECT_TRUE(q.certified);
+      // Our MSH, VTU and Nektar++ files of it.
+      for (const char* name : {"o.msh", "o.vtu", "o.xml"})
+        writeMesh(mesh, (dir / name).string(), {}, {});
+      expectSameMesh(mesh, readMsh((dir / "o.msh").string()), 1e-12);
+      // Nektar++ keeps every node but the elements' interiors, which it rebuilds itself.
+      const Mesh nektar = readMesh((dir / "o.xml").string());
+      EXPECT_EQ(nektar.numElements(), mesh.numElements());
+      EXPECT_EQ(storedNodes(nektar), storedNodes(mesh));
+      if (order == 1) {
+        EXPECT_NEAR(evaluateQuality(nektar).scaled.min, q.scaled.min, 1e-9);
+      }
+    }
+}
+
+TEST(MshWriter, GmshOpensOurFilesAtEveryOrder) {
+  const auto dir = test::tempDir();
+  const std::string path = (dir / "ours.msh").string();
+  const CadModel cad = test::toModel(test::sphere(1.0));
+  const Mesh linear = generateLinearMesh(cad, {0.8, 1, 0});
+  for (int order = 1; order <= 10; ++order) {  // tetrahedra, triangles, lines
+    writeMesh(elevateOrder(linear, order, &cad), path, {}, {order % 2 == 0, false});
+    const Mesh mesh = readMsh(path);
+    EXPECT_EQ(gmshCounts(path), ourCounts(mesh)) << "order " << order;
+  }
+  for (const bool prisms : {false, true})  // hexahedra or prisms, with quadrilaterals
+    for (int order = 1; order <= 9; ++order) {
+      const Mesh mesh = gmshStructuredMesh(prisms, order, (dir / "g.msh").string());
+      writeMesh(mesh, path, {}, {order % 2 == 1, false});
+      EXPECT_EQ(gmshCounts(path), ourCounts(mesh))
+          << (prisms ? "prisms" : "hexahedra") << " order " << order;
+    }
+}
+
+TEST(NektarXml, RoundTripsPlainAndCompressed) {
+  const auto dir = test::tempDir();
+  for (const Mesh& mesh : {curvedBoxWithHole(1), curvedBoxWithHole(2), curvedBoxWithHole(3),
+                           curvedBoxWithHole(5), curvedPlate(4)})
+    for (const bool compressed : {false, true}) {
+      const std::string path = (dir / (compressed ? "c.xml" : "p.xml")).string();
+      writeMesh(mesh, path, {}, {false, compressed});
+      const Mesh back = readMesh(path);
+      ASSERT_EQ(back.order, mesh.order);
+      ASSERT_EQ(back.numElements(), mesh.numElements());
+      // Element by element, every node the format stores comes back bit for bit.
+      EXPECT_EQ(storedNodes(back), storedNodes(mesh)) << "order " << mesh.order;
+      // Entities of elements and boundary groups survive.
+      std::map<int, std::size_t> groupsBefore, groupsAfter;
+      for (const ElementBlock& b : mesh.blocks)
+        if (cellDimension(b.type) == mesh.dim - 1)
+          for (const int e : b.entity) ++groupsBefore[e];
+      for (const ElementBlock& b : back.blocks)
+        if (cellDimension(b.type) == back.dim - 1)
+          for (const int e : b.entity) ++groupsAfter[e];
+      EXPECT_EQ(groupsAfter, groupsBefore);
+      EXPECT_EQ(back.blocks[0].entity, mesh.blocks[0].entity);
+      // Without element-interior nodes (tetrahedra up to order 3), the same elements exactly.
+      if (mesh.order <= 3) {
+        EXPECT_NEAR(evaluateQuality(back).scaled.min, evaluateQuality(mesh).scaled.min, 1e-9);
+      }
+    }
+}
+
+// Gmsh's worst minJ/maxJ (Plugin AnalyseMeshQuality, Bezier bounds) on a file.
+double gmshWorstScaledJacobian(const std::string& path, int dim) {
+  gmsh::initialize(0, nullptr, false);
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::open(path);
+  gmsh::plugin::setNumber("AnalyseMeshQuality", "JacobianDeterminant", 1);
+  gmsh::plugin::setNumber("AnalyseMeshQuality", "IGEMeasure", 0);
+  gmsh::plugin::setNumber("AnalyseMeshQuality", "ICNMeasure", 0);
+  gmsh::plugin::setNumber("AnalyseMeshQuality", "DimensionOfElements", dim);
+  gmsh::plugin::setNumber("AnalyseMeshQuality", "CreateView", 1);
+  gmsh::plugin::run("AnalyseMeshQuality");
+  std::vector<int> views;
+  gmsh::view::getTags(views);
+  double worst = 1e300;
+  for (const int v : views) {
+    std::string type;
+    std::vector<std::size_t> tags;
+    std::vector<std::vector<double>> data;
+    double time = 0;
+    int components = 0;
+    gmsh::view::getModelData(v, 0, type, tags, data, time, components);
+    for (const auto& d : data) worst = std::min(worst, d[0]);
+  }
+  gmsh::finalize();
+  return worst;
+}
+
+TEST(PeerMeshes, WorstScaledJacobianAgreesWithGmsh) {
+  const std::string dir = std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/optimiser/";
+  for (const auto& [file, dim] : {std::pair<std::string, int>{"varopti_cube_sphere.msh", 3},
+                                  std::pair<std::string, int>{"varopti_naca.msh", 2}}) {
+    ASSERT_TRUE(std::filesystem::exists(dir + file)) << dir + file << " is missing";
+    const Mesh mesh = readMsh(dir + file);
+    EXPECT_EQ(mesh.dim, dim);
+    const QualitySummary q = evaluateQuality(mesh);
+    const double gmsh = gmshWorstScaledJacobian(dir + file, dim);
+    std::printf("%s: worst scaled Jacobian, HOMesh %.6f, Gmsh %.6f\n", file.c_str(), q.scaled.min,
+                gmsh);
+    EXPECT_NEAR(q.scaled.min, gmsh, 1e-3) << file;
+    EXPECT_TRUE(q.certified);
+    EXPECT_EQ(q.invalid, 0u);
+  }
+}
+
+}  // namespace
+}  // namespace homesh
