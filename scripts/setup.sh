@@ -17,6 +17,6 @@ echo "homesh: workbench registered in $mods/HOMesh"
 
 mkdir -p out
 homesh mesh examples/bracket.step --order 4 --size 2.5 \
-  -o out/bracket.msh -o out/bracket.vtu --report out/bracket.json
+  -o out/bracket.msh -o out/bracket.vtu -o out/bracket.xml --report out/bracket.json
 cat out/bracket.json
-echo "homesh: wrote out/bracket.msh (Gmsh) and out/bracket.vtu (ParaView)"
+echo "homesh: wrote out/bracket.msh (Gmsh), out/bracket.vtu (ParaView), out/bracket.xml (Nektar++)"

@@ -40,6 +40,24 @@ std::string jsonQuote(const std::string& s) {
   return q + "\"";
 }
 
+namespace {
+
+std::string numberText(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.15g", v);
+  return buf;
+}
+
+template <typename T, typename Format>
+std::string inlineArray(const std::vector<T>& v, Format format) {
+  std::string text = "[";
+  for (std::size_t k = 0; k < v.size(); ++k) text += (k ? ", " : "") + format(v[k]);
+  return text + "]";
+}
+
+}  // namespace
+
 void JsonWriter::prefix(const std::string& key) {
   if (!first_.empty()) {
     if (!first_.back()) out_ += ",";
@@ -84,13 +102,7 @@ JsonWriter& JsonWriter::endArray() {
 }
 
 JsonWriter& JsonWriter::value(const std::string& key, double v) {
-  if (!std::isfinite(v)) {
-    raw(key, "null");
-    return *this;
-  }
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.15g", v);
-  raw(key, buf);
+  raw(key, numberText(v));
   return *this;
 }
 
@@ -106,6 +118,17 @@ JsonWriter& JsonWriter::value(const std::string& key, bool v) {
 
 JsonWriter& JsonWriter::value(const std::string& key, const std::string& v) {
   raw(key, jsonQuote(v));
+  return *this;
+}
+
+
+JsonWriter& JsonWriter::numbers(const std::string& key, const std::vector<double>& v) {
+  raw(key, inlineArray(v, numberText));
+  return *this;
+}
+
+JsonWriter& JsonWriter::numbers(const std::string& key, const std::vector<std::size_t>& v) {
+  raw(key, inlineArray(v, [](std::size_t n) { return std::to_string(n); }));
   return *this;
 }
 

@@ -24,6 +24,9 @@ class JsonWriter {
   JsonWriter& value(const std::string& key, const std::string& v);
   JsonWriter& value(const std::string& key, const char* v) { return value(key, std::string(v)); }
   // Array elements use an empty key.
+  // A short array of numbers on one line (histogram edges and counts).
+  JsonWriter& numbers(const std::string& key, const std::vector<double>& v);
+  JsonWriter& numbers(const std::string& key, const std::vector<std::size_t>& v);
   const std::string& str() const { return out_; }
 
  private:

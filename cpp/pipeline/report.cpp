@@ -1,6 +1,11 @@
 #include "pipeline/report.hpp"
 
+#include <cstddef>
+#include <cstdio>
 #include <map>
+#include <vector>
+
+#include "quality/bezier_jacobian.hpp"
 
 namespace homesh {
 namespace {
@@ -14,13 +19,12 @@ void appendMeasure(JsonWriter& json, const std::string& key, const MeasureSummar
   json.value("mean", m.mean);
   if (histogram) {
     json.beginObject("histogram");
-    json.beginArray("edges");
+    std::vector<double> edges;
     for (int k = 0; k <= Histogram::kBins; ++k)
-      json.value("", static_cast<double>(k) / Histogram::kBins);
-    json.endArray();
-    json.beginArray("counts");
-    for (const std::size_t c : m.histogram.counts) json.value("", c);
-    json.endArray();
+      edges.push_back(static_cast<double>(k) / Histogram::kBins);
+    json.numbers("edges", edges);
+    json.numbers("counts", std::vector<std::size_t>(m.histogram.counts.begin(),
+                                                    m.histogram.counts.end()));
     json.value("below_zero", m.histogram.below);
     json.endObject();
   }
@@ -50,9 +54,12 @@ void appendQuality(JsonWriter& json, const QualitySummary& q) {
   json.value("invalid_elements", q.invalid);
   json.value("undecided_elements", q.undecided);
   json.value("certified", q.certified);
-  json.value("method",
-             "scaled Jacobian min J / max J from Bezier bounds refined to 1e-4 relative; "
-             "distortion d J^(2/d) / |F|^2 against the straight-sided element, sampled");
+  char method[200];
+  std::snprintf(method, sizeof method,
+                "scaled Jacobian min J / max J from Bezier bounds refined to %g relative; "
+                "distortion d J^(2/d) / |F|^2 against the straight-sided element, sampled",
+                kJacobianBoundTolerance);
+  json.value("method", method);
   json.beginObject("by_type");
   for (const auto& [type, t] : q.byType) {
     json.beginObject(cellShortName(type));

@@ -56,6 +56,57 @@ BernsteinSpace::BernsteinSpace(BernsteinFactors factors) : factors_(std::move(fa
     indices_ = std::move(next);
   }
   for (int j = 0; j < size(); ++j) position_[indices_[j]] = j;
+  // Lines parallel to each edge of each factor: group functions by their other entries.
+  int col = 0;
+  for (std::size_t f = 0; f < factors_.size(); ++f) {
+    const auto [d, m] = factors_[f];
+    const auto entry = [&, d = d, m = m](const std::vector<int>& flat, int slot) {
+      if (slot > 0) return flat[col + slot - 1];
+      int rest = m;
+      for (int k = 0; k < d; ++k) rest -= flat[col + k];
+      return rest;
+    };
+    for (int i = 0; i <= d; ++i)
+      for (int j = i + 1; j <= d; ++j) {
+        std::map<std::vector<int>, std::map<int, int>> lines;  // other entries -> (entry i, fn)
+        for (int fn = 0; fn < size(); ++fn) {
+          std::vector<int> key = indices_[fn];
+          for (int k = 0; k <= d; ++k)
+            key.push_back(k == i || k == j ? -1 : entry(indices_[fn], k));
+          for (int k = 0; k < d; ++k) key[col + k] = -1;
+          lines[key][entry(indices_[fn], i)] = fn;
+        }
+        EdgeLines e;
+        e.factor = static_cast<int>(f);
+        e.i = i;
+        e.j = j;
+        for (const auto& [key, line] : lines) {
+          e.start.push_back(static_cast<int>(e.index.size()));
+          for (const auto& [ai, fn] : line) e.index.push_back(fn);
+        }
+        e.start.push_back(static_cast<int>(e.index.size()));
+        edgeLines_.push_back(std::move(e));
+      }
+    col += d;
+  }
+}
+
+void BernsteinSpace::bisect(const EdgeLines& edge, const double* coeffs, double* keepJ,
+                            double* keepI) {
+  double b[64];
+  for (std::size_t l = 0; l + 1 < edge.start.size(); ++l) {
+    const int* idx = &edge.index[edge.start[l]];
+    const int s = edge.start[l + 1] - edge.start[l] - 1;  // the line's degree
+    if (s >= 64) throw Error("Bernstein bisection: degree too high");
+    for (int k = 0; k <= s; ++k) b[k] = coeffs[idx[k]];
+    keepJ[idx[0]] = b[0];
+    keepI[idx[s]] = b[s];
+    for (int level = 1; level <= s; ++level) {
+      for (int k = 0; k <= s - level; ++k) b[k] = 0.5 * (b[k] + b[k + 1]);
+      keepJ[idx[level]] = b[0];
+      keepI[idx[s - level]] = b[s - level];
+    }
+  }
 }
 
 const BernsteinSpace& BernsteinSpace::get(const BernsteinFactors& factors) {
@@ -173,41 +224,31 @@ BernsteinFactors BernsteinSpace::productFactors(const BernsteinFactors& a,
   return out;
 }
 
-namespace {
-
-struct ProductTerm {
-  int a, b, c;
-  double weight;
-};
-
-// The (a, b) -> c terms of a product of two spaces, cached.
-const std::vector<ProductTerm>& productTable(const BernsteinSpace& sa, const BernsteinSpace& sb) {
+const std::vector<BernsteinSpace::ProductTerm>& BernsteinSpace::productTerms(
+    const BernsteinSpace& other) const {
   static std::mutex mutex;
   static std::map<std::pair<BernsteinFactors, BernsteinFactors>, std::vector<ProductTerm>> cache;
   const std::lock_guard<std::mutex> lock(mutex);
-  auto& table = cache[{sa.factors(), sb.factors()}];
+  auto& table = cache[{factors_, other.factors_}];
   if (!table.empty()) return table;
-  const BernsteinSpace& sc =
-      BernsteinSpace::get(BernsteinSpace::productFactors(sa.factors(), sb.factors()));
-  table.reserve(static_cast<std::size_t>(sa.size()) * sb.size());
+  const BernsteinSpace& sc = get(productFactors(factors_, other.factors_));
+  table.reserve(static_cast<std::size_t>(size()) * other.size());
   std::vector<int> flat(sc.dim());
-  for (int i = 0; i < sa.size(); ++i)
-    for (int j = 0; j < sb.size(); ++j) {
-      for (int k = 0; k < sc.dim(); ++k) flat[k] = sa.multiIndex(i)[k] + sb.multiIndex(j)[k];
+  for (int i = 0; i < size(); ++i)
+    for (int j = 0; j < other.size(); ++j) {
+      for (int k = 0; k < sc.dim(); ++k) flat[k] = indices_[i][k] + other.indices_[j][k];
       const int c = sc.indexOf(flat);
       table.push_back(
-          {i, j, c, sa.multinomialWeight(i) * sb.multinomialWeight(j) / sc.multinomialWeight(c)});
+          {i, j, c, multinomialWeight(i) * other.multinomialWeight(j) / sc.multinomialWeight(c)});
     }
   return table;
 }
-
-}  // namespace
 
 Eigen::VectorXd BernsteinSpace::multiply(const Eigen::VectorXd& a, const BernsteinSpace& other,
                                          const Eigen::VectorXd& b) const {
   const BernsteinSpace& result = get(productFactors(factors_, other.factors_));
   Eigen::VectorXd c = Eigen::VectorXd::Zero(result.size());
-  for (const ProductTerm& t : productTable(*this, other)) c(t.c) += t.weight * a(t.a) * b(t.b);
+  for (const ProductTerm& t : productTerms(other)) c(t.c) += t.weight * a(t.a) * b(t.b);
   return c;
 }
 

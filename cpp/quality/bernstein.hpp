@@ -46,6 +46,28 @@ class BernsteinSpace {
   Eigen::VectorXd multiply(const Eigen::VectorXd& a, const BernsteinSpace& other,
                            const Eigen::VectorXd& b) const;
 
+  // The (a, b) -> c terms of the product of a function of this space (a) with one of `other`
+  // (b) into productFactors' space (c): c += weight * a * b. Cached, thread-safe.
+  struct ProductTerm {
+    int a, b, c;
+    double weight;
+  };
+  const std::vector<ProductTerm>& productTerms(const BernsteinSpace& other) const;
+
+  // Splitting the domain at the midpoint of one edge of a factor's simplex (between its
+  // barycentric slots i and j; slot 0 is the implicit first entry): every line of coefficients
+  // parallel to the edge is a 1D Bernstein polynomial, subdivided by de Casteljau. `index`
+  // holds the lines one after the other (line l from start[l] to start[l + 1]), each ordered by
+  // increasing entry i.
+  struct EdgeLines {
+    int factor = 0, i = 0, j = 0;
+    std::vector<int> start, index;
+  };
+  const std::vector<EdgeLines>& edgeLines() const { return edgeLines_; }
+  // The coefficients on the two halves: `keepJ` where slot i became the edge's midpoint (the
+  // half holding slot j's vertex), `keepI` where slot j did. Exact up to rounding (averages).
+  static void bisect(const EdgeLines& edge, const double* coeffs, double* keepJ, double* keepI);
+
   // The shared space for some factors (cached, thread-safe).
   static const BernsteinSpace& get(const BernsteinFactors& factors);
 
@@ -54,6 +76,7 @@ class BernsteinSpace {
   int dim_ = 0;
   std::vector<std::vector<int>> indices_;  // per function: flattened stored multi-indices
   std::map<std::vector<int>, int> position_;
+  std::vector<EdgeLines> edgeLines_;
 };
 
 }  // namespace homesh

@@ -17,8 +17,9 @@
 namespace homesh {
 namespace {
 
+// Limits on the refinement of one element: bisections deep (times the dimension) and in all.
 constexpr int kMaxDepth = 12;
-constexpr int kMaxSubdivisions = 1000;
+constexpr int kMaxSubdivisions = 4000;
 
 BernsteinFactors geometryFactors(CellType type, int p) {
   switch (type) {
@@ -37,105 +38,44 @@ BernsteinFactors geometryFactors(CellType type, int p) {
   }
 }
 
-// An affine part of the reference shape: xi = origin + map * local.
-struct Domain {
-  Eigen::VectorXd origin;
-  Eigen::MatrixXd map;
-};
+// The reference shape's vertices per factor of J's space (simplex factors: the origin, then
+// the unit vectors), flattened: what a part of the domain remembers to choose its next split.
+using Corners = std::array<double, 12>;
 
-Domain simplexDomain(const std::vector<Eigen::VectorXd>& v) {
-  Domain d;
-  d.origin = v[0];
-  d.map.resize(v[0].size(), static_cast<Eigen::Index>(v.size()) - 1);
-  for (std::size_t k = 1; k < v.size(); ++k)
-    d.map.col(static_cast<Eigen::Index>(k) - 1) = v[k] - v[0];
-  return d;
-}
-
-// Regular refinement of a triangle (4 parts) or tetrahedron (8 parts, octahedron split along
-// the diagonal between the midpoints of edges 02 and 13).
-std::vector<std::vector<Eigen::VectorXd>> splitSimplex(const std::vector<Eigen::VectorXd>& w) {
-  const auto mid = [&](int a, int b) { return Eigen::VectorXd(0.5 * (w[a] + w[b])); };
-  if (w.size() == 3) {
-    const auto m01 = mid(0, 1), m12 = mid(1, 2), m20 = mid(2, 0);
-    return {{w[0], m01, m20}, {m01, w[1], m12}, {m20, m12, w[2]}, {m12, m20, m01}};
+Corners referenceCorners(const BernsteinFactors& factors) {
+  Corners v{};
+  int at = 0;
+  for (const auto& [d, m] : factors) {
+    for (int slot = 0; slot <= d; ++slot)
+      for (int k = 0; k < d; ++k) v[at++] = slot == k + 1 ? 1.0 : 0.0;
   }
-  const auto m01 = mid(0, 1), m02 = mid(0, 2), m03 = mid(0, 3), m12 = mid(1, 2), m13 = mid(1, 3),
-             m23 = mid(2, 3);
-  return {{w[0], m01, m02, m03}, {m01, w[1], m12, m13}, {m02, m12, w[2], m23},
-          {m03, m13, m23, w[3]}, {m01, m02, m03, m13},  {m01, m02, m12, m13},
-          {m02, m03, m13, m23},  {m02, m12, m13, m23}};
+  return v;
 }
 
-// The parts of the reference shape one subdivision step makes.
-std::vector<Domain> subdomains(CellType type) {
-  const int dim = cellDimension(type);
-  std::vector<Domain> out;
-  if (type == CellType::Triangle || type == CellType::Tetrahedron) {
-    std::vector<Eigen::VectorXd> w{Eigen::VectorXd::Zero(dim)};
-    for (int k = 0; k < dim; ++k) w.push_back(Eigen::VectorXd::Unit(dim, k));
-    for (const auto& part : splitSimplex(w)) out.push_back(simplexDomain(part));
-  } else if (type == CellType::Quadrilateral || type == CellType::Hexahedron) {
-    for (int c = 0; c < (1 << dim); ++c) {
-      Domain d;
-      d.origin = Eigen::VectorXd::Zero(dim);
-      d.map = 0.5 * Eigen::MatrixXd::Identity(dim, dim);
-      for (int k = 0; k < dim; ++k)
-        if ((c & (1 << k)) != 0) d.origin(k) = 0.5;
-      out.push_back(d);
-    }
-  } else {  // prism: the triangle's parts times the halves in z
-    const std::vector<Eigen::VectorXd> w{Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0),
-                                         Eigen::Vector2d(0, 1)};
-    for (const auto& part : splitSimplex(w))
-      for (const double z0 : {0.0, 0.5}) {
-        Domain d;
-        d.origin = Eigen::Vector3d(part[0].x(), part[0].y(), z0);
-        d.map = Eigen::Matrix3d::Zero();
-        d.map.block<2, 1>(0, 0) = part[1] - part[0];
-        d.map.block<2, 1>(0, 1) = part[2] - part[0];
-        d.map(2, 2) = 0.5;
-        out.push_back(d);
-      }
+// Offset of each factor's block of (d + 1) x d vertex coordinates in Corners.
+std::vector<int> cornerOffsets(const BernsteinFactors& factors) {
+  std::vector<int> offsets;
+  int at = 0;
+  for (const auto& [d, m] : factors) {
+    offsets.push_back(at);
+    at += (d + 1) * d;
   }
-  return out;
-}
-
-struct ProductTerm {
-  int a, b, c;
-  double weight;
-};
-
-// The (a, b) -> c terms of the product of two Bernstein spaces.
-std::vector<ProductTerm> productTerms(const BernsteinSpace& sa, const BernsteinSpace& sb) {
-  const BernsteinSpace& sc =
-      BernsteinSpace::get(BernsteinSpace::productFactors(sa.factors(), sb.factors()));
-  std::vector<ProductTerm> terms;
-  terms.reserve(static_cast<std::size_t>(sa.size()) * sb.size());
-  std::vector<int> flat(sc.dim());
-  for (int i = 0; i < sa.size(); ++i)
-    for (int j = 0; j < sb.size(); ++j) {
-      for (int k = 0; k < sc.dim(); ++k) flat[k] = sa.multiIndex(i)[k] + sb.multiIndex(j)[k];
-      const int c = sc.indexOf(flat);
-      terms.push_back(
-          {i, j, c, sa.multinomialWeight(i) * sb.multinomialWeight(j) / sc.multinomialWeight(c)});
-    }
-  return terms;
+  return offsets;
 }
 
 // Everything about a shape and order that does not depend on the element: J's Bezier
 // coefficients are J = d0 . (d1 x d2) (or (d0 x d1) . n in 2D) with d_k = derivative[k] * x the
 // control points of dx/dxi_k, multiplied term by term.
 struct BezierTables {
+  using Terms = std::vector<BernsteinSpace::ProductTerm>;
   int dim = 3;
   std::vector<Eigen::MatrixXd> derivative;  // per k: (size of d_k's space) x nodes
-  std::vector<ProductTerm> inner;           // d1 x d2 (3D) or d0 x d1 (2D)
-  std::vector<ProductTerm> outer;           // d0 . (d1 x d2) (3D only)
+  const Terms* inner = nullptr;             // d1 x d2 (3D) or d0 x d1 (2D)
+  const Terms* outer = nullptr;             // d0 . (d1 x d2) (3D only)
   int innerSize = 0, jacobianSize = 0;
+  const BernsteinSpace* jacobian = nullptr;  // J's space
   std::vector<int> corners;                  // corner functions of J's space
-  std::vector<Eigen::MatrixXd> childNodal;   // a part's nodal values = this * parent's
-  std::vector<double> childDeterminant;      // det of the part's map
-  std::unique_ptr<JacobianSampler> lattice;  // J at the Bezier points of J's space
+  std::vector<int> cornerOffsets;            // per factor of J's space, into Corners
 };
 
 const BezierTables& tables(CellType type, int order) {
@@ -165,34 +105,26 @@ const BezierTables& tables(CellType type, int order) {
   }
   const BernsteinSpace& innerA = dim == 3 ? *spaces[1] : *spaces[0];
   const BernsteinSpace& innerB = dim == 3 ? *spaces[2] : *spaces[1];
-  t->inner = productTerms(innerA, innerB);
+  t->inner = &innerA.productTerms(innerB);
   const BernsteinSpace& innerSpace =
       BernsteinSpace::get(BernsteinSpace::productFactors(innerA.factors(), innerB.factors()));
   t->innerSize = innerSpace.size();
   const BernsteinSpace* jacobian = &innerSpace;
   if (dim == 3) {
-    t->outer = productTerms(*spaces[0], innerSpace);
+    t->outer = &spaces[0]->productTerms(innerSpace);
     jacobian = &BernsteinSpace::get(
         BernsteinSpace::productFactors(spaces[0]->factors(), innerSpace.factors()));
   }
   t->jacobianSize = jacobian->size();
-  Eigen::MatrixXd points(jacobian->size(), dim);
-  for (int j = 0; j < jacobian->size(); ++j) {
+  t->jacobian = jacobian;
+  t->cornerOffsets = cornerOffsets(jacobian->factors());
+  for (int j = 0; j < jacobian->size(); ++j)
     if (jacobian->isCorner(j)) t->corners.push_back(j);
-    points.row(j) = jacobian->point(j).transpose();
-  }
-  t->lattice = std::make_unique<JacobianSampler>(ref, points);
-  for (const Domain& d : subdomains(type)) {
-    const Eigen::MatrixXd childPoints =
-        (ref.nodes() * d.map.transpose()).rowwise() + d.origin.transpose();
-    t->childNodal.push_back(ref.valuesAt(childPoints));
-    t->childDeterminant.push_back(d.map.determinant());
-  }
   slot = std::move(t);
   return *slot;
 }
 
-// Bezier coefficients of J for nodal coordinates x (in the element's current parametrisation).
+// Bezier coefficients of J on the whole element for nodal coordinates x.
 void jacobianCoefficients(const BezierTables& t, const NodeCoordinates& x,
                           const Eigen::Vector3d* normal, Eigen::VectorXd& out) {
   std::array<NodeCoordinates, 3> d;
@@ -200,7 +132,7 @@ void jacobianCoefficients(const BezierTables& t, const NodeCoordinates& x,
   const NodeCoordinates& p = t.dim == 3 ? d[1] : d[0];
   const NodeCoordinates& q = t.dim == 3 ? d[2] : d[1];
   NodeCoordinates cross = NodeCoordinates::Zero(t.innerSize, 3);
-  for (const ProductTerm& term : t.inner) {
+  for (const BernsteinSpace::ProductTerm& term : *t.inner) {
     const double w = term.weight;
     cross(term.c, 0) += w * (p(term.a, 1) * q(term.b, 2) - p(term.a, 2) * q(term.b, 1));
     cross(term.c, 1) += w * (p(term.a, 2) * q(term.b, 0) - p(term.a, 0) * q(term.b, 2));
@@ -212,8 +144,27 @@ void jacobianCoefficients(const BezierTables& t, const NodeCoordinates& x,
     return;
   }
   out.setZero(t.jacobianSize);
-  for (const ProductTerm& term : t.outer)
+  for (const BernsteinSpace::ProductTerm& term : *t.outer)
     out(term.c) += term.weight * d[0].row(term.a).dot(cross.row(term.b));
+}
+
+// The edge a part is split across: the longest of its factors' simplex edges, in reference
+// coordinates (longest-edge bisection keeps the parts well shaped as they shrink).
+const BernsteinSpace::EdgeLines& longestEdge(const BezierTables& t, const Corners& v) {
+  const auto& edges = t.jacobian->edgeLines();
+  const BernsteinSpace::EdgeLines* best = &edges.front();
+  double bestLength = -1.0;
+  for (const auto& e : edges) {
+    const int d = t.jacobian->factors()[e.factor].first;
+    const double* p = &v[t.cornerOffsets[e.factor]];
+    double length = 0.0;
+    for (int k = 0; k < d; ++k) length += std::pow(p[e.i * d + k] - p[e.j * d + k], 2);
+    if (length > bestLength + 1e-12) {
+      bestLength = length;
+      best = &e;
+    }
+  }
+  return *best;
 }
 
 }  // namespace
@@ -222,46 +173,56 @@ JacobianBounds boundJacobian(CellType type, int order, const NodeCoordinates& x,
                              const Eigen::Vector3d* normal, double tolerance) {
   const BezierTables& t = tables(type, order);
   struct Part {
-    NodeCoordinates x;
-    double scale;  // J of the part's own parametrisation = scale * J of the element
+    Eigen::VectorXd coeffs;  // J's Bezier coefficients on the part
+    Corners corners;         // the part's vertices (see Corners)
     int depth;
-    double lo, hi;  // bounds of J on the part: its extreme Bezier coefficients
+    double lo, hi;  // bounds of J on the part: its extreme coefficients
   };
-  // Values of J at the Bezier points of the whole element: first estimates of its extremes.
-  Eigen::VectorXd values;
-  t.lattice->jacobians(x, normal, values);
-  double minFound = values.minCoeff(), maxFound = values.maxCoeff();
+  // Extreme values of J found so far: true values, so the minimum lies in [lower bound, found].
+  double minFound = std::numeric_limits<double>::infinity();
+  double maxFound = -std::numeric_limits<double>::infinity();
   std::vector<Part> parts;
-  Eigen::VectorXd coeffs;
-  const auto make = [&](NodeCoordinates px, double scale, int depth) {
-    jacobianCoefficients(t, px, normal, coeffs);
-    coeffs /= scale;
+  const auto add = [&](Eigen::VectorXd coeffs, const Corners& corners, int depth) {
     for (const int c : t.corners) {  // corner coefficients are values of J
       minFound = std::min(minFound, coeffs(c));
       maxFound = std::max(maxFound, coeffs(c));
     }
-    parts.push_back({std::move(px), scale, depth, coeffs.minCoeff(), coeffs.maxCoeff()});
+    const double lo = coeffs.minCoeff(), hi = coeffs.maxCoeff();
+    parts.push_back({std::move(coeffs), corners, depth, lo, hi});
   };
-  make(x, 1.0, 0);
+  Eigen::VectorXd whole;
+  jacobianCoefficients(t, x, normal, whole);
+  add(std::move(whole), referenceCorners(t.jacobian->factors()), 0);
   // Best first (Johnen et al.): always split the part with the lowest lower bound (then the
   // highest upper bound) until that bound is within the tolerance of the extreme value found
-  // and the sign of J is decided, or the subdivision budget is spent.
+  // and the sign of J is decided, or the subdivision budget is spent. A split is a de Casteljau
+  // bisection of the part's coefficients: no geometry is evaluated again.
   int budget = kMaxSubdivisions;
+  const int maxDepth = kMaxDepth * t.dim;
   const auto refine = [&](auto worse, auto open) {
     std::make_heap(parts.begin(), parts.end(), worse);
     while (budget > 0) {
       const double tol = tolerance * std::max({std::abs(minFound), std::abs(maxFound), 1e-300});
       const Part& top = parts.front();
-      if (!open(top, tol) || top.depth >= kMaxDepth) break;
+      if (!open(top, tol) || top.depth >= maxDepth) break;
       std::pop_heap(parts.begin(), parts.end(), worse);
       Part parent = std::move(parts.back());
       parts.pop_back();
       --budget;
-      for (std::size_t c = 0; c < t.childNodal.size(); ++c) {
-        make(t.childNodal[c].lazyProduct(parent.x), parent.scale * t.childDeterminant[c],
-             parent.depth + 1);
-        std::push_heap(parts.begin(), parts.end(), worse);
-      }
+      const BernsteinSpace::EdgeLines& edge = longestEdge(t, parent.corners);
+      Eigen::VectorXd keepJ(t.jacobianSize), keepI(t.jacobianSize);
+      BernsteinSpace::bisect(edge, parent.coeffs.data(), keepJ.data(), keepI.data());
+      const int d = t.jacobian->factors()[edge.factor].first;
+      Corners cornersJ = parent.corners, cornersI = parent.corners;
+      double* vi = &cornersJ[t.cornerOffsets[edge.factor] + edge.i * d];
+      double* vj = &cornersI[t.cornerOffsets[edge.factor] + edge.j * d];
+      const double* pi = &parent.corners[t.cornerOffsets[edge.factor] + edge.i * d];
+      const double* pj = &parent.corners[t.cornerOffsets[edge.factor] + edge.j * d];
+      for (int k = 0; k < d; ++k) vi[k] = vj[k] = 0.5 * (pi[k] + pj[k]);
+      add(std::move(keepJ), cornersJ, parent.depth + 1);
+      std::push_heap(parts.begin(), parts.end(), worse);
+      add(std::move(keepI), cornersI, parent.depth + 1);
+      std::push_heap(parts.begin(), parts.end(), worse);
     }
   };
   refine([](const Part& a, const Part& b) { return a.lo > b.lo; },

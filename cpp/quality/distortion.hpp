@@ -6,7 +6,8 @@
 // q = d J^(2/d) / |F|^2 with J = det F (Frobenius norm; d the dimension): 1 where the curved
 // element is locally a rotation and uniform scaling of the straight one, towards 0 as it
 // distorts, negative (same magnitude, sign of J) where it is inverted. An element's quality is
-// the minimum over quadrature points of degree 2P and its nodes (sampled, not certified).
+// the minimum over its nodes and the points of a quadrature rule of degree P (sampled, not
+// certified).
 #pragma once
 
 #include <Eigen/Core>
@@ -16,10 +17,9 @@
 
 namespace homesh {
 
-// Quality at one point from the curved and straight Jacobian matrices (3 x d each); 2D cells
-// are measured in their plane.
-double distortionQuality(const Eigen::Matrix<double, 3, Eigen::Dynamic>& curved,
-                         const Eigen::Matrix<double, 3, Eigen::Dynamic>& straight);
+// Quality at one point from the curved and straight Jacobian matrices, whose first `dim`
+// columns are dx/dxi_k (the others are ignored); 2D cells are measured in their plane.
+double distortionQuality(const Eigen::Matrix3d& curved, const Eigen::Matrix3d& straight, int dim);
 
 // Minimum quality over the element's sample points (x: node coordinates in Gmsh order).
 double elementDistortion(CellType type, int order, const NodeCoordinates& x);

@@ -37,11 +37,9 @@ void JacobianSampler::jacobians(const NodeCoordinates& x, const Eigen::Vector3d*
   for (int s = 0; s < n; ++s) out(s) = a.row(s).cross(b.row(s)).dot(c.row(s));
 }
 
-Eigen::Matrix<double, 3, Eigen::Dynamic> JacobianSampler::jacobianMatrix(const NodeCoordinates& x,
-                                                                         int p) const {
-  Eigen::Matrix<double, 3, Eigen::Dynamic> m(3, dim());
-  for (int k = 0; k < dim(); ++k) m.col(k) = (dxi_[k].row(p) * x).transpose();
-  return m;
+void JacobianSampler::derivatives(const NodeCoordinates& x,
+                                  std::array<NodeCoordinates, 3>& out) const {
+  for (int k = 0; k < dim(); ++k) out[k].noalias() = dxi_[k] * x;
 }
 
 double jacobianDeterminant(const Eigen::Matrix<double, 3, Eigen::Dynamic>& columns,

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "element/reference_element.hpp"
@@ -26,8 +27,8 @@ class JacobianSampler {
   void jacobians(const NodeCoordinates& x, const Eigen::Vector3d* normal,
                  Eigen::VectorXd& out) const;
 
-  // The Jacobian matrix dx/dxi (3 x dim) at point p.
-  Eigen::Matrix<double, 3, Eigen::Dynamic> jacobianMatrix(const NodeCoordinates& x, int p) const;
+  // dx/dxi_k at every point (points x 3), for k < dim: one matrix product per direction.
+  void derivatives(const NodeCoordinates& x, std::array<NodeCoordinates, 3>& out) const;
 
  private:
   std::vector<Eigen::MatrixXd> dxi_;  // per reference direction: points x nodes

@@ -154,10 +154,13 @@ TEST(JsonWriter, NestsAndEscapes) {
   json.value("nan", std::numeric_limits<double>::quiet_NaN());
   json.beginObject("empty").endObject();
   json.beginArray("list").value("", 1).value("", true).endArray();
+  json.numbers("edges", std::vector<double>{0, 0.5, 1});
+  json.numbers("counts", std::vector<std::size_t>{2, 0});
   json.endObject();
   EXPECT_EQ(json.str(),
             "{\n  \"name\": \"a \\\"quoted\\\"\\nline\",\n  \"n\": 3,\n  \"x\": 0.25,\n"
-            "  \"nan\": null,\n  \"empty\": {},\n  \"list\": [\n    1,\n    true\n  ]\n}\n");
+            "  \"nan\": null,\n  \"empty\": {},\n  \"list\": [\n    1,\n    true\n  ],\n"
+            "  \"edges\": [0, 0.5, 1],\n  \"counts\": [2, 0]\n}\n");
 }
 
 }  // namespace

@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 
 #include "core/error.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
+#include "quality/bernstein.hpp"
 #include "quality/bezier_jacobian.hpp"
 #include "quality/distortion.hpp"
 #include "quality/mesh_quality.hpp"
@@ -46,6 +48,61 @@ Mesh singleElementMesh(CellType type, int order, const NodeCoordinates& x) {
   block.entity.push_back(1);
   mesh.blocks.push_back(block);
   return mesh;
+}
+
+// Value at reference point x of the polynomial with Bernstein coefficients c.
+double bernsteinValue(const BernsteinSpace& space, const Eigen::VectorXd& c, const double* x) {
+  double v = 0.0;
+  for (int j = 0; j < space.size(); ++j) v += c(j) * space.basis(j, x);
+  return v;
+}
+
+TEST(Bernstein, BisectionGivesThePolynomialOnEachHalf) {
+  // Spaces of J for triangles, tetrahedra, quadrilaterals, hexahedra and prisms.
+  const BernsteinFactors spaces[] = {{{2, 6}}, {{3, 9}}, {{1, 7}, {1, 7}},
+                                     {{1, 5}, {1, 5}, {1, 5}}, {{2, 4}, {1, 5}}};
+  std::srand(7);
+  for (const BernsteinFactors& factors : spaces) {
+    const BernsteinSpace& space = BernsteinSpace::get(factors);
+    const Eigen::VectorXd c = Eigen::VectorXd::Random(space.size());
+    // Each factor's simplex: vertex 0 the origin, vertex k the unit vector k.
+    for (const BernsteinSpace::EdgeLines& edge : space.edgeLines()) {
+      Eigen::VectorXd keepJ(space.size()), keepI(space.size());
+      BernsteinSpace::bisect(edge, c.data(), keepJ.data(), keepI.data());
+      int col = 0;
+      for (int f = 0; f < edge.factor; ++f) col += factors[f].first;
+      const int d = factors[edge.factor].first;
+      const auto vertex = [&](int slot) {
+        Eigen::VectorXd v = Eigen::VectorXd::Zero(d);
+        if (slot > 0) v(slot - 1) = 1.0;
+        return v;
+      };
+      const Eigen::VectorXd vi = vertex(edge.i), vj = vertex(edge.j), mid = 0.5 * (vi + vj);
+      for (int trial = 0; trial < 20; ++trial) {
+        // A random point of the half's own reference shape, and where it lies in the parent.
+        Eigen::VectorXd local = 0.5 * (Eigen::VectorXd::Random(space.dim()).array() + 1.0);
+        Eigen::VectorXd lambda(d + 1);  // barycentric coordinates in the factor's simplex
+        double sum = 0.0;
+        for (int k = 0; k < d; ++k) sum += local(col + k);
+        if (sum > 1.0) local.segment(col, d) /= 1.001 * sum;
+        lambda(0) = 1.0 - local.segment(col, d).sum();
+        lambda.tail(d) = local.segment(col, d);
+        for (const bool half : {false, true}) {  // false: keepJ (slot i moved to the midpoint)
+          Eigen::VectorXd parent = local;
+          Eigen::VectorXd p = Eigen::VectorXd::Zero(d);
+          for (int slot = 0; slot <= d; ++slot) {
+            const bool moved = half ? slot == edge.j : slot == edge.i;
+            p += lambda(slot) * (moved ? mid : vertex(slot));
+          }
+          parent.segment(col, d) = p;
+          const double expected = bernsteinValue(space, c, parent.data());
+          const double got = bernsteinValue(space, half ? keepI : keepJ, local.data());
+          EXPECT_NEAR(got, expected, 1e-12) << "factor " << edge.factor << " edge " << edge.i
+                                            << "-" << edge.j;
+        }
+      }
+    }
+  }
 }
 
 TEST(Quality, StraightElementsScoreOneAndAreCertifiedValid) {

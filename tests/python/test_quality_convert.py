@@ -1,0 +1,166 @@
+"""`homesh quality` and `homesh convert`: the JSON quality report, --strict on a certified-invalid
+mesh, conversions between MSH, Nektar++ XML and VTU that keep every node, and third-party
+readers (Gmsh, meshio) on the binary and appended outputs."""
+
+import json
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+from conftest import run
+from homesh import HighOrderMesh, _core, read
+
+PEERS = Path(__file__).resolve().parents[3] / "shared" / "peer-cases" / "nekmesh" / "optimiser"
+NACA = PEERS / "varopti_naca.msh"
+CUBE_SPHERE = PEERS / "varopti_cube_sphere.msh"
+
+
+def two_tetrahedra(order, fold=False):
+    """Two disjoint straight tetrahedra of order `order` (our reference element and a shifted
+    copy); with `fold`, the second one's node on edge 0-1 is pulled far beyond vertex 1, which
+    reverses the edge at that vertex: a negative Jacobian there."""
+    xi = _core.reference_nodes("tet", order)
+    n = len(xi)
+    second = xi + np.array([3.0, 0.0, 0.0])
+    if fold:
+        second[4] = second[0] + 5.0 * (second[1] - second[0])  # Gmsh order: node 4 is on edge 0-1
+    nodes = np.vstack([xi, second])
+    m = len(nodes)
+    core = _core.mesh_from_arrays(
+        3, order, nodes, np.full(m, 3, dtype=np.uint8), np.ones(m, dtype=np.int32),
+        np.full((m, 2), np.nan),
+        [("tet", order, np.arange(m, dtype=np.int64).reshape(2, n), np.ones(2, dtype=np.int32))],
+        (0.0, 0.0, 1.0))
+    return HighOrderMesh(core)
+
+
+def test_quality_report_of_a_peer_mesh(homesh_bin, tmp_path):
+    report = tmp_path / "q.json"
+    r = run([homesh_bin, "quality", NACA, "--report", report])
+    assert r.returncode == 0, r.stderr
+    assert "certified valid" in r.stdout
+    q = json.loads(report.read_text())
+    assert q["elements"]["tri"] == 524 and q["order"] == 3
+    quality = q["quality"]
+    for key in ("scaled_jacobian", "distortion"):
+        m = quality[key]
+        assert 0.0 < m["min"] <= m["mean"] <= 1.0
+        assert len(m["histogram"]["edges"]) == 21 and len(m["histogram"]["counts"]) == 20
+        assert sum(m["histogram"]["counts"]) + m["histogram"]["below_zero"] == 524
+    # Gmsh's AnalyseMeshQuality on this file gives 0.345951 (tests/cpp/io/test_readers.cpp).
+    assert abs(quality["scaled_jacobian"]["min"] - 0.345951) < 1e-3
+    assert quality["invalid_elements"] == 0 and quality["certified"] is True
+    assert quality["by_type"]["tri"]["count"] == 524
+    # The report on standard output is the same document.
+    r = run([homesh_bin, "quality", NACA, "--report", "-", "-q", "-j", "2"])
+    assert r.returncode == 0 and json.loads(r.stdout)["quality"] == quality
+
+
+def test_strict_fails_on_a_certified_invalid_mesh(homesh_bin, tmp_path):
+    good, bad = two_tetrahedra(2), two_tetrahedra(2, fold=True)
+    assert good.quality()["invalid_elements"] == 0
+    for name, mesh, invalid in (("good.msh", good, 0), ("bad.msh", bad, 1)):
+        mesh.write(tmp_path / name)
+        report = tmp_path / (name + ".json")
+        r = run([homesh_bin, "quality", tmp_path / name, "--strict", "--report", report])
+        assert r.returncode == (3 if invalid else 0), (name, r.stdout, r.stderr)
+        q = json.loads(report.read_text())["quality"]
+        assert q["invalid_elements"] == invalid
+        assert q["certified"] is True  # invalid for certain, not undecided
+        if invalid:
+            assert q["scaled_jacobian"]["min"] < 0.0
+            assert q["scaled_jacobian"]["histogram"]["below_zero"] == 1
+    # Without --strict the verdict is printed but the command succeeds.
+    r = run([homesh_bin, "quality", tmp_path / "bad.msh"])
+    assert r.returncode == 0 and "invalid elements 1" in r.stdout
+
+
+def barycentric(kind, order):
+    """Barycentric coordinates of the reference nodes of a simplex (rows), to 1e-12."""
+    xi = _core.reference_nodes(kind, order)
+    nv = xi.shape[1] + 1
+    corners = np.hstack([xi[:nv], np.ones((nv, 1))])
+    return np.linalg.solve(corners.T, np.hstack([xi, np.ones((len(xi), 1))]).T).T
+
+
+def same_mesh(a, b, tol, interior=0):
+    """Same elements, in the same order, with the same node coordinates. Formats may renumber
+    an element's vertices (Nektar++ does, for positive volumes): each node is matched through
+    that renumbering by its barycentric coordinates, so a node in the wrong slot still fails.
+    `interior`: that many nodes at the end of each element (inside it) are not compared."""
+    assert a.order == b.order and a.dim == b.dim
+    assert [x.element_type for x in a.element_blocks] == [x.element_type for x in b.element_blocks]
+    for x, y in zip(a.element_blocks, b.element_blocks):
+        assert x.elements.shape == y.elements.shape and x.element_type in ("tet", "tri")
+        assert np.array_equal(x.cad_entity, y.cad_entity)
+        lam = barycentric(x.element_type, a.order)
+        nv = lam.shape[1]
+        keys = {tuple(np.round(row * a.order).astype(int)): n for n, row in enumerate(lam)}
+        for ea, eb in zip(x.elements, y.elements):
+            va, vb = a.nodes[ea[:nv]], b.nodes[eb[:nv]]
+            # b's vertex k is a's vertex sigma[k].
+            sigma = [int(np.argmin(np.abs(va - v).max(axis=1))) for v in vb]
+            assert sorted(sigma) == list(range(nv)) and np.abs(va[sigma] - vb).max() <= tol
+            for n in range(len(eb) - interior):
+                mu = np.zeros(nv)
+                mu[sigma] = lam[n]
+                m = keys[tuple(np.round(mu * a.order).astype(int))]
+                assert np.abs(a.nodes[ea[m]] - b.nodes[eb[n]]).max() <= tol, (n, m)
+
+
+@pytest.mark.parametrize("binary", [False, True])
+def test_convert_round_trips(homesh_bin, tmp_path, binary):
+    source = read(CUBE_SPHERE)
+    flag = ["--binary"] if binary else []
+    # MSH 2.2 in -> MSH 4.1 (ASCII or binary) and compressed Nektar++ XML in one run.
+    r = run([homesh_bin, "convert", CUBE_SPHERE, "-o", tmp_path / "a.msh", "-o",
+             tmp_path / "a.xml", "--compressed", "-q"] + flag)
+    assert r.returncode == 0 and r.stdout == "", r.stderr
+    assert "B64Z-LittleEndian" in (tmp_path / "a.xml").read_text()
+    tol = 0.0 if binary else 1e-12
+    same_mesh(source, read(tmp_path / "a.msh"), tol)
+    # From XML back to MSH: the same mesh again. Nektar++ files store vertices, edges and faces
+    # but not the one interior node of these order-4 tetrahedra (last in Gmsh order), which the
+    # reader rebuilds.
+    r = run([homesh_bin, "convert", tmp_path / "a.xml", "-o", tmp_path / "b.msh", "-q"] + flag)
+    assert r.returncode == 0, r.stderr
+    assert source.order == 4
+    same_mesh(source, read(tmp_path / "b.msh"), tol, interior=1)
+    r = run([homesh_bin, "convert", tmp_path / "a.msh", "-o", tmp_path / "c.vtu", "-q"] + flag)
+    assert r.returncode == 0, r.stderr
+    vtu = meshio.read(tmp_path / "c.vtu")
+    assert sum(len(c.data) for c in vtu.cells if c.type.startswith("VTK_LAGRANGE_TETRA")) == \
+        source.num_elements
+    assert len(vtu.cell_data["scaled_jacobian"][0]) == source.num_elements
+    assert abs(min(vtu.cell_data["scaled_jacobian"][0]) - source.quality()["min"]) < 1e-12
+
+
+def test_meshio_reads_binary_msh_and_appended_vtu(tmp_path):
+    mesh = read(NACA)
+    mesh.write(tmp_path / "n.msh", binary=True)
+    mesh.write(tmp_path / "n.vtu", binary=True)
+    msh = meshio.read(tmp_path / "n.msh")
+    assert sum(len(c.data) for c in msh.cells if c.type == "triangle10") == 524
+    # meshio keeps Gmsh's node order within cells (MSH 4.1 lists nodes by entity, so compare
+    # through the connectivity).
+    triangles = np.vstack([c.data for c in msh.cells if c.type == "triangle10"])
+    assert np.array_equal(msh.points[triangles], mesh.nodes[mesh.elements])
+    vtu = meshio.read(tmp_path / "n.vtu")
+    assert np.array_equal(vtu.points, mesh.nodes)
+    assert sum(len(c.data) for c in vtu.cells) == 524
+    assert np.array_equal(vtu.cell_data["scaled_jacobian"][0], mesh.quality()["scaled_jacobian"])
+
+
+def test_convert_errors_name_the_problem(homesh_bin, tmp_path):
+    r = run([homesh_bin, "convert", NACA, "-o", tmp_path / "x.foo"])
+    assert r.returncode != 0 and "unknown mesh format '.foo'" in r.stderr
+    assert not (tmp_path / "x.foo").exists()
+    r = run([homesh_bin, "convert", NACA])
+    assert r.returncode != 0 and "-o" in r.stderr
+    garbage = tmp_path / "garbage.msh"
+    garbage.write_text("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2\n")
+    r = run([homesh_bin, "quality", garbage])
+    assert r.returncode != 0 and "garbage.msh" in r.stderr
+    assert r.stderr.count("\n") == 1, r.stderr  # one line, no trace
