@@ -92,12 +92,16 @@ class HighOrderMesh:
         """Quality per element (in block order) and its summary.
 
         Returns a dict: ``scaled_jacobian`` (E,) array (certified lower bound of min J / max J,
-        from Bezier bounds), ``distortion`` (E,) array, ``min``/``mean`` of the scaled
-        Jacobian, ``distortion_min``/``distortion_mean``, ``invalid_elements``,
-        ``undecided_elements``, ``certified`` and ``by_type``.
+        from Bezier bounds), ``scaled_jacobian_upper`` (E,) (the true value lies between the
+        two), ``validity`` (E,) int8 (1 proven valid, -1 invalid, 0 undecided),
+        ``distortion`` (E,) array, ``min``/``mean`` of the scaled Jacobian,
+        ``distortion_min``/``distortion_mean``, ``invalid_elements``, ``undecided_elements``,
+        ``certified`` and ``by_type``.
         """
         summary = dict(self._core.quality_summary())
         summary["scaled_jacobian"] = self._core.scaled_jacobian()
+        summary["scaled_jacobian_upper"] = self._core.scaled_jacobian_upper()
+        summary["validity"] = self._core.validity()
         summary["distortion"] = self._core.distortion()
         return summary
 

@@ -2,6 +2,8 @@
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
 #include <Message_PrinterOStream.hxx>
+#include <algorithm>
+#include <cstddef>
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -95,6 +97,15 @@ void printQuality(std::FILE* out, const std::string& input, const homesh::Mesh& 
                q.invalid > 0      ? "INVALID"
                : q.undecided > 0 ? "validity not proven"
                                   : "certified valid");
+  const std::size_t flagged = q.invalid + q.undecided;
+  const auto listed = homesh::flaggedElements(mesh, q, 10);
+  for (const homesh::FlaggedElement& f : listed)
+    std::fprintf(out, "    element %zu (%s, entity %d): %s, min J / max J in [%.4g, %.4g]\n",
+                 f.index, homesh::cellShortName(f.type).c_str(), f.entity,
+                 homesh::validityName(f.validity), f.lower, f.upper);
+  if (flagged > listed.size())
+    std::fprintf(out, "    ... and %zu more (the JSON report lists %zu)\n", flagged - listed.size(),
+                 std::min(flagged, homesh::kMaxFlaggedElements));
   std::fprintf(out, "  histogram of the scaled Jacobian:\n");
   if (q.scaled.histogram.below > 0)
     std::fprintf(out, "    < 0          %8zu\n", q.scaled.histogram.below);

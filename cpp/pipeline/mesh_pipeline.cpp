@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -127,7 +128,12 @@ std::vector<CellField> qualityFields(const QualitySummary& quality) {
   CellField distortion{"distortion", quality.distortion};
   distortion.values.insert(distortion.values.end(), quality.boundaryDistortion.begin(),
                            quality.boundaryDistortion.end());
-  return {scaled, distortion};
+  // 1 proven valid, -1 invalid, 0 undecided; boundary cells have no verdict (NaN).
+  CellField validity{"validity", {}};
+  for (const Validity v : quality.validity)
+    validity.values.push_back(v == Validity::Valid ? 1.0 : v == Validity::Invalid ? -1.0 : 0.0);
+  validity.values.resize(scaled.values.size(), std::numeric_limits<double>::quiet_NaN());
+  return {scaled, distortion, validity};
 }
 
 void writeMeshFiles(const MeshResult& result, const std::vector<std::string>& paths,

@@ -47,7 +47,18 @@ void appendCounts(JsonWriter& json, const Mesh& mesh) {
   json.endObject();
 }
 
-void appendQuality(JsonWriter& json, const QualitySummary& q) {
+const char* validityName(Validity v) {
+  switch (v) {
+    case Validity::Valid:
+      return "valid";
+    case Validity::Invalid:
+      return "invalid";
+    default:
+      return "undecided";
+  }
+}
+
+void appendQuality(JsonWriter& json, const Mesh& mesh, const QualitySummary& q) {
   json.beginObject("quality");
   appendMeasure(json, "scaled_jacobian", q.scaled, true);
   appendMeasure(json, "distortion", q.distortionSummary, true);
@@ -71,6 +82,19 @@ void appendQuality(JsonWriter& json, const QualitySummary& q) {
     json.endObject();
   }
   json.endObject();
+  // Where the problems are: element index, type, CAD entity, verdict, and the interval that
+  // holds its min J / max J.
+  json.beginArray("flagged_elements");
+  for (const FlaggedElement& f : flaggedElements(mesh, q, kMaxFlaggedElements)) {
+    json.beginObject();
+    json.value("element", f.index);
+    json.value("type", cellShortName(f.type));
+    json.value("entity", f.entity);
+    json.value("verdict", validityName(f.validity));
+    json.numbers("scaled_jacobian", std::vector<double>{f.lower, f.upper});
+    json.endObject();
+  }
+  json.endArray();
   json.endObject();
 }
 
@@ -83,7 +107,7 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
   json.value("size", result.options.size.value_or(0.0));
   json.value("nodes", result.mesh.numNodes());
   appendCounts(json, result.mesh);
-  appendQuality(json, result.quality);
+  appendQuality(json, result.mesh, result.quality);
   json.beginObject("timings_s");
   for (const auto& [stage, s] : result.timings.seconds) json.value(stage, s);
   json.endObject();
@@ -100,7 +124,7 @@ std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
   json.value("order", mesh.order);
   json.value("nodes", mesh.numNodes());
   appendCounts(json, mesh);
-  appendQuality(json, quality);
+  appendQuality(json, mesh, quality);
   json.endObject();
   return json.str();
 }

@@ -1,6 +1,7 @@
 // JSON reports (schema in README.md), shared by the command line and the Python module.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "core/mesh.hpp"
@@ -11,8 +12,13 @@
 namespace homesh {
 
 // Appends "quality": {...} (scaled Jacobian and distortion with histograms, invalid and
-// undecided counts, certified, per cell type) to an open JSON object.
-void appendQuality(JsonWriter& json, const QualitySummary& quality);
+// undecided counts, certified, per cell type, and the first kMaxFlaggedElements elements not
+// proven valid) to an open JSON object.
+inline constexpr std::size_t kMaxFlaggedElements = 100;
+void appendQuality(JsonWriter& json, const Mesh& mesh, const QualitySummary& quality);
+
+// "invalid", "undecided" or "valid".
+const char* validityName(Validity v);
 
 // Appends "elements" (cells of the mesh dimension by type) and "boundary" (lower cells).
 void appendCounts(JsonWriter& json, const Mesh& mesh);

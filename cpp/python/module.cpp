@@ -208,6 +208,20 @@ class PyMesh {
     return toArray(result_->quality.distortion, result_->quality.distortion.size(), 0);
   }
 
+  // Upper ends of the intervals that hold each element's min J / max J.
+  np::ndarray scaledJacobianUpper() const {
+    const auto& v = result_->quality.scaledJacobianUpper;
+    return toArray(v, v.size(), 0);
+  }
+
+  // Per element: 1 proven valid, -1 invalid, 0 undecided.
+  np::ndarray validity() const {
+    std::vector<std::int8_t> v;
+    for (const Validity x : result_->quality.validity)
+      v.push_back(x == Validity::Valid ? 1 : x == Validity::Invalid ? -1 : 0);
+    return toArray(v, v.size(), 0);
+  }
+
   bp::dict timings() const {
     bp::dict d;
     for (const auto& [stage, s] : result_->timings.seconds) d[stage] = s;
@@ -388,6 +402,8 @@ BOOST_PYTHON_MODULE(_core) {
       .def("blocks", &PyMesh::blocks)
       .def("scaled_jacobian", &PyMesh::scaledJacobian)
       .def("distortion", &PyMesh::distortion)
+      .def("scaled_jacobian_upper", &PyMesh::scaledJacobianUpper)
+      .def("validity", &PyMesh::validity)
       .def("quality_summary", &PyMesh::qualitySummary)
       .def("timings", &PyMesh::timings)
       .def("write", &PyMesh::write, (bp::arg("path"), bp::arg("binary") = false,

@@ -40,8 +40,12 @@ struct JacobianBounds {
     if (maxLower <= 0.0) return -1.0;
     return minLower >= 0.0 ? minLower / maxUpper : minLower / maxLower;
   }
-  // The estimate from values of J actually found: an upper bound of min J / max J.
-  double scaledJacobianEstimate() const { return maxLower > 0.0 ? minUpper / maxLower : -1.0; }
+  // From values of J actually found: an upper bound of min J / max J (with the certified
+  // lower bound above, the interval that holds it).
+  double scaledJacobianEstimate() const {
+    if (maxLower <= 0.0) return -1.0;
+    return minUpper >= 0.0 ? minUpper / maxLower : minUpper / maxUpper;
+  }
 };
 
 // Gmsh's AnalyseMeshQuality refines its bounds to the same relative tolerance.

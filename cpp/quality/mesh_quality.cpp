@@ -88,6 +88,7 @@ QualitySummary evaluateQuality(const Mesh& mesh, int threads) {
     for (std::size_t e = 0; e < block.count(); ++e) {
       const double scaled = bounds[e].scaledJacobian();
       summary.scaledJacobian.push_back(scaled);
+      summary.scaledJacobianUpper.push_back(bounds[e].scaledJacobianEstimate());
       summary.distortion.push_back(distortion[e]);
       summary.validity.push_back(bounds[e].validity);
       ++type.count;
@@ -120,6 +121,24 @@ QualitySummary evaluateQuality(const Mesh& mesh, int threads) {
   summary.distortionSummary.mean /= count;
   if (summary.undecided > 0) summary.certified = false;
   return summary;
+}
+
+std::vector<FlaggedElement> flaggedElements(const Mesh& mesh, const QualitySummary& quality,
+                                            std::size_t limit) {
+  std::vector<FlaggedElement> out;
+  std::size_t index = 0;
+  for (const ElementBlock& block : mesh.blocks) {
+    if (cellDimension(block.type) != mesh.dim) continue;
+    for (std::size_t e = 0; e < block.count(); ++e, ++index) {
+      if (index >= quality.validity.size()) return out;
+      const Validity v = quality.validity[index];
+      if (v == Validity::Valid) continue;
+      if (out.size() >= limit) return out;
+      out.push_back({index, block.type, block.entity[e], v, quality.scaledJacobian[index],
+                     quality.scaledJacobianUpper[index]});
+    }
+  }
+  return out;
 }
 
 }  // namespace homesh

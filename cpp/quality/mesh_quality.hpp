@@ -44,8 +44,11 @@ struct TypeQuality {
 };
 
 struct QualitySummary {
-  // Per element of dimension mesh.dim, in block order.
+  // Per element of dimension mesh.dim, in block order. The element's true min J / max J lies
+  // in [scaledJacobian, scaledJacobianUpper]: the certified bound and the ratio of values of J
+  // actually found.
   std::vector<double> scaledJacobian;
+  std::vector<double> scaledJacobianUpper;
   std::vector<double> distortion;
   std::vector<Validity> validity;
   // Per lower-dimensional cell, in block order (distortion of a line is 1 by definition).
@@ -58,6 +61,20 @@ struct QualitySummary {
   MeasureSummary scaled, distortionSummary;
   std::map<CellType, TypeQuality> byType;
 };
+
+// An element that is not proven valid: where it is, its verdict, and the interval holding its
+// min J / max J.
+struct FlaggedElement {
+  std::size_t index = 0;  // among the elements of dimension mesh.dim, in block order
+  CellType type = CellType::Tetrahedron;
+  int entity = 0;  // its CAD entity (solid or face)
+  Validity validity = Validity::Undecided;
+  double lower = 0.0, upper = 0.0;
+};
+
+// The invalid and undecided elements, at most `limit` of them, in element order.
+std::vector<FlaggedElement> flaggedElements(const Mesh& mesh, const QualitySummary& quality,
+                                            std::size_t limit);
 
 // Evaluates every element on `threads` threads (the result does not depend on their number).
 // Throws Error for a mesh without elements.

@@ -53,6 +53,7 @@ def test_quality_report_of_a_peer_mesh(homesh_bin, tmp_path):
     assert abs(quality["scaled_jacobian"]["min"] - 0.345951) < 1e-3
     assert quality["invalid_elements"] == 0 and quality["certified"] is True
     assert quality["by_type"]["tri"]["count"] == 524
+    assert quality["flagged_elements"] == []
     # The report on standard output is the same document.
     r = run([homesh_bin, "quality", NACA, "--report", "-", "-q", "-j", "2"])
     assert r.returncode == 0 and json.loads(r.stdout)["quality"] == quality
@@ -72,6 +73,13 @@ def test_strict_fails_on_a_certified_invalid_mesh(homesh_bin, tmp_path):
         if invalid:
             assert q["scaled_jacobian"]["min"] < 0.0
             assert q["scaled_jacobian"]["histogram"]["below_zero"] == 1
+            # The report says which element, and the interval holding its min J / max J.
+            [flagged] = q["flagged_elements"]
+            assert flagged["element"] == 1 and flagged["type"] == "tet"
+            assert flagged["verdict"] == "invalid"
+            lower, upper = flagged["scaled_jacobian"]
+            assert lower == q["scaled_jacobian"]["min"] and lower <= upper < 0.0
+            assert "element 1 (tet, entity 1): invalid" in r.stdout
     # Without --strict the verdict is printed but the command succeeds.
     r = run([homesh_bin, "quality", tmp_path / "bad.msh"])
     assert r.returncode == 0 and "invalid elements 1" in r.stdout
@@ -83,6 +91,25 @@ def barycentric(kind, order):
     nv = xi.shape[1] + 1
     corners = np.hstack([xi[:nv], np.ones((nv, 1))])
     return np.linalg.solve(corners.T, np.hstack([xi, np.ones((len(xi), 1))]).T).T
+
+
+def test_per_element_verdicts_and_intervals():
+    q = two_tetrahedra(2, fold=True).quality()
+    assert list(q["validity"]) == [1, -1]
+    assert q["scaled_jacobian"][0] == pytest.approx(1.0) and q["scaled_jacobian"][1] < 0.0
+    for name in ("varopti_naca.msh", "varopti_cube_sphere.msh"):
+        q = read(PEERS / name).quality()
+        assert (q["validity"] == 1).all()
+        # min J / max J lies in [lower, upper]; both ends are refined to 1e-3 relative.
+        gap = q["scaled_jacobian_upper"] - q["scaled_jacobian"]
+        assert gap.min() >= 0.0 and gap.max() < 2e-3, name
+
+
+def test_validity_field_in_files(tmp_path):
+    mesh = two_tetrahedra(2, fold=True)
+    mesh.write(tmp_path / "bad.vtu")
+    vtu = meshio.read(tmp_path / "bad.vtu")
+    assert list(vtu.cell_data["validity"][0]) == [1.0, -1.0]
 
 
 def same_mesh(a, b, tol, interior=0):
