@@ -27,6 +27,7 @@
 #include "core/error.hpp"
 #include "io/mesh_readers.hpp"
 #include "io/mesh_writers.hpp"
+#include "peers/gmsh_quality.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "quality/bezier_jacobian.hpp"
 #include "quality/mesh_quality.hpp"
@@ -102,31 +103,6 @@ double homeshScaledJacobian(const Mesh& mesh, int threads) {
   return worst;
 }
 
-// Gmsh's plugin on the model it has open: its worst minJ/maxJ.
-double gmshScaledJacobian() {
-  gmsh::plugin::setNumber("AnalyseMeshQuality", "JacobianDeterminant", 1);
-  gmsh::plugin::setNumber("AnalyseMeshQuality", "IGEMeasure", 0);
-  gmsh::plugin::setNumber("AnalyseMeshQuality", "ICNMeasure", 0);
-  gmsh::plugin::setNumber("AnalyseMeshQuality", "DimensionOfElements", 3);
-  gmsh::plugin::setNumber("AnalyseMeshQuality", "Recompute", 1);
-  gmsh::plugin::setNumber("AnalyseMeshQuality", "CreateView", 1);
-  gmsh::plugin::run("AnalyseMeshQuality");
-  std::vector<int> views;
-  gmsh::view::getTags(views);
-  double worst = 1e300;
-  for (const int v : views) {
-    std::string type;
-    std::vector<std::size_t> tags;
-    std::vector<std::vector<double>> data;
-    double time = 0;
-    int components = 0;
-    gmsh::view::getModelData(v, 0, type, tags, data, time, components);
-    for (const auto& d : data) worst = std::min(worst, d[0]);
-    gmsh::view::remove(v);
-  }
-  return worst;
-}
-
 int run(const Options& o) {
   std::string path = o.mesh;
   std::string generated;  // a mesh file we made, removed at the end
@@ -155,7 +131,8 @@ int run(const Options& o) {
   gmsh::option::setNumber("General.Terminal", 0);
   gmsh::open(path);
   double gmshWorst = 0.0;
-  const double gmshSeconds = bestSeconds(o.repeat, [&] { gmshWorst = gmshScaledJacobian(); });
+  const double gmshSeconds =
+      bestSeconds(o.repeat, [&] { gmshWorst = homesh::peers::gmshAnalyseScaledJacobian(3); });
   gmsh::finalize();
   if (!generated.empty()) std::filesystem::remove(generated);
 

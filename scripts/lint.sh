@@ -4,11 +4,11 @@
 set -eu
 cd "$(dirname "$0")/.."
 [ -f build/compile_commands.json ] || scripts/build.sh build
-files=$(git ls-files 'cpp/*.cpp' 'cpp/*.hpp' 'tests/cpp/*.cpp' 'tests/cpp/*.hpp')
+files=$(git ls-files 'cpp/*.cpp' 'cpp/*.hpp' 'tests/cpp/*.cpp' 'tests/cpp/*.hpp' 'bench/*.cpp')
 status=0
 clang-format --dry-run --Werror $files || status=1
 # shellcheck disable=SC2086
 # Only diagnostics located in our files count (the analyser also walks into Eigen's headers).
 clang-tidy -p build --quiet $(echo "$files" | grep '\.cpp$') 2>/dev/null |
-  grep -E "^$(pwd)/(cpp|tests)/.*(warning|error):" && status=1
+  grep -E "^$(pwd)/(cpp|tests|bench)/.*(warning|error):" && status=1
 exit $status

@@ -70,8 +70,7 @@ void addCommon(OptionTable& table, CommonOptions& c, bool outputs, bool report) 
   table.value({"--threads", "-j"}, [&c](const std::string& o, const std::string& v) {
     c.threads = parseInteger(o, v);
     if (c.threads < 1 || c.threads > kMaxThreads)
-      throw UsageError{"--threads must be from 1 to " + std::to_string(kMaxThreads) + ", got " +
-                       v};
+      throw UsageError{"--threads must be from 1 to " + std::to_string(kMaxThreads) + ", got " + v};
   });
   table.flag({"--quiet", "-q"}, [&c] { c.quiet = true; });
   if (outputs) {
@@ -98,8 +97,7 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   addCommon(table, cmd.common, true, true);
   table.value({"--order", "-p"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.order = parseInteger(o, v);
-    if (cmd.order < 1 || cmd.order > 10)
-      throw UsageError{"--order must be from 1 to 10, got " + v};
+    if (cmd.order < 1 || cmd.order > 10) throw UsageError{"--order must be from 1 to 10, got " + v};
   });
   table.value({"--size", "-s"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.size = parseNumber(o, v);

@@ -94,9 +94,9 @@ void printQuality(std::FILE* out, const std::string& input, const homesh::Mesh& 
   std::fprintf(out, "  scaled Jacobian (certified lower bound, Bezier): worst %.4f mean %.4f\n",
                q.scaled.min, q.scaled.mean);
   std::fprintf(out, "  invalid elements %zu, undecided %zu: %s\n", q.invalid, q.undecided,
-               q.invalid > 0      ? "INVALID"
+               q.invalid > 0     ? "INVALID"
                : q.undecided > 0 ? "validity not proven"
-                                  : "certified valid");
+                                 : "certified valid");
   const std::size_t flagged = q.invalid + q.undecided;
   const auto listed = homesh::flaggedElements(mesh, q, 10);
   for (const homesh::FlaggedElement& f : listed)

@@ -121,7 +121,6 @@ JsonWriter& JsonWriter::value(const std::string& key, const std::string& v) {
   return *this;
 }
 
-
 JsonWriter& JsonWriter::numbers(const std::string& key, const std::vector<double>& v) {
   raw(key, inlineArray(v, numberText));
   return *this;

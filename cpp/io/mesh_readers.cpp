@@ -19,8 +19,7 @@ Mesh readMesh(const std::string& path) {
     throw IoError("mesh file '" + path + "' does not exist");
   if (ext == ".msh") return readMsh(path);
   if (ext == ".xml") return readNektarXml(path);
-  throw IoError("cannot read '" + path + "': unknown mesh format '" + ext +
-                "' (use .msh or .xml)");
+  throw IoError("cannot read '" + path + "': unknown mesh format '" + ext + "' (use .msh or .xml)");
 }
 
 }  // namespace homesh

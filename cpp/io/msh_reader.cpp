@@ -80,10 +80,27 @@ class Cursor {
     pos_ += sizeof(T);
     return v;
   }
-  // After the binary data of a section: skip the newline before $End....
   void expect(const std::string& keyword) {
     const std::string w = word();
     if (w != keyword) fail("'" + keyword + "' expected, found '" + w.substr(0, 40) + "'");
+  }
+  // After a block of binary data: exactly one newline, then the keyword. Skipping white space
+  // here would let a block that is short by a byte or two pass, its last value made of the
+  // newline.
+  void expectAfterBinary(const std::string& keyword) {
+    if (pos_ < data_.size() && data_[pos_] == '\n' &&
+        data_.compare(pos_ + 1, keyword.size(), keyword) == 0) {
+      pos_ += 1 + keyword.size();
+      return;
+    }
+    fail("the binary data does not end where '" + keyword +
+         "' should follow (a size or count disagrees with the data)");
+  }
+  // A node coordinate: a finite number.
+  double coordinate(bool binary) {
+    const double v = binary ? this->binary<double>() : real();
+    if (!std::isfinite(v)) fail("a node coordinate is not a finite number");
+    return v;
   }
   // Skips to the line after "$EndX" for an unknown section "$X".
   void skipSection(const std::string& name) {
@@ -121,17 +138,16 @@ void readNodes22(Cursor& c, bool binary, RawMesh& raw) {
     double x[3];
     if (binary) {
       tag = static_cast<std::size_t>(c.binary<int>());
-      for (double& v : x) v = c.binary<double>();
     } else {
       tag = static_cast<std::size_t>(c.integer());
-      for (double& v : x) v = c.real();
     }
+    for (double& v : x) v = c.coordinate(binary);
     raw.nodeTags.push_back(tag);
     raw.xyz.insert(raw.xyz.end(), x, x + 3);
     raw.nodeDim.push_back(-1);
     raw.nodeEntity.push_back(-1);
   }
-  c.expect("$EndNodes");
+  binary ? c.expectAfterBinary("$EndNodes") : c.expect("$EndNodes");
 }
 
 int nodesOfType(Cursor& c, int type) {
@@ -180,7 +196,7 @@ void readElements22(Cursor& c, bool binary, RawMesh& raw) {
       raw.elements.push_back(std::move(el));
     }
   }
-  c.expect("$EndElements");
+  binary ? c.expectAfterBinary("$EndElements") : c.expect("$EndElements");
 }
 
 // MSH 4.1 sizes: ints for dimensions, tags of entities and types; size_t for counts and tags of
@@ -202,7 +218,7 @@ void readNodes41(Cursor& c, bool binary, RawMesh& raw) {
     const std::size_t count = size41(c, binary);
     for (std::size_t i = 0; i < count; ++i) raw.nodeTags.push_back(size41(c, binary));
     for (std::size_t i = 0; i < count; ++i) {
-      for (int k = 0; k < 3; ++k) raw.xyz.push_back(binary ? c.binary<double>() : c.real());
+      for (int k = 0; k < 3; ++k) raw.xyz.push_back(c.coordinate(binary));
       for (int k = 0; parametric != 0 && k < dim; ++k) {  // parametric coordinates: unused
         if (binary)
           c.binary<double>();
@@ -214,7 +230,7 @@ void readNodes41(Cursor& c, bool binary, RawMesh& raw) {
     raw.nodeEntity.insert(raw.nodeEntity.end(), count, entity);
   }
   if (raw.nodeTags.size() != total) c.fail("$Nodes announces " + std::to_string(total) + " nodes");
-  c.expect("$EndNodes");
+  binary ? c.expectAfterBinary("$EndNodes") : c.expect("$EndNodes");
 }
 
 void readElements41(Cursor& c, bool binary, RawMesh& raw) {
@@ -234,7 +250,7 @@ void readElements41(Cursor& c, bool binary, RawMesh& raw) {
       raw.elements.push_back(std::move(el));
     }
   }
-  c.expect("$EndElements");
+  binary ? c.expectAfterBinary("$EndElements") : c.expect("$EndElements");
 }
 
 Mesh assemble(RawMesh& raw, const std::string& path) {
@@ -323,7 +339,8 @@ Mesh assemble(RawMesh& raw, const std::string& path) {
       for (std::size_t e = 0; e < b.count(); ++e) {
         const std::int64_t* v = b.element(e);
         const auto p = [&](int k) {
-          return Eigen::Vector3d(mesh.xyz[3 * v[k]], mesh.xyz[3 * v[k] + 1], mesh.xyz[3 * v[k] + 2]);
+          return Eigen::Vector3d(mesh.xyz[3 * v[k]], mesh.xyz[3 * v[k] + 1],
+                                 mesh.xyz[3 * v[k] + 2]);
         };
         const Eigen::Vector3d normal = (p(1) - p(0)).cross(p(2) - p(0));
         if (normal.norm() > 0.0) sum += normal.normalized();
@@ -357,8 +374,10 @@ Mesh readMsh(const std::string& path) {
   if (binary) {
     c.endOfLine();
     if (c.binary<int>() != 1) c.fail("binary data is not little-endian");
+    c.expectAfterBinary("$EndMeshFormat");
+  } else {
+    c.expect("$EndMeshFormat");
   }
-  c.expect("$EndMeshFormat");
   RawMesh raw;
   bool nodes = false, elements = false;
   while (!c.atEnd()) {

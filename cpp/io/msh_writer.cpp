@@ -50,7 +50,9 @@ class MshSink {
 };
 
 // Gmsh entity tags must be positive; meshes without CAD have index 0.
-int entityTag(int cadIndex) { return std::max(1, cadIndex); }
+int entityTag(int cadIndex) {
+  return std::max(1, cadIndex);
+}
 
 struct Box {
   double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),

@@ -47,6 +47,8 @@ std::string encode(const void* data, std::size_t bytes) {
   return base64EncodeZeroPadded(compressed.data(), compressed.size());
 }
 
-std::string decode(const std::string& text) { return zlibDecompress(base64Decode(text)); }
+std::string decode(const std::string& text) {
+  return zlibDecompress(base64Decode(text));
+}
 
 }  // namespace homesh::nektar

@@ -2,16 +2,20 @@
 
 #include <Eigen/Core>
 #include <algorithm>
-#include <cstring>
+#include <charconv>
+#include <climits>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <optional>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "element/reference_element.hpp"
 #include "io/nektar_format.hpp"
 #include "io/xml_document.hpp"
@@ -62,6 +66,18 @@ class Reader {
   template <class Record>
   std::vector<Record> records(const XmlElement& e, bool tagged = true) const;
   std::vector<double> numbers(const std::string& text, const std::string& where) const;
+  // Entity ids: from an attribute, from text, from a number read as text or from a record;
+  // each must be an integer in 0..INT_MAX.
+  int idAttribute(const XmlElement& e, const char* key = "ID") const;
+  std::vector<int> ids(const std::string& text, std::size_t count, const std::string& where) const;
+  int toId(long long value, const std::string& what) const;
+  std::vector<int> parseIdList(const std::string& list, const std::string& where,
+                               std::size_t limit) const;
+  // Entities by id, failing with the id when one is missing.
+  const std::array<int, 2>& edge(int id) const;
+  const Face& face(int id) const;
+  std::int64_t vertexNode(int id) const;
+  const Point& vertexPoint(int id) const;
 
   // Topology.
   int common(int edgeA, int edgeB) const;  // the vertex two edges share
@@ -72,7 +88,7 @@ class Reader {
 
   // Nodes.
   std::int64_t newNode(const Point& p, bool known);
-  std::int64_t edgeNode(int edge, int fromVertex, int t);
+  std::int64_t edgeNode(int edgeId, int fromVertex, int t);
   int edgeBetween(int a, int b) const;
   std::vector<std::int64_t> interiorNodes(bool triangle, const Curve* curve);
   std::vector<std::int64_t> polygonNodes(const std::vector<int>& own,
@@ -104,21 +120,84 @@ class Reader {
   std::vector<bool> known_;  // node position given by the file (else to be filled)
 };
 
-std::vector<int> parseIdList(const std::string& list) {
-  std::vector<int> ids;
+int Reader::toId(long long value, const std::string& what) const {
+  if (value < 0 || value > INT_MAX) fail(what + " is not a valid id: " + std::to_string(value));
+  return static_cast<int>(value);
+}
+
+int Reader::idAttribute(const XmlElement& e, const char* key) const {
+  const std::string text = e.attribute(key);
+  long long v = -1;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || error != std::errc() || end != text.data() + text.size() || v < 0 ||
+      v > INT_MAX)
+    fail("<" + e.name + "> has " + key + "=\"" + excerpt(text) + "\", not an id");
+  return static_cast<int>(v);
+}
+
+std::vector<int> Reader::ids(const std::string& text, std::size_t count,
+                             const std::string& where) const {
+  const std::vector<double> v = numbers(text, where);
+  if (v.size() != count)
+    fail(where + " needs " + std::to_string(count) + " ids, has " + std::to_string(v.size()));
+  std::vector<int> out;
+  out.reserve(v.size());
+  for (const double x : v) {
+    if (!(x >= 0.0 && x <= INT_MAX) || x != std::floor(x))
+      fail(where + " has an id that is not one");
+    out.push_back(static_cast<int>(x));
+  }
+  return out;
+}
+
+// "0-3,5,7-9": Nektar++'s compact id lists; `limit` bounds how many ids it may expand to.
+std::vector<int> Reader::parseIdList(const std::string& list, const std::string& where,
+                                     std::size_t limit) const {
+  std::vector<int> out;
   std::stringstream ss(list);
   std::string part;
+  const auto number = [&](const std::string& t) {
+    long long v = -1;
+    const auto [end, error] = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (t.empty() || error != std::errc() || end != t.data() + t.size() || v < 0 || v > INT_MAX)
+      fail(where + " lists '" + excerpt(t) + "', not an id");
+    return static_cast<int>(v);
+  };
   while (std::getline(ss, part, ',')) {
     if (part.empty()) continue;
     const std::size_t dash = part.find('-');
-    if (dash == std::string::npos) {
-      ids.push_back(std::stoi(part));
-    } else {
-      const int a = std::stoi(part.substr(0, dash)), b = std::stoi(part.substr(dash + 1));
-      for (int i = a; i <= b; ++i) ids.push_back(i);
-    }
+    const int a = number(part.substr(0, dash));
+    const int b = dash == std::string::npos ? a : number(part.substr(dash + 1));
+    if (b < a) fail(where + " has the range " + excerpt(part) + ", which runs backwards");
+    if (static_cast<std::size_t>(b - a) + out.size() >= limit)
+      fail(where + " lists more ids than the file has entities");
+    for (int i = a; i <= b; ++i) out.push_back(i);
   }
-  return ids;
+  return out;
+}
+
+const std::array<int, 2>& Reader::edge(int id) const {
+  const auto it = edges_.find(id);
+  if (it == edges_.end()) fail("edge " + std::to_string(id) + " is referred to but missing");
+  return it->second;
+}
+
+const Face& Reader::face(int id) const {
+  const auto it = faces_.find(id);
+  if (it == faces_.end()) fail("face " + std::to_string(id) + " is referred to but missing");
+  return it->second;
+}
+
+const Point& Reader::vertexPoint(int id) const {
+  const auto it = vertices_.find(id);
+  if (it == vertices_.end()) fail("vertex " + std::to_string(id) + " is referred to but missing");
+  return it->second;
+}
+
+std::int64_t Reader::vertexNode(int id) const {
+  const auto it = vertexNode_.find(id);
+  if (it == vertexNode_.end()) fail("vertex " + std::to_string(id) + " is referred to but missing");
+  return it->second;
 }
 
 std::vector<double> Reader::numbers(const std::string& text, const std::string& where) const {
@@ -128,6 +207,7 @@ std::vector<double> Reader::numbers(const std::string& text, const std::string& 
   for (;;) {
     const double x = std::strtod(p, &end);
     if (end == p) break;
+    if (!std::isfinite(x)) fail(where + " holds a number that is not finite");
     v.push_back(x);
     p = end;
   }
@@ -141,7 +221,7 @@ std::vector<Record> Reader::records(const XmlElement& e, bool tagged) const {
   if (tagged && !e.has("COMPRESSED"))
     fail("<" + e.name + "> is not compressed like the rest of the file");
   if (tagged && e.attribute("COMPRESSED") != nektar::kCompressed)
-    fail("unsupported compression '" + e.attribute("COMPRESSED") + "'");
+    fail("unsupported compression '" + excerpt(e.attribute("COMPRESSED")) + "'");
   const std::string bytes = nektar::decode(e.text);
   std::vector<Record> out(bytes.size() / sizeof(Record));
   if (!out.empty()) std::memcpy(out.data(), bytes.data(), out.size() * sizeof(Record));
@@ -150,27 +230,33 @@ std::vector<Record> Reader::records(const XmlElement& e, bool tagged) const {
 
 void Reader::readVertices(const XmlElement& section) {
   if (section.has("COMPRESSED")) {
-    for (const auto& v : records<nektar::Vertex>(section))
-      vertices_[static_cast<int>(v.id)] = {v.x, v.y, v.z};
+    for (const auto& v : records<nektar::Vertex>(section)) {
+      const int id = toId(v.id, "a vertex record's id");
+      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+        fail("vertex " + std::to_string(id) + " has a coordinate that is not finite");
+      vertices_[id] = {v.x, v.y, v.z};
+    }
     return;
   }
   for (const XmlElement* v : section.childrenNamed("V")) {
-    const std::vector<double> x = numbers(v->text, "vertex " + v->attribute("ID"));
-    if (x.size() != 3) fail("vertex " + v->attribute("ID") + " needs 3 coordinates");
-    vertices_[std::stoi(v->attribute("ID"))] = {x[0], x[1], x[2]};
+    const int id = idAttribute(*v);
+    const std::vector<double> x = numbers(v->text, "vertex " + std::to_string(id));
+    if (x.size() != 3) fail("vertex " + std::to_string(id) + " needs 3 coordinates");
+    vertices_[id] = {x[0], x[1], x[2]};
   }
 }
 
 void Reader::readEdges(const XmlElement& section) {
   if (section.has("COMPRESSED")) {
     for (const auto& e : records<nektar::Edge>(section))
-      edges_[static_cast<int>(e.id)] = {static_cast<int>(e.v0), static_cast<int>(e.v1)};
+      edges_[toId(e.id, "an edge record's id")] = {toId(e.v0, "an edge's vertex"),
+                                                   toId(e.v1, "an edge's vertex")};
     return;
   }
   for (const XmlElement* e : section.childrenNamed("E")) {
-    const std::vector<double> v = numbers(e->text, "edge " + e->attribute("ID"));
-    if (v.size() != 2) fail("edge " + e->attribute("ID") + " needs 2 vertices");
-    edges_[std::stoi(e->attribute("ID"))] = {static_cast<int>(v[0]), static_cast<int>(v[1])};
+    const int id = idAttribute(*e);
+    const std::vector<int> v = ids(e->text, 2, "edge " + std::to_string(id));
+    edges_[id] = {v[0], v[1]};
   }
 }
 
@@ -185,17 +271,20 @@ void Reader::readFaces(const XmlElement& section) {
       faces_[id] = f;
     };
     if (child->has("COMPRESSED")) {
+      const auto take = [&](const auto& records) {
+        for (const auto& r : records) {
+          std::vector<int> edgeIds;
+          for (const std::int64_t e : r.ids) edgeIds.push_back(toId(e, "a face's edge"));
+          add(toId(r.id, "a face record's id"), edgeIds);
+        }
+      };
       if (tri)
-        for (const auto& r : records<nektar::Entity<3>>(*child))
-          add(static_cast<int>(r.id), {int(r.ids[0]), int(r.ids[1]), int(r.ids[2])});
+        take(records<nektar::Entity<3>>(*child));
       else
-        for (const auto& r : records<nektar::Entity<4>>(*child))
-          add(static_cast<int>(r.id),
-              {int(r.ids[0]), int(r.ids[1]), int(r.ids[2]), int(r.ids[3])});
+        take(records<nektar::Entity<4>>(*child));
     } else {
-      const std::vector<double> v = numbers(child->text, "face " + child->attribute("ID"));
-      if (v.size() != (tri ? 3u : 4u)) fail("face " + child->attribute("ID") + " has wrong size");
-      add(std::stoi(child->attribute("ID")), std::vector<int>(v.begin(), v.end()));
+      const int id = idAttribute(*child);
+      add(id, ids(child->text, tri ? 3 : 4, "face " + std::to_string(id)));
     }
   }
 }
@@ -205,25 +294,40 @@ void Reader::readElements(const XmlElement& section) {
     const std::string& tag = child->name;
     CellType type;
     int n = 0;
-    if (dim_ == 3 && tag == "A") { type = CellType::Tetrahedron; n = 4; }
-    else if (dim_ == 3 && tag == "R") { type = CellType::Prism; n = 5; }
-    else if (dim_ == 3 && tag == "H") { type = CellType::Hexahedron; n = 6; }
-    else if (dim_ == 2 && tag == "T") { type = CellType::Triangle; n = 3; }
-    else if (dim_ == 2 && tag == "Q") { type = CellType::Quadrilateral; n = 4; }
-    else fail("element <" + tag + "> is not supported in a " + std::to_string(dim_) + "D mesh");
+    if (dim_ == 3 && tag == "A") {
+      type = CellType::Tetrahedron;
+      n = 4;
+    } else if (dim_ == 3 && tag == "R") {
+      type = CellType::Prism;
+      n = 5;
+    } else if (dim_ == 3 && tag == "H") {
+      type = CellType::Hexahedron;
+      n = 6;
+    } else if (dim_ == 2 && tag == "T") {
+      type = CellType::Triangle;
+      n = 3;
+    } else if (dim_ == 2 && tag == "Q") {
+      type = CellType::Quadrilateral;
+      n = 4;
+    } else
+      fail("element <" + tag + "> is not supported in a " + std::to_string(dim_) + "D mesh");
     const auto add = [&](int id, std::vector<int> ids) { elements_.push_back({type, id, ids}); };
     if (child->has("COMPRESSED")) {
       const auto take = [&](const auto& recs) {
-        for (const auto& r : recs) add(int(r.id), std::vector<int>(r.ids, r.ids + n));
+        for (const auto& r : recs) {
+          std::vector<int> parts;
+          for (const std::int64_t id : r.ids)
+            parts.push_back(toId(id, "an element's face or edge"));
+          add(toId(r.id, "an element record's id"), parts);
+        }
       };
       if (n == 3) take(records<nektar::Entity<3>>(*child));
       if (n == 4) take(records<nektar::Entity<4>>(*child));
       if (n == 5) take(records<nektar::Entity<5>>(*child));
       if (n == 6) take(records<nektar::Entity<6>>(*child));
     } else {
-      const std::vector<double> v = numbers(child->text, "element " + child->attribute("ID"));
-      if (static_cast<int>(v.size()) != n) fail("element " + child->attribute("ID") + " has wrong size");
-      add(std::stoi(child->attribute("ID")), std::vector<int>(v.begin(), v.end()));
+      const int id = idAttribute(*child);
+      add(id, ids(child->text, static_cast<std::size_t>(n), "element " + std::to_string(id)));
     }
   }
   std::sort(elements_.begin(), elements_.end(),
@@ -243,13 +347,24 @@ void Reader::readCurves(const XmlElement& section) {
       const XmlElement* info = section.child(kind);
       if (info == nullptr) continue;
       for (const auto& c : records<nektar::CurvedInfo>(*info, false)) {
+        const int entity = toId(c.entityId, "a curve's entity");
+        const std::string what =
+            std::string(kind[0] == 'E' ? "edge " : "face ") + std::to_string(entity) + "'s curve";
+        if (c.numPoints < 0 || c.offset < 0 ||
+            static_cast<std::uint64_t>(c.offset) + static_cast<std::uint64_t>(c.numPoints) >
+                index.size())
+          fail(what + " points outside DATAPOINTS/INDEX");
         Curve curve;
         for (std::int64_t k = 0; k < c.numPoints; ++k) {
-          const auto at = static_cast<std::size_t>(index.at(static_cast<std::size_t>(c.offset + k)));
-          const auto& v = points.at(at);
+          const std::int64_t at = index[static_cast<std::size_t>(c.offset + k)];
+          if (at < 0 || static_cast<std::uint64_t>(at) >= points.size())
+            fail(what + " points outside DATAPOINTS/POINTS");
+          const auto& v = points[static_cast<std::size_t>(at)];
+          if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+            fail(what + " has a coordinate that is not finite");
           curve.points.emplace_back(v.x, v.y, v.z);
         }
-        (kind[0] == 'E' ? edgeCurves_ : faceCurves_)[static_cast<int>(c.entityId)] = curve;
+        (kind[0] == 'E' ? edgeCurves_ : faceCurves_)[entity] = curve;
       }
     }
     return;
@@ -257,10 +372,14 @@ void Reader::readCurves(const XmlElement& section) {
   for (const auto& child : section.children) {
     const bool edge = child->name == "E";
     if (!edge && child->name != "F") fail("unknown curve <" + child->name + ">");
-    const std::vector<double> v = numbers(child->text, "a curve");
+    const int entity = idAttribute(*child, edge ? "EDGEID" : "FACEID");
+    const std::string what =
+        std::string(edge ? "edge " : "face ") + std::to_string(entity) + "'s curve";
+    const std::vector<double> v = numbers(child->text, what);
+    if (v.size() % 3 != 0) fail(what + " has a point with fewer than 3 coordinates");
     Curve c;
-    for (std::size_t k = 0; k + 2 < v.size(); k += 3) c.points.emplace_back(v[k], v[k + 1], v[k + 2]);
-    const int entity = std::stoi(child->attribute(edge ? "EDGEID" : "FACEID"));
+    for (std::size_t k = 0; k + 2 < v.size(); k += 3)
+      c.points.emplace_back(v[k], v[k + 1], v[k + 2]);
     (edge ? edgeCurves_ : faceCurves_)[entity] = c;
   }
 }
@@ -271,32 +390,36 @@ void Reader::readComposites(const XmlElement& section) {
     std::string token;
     while (ss >> token) {
       const std::size_t open = token.find('['), close = token.rfind(']');
-      if (open == std::string::npos || close == std::string::npos || open == 0)
-        fail("composite " + c->attribute("ID") + " is malformed");
+      const std::string where = "composite " + excerpt(c->attribute("ID"));
+      if (open == std::string::npos || close == std::string::npos || open == 0 || close < open)
+        fail(where + " is malformed");
+      const std::size_t entities =
+          vertices_.size() + edges_.size() + faces_.size() + elements_.size();
       composites_.push_back(
-          {c->attribute("NAME"), token[0], parseIdList(token.substr(open + 1, close - open - 1))});
+          {c->attribute("NAME"), token[0],
+           parseIdList(token.substr(open + 1, close - open - 1), where, entities + 1)});
     }
   }
 }
 
 int Reader::common(int a, int b) const {
-  const auto& ea = edges_.at(a);
-  const auto& eb = edges_.at(b);
+  const auto& ea = edge(a);
+  const auto& eb = edge(b);
   for (const int v : ea)
     if (v == eb[0] || v == eb[1]) return v;
   fail("edges " + std::to_string(a) + " and " + std::to_string(b) + " do not meet");
 }
 
-int Reader::otherEnd(int edge, int vertex) const {
-  const auto& e = edges_.at(edge);
+int Reader::otherEnd(int edgeId, int vertex) const {
+  const auto& e = edge(edgeId);
   if (e[0] == vertex) return e[1];
   if (e[1] == vertex) return e[0];
-  fail("vertex " + std::to_string(vertex) + " is not on edge " + std::to_string(edge));
+  fail("vertex " + std::to_string(vertex) + " is not on edge " + std::to_string(edgeId));
 }
 
 int Reader::sharedEdge(int fa, int fb) const {
-  for (const int a : faces_.at(fa).edges)
-    for (const int b : faces_.at(fb).edges)
+  for (const int a : face(fa).edges)
+    for (const int b : face(fb).edges)
       if (a == b) return a;
   fail("faces " + std::to_string(fa) + " and " + std::to_string(fb) + " share no edge");
 }
@@ -317,7 +440,7 @@ std::vector<int> Reader::elementVertices(const Element& e) const {
       return loopVertices(f);
     case CellType::Tetrahedron: {
       // As Nektar++: e0, e1, e2 are face 0's edges that start faces 1, 2, 3.
-      const int e0 = faces_.at(f[1]).edges[0], e1 = faces_.at(f[2]).edges[0];
+      const int e0 = face(f[1]).edges[0], e1 = face(f[2]).edges[0];
       const int e3 = sharedEdge(f[1], f[3]);
       const int v1 = common(e0, e1), v0 = otherEnd(e0, v1), v2 = otherEnd(e1, v1);
       return {v0, v1, v2, otherEnd(e3, v0)};
@@ -353,16 +476,16 @@ std::int64_t Reader::newNode(const Point& p, bool known) {
 }
 
 // Interior node t (1..P-1) of `edge` counted from its end `fromVertex`.
-std::int64_t Reader::edgeNode(int edge, int fromVertex, int t) {
-  auto& nodes = edgeNodes_[edge];
-  const auto& ev = edges_.at(edge);
+std::int64_t Reader::edgeNode(int edgeId, int fromVertex, int t) {
+  auto& nodes = edgeNodes_[edgeId];
+  const auto& ev = edge(edgeId);
   if (nodes.empty()) {
-    const auto curve = edgeCurves_.find(edge);
-    const Point a = vertices_.at(ev[0]), b = vertices_.at(ev[1]);
+    const auto curve = edgeCurves_.find(edgeId);
+    const Point a = vertexPoint(ev[0]), b = vertexPoint(ev[1]);
     for (int k = 1; k < order_; ++k)
-      nodes.push_back(newNode(curve != edgeCurves_.end() ? curve->second.points.at(k)
-                                                         : Point(a + (b - a) * k / order_),
-                              true));
+      nodes.push_back(newNode(
+          curve != edgeCurves_.end() ? curve->second.points.at(k) : Point(a + (b - a) * k / order_),
+          true));
   }
   return nodes.at(ev[0] == fromVertex ? t - 1 : order_ - t - 1);
 }
@@ -378,6 +501,12 @@ int Reader::edgeBetween(int a, int b) const {
 std::vector<std::int64_t> Reader::interiorNodes(bool triangle, const Curve* curve) {
   std::vector<std::int64_t> nodes;
   const int n = order_ + 1;
+  const std::size_t expected =
+      triangle ? static_cast<std::size_t>(n * (n + 1) / 2) : static_cast<std::size_t>(n * n);
+  if (curve != nullptr && curve->points.size() != expected)
+    fail(std::string("a curved ") + (triangle ? "triangle" : "quadrilateral") + " has " +
+         std::to_string(curve->points.size()) + " points; order " + std::to_string(order_) +
+         " needs " + std::to_string(expected));
   int k = 3 * order_;
   for (int i = 1; i < order_; ++i)
     for (int j = 1; j < order_; ++j) {
@@ -398,7 +527,7 @@ std::vector<std::int64_t> Reader::polygonNodes(const std::vector<int>& own,
   const ReferenceElement& ref = ReferenceElement::get(type, order_);
   std::map<Lattice, std::int64_t> at;
   const int nv = static_cast<int>(own.size());
-  for (int k = 0; k < nv; ++k) at[ref.lattice()[k]] = vertexNode_.at(own[k]);
+  for (int k = 0; k < nv; ++k) at[ref.lattice()[k]] = vertexNode(own[k]);
   for (int k = 0; k < nv; ++k) {
     const Lattice& a = ref.lattice()[k];
     const Lattice& b = ref.lattice()[(k + 1) % nv];
@@ -472,8 +601,9 @@ Mesh Reader::read() {
   if (root->name != "NEKTAR") fail("the root element is <" + root->name + ">, not <NEKTAR>");
   const XmlElement* geometry = root->child("GEOMETRY");
   if (geometry == nullptr) fail("no <GEOMETRY>");
-  dim_ = std::stoi(geometry->attribute("DIM", "3"));
-  if (dim_ != 2 && dim_ != 3) fail("DIM must be 2 or 3");
+  const std::string dim = geometry->attribute("DIM", "3");
+  if (dim != "2" && dim != "3") fail("DIM must be 2 or 3, not '" + excerpt(dim) + "'");
+  dim_ = dim == "2" ? 2 : 3;
   const auto section = [&](const char* name, bool required) {
     const XmlElement* s = geometry->child(name);
     if (s == nullptr && required) fail(std::string("no <") + name + ">");
@@ -563,10 +693,10 @@ Mesh Reader::read() {
       const auto it = faceGmshNodes.find(id);
       if (it == faceGmshNodes.end()) fail("composite refers to missing face " + std::to_string(id));
       nodes = it->second;
-      block = faces_.at(id).triangle ? &tris : &quads;
+      block = face(id).triangle ? &tris : &quads;
     } else {
-      const auto& ev = edges_.at(id);
-      nodes = {vertexNode_.at(ev[0]), vertexNode_.at(ev[1])};
+      const auto& ev = edge(id);
+      nodes = {vertexNode(ev[0]), vertexNode(ev[1])};
       for (int t = 1; t < order_; ++t) nodes.push_back(edgeNode(id, ev[0], t));
     }
     block->nodes.insert(block->nodes.end(), nodes.begin(), nodes.end());
@@ -592,7 +722,7 @@ std::vector<std::int64_t> Reader::volumeNodes(
   const ReferenceElement& ref = ReferenceElement::get(type, order_);
   const int nv = cellNumVertices(type);
   std::map<Lattice, std::int64_t> at;
-  for (int k = 0; k < nv; ++k) at[ref.lattice()[k]] = vertexNode_.at(v[k]);
+  for (int k = 0; k < nv; ++k) at[ref.lattice()[k]] = vertexNode(v[k]);
   // Faces in Gmsh's local numbering: their nodes from the shared face, mapped by lattice.
   static const std::map<CellType, std::vector<std::vector<int>>> gmshFaces = {
       {CellType::Tetrahedron, {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}}},
@@ -614,9 +744,10 @@ std::vector<std::int64_t> Reader::volumeNodes(
     std::vector<Lattice> corner;
     for (std::size_t k = 0; k < local.size(); ++k) {
       const std::int64_t node = faceNodes[k];
-      const int lv = static_cast<int>(
-          std::find_if(local.begin(), local.end(),
-                       [&](int x) { return vertexNode_.at(v[x]) == node; }) - local.begin());
+      const int lv =
+          static_cast<int>(std::find_if(local.begin(), local.end(),
+                                        [&](int x) { return vertexNode(v[x]) == node; }) -
+                           local.begin());
       corner.push_back(ref.lattice()[local.at(lv)]);
     }
     for (int n = 0; n < fref.numNodes(); ++n) {
@@ -641,6 +772,15 @@ std::vector<std::int64_t> Reader::volumeNodes(
 
 }  // namespace
 
-Mesh readNektarXml(const std::string& path) { return Reader(path).read(); }
+Mesh readNektarXml(const std::string& path) {
+  try {
+    return Reader(path).read();
+  } catch (const std::out_of_range&) {
+    // Checks above name the usual faults; this catches any inconsistency they do not foresee.
+    throw IoError("'" + path +
+                  "' is not a valid Nektar++ geometry: its entities do not fit "
+                  "together (an id, count or face does not match the rest of the file)");
+  }
+}
 
 }  // namespace homesh

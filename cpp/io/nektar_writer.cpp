@@ -92,9 +92,7 @@ class Builder {
     const std::vector<Lattice>* lattice;
     const std::vector<int>* vertexId;  // per local vertex
   };
-  Point at(const Context& c, const Lattice& l) const {
-    return nodePoint(c.nodes[c.index->at(l)]);
-  }
+  Point at(const Context& c, const Lattice& l) const { return nodePoint(c.nodes[c.index->at(l)]); }
 
   // Edge between local vertices la and lb of the element.
   int edge(const Context& c, int la, int lb) {
@@ -119,8 +117,7 @@ class Builder {
   int triangle(const Context& c, std::array<int, 3> local) {
     std::sort(local.begin(), local.end(),
               [&](int x, int y) { return (*c.vertexId)[x] < (*c.vertexId)[y]; });
-    std::vector<int> key{(*c.vertexId)[local[0]], (*c.vertexId)[local[1]],
-                         (*c.vertexId)[local[2]]};
+    std::vector<int> key{(*c.vertexId)[local[0]], (*c.vertexId)[local[1]], (*c.vertexId)[local[2]]};
     const auto [it, added] = faceOf.try_emplace(key, static_cast<int>(faces.size()));
     if (!added) return it->second;
     Face f;
@@ -164,8 +161,7 @@ class Builder {
     Face f;
     f.triangle = false;
     f.vertices = {id(q[0]), id(q[1]), id(q[2]), id(q[3])};
-    f.edges = {edge(c, q[0], q[1]), edge(c, q[1], q[2]), edge(c, q[2], q[3]),
-               edge(c, q[3], q[0])};
+    f.edges = {edge(c, q[0], q[1]), edge(c, q[1], q[2]), edge(c, q[2], q[3]), edge(c, q[3], q[0])};
     f.points = quadrilateralPoints(c, q);
     faces.push_back(std::move(f));
     return it->second;
@@ -301,8 +297,8 @@ std::string compressedTag(const char* name) {
 
 // Writes the entities of one 3D face kind or element kind with N ids each.
 template <int N>
-void writeEntities(std::ostream& os, char tag, const std::vector<std::pair<int, std::vector<int>>>& items,
-                   bool compressed) {
+void writeEntities(std::ostream& os, char tag,
+                   const std::vector<std::pair<int, std::vector<int>>>& items, bool compressed) {
   if (items.empty()) return;
   if (compressed) {
     std::vector<nektar::Entity<N>> records;

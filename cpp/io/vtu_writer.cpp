@@ -10,27 +10,11 @@
 #include "core/error.hpp"
 #include "element/node_ordering.hpp"
 #include "io/atomic_file.hpp"
+#include "io/base64.hpp"
 
 namespace homesh {
 
 namespace {
-
-std::string base64(const std::uint8_t* data, std::size_t size) {
-  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((size + 2) / 3 * 4);
-  for (std::size_t i = 0; i < size; i += 3) {
-    const std::uint32_t b0 = data[i];
-    const std::uint32_t b1 = i + 1 < size ? data[i + 1] : 0;
-    const std::uint32_t b2 = i + 2 < size ? data[i + 2] : 0;
-    const std::uint32_t triple = (b0 << 16) | (b1 << 8) | b2;
-    out += table[(triple >> 18) & 63];
-    out += table[(triple >> 12) & 63];
-    out += i + 1 < size ? table[(triple >> 6) & 63] : '=';
-    out += i + 2 < size ? table[triple & 63] : '=';
-  }
-  return out;
-}
 
 // [UInt64 byte count][raw little-endian values]: VTK's layout of one binary data array.
 template <class T>
@@ -59,8 +43,7 @@ class DataArrays {
       os_ << " format=\"appended\" offset=\"" << appendix_.size() << "\"/>\n";
       appendix_ += data;
     } else {
-      os_ << " format=\"binary\">\n          "
-          << base64(reinterpret_cast<const std::uint8_t*>(data.data()), data.size())
+      os_ << " format=\"binary\">\n          " << base64Encode(data.data(), data.size())
           << "\n        </DataArray>\n";
     }
   }
@@ -151,7 +134,7 @@ void writeVtu(const Mesh& mesh, const std::string& path, const std::vector<CellF
   os << "      <CellData" << (fields.empty() ? "" : " Scalars=\"" + fields[0].name + "\"") << ">\n";
   for (const CellField& f : fields)
     arrays.add("Float64", f.name, 1,
-              std::vector<double>(f.values.begin(), f.values.begin() + types.size()));
+               std::vector<double>(f.values.begin(), f.values.begin() + types.size()));
   arrays.add("Int32", "cad_entity", 1, entity);
   os << "      </CellData>\n";
   os << "      <Points>\n";

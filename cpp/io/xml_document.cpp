@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "core/error.hpp"
+#include "core/format.hpp"
 
 namespace homesh {
 
@@ -45,8 +46,7 @@ class Parser {
     std::size_t line = 1;
     for (std::size_t i = 0; i < pos_ && i < s_.size(); ++i)
       if (s_[i] == '\n') ++line;
-    throw IoError("'" + source_ + "' is not valid XML: " + what + ", line " +
-                  std::to_string(line));
+    throw IoError("'" + source_ + "' is not valid XML: " + what + ", line " + std::to_string(line));
   }
   bool startsWith(const char* t) const { return s_.compare(pos_, std::strlen(t), t) == 0; }
   void skipSpace() {
@@ -73,9 +73,9 @@ class Parser {
   }
   std::string name() {
     const std::size_t start = pos_;
-    while (pos_ < s_.size() && (std::isalnum(static_cast<unsigned char>(s_[pos_])) ||
-                                s_[pos_] == '_' || s_[pos_] == '-' || s_[pos_] == ':' ||
-                                s_[pos_] == '.'))
+    while (pos_ < s_.size() &&
+           (std::isalnum(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '_' ||
+            s_[pos_] == '-' || s_[pos_] == ':' || s_[pos_] == '.'))
       ++pos_;
     if (pos_ == start) fail("a name was expected");
     return s_.substr(start, pos_ - start);
@@ -88,18 +88,30 @@ class Parser {
         continue;
       }
       const std::size_t semi = raw.find(';', i);
+      if (semi == std::string::npos || semi - i > 8)
+        fail("'&' does not start an entity (&lt; &gt; &amp; &quot; &apos;) near '" +
+             excerpt(raw.substr(i, 12)) + "'");
       const std::string entity = raw.substr(i + 1, semi - i - 1);
-      if (entity == "lt") out += '<';
-      else if (entity == "gt") out += '>';
-      else if (entity == "amp") out += '&';
-      else if (entity == "quot") out += '"';
-      else if (entity == "apos") out += '\'';
-      else fail("unknown entity &" + entity + ";");
+      if (entity == "lt")
+        out += '<';
+      else if (entity == "gt")
+        out += '>';
+      else if (entity == "amp")
+        out += '&';
+      else if (entity == "quot")
+        out += '"';
+      else if (entity == "apos")
+        out += '\'';
+      else
+        fail("unknown entity &" + excerpt(entity) + ";");
       i = semi;
     }
     return out;
   }
-  std::unique_ptr<XmlElement> element() {
+  // `depth`: elements open around this one. Nesting is bounded so that a hostile file cannot
+  // exhaust the stack (our formats nest a handful of levels).
+  std::unique_ptr<XmlElement> element(int depth = 0) {
+    if (depth >= kMaxDepth) fail("elements are nested deeper than " + std::to_string(kMaxDepth));
     ++pos_;  // '<'
     auto e = std::make_unique<XmlElement>();
     e->name = name();
@@ -148,11 +160,12 @@ class Parser {
       } else if (startsWith("<?")) {
         skipTo("?>");
       } else {
-        e->children.push_back(element());
+        e->children.push_back(element(depth + 1));
       }
     }
   }
 
+  static constexpr int kMaxDepth = 100;
   const std::string& s_;
   std::string source_;
   std::size_t pos_ = 0;

@@ -23,8 +23,8 @@ void appendMeasure(JsonWriter& json, const std::string& key, const MeasureSummar
     for (int k = 0; k <= Histogram::kBins; ++k)
       edges.push_back(static_cast<double>(k) / Histogram::kBins);
     json.numbers("edges", edges);
-    json.numbers("counts", std::vector<std::size_t>(m.histogram.counts.begin(),
-                                                    m.histogram.counts.end()));
+    json.numbers("counts",
+                 std::vector<std::size_t>(m.histogram.counts.begin(), m.histogram.counts.end()));
     json.value("below_zero", m.histogram.below);
     json.endObject();
   }

@@ -8,6 +8,7 @@
 
 #include <boost/python.hpp>
 #include <boost/python/numpy.hpp>
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -18,9 +19,9 @@
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 #include "io/mesh_readers.hpp"
-#include "quality/element_measure.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
+#include "quality/element_measure.hpp"
 
 namespace bp = boost::python;
 namespace np = boost::python::numpy;
@@ -293,6 +294,10 @@ PyMesh meshFromArrays(int dim, int order, const bp::object& nodes, const bp::obj
   if (bp::len(normal) != 3) throw ParameterError("plane normal needs 3 components");
   for (int k = 0; k < 3; ++k) mesh.planeNormal[k] = bp::extract<double>(normal[k]);
   mesh.xyz = fromArray<double>(nodes, "nodes");
+  for (std::size_t k = 0; k < mesh.xyz.size(); ++k)
+    if (!std::isfinite(mesh.xyz[k]))
+      throw ParameterError("nodes: node " + std::to_string(k / 3) +
+                           " has a coordinate that is not finite");
   mesh.nodeCadDim = fromArray<std::uint8_t>(cadDim, "node_cad_dim");
   mesh.nodeCadIndex = fromArray<std::int32_t>(cadIndex, "node_cad_index");
   mesh.nodeCadParam = fromArray<double>(cadParams, "node_cad_params");
@@ -406,8 +411,8 @@ BOOST_PYTHON_MODULE(_core) {
       .def("validity", &PyMesh::validity)
       .def("quality_summary", &PyMesh::qualitySummary)
       .def("timings", &PyMesh::timings)
-      .def("write", &PyMesh::write, (bp::arg("path"), bp::arg("binary") = false,
-                                       bp::arg("compressed") = false))
+      .def("write", &PyMesh::write,
+           (bp::arg("path"), bp::arg("binary") = false, bp::arg("compressed") = false))
       .def("element_volumes", &PyMesh::elementVolumes)
       .def("report_json", &PyMesh::reportJson);
 

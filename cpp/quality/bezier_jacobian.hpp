@@ -55,6 +55,7 @@ constexpr double kJacobianBoundTolerance = 1e-3;
 // `normal`: the plane normal for 2D cells. `tolerance`: the gap left between each bound and
 // the extreme value found, relative to the largest |J|.
 JacobianBounds boundJacobian(CellType type, int order, const NodeCoordinates& x,
-                             const Eigen::Vector3d* normal, double tolerance = kJacobianBoundTolerance);
+                             const Eigen::Vector3d* normal,
+                             double tolerance = kJacobianBoundTolerance);
 
 }  // namespace homesh

@@ -84,9 +84,9 @@ const DistortionSamplers& samplers(CellType type, int order) {
       for (int k = 0; k < dim; ++k)
         points(q, k) = rule.points[static_cast<std::size_t>(q) * dim + k];
     points.bottomRows(ref.numNodes()) = ref.nodes();
-    slot = std::make_unique<DistortionSamplers>(DistortionSamplers{
-        dim, static_cast<int>(points.rows()), stackedDerivatives(ref, points),
-        stackedDerivatives(ReferenceElement::get(type, 1), points)});
+    slot = std::make_unique<DistortionSamplers>(
+        DistortionSamplers{dim, static_cast<int>(points.rows()), stackedDerivatives(ref, points),
+                           stackedDerivatives(ReferenceElement::get(type, 1), points)});
   }
   return *slot;
 }

@@ -10,7 +10,7 @@
 namespace homesh {
 
 void Histogram::add(double value) {
-  if (value < 0.0) {
+  if (value < 0.0 || std::isnan(value)) {  // invalid, or undefined (never a bin index)
     ++below;
   } else if (value > 1.0 + 1e-12) {
     ++above;
@@ -27,10 +27,18 @@ void accumulate(MeasureSummary& s, double value) {
   s.histogram.add(value);
 }
 
+// An element's node coordinates, moved to the origin and scaled to unit size. Every measure
+// here is invariant under translation and uniform scaling, and J's Bezier coefficients are
+// products of three coordinate differences: at unit size they stay far inside double range
+// whatever coordinates a file holds.
 NodeCoordinates gather(const Mesh& mesh, const std::int64_t* nodes, int n) {
   NodeCoordinates x(n, 3);
   for (int i = 0; i < n; ++i)
     for (int c = 0; c < 3; ++c) x(i, c) = mesh.xyz[3 * nodes[i] + c];
+  const Eigen::RowVector3d origin = x.row(0);
+  x.rowwise() -= origin;
+  const double size = x.cwiseAbs().maxCoeff();
+  if (size > 0.0 && std::isfinite(size)) x /= size;
   return x;
 }
 

@@ -25,7 +25,7 @@ namespace homesh {
 struct Histogram {
   static constexpr int kBins = 20;
   std::array<std::size_t, kBins> counts{};
-  std::size_t below = 0;  // values < 0 (invalid elements)
+  std::size_t below = 0;  // values < 0 (invalid elements) or undefined (NaN)
   std::size_t above = 0;  // values > 1 (never for these measures, kept for honesty)
   void add(double value);
 };

@@ -1,4 +1,5 @@
-"""File > Export of HighOrderMesh objects (registered in Init.py): .msh and .vtu."""
+"""File > Export of HighOrderMesh objects (registered in Init.py): .msh (Gmsh), .vtu (ParaView)
+and .xml (Nektar++)."""
 
 import FreeCAD
 

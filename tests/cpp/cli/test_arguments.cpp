@@ -47,8 +47,8 @@ TEST(Arguments, QualityAndConvert) {
   EXPECT_TRUE(q.quality.strict);
   EXPECT_EQ(q.quality.common.report.value_or(""), "-");
   EXPECT_EQ(q.quality.common.threads, 2);
-  const ParsedCommand c = parse({"convert", "m.msh", "-o", "m.xml", "--compressed", "-o", "m.msh",
-                                 "--binary"});
+  const ParsedCommand c =
+      parse({"convert", "m.msh", "-o", "m.xml", "--compressed", "-o", "m.msh", "--binary"});
   ASSERT_EQ(c.kind, ParsedCommand::Kind::Convert);
   EXPECT_EQ(c.convert.common.outputs, (std::vector<std::string>{"m.xml", "m.msh"}));
   EXPECT_TRUE(c.convert.common.compressed);

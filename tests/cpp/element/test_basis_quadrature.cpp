@@ -144,8 +144,7 @@ TEST_P(Shapes, BasisReproducesItsPolynomialsAndTheirDerivatives) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(All, Shapes, ::testing::ValuesIn(kShapes),
-                         shapeName);
+INSTANTIATE_TEST_SUITE_P(All, Shapes, ::testing::ValuesIn(kShapes), shapeName);
 
 TEST(NodeSets, OptimalSetsPutGllPointsOnEdgesAndTriangleNodesOnTetrahedronFaces) {
   for (int p = 1; p <= 10; ++p) {

@@ -5,10 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <BRepBuilderAPI_MakeFace.hxx>
-#include <gp_Pln.hxx>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <gp_Pln.hxx>
 #include <map>
 
 #include "core/error.hpp"
@@ -18,6 +18,7 @@
 #include "io/mesh_writers.hpp"
 #include "io/msh_reader.hpp"
 #include "linear/linear_mesher.hpp"
+#include "peers/gmsh_quality.hpp"
 #include "quality/mesh_quality.hpp"
 #include "test_support.hpp"
 
@@ -61,8 +62,8 @@ void expectSameMesh(const Mesh& a, const Mesh& b, double tol) {
 
 TEST(MshReader, RoundTripsOurFilesExactly) {
   const auto dir = test::tempDir();
-  for (const Mesh& mesh : {curvedBoxWithHole(1), curvedBoxWithHole(3), curvedBoxWithHole(6),
-                           curvedPlate(4)})
+  for (const Mesh& mesh :
+       {curvedBoxWithHole(1), curvedBoxWithHole(3), curvedBoxWithHole(6), curvedPlate(4)})
     for (const bool binary : {false, true}) {
       const std::string path = (dir / (binary ? "b.msh" : "a.msh")).string();
       writeMesh(mesh, path, {}, {binary, false});
@@ -134,9 +135,9 @@ TEST(MshReader, ReadsFilesGmshWrote) {
   gmsh::open(ours);
   for (const double version : {2.2, 4.1})
     for (const int binary : {0, 1}) {
-      const std::string path = (dir / ("gmsh" + std::to_string(version) + "_" +
-                                       std::to_string(binary) + ".msh"))
-                                   .string();
+      const std::string path =
+          (dir / ("gmsh" + std::to_string(version) + "_" + std::to_string(binary) + ".msh"))
+              .string();
       gmsh::option::setNumber("Mesh.MshFileVersion", version);
       gmsh::option::setNumber("Mesh.Binary", binary);
       gmsh::option::setNumber("Mesh.SaveAll", 1);
@@ -190,8 +191,8 @@ std::vector<std::vector<std::array<double, 3>>> storedNodes(const Mesh& mesh) {
         const int p = b.order;
         const bool tetInside = b.type == CellType::Tetrahedron && l[0] > 0 && l[1] > 0 &&
                                l[2] > 0 && l[0] + l[1] + l[2] < p;
-        const bool boxInside = b.type == CellType::Hexahedron && l[0] > 0 && l[1] > 0 &&
-                               l[2] > 0 && l[0] < p && l[1] < p && l[2] < p;
+        const bool boxInside = b.type == CellType::Hexahedron && l[0] > 0 && l[1] > 0 && l[2] > 0 &&
+                               l[0] < p && l[1] < p && l[2] < p;
         const bool prismInside = b.type == CellType::Prism && l[0] > 0 && l[1] > 0 &&
                                  l[0] + l[1] < p && l[2] > 0 && l[2] < p;
         if (tetInside || boxInside || prismInside) continue;
@@ -227,7 +228,8 @@ Mesh gmshStructuredMesh(bool prisms, int order, const std::string& path) {
   gmsh::model::mesh::getNodes(tags, coord, param, -1, -1, true, false);
   for (std::size_t k = 0; k < tags.size(); ++k) {
     double* x = &coord[3 * k];
-    const std::vector<double> moved{x[0] + 0.05 * std::sin(3 * x[1]), x[1] + 0.05 * std::sin(2 * x[2]),
+    const std::vector<double> moved{x[0] + 0.05 * std::sin(3 * x[1]),
+                                    x[1] + 0.05 * std::sin(2 * x[2]),
                                     x[2] + 0.05 * std::sin(2 * x[0])};
     gmsh::model::mesh::setNode(tags[k], moved, {});
   }
@@ -241,8 +243,8 @@ TEST(Readers, HexahedraPrismsAndQuadrilateralsFromGmsh) {
   const auto dir = test::tempDir();
   for (const bool prisms : {false, true})
     for (const int order : {1, 2, 4}) {
-      const Mesh mesh =
-          gmshStructuredMesh(prisms, order, (dir / ("g" + std::to_string(order) + ".msh")).string());
+      const Mesh mesh = gmshStructuredMesh(prisms, order,
+                                           (dir / ("g" + std::to_string(order) + ".msh")).string());
       ASSERT_EQ(mesh.dim, 3);
       EXPECT_EQ(mesh.blocks[0].type, prisms ? CellType::Prism : CellType::Hexahedron);
       const QualitySummary q = evaluateQuality(mesh);
@@ -310,33 +312,6 @@ TEST(NektarXml, RoundTripsPlainAndCompressed) {
     }
 }
 
-// Gmsh's worst minJ/maxJ (Plugin AnalyseMeshQuality, Bezier bounds) on a file.
-double gmshWorstScaledJacobian(const std::string& path, int dim) {
-  gmsh::initialize(0, nullptr, false);
-  gmsh::option::setNumber("General.Terminal", 0);
-  gmsh::open(path);
-  gmsh::plugin::setNumber("AnalyseMeshQuality", "JacobianDeterminant", 1);
-  gmsh::plugin::setNumber("AnalyseMeshQuality", "IGEMeasure", 0);
-  gmsh::plugin::setNumber("AnalyseMeshQuality", "ICNMeasure", 0);
-  gmsh::plugin::setNumber("AnalyseMeshQuality", "DimensionOfElements", dim);
-  gmsh::plugin::setNumber("AnalyseMeshQuality", "CreateView", 1);
-  gmsh::plugin::run("AnalyseMeshQuality");
-  std::vector<int> views;
-  gmsh::view::getTags(views);
-  double worst = 1e300;
-  for (const int v : views) {
-    std::string type;
-    std::vector<std::size_t> tags;
-    std::vector<std::vector<double>> data;
-    double time = 0;
-    int components = 0;
-    gmsh::view::getModelData(v, 0, type, tags, data, time, components);
-    for (const auto& d : data) worst = std::min(worst, d[0]);
-  }
-  gmsh::finalize();
-  return worst;
-}
-
 TEST(PeerMeshes, WorstScaledJacobianAgreesWithGmsh) {
   const std::string dir = std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/optimiser/";
   for (const auto& [file, dim] : {std::pair<std::string, int>{"varopti_cube_sphere.msh", 3},
@@ -345,7 +320,7 @@ TEST(PeerMeshes, WorstScaledJacobianAgreesWithGmsh) {
     const Mesh mesh = readMsh(dir + file);
     EXPECT_EQ(mesh.dim, dim);
     const QualitySummary q = evaluateQuality(mesh);
-    const double gmsh = gmshWorstScaledJacobian(dir + file, dim);
+    const double gmsh = peers::gmshWorstScaledJacobian(dir + file, dim);
     std::printf("%s: worst scaled Jacobian, HOMesh %.6f, Gmsh %.6f\n", file.c_str(), q.scaled.min,
                 gmsh);
     EXPECT_NEAR(q.scaled.min, gmsh, 1e-3) << file;

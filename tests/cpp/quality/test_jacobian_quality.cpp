@@ -59,8 +59,8 @@ double bernsteinValue(const BernsteinSpace& space, const Eigen::VectorXd& c, con
 
 TEST(Bernstein, BisectionGivesThePolynomialOnEachHalf) {
   // Spaces of J for triangles, tetrahedra, quadrilaterals, hexahedra and prisms.
-  const BernsteinFactors spaces[] = {{{2, 6}}, {{3, 9}}, {{1, 7}, {1, 7}},
-                                     {{1, 5}, {1, 5}, {1, 5}}, {{2, 4}, {1, 5}}};
+  const BernsteinFactors spaces[] = {
+      {{2, 6}}, {{3, 9}}, {{1, 7}, {1, 7}}, {{1, 5}, {1, 5}, {1, 5}}, {{2, 4}, {1, 5}}};
   std::srand(7);
   for (const BernsteinFactors& factors : spaces) {
     const BernsteinSpace& space = BernsteinSpace::get(factors);
@@ -97,8 +97,8 @@ TEST(Bernstein, BisectionGivesThePolynomialOnEachHalf) {
           parent.segment(col, d) = p;
           const double expected = bernsteinValue(space, c, parent.data());
           const double got = bernsteinValue(space, half ? keepI : keepJ, local.data());
-          EXPECT_NEAR(got, expected, 1e-12) << "factor " << edge.factor << " edge " << edge.i
-                                            << "-" << edge.j;
+          EXPECT_NEAR(got, expected, 1e-12)
+              << "factor " << edge.factor << " edge " << edge.i << "-" << edge.j;
         }
       }
     }
