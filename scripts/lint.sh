@@ -4,7 +4,7 @@
 set -eu
 cd "$(dirname "$0")/.."
 [ -f build/compile_commands.json ] || scripts/build.sh build
-files=$(git ls-files 'cpp/*.cpp' 'cpp/*.hpp' 'tests/cpp/*.cpp' 'tests/cpp/*.hpp' 'bench/*.cpp')
+files=$(git ls-files 'cpp/*.cpp' 'cpp/*.hpp' 'tests/cpp/*.cpp' 'tests/cpp/*.hpp' 'bench/*.cpp' 'bench/*.hpp')
 status=0
 clang-format --dry-run --Werror $files || status=1
 # shellcheck disable=SC2086

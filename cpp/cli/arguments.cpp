@@ -35,10 +35,10 @@ int parseInteger(const std::string& option, const std::string& text) {
 class OptionTable {
  public:
   using Handler = std::function<void(const std::string& option, const std::string& value)>;
-  void flag(std::initializer_list<const char*> names, std::function<void()> handler) {
+  void flag(std::initializer_list<const char*> names, const std::function<void()>& handler) {
     for (const char* n : names) flags_[n] = handler;
   }
-  void value(std::initializer_list<const char*> names, Handler handler) {
+  void value(std::initializer_list<const char*> names, const Handler& handler) {
     for (const char* n : names) values_[n] = handler;
   }
   // Parses args[first..]; returns the positional arguments.
@@ -53,7 +53,10 @@ class OptionTable {
         if (i + 1 >= args.size()) throw UsageError{a + " needs a value"};
         v->second(a, args[++i]);
       } else if (!a.empty() && a[0] == '-' && a != "-") {
-        throw UsageError{"unknown option '" + a + "' for 'homesh " + command + "'"};
+        std::string message = "unknown option '" + a + "' for 'homesh ";
+        message += command;
+        message += "'";
+        throw UsageError{message};
       } else {
         positional.push_back(a);
       }

@@ -144,6 +144,7 @@ void gmshHexahedron(Nodes& out, const std::vector<P3>& v, int n) {
     static const int adjacent[8][3] = {{1, 3, 4}, {0, 2, 5}, {1, 3, 6}, {0, 2, 7},
                                        {0, 5, 7}, {1, 4, 6}, {2, 5, 7}, {3, 4, 6}};
     std::vector<P3> inner;
+    inner.reserve(8);
     for (int i = 0; i < 8; ++i)
       inner.push_back(inward(v[i], {v[adjacent[i][0]], v[adjacent[i][1]], v[adjacent[i][2]]}, n));
     gmshHexahedron(out, inner, n - 2);

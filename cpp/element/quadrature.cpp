@@ -112,7 +112,9 @@ QuadratureRule quadratureRule(CellType type, int degree) {
       const QuadratureRule tri = quadratureRule(CellType::Triangle, degree);
       for (int k = 0; k < n; ++k)
         for (int t = 0; t < tri.size(); ++t) {
-          rule.points.insert(rule.points.end(), {tri.points[2 * t], tri.points[2 * t + 1], p[k]});
+          rule.points.insert(rule.points.end(),
+                             {tri.points[2 * static_cast<std::size_t>(t)],
+                              tri.points[2 * static_cast<std::size_t>(t) + 1], p[k]});
           rule.weights.push_back(tri.weights[t] * wp[k]);
         }
       return rule;

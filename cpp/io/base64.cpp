@@ -50,7 +50,7 @@ std::string base64Decode(const std::string& text) {
   int bits = 0;
   for (const char ch : text) {
     const auto c = static_cast<unsigned char>(ch);
-    if (c == '=' || std::isspace(c)) continue;
+    if (c == '=' || std::isspace(c) != 0) continue;
     if (value[c] < 0) throw IoError("invalid character in base64 data");
     buffer = (buffer << 6) | static_cast<std::uint32_t>(value[c]);
     bits += 6;

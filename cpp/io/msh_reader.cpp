@@ -35,7 +35,8 @@ class Cursor {
     return pos_ >= data_.size();
   }
   void skipSpace() {
-    while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_]))) ++pos_;
+    while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_])) != 0)
+      ++pos_;
   }
   // Before binary data: consume the rest of the current line and its newline only (binary bytes
   // may look like white space).
@@ -46,7 +47,8 @@ class Cursor {
   std::string word() {
     skipSpace();
     const std::size_t start = pos_;
-    while (pos_ < data_.size() && !std::isspace(static_cast<unsigned char>(data_[pos_]))) ++pos_;
+    while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_])) == 0)
+      ++pos_;
     return data_.substr(start, pos_ - start);
   }
   // The rest of the current line (for quoted names).

@@ -79,9 +79,9 @@ void writeEntities(MshSink& out, const std::map<EntityKey, Box>& entities,
   for (const auto& [key, box] : entities) {
     const auto [dim, tag] = key;
     out.integer(tag);
-    for (int c = 0; c < 3; ++c) out.real(box.lo[c]);
+    for (const double lo : box.lo) out.real(lo);
     if (dim > 0)
-      for (int c = 0; c < 3; ++c) out.real(box.hi[c]);
+      for (const double hi : box.hi) out.real(hi);
     if (physical.count(key) > 0) {
       out.size(1);
       out.integer(tag);

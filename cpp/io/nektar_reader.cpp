@@ -211,7 +211,7 @@ std::vector<double> Reader::numbers(const std::string& text, const std::string& 
     v.push_back(x);
     p = end;
   }
-  while (*p != '\0' && std::isspace(static_cast<unsigned char>(*p))) ++p;
+  while (*p != '\0' && std::isspace(static_cast<unsigned char>(*p)) != 0) ++p;
   if (*p != '\0') fail("unexpected text in " + where);
   return v;
 }
@@ -311,7 +311,9 @@ void Reader::readElements(const XmlElement& section) {
       n = 4;
     } else
       fail("element <" + tag + "> is not supported in a " + std::to_string(dim_) + "D mesh");
-    const auto add = [&](int id, std::vector<int> ids) { elements_.push_back({type, id, ids}); };
+    const auto add = [&](int id, const std::vector<int>& ids) {
+      elements_.push_back({type, id, ids});
+    };
     if (child->has("COMPRESSED")) {
       const auto take = [&](const auto& recs) {
         for (const auto& r : recs) {
@@ -417,17 +419,18 @@ int Reader::otherEnd(int edgeId, int vertex) const {
   fail("vertex " + std::to_string(vertex) + " is not on edge " + std::to_string(edgeId));
 }
 
-int Reader::sharedEdge(int fa, int fb) const {
-  for (const int a : face(fa).edges)
-    for (const int b : face(fb).edges)
+int Reader::sharedEdge(int faceA, int faceB) const {
+  for (const int a : face(faceA).edges)
+    for (const int b : face(faceB).edges)
       if (a == b) return a;
-  fail("faces " + std::to_string(fa) + " and " + std::to_string(fb) + " share no edge");
+  fail("faces " + std::to_string(faceA) + " and " + std::to_string(faceB) + " share no edge");
 }
 
 // Vertex j of an edge loop: the vertex shared by edges j-1 and j.
 std::vector<int> Reader::loopVertices(const std::vector<int>& e) const {
   std::vector<int> v;
   const int n = static_cast<int>(e.size());
+  v.reserve(e.size());
   for (int j = 0; j < n; ++j) v.push_back(common(e[(j + n - 1) % n], e[j]));
   return v;
 }
@@ -731,6 +734,7 @@ std::vector<std::int64_t> Reader::volumeNodes(
        {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}}}};
   for (const std::vector<int>& local : gmshFaces.at(type)) {
     std::vector<int> key;
+    key.reserve(local.size());
     for (const int k : local) key.push_back(v[k]);
     std::sort(key.begin(), key.end());
     const auto it = faceByVertices.find(key);

@@ -292,7 +292,7 @@ std::string blob(const std::vector<Record>& records) {
 }
 
 std::string compressedTag(const char* name) {
-  return std::string("<") + name + " COMPRESSED=\"" + nektar::kCompressed + "\" BITSIZE=\"64\">";
+  return std::string("<") + name + R"( COMPRESSED=")" + nektar::kCompressed + R"(" BITSIZE="64">)";
 }
 
 // Writes the entities of one 3D face kind or element kind with N ids each.

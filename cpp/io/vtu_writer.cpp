@@ -40,7 +40,7 @@ class DataArrays {
     if (components > 1) os_ << " NumberOfComponents=\"" << components << "\"";
     const std::string data = withHeader(values);
     if (appended_) {
-      os_ << " format=\"appended\" offset=\"" << appendix_.size() << "\"/>\n";
+      os_ << R"( format="appended" offset=")" << appendix_.size() << "\"/>\n";
       appendix_ += data;
     } else {
       os_ << " format=\"binary\">\n          " << base64Encode(data.data(), data.size())

@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cstring>
+#include <utility>
 
 #include "core/error.hpp"
 #include "core/format.hpp"
@@ -30,7 +31,7 @@ namespace {
 
 class Parser {
  public:
-  Parser(const std::string& text, const std::string& source) : s_(text), source_(source) {}
+  Parser(const std::string& text, std::string source) : s_(text), source_(std::move(source)) {}
 
   std::unique_ptr<XmlElement> document() {
     skipMisc();
@@ -50,7 +51,7 @@ class Parser {
   }
   bool startsWith(const char* t) const { return s_.compare(pos_, std::strlen(t), t) == 0; }
   void skipSpace() {
-    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_])) != 0) ++pos_;
   }
   void skipTo(const char* end) {
     const std::size_t at = s_.find(end, pos_);
@@ -74,7 +75,7 @@ class Parser {
   std::string name() {
     const std::size_t start = pos_;
     while (pos_ < s_.size() &&
-           (std::isalnum(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '_' ||
+           (std::isalnum(static_cast<unsigned char>(s_[pos_])) != 0 || s_[pos_] == '_' ||
             s_[pos_] == '-' || s_[pos_] == ':' || s_[pos_] == '.'))
       ++pos_;
     if (pos_ == start) fail("a name was expected");

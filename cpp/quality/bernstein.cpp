@@ -93,10 +93,11 @@ BernsteinSpace::BernsteinSpace(BernsteinFactors factors) : factors_(std::move(fa
 
 void BernsteinSpace::bisect(const EdgeLines& edge, const double* coeffs, double* keepJ,
                             double* keepI) {
-  double b[64];
+  double b[64] = {};
   for (std::size_t l = 0; l + 1 < edge.start.size(); ++l) {
     const int* idx = &edge.index[edge.start[l]];
     const int s = edge.start[l + 1] - edge.start[l] - 1;  // the line's degree
+    if (s < 0) continue;
     if (s >= 64) throw Error("Bernstein bisection: degree too high");
     for (int k = 0; k <= s; ++k) b[k] = coeffs[idx[k]];
     keepJ[idx[0]] = b[0];

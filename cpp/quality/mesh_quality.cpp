@@ -58,7 +58,7 @@ JacobianSampler boundarySampler(CellType type, int order) {
     for (int k = 0; k < ref.dim(); ++k)
       points(q, k) = rule.points[static_cast<std::size_t>(q) * ref.dim() + k];
   points.bottomRows(ref.numNodes()) = ref.nodes();
-  return JacobianSampler(ref, points);
+  return {ref, points};
 }
 
 }  // namespace

@@ -114,6 +114,7 @@ std::vector<std::vector<std::int64_t>> elementNodeSets(const Mesh& mesh,
     if (cellDimension(b.type) != mesh.dim) continue;
     for (std::size_t e = 0; e < b.count(); ++e) {
       std::vector<std::int64_t> ids;
+      ids.reserve(static_cast<std::size_t>(b.nodesPerElement()));
       for (int k = 0; k < b.nodesPerElement(); ++k)
         ids.push_back(rename.empty() ? b.element(e)[k] : rename[b.element(e)[k]]);
       std::sort(ids.begin(), ids.end());
@@ -149,7 +150,7 @@ TEST(MshReader, ReadsFilesGmshWrote) {
       EXPECT_EQ(back.blocks[0].count(), mesh.blocks[0].count()) << path;
       // Gmsh may renumber nodes and elements: match every node to ours (exactly in binary
       // files; Gmsh writes ASCII numbers with 16 significant digits), then the elements.
-      const std::vector<std::int64_t> match = matchNodes(back, mesh, binary ? 0.0 : 1e-13);
+      const std::vector<std::int64_t> match = matchNodes(back, mesh, binary != 0 ? 0.0 : 1e-13);
       EXPECT_EQ(std::count(match.begin(), match.end(), -1), 0) << path;
       EXPECT_EQ(elementNodeSets(back, match), elementNodeSets(mesh, {})) << path;
     }
