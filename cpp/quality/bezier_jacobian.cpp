@@ -20,6 +20,7 @@ namespace {
 // Limits on the refinement of one element: bisections deep (times the dimension) and in all.
 constexpr int kMaxDepth = 12;
 constexpr int kMaxSubdivisions = 4000;
+constexpr int kMaxCoefficients = 10'000'000;  // 80 MB of open parts per element at most
 
 BernsteinFactors geometryFactors(CellType type, int p) {
   switch (type) {
@@ -70,13 +71,62 @@ struct BezierTables {
   using Terms = std::vector<BernsteinSpace::ProductTerm>;
   int dim = 3;
   std::vector<Eigen::MatrixXd> derivative;  // per k: (size of d_k's space) x nodes
-  const Terms* inner = nullptr;             // d1 x d2 (3D) or d0 x d1 (2D)
-  const Terms* outer = nullptr;             // d0 . (d1 x d2) (3D only)
+  std::vector<double> derivativeNorm;       // per k: its largest row sum of |entries|
+  std::vector<double> derivativeError;      // per k: relative error of its entries (estimate)
+  int maxTerms = 0;  // most product terms summed into one coefficient (inner plus outer)
+  const Terms* inner = nullptr;  // d1 x d2 (3D) or d0 x d1 (2D)
+  const Terms* outer = nullptr;  // d0 . (d1 x d2) (3D only)
   int innerSize = 0, jacobianSize = 0;
   const BernsteinSpace* jacobian = nullptr;  // J's space
   std::vector<int> corners;                  // corner functions of J's space
   std::vector<int> cornerOffsets;            // per factor of J's space, into Corners
 };
+
+// Lagrange (equispaced nodes) to Bernstein coefficients of the geometry. The geometry space is a
+// product of factors (a hexahedron's three intervals, a prism's triangle and interval), and so
+// is this matrix: each entry is a product of the factors' own inverses, which are small and well
+// conditioned, where inverting the whole n x n matrix of a tensor-product shape at once loses
+// digits that then leak into J (rows of the derivative matrices that should sum to zero would
+// not, and J would depend on where the element sits).
+Eigen::MatrixXd lagrangeToBezier(const ReferenceElement& ref, const BernsteinSpace& geometry) {
+  const int n = ref.numNodes(), p = ref.order();
+  for (int i = 0; i < n; ++i)
+    for (int c = 0; c < ref.dim(); ++c)
+      if (std::abs(ref.nodes()(i, c) - static_cast<double>(ref.lattice()[i][c]) / p) > 1e-12)
+        throw Error("Bezier tables need equispaced nodes on the lattice");
+  struct Factor {
+    const BernsteinSpace* space;
+    Eigen::MatrixXd inverse;  // (function, node) of the factor alone
+    int col, d;
+  };
+  std::vector<Factor> factors;
+  int col = 0;
+  for (const auto& [d, m] : geometry.factors()) {
+    const BernsteinSpace& s = BernsteinSpace::get({{d, m}});
+    Eigen::MatrixXd values(s.size(), s.size());  // function j at the node with its own index r
+    for (int r = 0; r < s.size(); ++r) {
+      const Eigen::VectorXd x = s.point(r);
+      for (int j = 0; j < s.size(); ++j) values(r, j) = s.basis(j, x.data());
+    }
+    factors.push_back({&s, values.fullPivLu().inverse(), col, d});
+    col += d;
+  }
+  Eigen::MatrixXd out(n, n);
+  std::vector<int> sub;
+  for (int f = 0; f < n; ++f)
+    for (int node = 0; node < n; ++node) {
+      double v = 1.0;
+      for (const Factor& factor : factors) {
+        const std::vector<int>& fi = geometry.multiIndex(f);
+        sub.assign(fi.begin() + factor.col, fi.begin() + factor.col + factor.d);
+        const int j = factor.space->indexOf(sub);
+        for (int k = 0; k < factor.d; ++k) sub[k] = ref.lattice()[node][factor.col + k];
+        v *= factor.inverse(j, factor.space->indexOf(sub));
+      }
+      out(f, node) = v;
+    }
+  return out;
+}
 
 const BezierTables& tables(CellType type, int order) {
   static std::mutex mutex;
@@ -89,18 +139,18 @@ const BezierTables& tables(CellType type, int order) {
   const int n = ref.numNodes(), dim = ref.dim();
   t->dim = dim;
   const BernsteinSpace& geometry = BernsteinSpace::get(geometryFactors(type, order));
-  Eigen::MatrixXd b(n, n);  // Bernstein function j at node i
-  for (int i = 0; i < n; ++i) {
-    const Eigen::VectorXd xi = ref.nodes().row(i).transpose();
-    for (int j = 0; j < n; ++j) b(i, j) = geometry.basis(j, xi.data());
-  }
-  const Eigen::MatrixXd lagrangeToBezier = b.partialPivLu().inverse();
+  const Eigen::MatrixXd toBezier = lagrangeToBezier(ref, geometry);
   std::vector<const BernsteinSpace*> spaces;
   for (int k = 0; k < dim; ++k) {
     // The derivative as a matrix on control points, composed with Lagrange-to-Bezier.
     Eigen::MatrixXd d(BernsteinSpace::get(geometry.derivativeFactors(k)).size(), n);
-    for (int j = 0; j < n; ++j) d.col(j) = geometry.derivative(k, lagrangeToBezier.col(j));
+    for (int j = 0; j < n; ++j) d.col(j) = geometry.derivative(k, toBezier.col(j));
     t->derivative.push_back(d);
+    t->derivativeNorm.push_back(d.cwiseAbs().rowwise().sum().maxCoeff());
+    // Exact rows sum to zero (a constant has no derivative): what they sum to measures the
+    // tables' own rounding, relative to the row norms; four times it is allowed for.
+    t->derivativeError.push_back(4.0 * d.rowwise().sum().cwiseAbs().maxCoeff() /
+                                 t->derivativeNorm.back());
     spaces.push_back(&BernsteinSpace::get(geometry.derivativeFactors(k)));
   }
   const BernsteinSpace& innerA = dim == 3 ? *spaces[1] : *spaces[0];
@@ -117,6 +167,13 @@ const BezierTables& tables(CellType type, int order) {
   }
   t->jacobianSize = jacobian->size();
   t->jacobian = jacobian;
+  const auto mostTerms = [](const BezierTables::Terms* terms, int size) {
+    std::vector<int> count(static_cast<std::size_t>(size), 0);
+    for (const auto& term : *terms) ++count[static_cast<std::size_t>(term.c)];
+    return *std::max_element(count.begin(), count.end());
+  };
+  t->maxTerms =
+      mostTerms(t->inner, t->innerSize) + (dim == 3 ? mostTerms(t->outer, t->jacobianSize) : 0);
   t->cornerOffsets = cornerOffsets(jacobian->factors());
   for (int j = 0; j < jacobian->size(); ++j)
     if (jacobian->isCorner(j)) t->corners.push_back(j);
@@ -125,10 +182,37 @@ const BezierTables& tables(CellType type, int order) {
 }
 
 // Bezier coefficients of J on the whole element for nodal coordinates x.
-void jacobianCoefficients(const BezierTables& t, const NodeCoordinates& x,
-                          const Eigen::Vector3d* normal, Eigen::VectorXd& out) {
+// What the coefficients' computation knows of its own accuracy.
+struct Rounding {
+  double error = 0.0;  // a bound on the rounding error of every coefficient
+  double size = 0.0;   // the element's extent (largest centred coordinate)
+};
+
+Rounding jacobianCoefficients(const BezierTables& t, const NodeCoordinates& x,
+                              const Eigen::Vector3d* normal, Eigen::VectorXd& out) {
+  // J does not change when the element moves; centred coordinates keep the products' rounding
+  // proportional to the element's size, not to its distance from the origin.
+  thread_local NodeCoordinates centred;
+  centred = x.rowwise() - x.row(0);
   std::array<NodeCoordinates, 3> d;
-  for (int k = 0; k < t.dim; ++k) d[k].noalias() = t.derivative[k].lazyProduct(x);
+  for (int k = 0; k < t.dim; ++k) d[k].noalias() = t.derivative[k].lazyProduct(centred);
+  // Rounding (Higham's gamma_n bounds): each entry of d_k is a sum of n products, off by at most
+  // gamma * |D_k| |x|, plus the tables' own error (estimated when they were built); the product
+  // sums add gamma_m * |terms|, and the Bernstein product weights into one coefficient sum to 1.
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  const double size = centred.cwiseAbs().maxCoeff();
+  const double gammaD = (static_cast<double>(x.rows()) + 16.0) * eps;
+  std::array<double, 3> m{}, delta{};
+  for (int k = 0; k < t.dim; ++k) {
+    delta[k] = (gammaD + t.derivativeError[k]) * t.derivativeNorm[k] * size;
+    m[k] = d[k].cwiseAbs().maxCoeff() + delta[k];
+  }
+  const double gammaP = (t.maxTerms + 10.0) * eps;
+  const double error =
+      t.dim == 3
+          ? 6.0 * (delta[0] * m[1] * m[2] + m[0] * delta[1] * m[2] + m[0] * m[1] * delta[2]) +
+                gammaP * 6.0 * m[0] * m[1] * m[2]
+          : 2.0 * (delta[0] * m[1] + m[0] * delta[1]) + gammaP * 2.0 * m[0] * m[1];
   const NodeCoordinates& p = t.dim == 3 ? d[1] : d[0];
   const NodeCoordinates& q = t.dim == 3 ? d[2] : d[1];
   NodeCoordinates cross = NodeCoordinates::Zero(t.innerSize, 3);
@@ -141,11 +225,12 @@ void jacobianCoefficients(const BezierTables& t, const NodeCoordinates& x,
   if (t.dim == 2) {
     if (normal == nullptr) throw Error("Bezier bounds of a 2D cell need its plane normal");
     out = cross * *normal;
-    return;
+    return {error * std::max(1.0, normal->lpNorm<1>()), size};
   }
   out.setZero(t.jacobianSize);
   for (const BernsteinSpace::ProductTerm& term : *t.outer)
     out(term.c) += term.weight * d[0].row(term.a).dot(cross.row(term.b));
+  return {error, size};
 }
 
 // The edge a part is split across: the longest of its factors' simplex edges, in reference
@@ -172,6 +257,13 @@ const BernsteinSpace::EdgeLines& longestEdge(const BezierTables& t, const Corner
 JacobianBounds boundJacobian(CellType type, int order, const NodeCoordinates& x,
                              const Eigen::Vector3d* normal, double tolerance) {
   const BezierTables& t = tables(type, order);
+  JacobianBounds b;
+  if (!x.allFinite()) {  // nothing can be proven about an element with undefined nodes
+    b.minLower = b.minUpper = b.maxLower = b.maxUpper = std::numeric_limits<double>::quiet_NaN();
+    b.validity = Validity::Undecided;
+    b.certified = false;
+    return b;
+  }
   struct Part {
     Eigen::VectorXd coeffs;  // J's Bezier coefficients on the part
     Corners corners;         // the part's vertices (see Corners)
@@ -191,13 +283,19 @@ JacobianBounds boundJacobian(CellType type, int order, const NodeCoordinates& x,
     parts.push_back({std::move(coeffs), corners, depth, lo, hi});
   };
   Eigen::VectorXd whole;
-  jacobianCoefficients(t, x, normal, whole);
+  // Every coefficient, and so every bound and found value, is within `margin` of its exact
+  // value: the products' rounding, plus one rounding per de Casteljau level.
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  const Rounding rounding = jacobianCoefficients(t, x, normal, whole);
+  const double margin =
+      rounding.error + 4.0 * kMaxDepth * t.dim * eps * whole.cwiseAbs().maxCoeff();
   add(std::move(whole), referenceCorners(t.jacobian->factors()), 0);
   // Best first (Johnen et al.): always split the part with the lowest lower bound (then the
   // highest upper bound) until that bound is within the tolerance of the extreme value found
   // and the sign of J is decided, or the subdivision budget is spent. A split is a de Casteljau
   // bisection of the part's coefficients: no geometry is evaluated again.
-  int budget = kMaxSubdivisions;
+  // The budget also bounds the memory: every open part keeps its coefficients.
+  int budget = std::min(kMaxSubdivisions, std::max(1, kMaxCoefficients / t.jacobianSize));
   const int maxDepth = kMaxDepth * t.dim;
   const auto refine = [&](auto worse, auto open) {
     std::make_heap(parts.begin(), parts.end(), worse);
@@ -225,30 +323,33 @@ JacobianBounds boundJacobian(CellType type, int order, const NodeCoordinates& x,
       std::push_heap(parts.begin(), parts.end(), worse);
     }
   };
-  refine([](const Part& a, const Part& b) { return a.lo > b.lo; },
+  refine([](const Part& p, const Part& q) { return p.lo > q.lo; },
          [&](const Part& p, double tol) {
-           return p.lo < minFound - tol || (p.lo <= 0.0 && minFound > 0.0);
+           return p.lo < minFound - tol || (p.lo <= margin && minFound > margin);
          });
-  refine([](const Part& a, const Part& b) { return a.hi < b.hi; },
+  refine([](const Part& p, const Part& q) { return p.hi < q.hi; },
          [&](const Part& p, double tol) {
-           return p.hi > maxFound + tol || (p.hi >= 0.0 && maxFound < 0.0);
+           return p.hi > maxFound + tol || (p.hi >= -margin && maxFound < -margin);
          });
-  JacobianBounds b;
-  b.minUpper = minFound;
-  b.maxLower = maxFound;
-  b.minLower = minFound;
-  b.maxUpper = maxFound;
+  double lowest = minFound, highest = maxFound;
   for (const Part& p : parts) {
-    b.minLower = std::min(b.minLower, p.lo);
-    b.maxUpper = std::max(b.maxUpper, p.hi);
+    lowest = std::min(lowest, p.lo);
+    highest = std::max(highest, p.hi);
   }
+  // Widened by the rounding margin, these hold the exact extremes of J.
+  b.minLower = lowest - margin;
+  b.minUpper = minFound + margin;
+  b.maxLower = maxFound - margin;
+  b.maxUpper = highest + margin;
   b.certified = true;
+  // Flat: J is proven below 1e-10 of the element's size to the power d everywhere.
+  const bool flat = b.maxUpper <= 1e-10 * std::pow(rounding.size, t.dim);
   if (b.minLower > 0.0)
     b.validity = Validity::Valid;
-  else if (b.minUpper <= 0.0)
+  else if (b.minUpper < 0.0 || flat)
     b.validity = Validity::Invalid;
   else
-    b.validity = Validity::Undecided;
+    b.validity = Validity::Undecided;  // undecided within the budget, or lost in rounding
   return b;
 }
 

@@ -26,16 +26,24 @@
 
 namespace homesh {
 
+// Valid: J > 0 everywhere, proven. Invalid: a value J < 0 was found, or J is proven below 1e-10
+// of the element's size to the power d everywhere (a flat element). Undecided: neither, within
+// the subdivision budget or because rounding hides the sign (high-order elements whose
+// interior nodes oscillate have Bezier coefficients far larger than J), or the element has
+// non-finite coordinates; never counted as valid.
 enum class Validity { Valid, Invalid, Undecided };
 
+// The bounds include a bound on the floating-point rounding of the computation (from the
+// tables' norms, the element's size and Higham's gamma_n), so they hold for the exact J.
 struct JacobianBounds {
   double minLower = 0.0, minUpper = 0.0;  // the minimum of J lies in [minLower, minUpper]
   double maxLower = 0.0, maxUpper = 0.0;  // the maximum of J lies in [maxLower, maxUpper]
   Validity validity = Validity::Undecided;
-  bool certified = true;  // the bounds are proven (Bezier), not sampled
+  bool certified = true;  // the bounds are proven (false only for non-finite input: NaN)
 
   // The certified scaled Jacobian: a lower bound of min J / max J, the ratio of the bounds
-  // (what Gmsh's AnalyseMeshQuality reports as minJ/maxJ); -1 if J is nowhere positive.
+  // (what Gmsh's AnalyseMeshQuality reports as minJ/maxJ); -1 when no clearly positive value of
+  // J was found (the element is inverted or flat wherever it was probed).
   double scaledJacobian() const {
     if (maxLower <= 0.0) return -1.0;
     return minLower >= 0.0 ? minLower / maxUpper : minLower / maxLower;

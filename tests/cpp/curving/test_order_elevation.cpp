@@ -125,7 +125,8 @@ TEST(OrderElevation, WithoutCadTheElementsStayStraight) {
     }
   }
   const QualitySummary q = evaluateQuality(mesh);
-  EXPECT_NEAR(q.scaled.min, 1.0, 1e-9);
+  // The certified bound sits below 1 by the proven rounding margin only.
+  EXPECT_NEAR(q.scaled.min, 1.0, 1e-7);
   EXPECT_EQ(q.invalid, 0u);
 }
 
