@@ -5,6 +5,8 @@
 #include <functional>
 #include <map>
 
+#include "core/error.hpp"
+#include "optimise/functional.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 
 namespace homesh {
@@ -130,6 +132,48 @@ ConvertCommand parseConvert(const std::vector<std::string>& args) {
   return cmd;
 }
 
+OptimiseCommand parseOptimise(const std::vector<std::string>& args) {
+  OptimiseCommand cmd;
+  OptionTable table;
+  addCommon(table, cmd.common, true, true);
+  table.value({"--functional", "-f"}, [&cmd](const std::string&, const std::string& v) {
+    try {
+      cmd.functional = functionalName(parseFunctional(v));
+    } catch (const Error& e) {
+      throw UsageError{std::string("--functional: ") + e.what()};
+    }
+  });
+  table.value({"--maxiter", "-n"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.maxIterations = parseInteger(o, v);
+    if (cmd.maxIterations < 0) throw UsageError{"--maxiter must be >= 0, got " + v};
+  });
+  table.value({"--tolerance"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.tolerance = parseNumber(o, v);
+    if (cmd.tolerance < 0.0) throw UsageError{"--tolerance must be >= 0, got " + v};
+  });
+  table.value({"--order", "-p"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.order = parseInteger(o, v);
+    if (*cmd.order < 1 || *cmd.order > 10)
+      throw UsageError{"--order must be from 1 to 10, got " + v};
+  });
+  table.value({"--region"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.regionThreshold = parseNumber(o, v);
+    if (!(*cmd.regionThreshold > 0.0 && *cmd.regionThreshold <= 1.0))
+      throw UsageError{"--region must be a scaled Jacobian in (0, 1], got " + v};
+  });
+  table.value({"--layers"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.regionLayers = parseInteger(o, v);
+    if (cmd.regionLayers < 0) throw UsageError{"--layers must be >= 0, got " + v};
+  });
+  table.value({"--focus"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.focusPasses = parseInteger(o, v);
+    if (cmd.focusPasses < 0) throw UsageError{"--focus must be >= 0, got " + v};
+  });
+  table.flag({"--free-interfaces"}, [&cmd] { cmd.freeInterfaces = true; });
+  cmd.input = onlyInput(table.parse(args, 1, "optimise"), "optimise", "an INPUT mesh file");
+  return cmd;
+}
+
 }  // namespace
 
 ParsedCommand parseCommandLine(const std::vector<std::string>& args) {
@@ -145,11 +189,12 @@ ParsedCommand parseCommandLine(const std::vector<std::string>& args) {
     parsed.kind = ParsedCommand::Kind::Version;
     return parsed;
   }
-  if (first != "mesh" && first != "quality" && first != "convert")
+  const bool optimise = first == "optimise" || first == "optimize";
+  if (first != "mesh" && first != "quality" && first != "convert" && !optimise)
     throw UsageError{"unknown command '" + first + "'"};
   for (std::size_t i = 1; i < args.size(); ++i)
     if (args[i] == "-h" || args[i] == "--help") {
-      parsed.helpTopic = first;
+      parsed.helpTopic = optimise ? "optimise" : first;
       return parsed;
     }
   if (first == "mesh") {
@@ -158,6 +203,9 @@ ParsedCommand parseCommandLine(const std::vector<std::string>& args) {
   } else if (first == "quality") {
     parsed.kind = ParsedCommand::Kind::Quality;
     parsed.quality = parseQuality(args);
+  } else if (optimise) {
+    parsed.kind = ParsedCommand::Kind::Optimise;
+    parsed.optimise = parseOptimise(args);
   } else {
     parsed.kind = ParsedCommand::Kind::Convert;
     parsed.convert = parseConvert(args);
@@ -213,12 +261,39 @@ options:
   -j, --threads N     threads (default 1)
   -q, --quiet         print nothing but errors
 )";
+  if (topic == "optimise" || topic == "optimize")
+    return R"(usage: homesh optimise INPUT [-o OUTPUT] [options]
+
+Curves the interior of a high-order mesh (.msh 2.2 or 4.1, .xml Nektar++) by minimising a
+variational energy node by node (Newton steps, parallel by node colours). Nodes on the
+boundary, on interfaces between volumes and on the file's boundary cells stay fixed. Prints the worst certified scaled Jacobian and the invalid count after every sweep; the
+mesh returned is never worse than the input in either.
+
+options:
+  -f, --functional F  hyperelastic (default), linearelastic, winslow, distortion
+  -n, --maxiter N     at most N sweeps (default 100)
+      --tolerance T   stop when no node moves more than T x the mean element size (1e-6)
+  -p, --order P       first re-interpolate the mesh at order P (1..10)
+      --region Q      move only nodes near elements with scaled Jacobian below Q
+      --layers K      ... and K layers of neighbours around them (default 2)
+      --focus K       after each sweep, K more passes over the nodes of the elements within
+                      0.05 of the worst scaled Jacobian (default 2; 0: plain sweeps)
+      --free-interfaces  also move the nodes on internal interfaces between volumes (as
+                      NekMesh does without CAD; the interface then leaves its geometry)
+  -o, --output FILE   write the mesh: .msh, .vtu, .xml; repeatable
+      --binary        binary MSH, raw appended VTU data
+      --compressed    compressed Nektar++ XML (B64Z-LittleEndian)
+      --report FILE   write the JSON report with "optimiser" ("-" for standard output)
+  -j, --threads N     threads (default 1)
+  -q, --quiet         print nothing but errors
+)";
   return R"(usage: homesh COMMAND [options]
 
 commands:
   mesh INPUT      CAD file to curved high-order mesh (homesh mesh --help)
   quality INPUT   certified quality of a mesh file (homesh quality --help)
   convert INPUT   mesh file to another format (homesh convert --help)
+  optimise INPUT  curve the interior of a mesh file (homesh optimise --help)
   --version       print the version
   --help          this text
 )";

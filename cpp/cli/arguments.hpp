@@ -41,12 +41,26 @@ struct ConvertCommand {
   CommonOptions common;
 };
 
+struct OptimiseCommand {
+  std::string input;
+  std::string functional = "hyperelastic";
+  int maxIterations = 100;
+  double tolerance = 1e-6;
+  std::optional<int> order;               // re-interpolate at this order first
+  std::optional<double> regionThreshold;  // --region Q
+  int regionLayers = 2;
+  int focusPasses = 2;
+  bool freeInterfaces = false;
+  CommonOptions common;
+};
+
 struct ParsedCommand {
-  enum class Kind { Help, Version, Mesh, Quality, Convert } kind = Kind::Help;
+  enum class Kind { Help, Version, Mesh, Quality, Convert, Optimise } kind = Kind::Help;
   std::string helpTopic;  // "" or a command name
   MeshCommand mesh;
   QualityCommand quality;
   ConvertCommand convert;
+  OptimiseCommand optimise;
 };
 
 // argv without the program name. Throws UsageError.

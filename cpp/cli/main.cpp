@@ -12,9 +12,11 @@
 #include "cli/arguments.hpp"
 #include "core/error.hpp"
 #include "core/version.hpp"
+#include "curving/order_elevation.hpp"
 #include "io/atomic_file.hpp"
 #include "io/mesh_readers.hpp"
 #include "io/mesh_writers.hpp"
+#include "optimise/optimiser.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
 
@@ -138,6 +140,58 @@ int runConvert(const homesh::ConvertCommand& cmd) {
   return 0;
 }
 
+// Prints each sweep's state on stderr.
+class SweepLog : public homesh::OptimiserObserver {
+ public:
+  void iterationFinished(const homesh::IterationRecord& r) override {
+    std::fprintf(stderr,
+                 "homesh: iteration %3d  worst scaled Jacobian %8.5f  invalid %zu  undecided %zu  "
+                 "max move %.3g  %.3f s\n",
+                 r.iteration, r.worst, r.invalid, r.undecided, r.maxDisplacement, r.seconds);
+  }
+};
+
+int runOptimise(const homesh::OptimiseCommand& cmd) {
+  const homesh::CommonOptions& c = cmd.common;
+  checkOutputs(c);
+  homesh::OptimiserOptions options;
+  options.functional = homesh::parseFunctional(cmd.functional);
+  options.maxIterations = cmd.maxIterations;
+  options.tolerance = cmd.tolerance;
+  options.threads = c.threads;
+  options.regionThreshold = cmd.regionThreshold;
+  options.regionLayers = cmd.regionLayers;
+  options.focusPasses = cmd.focusPasses;
+  options.freeInterfaces = cmd.freeInterfaces;
+  homesh::Mesh mesh = homesh::readMesh(cmd.input);
+  if (cmd.order && *cmd.order != mesh.order) mesh = homesh::changeOrder(mesh, *cmd.order, nullptr);
+  SweepLog log;
+  const homesh::OptimiserResult r = homesh::optimiseMesh(mesh, options, c.quiet ? nullptr : &log);
+  const homesh::QualitySummary q = homesh::evaluateQuality(mesh, c.threads);
+  if (!c.quiet) {
+    std::fprintf(stderr,
+                 "homesh: %s, %d iterations (%s), %zu free nodes in %zu colours, %.3f s (sweeps "
+                 "%.3f s)\n",
+                 homesh::functionalName(r.functional).c_str(), r.iterations,
+                 r.converged ? "converged" : (r.cancelled ? "cancelled" : "iteration limit"),
+                 r.freeNodes, r.colours, r.seconds, r.sweepSeconds);
+    std::fprintf(stderr,
+                 "homesh: worst scaled Jacobian %.5f -> %.5f (at nodes %.5f -> %.5f), invalid %zu "
+                 "-> %zu\n",
+                 r.worstBefore, r.worstAfter, r.nodalWorstBefore, r.nodalWorstAfter,
+                 r.invalidBefore, r.invalidAfter);
+    if (r.keptIteration != r.iterations)
+      std::fprintf(stderr, "homesh: kept the state of %s%d, the best no worse than the input\n",
+                   r.keptIteration == 0 ? "the input, iteration " : "iteration ", r.keptIteration);
+  }
+  for (const std::string& path : c.outputs) {
+    homesh::writeMesh(mesh, path, homesh::qualityFields(q), writeOptions(c));
+    if (!c.quiet) std::fprintf(stderr, "homesh: wrote %s\n", path.c_str());
+  }
+  if (c.report) writeReport(*c.report, homesh::optimiseReportJson(mesh, q, r, cmd.input));
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -158,6 +212,8 @@ int main(int argc, char** argv) {
         return runQuality(parsed.quality);
       case homesh::ParsedCommand::Kind::Convert:
         return runConvert(parsed.convert);
+      case homesh::ParsedCommand::Kind::Optimise:
+        return runOptimise(parsed.optimise);
     }
   } catch (const homesh::UsageError& e) {
     std::fprintf(stderr, "homesh: error: %s (see 'homesh --help')\n", e.message.c_str());

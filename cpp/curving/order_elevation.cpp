@@ -106,14 +106,19 @@ struct Elevator {
     return {cellDim, cellEntity};
   }
 
-  std::int64_t node(const NodeKey& key, CellType cell, int cellEntity) {
+  // `curved`: the position from the source element's own map (null: on the straight element).
+  std::int64_t node(const NodeKey& key, CellType cell, int cellEntity, const double* curved) {
     if (key.size == 1) return key.vertex[0];
     const auto [it, inserted] = ids.try_emplace(key, 0);
     if (!inserted) return it->second;
     double p[3] = {0.0, 0.0, 0.0};
-    for (int i = 0; i < key.size; ++i)
-      for (int c = 0; c < 3; ++c)
-        p[c] += linear.xyz[3 * key.vertex[i] + c] * key.index[i] / static_cast<double>(order);
+    if (curved != nullptr) {
+      std::copy(curved, curved + 3, p);
+    } else {
+      for (int i = 0; i < key.size; ++i)
+        for (int c = 0; c < 3; ++c)
+          p[c] += linear.xyz[3 * key.vertex[i] + c] * key.index[i] / static_cast<double>(order);
+    }
     const auto [dim, entity] = classify(key, cell, cellEntity);
     it->second = out.addNode(p, dim, entity, kNaN, kNaN);
     return it->second;
@@ -122,7 +127,7 @@ struct Elevator {
   void elevateBlock(const ElementBlock& block) {
     if (block.type != CellType::Line && block.type != CellType::Triangle &&
         block.type != CellType::Tetrahedron)
-      throw ParameterError("order elevation supports lines, triangles and tetrahedra, not " +
+      throw ParameterError("changing the order supports lines, triangles and tetrahedra, not " +
                            cellShortName(block.type));
     const ReferenceElement& ref = ReferenceElement::get(block.type, order);
     const int nv = cellNumVertices(block.type);
@@ -131,9 +136,20 @@ struct Elevator {
     high.order = order;
     high.entity = block.entity;
     high.nodes.reserve(block.count() * ref.numNodes());
+    // A curved source: its basis at the new nodes (new nodes x source nodes).
+    const bool curvedSource = block.order > 1;
+    Eigen::MatrixXd interpolation;
+    if (curvedSource)
+      interpolation = ReferenceElement::get(block.type, block.order).valuesAt(ref.nodes());
+    const int sourceNodes = block.nodesPerElement();
     for (std::size_t e = 0; e < block.count(); ++e) {
       const std::int64_t* v = block.element(e);
-      for (const LatticePoint& point : ref.lattice()) {
+      for (int r = 0; r < ref.numNodes(); ++r) {
+        const LatticePoint& point = ref.lattice()[static_cast<std::size_t>(r)];
+        double curved[3] = {0.0, 0.0, 0.0};
+        if (curvedSource)
+          for (int j = 0; j < sourceNodes; ++j)
+            for (int c = 0; c < 3; ++c) curved[c] += interpolation(r, j) * linear.xyz[3 * v[j] + c];
         const std::array<int, 4> a = simplexBarycentric(point, ref.dim(), order);
         std::array<std::pair<std::int64_t, int>, 4> support{};
         int n = 0;
@@ -148,7 +164,8 @@ struct Elevator {
           key.vertex[i] = support[i].first;
           key.index[i] = support[i].second;
         }
-        high.nodes.push_back(node(key, block.type, block.entity[e]));
+        high.nodes.push_back(
+            node(key, block.type, block.entity[e], curvedSource ? curved : nullptr));
       }
     }
     out.blocks.push_back(std::move(high));
@@ -177,7 +194,44 @@ void projectNewNodes(Mesh& mesh, std::size_t firstNew, const CadModel& cad) {
   }
 }
 
+// Drops the nodes no cell uses (the source's high-order nodes after an order change) and
+// renumbers the rest in their original order.
+void compactNodes(Mesh& mesh) {
+  std::vector<std::int64_t> newId(mesh.numNodes(), -1);
+  for (const ElementBlock& block : mesh.blocks)
+    for (const std::int64_t id : block.nodes) newId[id] = 0;
+  std::int64_t next = 0;
+  for (std::size_t i = 0; i < newId.size(); ++i) {
+    if (newId[i] < 0) continue;
+    newId[i] = next;
+    const auto j = static_cast<std::size_t>(next++);
+    for (int c = 0; c < 3; ++c) mesh.xyz[3 * j + c] = mesh.xyz[3 * i + c];
+    mesh.nodeCadDim[j] = mesh.nodeCadDim[i];
+    mesh.nodeCadIndex[j] = mesh.nodeCadIndex[i];
+    mesh.nodeCadParam[2 * j] = mesh.nodeCadParam[2 * i];
+    mesh.nodeCadParam[2 * j + 1] = mesh.nodeCadParam[2 * i + 1];
+  }
+  const auto n = static_cast<std::size_t>(next);
+  mesh.xyz.resize(3 * n);
+  mesh.nodeCadDim.resize(n);
+  mesh.nodeCadIndex.resize(n);
+  mesh.nodeCadParam.resize(2 * n);
+  for (ElementBlock& block : mesh.blocks)
+    for (std::int64_t& id : block.nodes) id = newId[id];
+}
+
 }  // namespace
+
+Mesh changeOrder(const Mesh& mesh, int order, const CadModel* cad) {
+  if (order < 1 || order > 10)
+    throw ParameterError("order must be between 1 and 10, got " + std::to_string(order));
+  Elevator elevator(mesh, order);
+  for (const ElementBlock& block : mesh.blocks) elevator.elevateBlock(block);
+  if (cad != nullptr) projectNewNodes(elevator.out, mesh.numNodes(), *cad);
+  compactNodes(elevator.out);
+  elevator.out.checkConsistency();
+  return std::move(elevator.out);
+}
 
 Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad) {
   if (linear.order != 1)

@@ -17,4 +17,11 @@ namespace homesh {
 // Throws ParameterError for an order outside 1..10.
 Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad);
 
+// The same for a mesh of any order: each new node is the source element's own (curved) map
+// evaluated at the node's reference position, so raising the order keeps the geometry exactly
+// and lowering it interpolates it (what NekMesh does before optimising at a lower order). Nodes
+// the new mesh no longer uses are dropped and the rest renumbered in order. With `cad`, new
+// nodes on CAD curves and faces are projected onto them as above.
+Mesh changeOrder(const Mesh& mesh, int order, const CadModel* cad);
+
 }  // namespace homesh

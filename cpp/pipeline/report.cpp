@@ -129,4 +129,55 @@ std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
   return json.str();
 }
 
+void appendOptimiser(JsonWriter& json, const OptimiserResult& r) {
+  json.beginObject("optimiser");
+  json.value("functional", functionalName(r.functional));
+  json.value("iterations", r.iterations);
+  json.value("converged", r.converged);
+  json.value("cancelled", r.cancelled);
+  json.value("kept_iteration", r.keptIteration);
+  json.value("worst_before", r.worstBefore);
+  json.value("worst_after", r.worstAfter);
+  json.value("invalid_before", r.invalidBefore);
+  json.value("invalid_after", r.invalidAfter);
+  json.value("undecided_before", r.undecidedBefore);
+  json.value("undecided_after", r.undecidedAfter);
+  json.value("nodal_worst_before", r.nodalWorstBefore);
+  json.value("nodal_worst_after", r.nodalWorstAfter);
+  json.value("free_nodes", r.freeNodes);
+  json.value("colours", r.colours);
+  json.value("region_elements", r.regionElements);
+  json.value("seconds", r.seconds);
+  json.value("setup_seconds", r.setupSeconds);
+  json.value("sweep_seconds", r.sweepSeconds);
+  json.beginArray("history");
+  for (const IterationRecord& h : r.history) {
+    json.beginObject();
+    json.value("iteration", h.iteration);
+    json.value("worst", h.worst);
+    json.value("invalid", h.invalid);
+    json.value("undecided", h.undecided);
+    json.value("max_displacement", h.maxDisplacement);
+    json.value("seconds", h.seconds);
+    json.endObject();
+  }
+  json.endArray();
+  json.endObject();
+}
+
+std::string optimiseReportJson(const Mesh& mesh, const QualitySummary& quality,
+                               const OptimiserResult& result, const std::string& input) {
+  JsonWriter json;
+  json.beginObject();
+  json.value("input", input);
+  json.value("dimension", mesh.dim);
+  json.value("order", mesh.order);
+  json.value("nodes", mesh.numNodes());
+  appendCounts(json, mesh);
+  appendQuality(json, mesh, quality);
+  appendOptimiser(json, result);
+  json.endObject();
+  return json.str();
+}
+
 }  // namespace homesh

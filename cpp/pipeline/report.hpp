@@ -6,6 +6,7 @@
 
 #include "core/mesh.hpp"
 #include "io/json_writer.hpp"
+#include "optimise/optimiser.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "quality/mesh_quality.hpp"
 
@@ -29,5 +30,13 @@ std::string meshReportJson(const MeshResult& result, const std::string& input);
 // The report of `homesh quality`: input, order, counts, quality.
 std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
                               const std::string& input);
+
+// Appends "optimiser": {functional, iterations, worst_before, worst_after, invalid_before,
+// invalid_after, seconds, ...} with the per-sweep history.
+void appendOptimiser(JsonWriter& json, const OptimiserResult& result);
+
+// The report of `homesh optimise`: the quality report of the result plus "optimiser".
+std::string optimiseReportJson(const Mesh& mesh, const QualitySummary& quality,
+                               const OptimiserResult& result, const std::string& input);
 
 }  // namespace homesh

@@ -244,6 +244,34 @@ class PyMesh {
 
   std::string reportJson(const std::string& input) const { return meshReportJson(*result_, input); }
 
+  // A copy of this mesh optimised (optimise/optimiser.hpp), and the optimiser's JSON record.
+  bp::tuple optimise(const std::string& functional, int maxIterations, double tolerance,
+                     int threads, const bp::object& region, int layers, int focus,
+                     bool freeInterfaces) const {
+    OptimiserOptions options;
+    options.functional = parseFunctional(functional);
+    options.maxIterations = maxIterations;
+    options.tolerance = tolerance;
+    options.threads = threads;
+    if (!region.is_none()) options.regionThreshold = bp::extract<double>(region)();
+    options.regionLayers = layers;
+    options.focusPasses = focus;
+    options.freeInterfaces = freeInterfaces;
+    options.validate();
+    MeshResult copy = *result_;
+    OptimiserResult record;
+    {
+      const ReleaseGil nogil;
+      record = optimiseMesh(copy.mesh, options);
+      copy.quality = evaluateQuality(copy.mesh, threads);
+    }
+    JsonWriter json;
+    json.beginObject();
+    appendOptimiser(json, record);
+    json.endObject();
+    return bp::make_tuple(PyMesh(std::move(copy)), json.str());
+  }
+
   std::shared_ptr<const MeshResult> result_;  // immutable: safe to read without the GIL
 };
 
@@ -414,7 +442,8 @@ BOOST_PYTHON_MODULE(_core) {
       .def("write", &PyMesh::write,
            (bp::arg("path"), bp::arg("binary") = false, bp::arg("compressed") = false))
       .def("element_volumes", &PyMesh::elementVolumes)
-      .def("report_json", &PyMesh::reportJson);
+      .def("report_json", &PyMesh::reportJson)
+      .def("optimise", &PyMesh::optimise);
 
   bp::def("mesh_file", &meshFile,
           (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),

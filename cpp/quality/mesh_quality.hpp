@@ -76,6 +76,11 @@ struct FlaggedElement {
 std::vector<FlaggedElement> flaggedElements(const Mesh& mesh, const QualitySummary& quality,
                                             std::size_t limit);
 
+// Certified Jacobian bounds of one element of `block` (of dimension mesh.dim), computed on its
+// node coordinates moved to the origin and scaled to unit size (every measure here is invariant
+// under both).
+JacobianBounds elementJacobianBounds(const Mesh& mesh, const ElementBlock& block, std::size_t e);
+
 // Evaluates every element on `threads` threads (the result does not depend on their number).
 // Throws Error for a mesh without elements.
 QualitySummary evaluateQuality(const Mesh& mesh, int threads = 1);

@@ -1,0 +1,119 @@
+// The variational optimiser: moves the free nodes of a curved mesh to minimise an energy that
+// measures how far each element is from its straight-sided (ideal) shape (DESIGN.md section 6;
+// the functionals are in optimise/functional.hpp).
+//
+// Each sweep (iteration) visits every free node once and takes one Newton step on that node
+// alone (the node's energy is a function of its 2 or 3 coordinates; gradient and Hessian are
+// exact), then `focusPasses` more steps on the nodes of the worst elements only. Each step
+// shifts the Hessian to be positive definite and uses a backtracking Armijo line search that
+// rejects the move if the energy does not decrease. Nodes are coloured so that two nodes of
+// one colour never share an element; the nodes of a colour are moved in parallel, colours in
+// sequence, so the result does not depend on the number of threads.
+//
+// Free nodes are those not on the mesh's boundary (faces in 3D, edges in 2D, of exactly one
+// element), not on an interface between elements of different entities and not on a
+// lower-dimensional cell of the mesh; the others stay fixed. With a region threshold, only the
+// nodes of elements whose scaled Jacobian is below it, grown by `regionLayers` layers of
+// neighbours, move.
+//
+// Never worse: after every sweep the certified scaled Jacobian (quality/bezier_jacobian.hpp)
+// of every element that can have changed is recomputed; the state kept at the end is the best
+// one seen among those whose worst value and invalid count are no worse than the input's (the
+// input itself if no sweep qualifies), and the result says which sweep it was.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/mesh.hpp"
+#include "optimise/functional.hpp"
+
+namespace homesh {
+
+struct OptimiserOptions {
+  Functional functional = Functional::Hyperelastic;
+  int maxIterations = 100;  // sweeps, >= 0
+  // Stop when a sweep moves no node by more than tolerance x the mean element size.
+  double tolerance = 1e-6;
+  int threads = 1;
+  // Work only around elements whose certified scaled Jacobian is below this (in (0, 1]).
+  std::optional<double> regionThreshold;
+  int regionLayers = 2;  // layers of neighbours (sharing a node) added to the region
+  // After each sweep, this many extra Newton steps on the nodes of the elements whose scaled
+  // Jacobian is within focusMargin of the mesh's worst (see sweep() in optimiser.cpp).
+  int focusPasses = 2;
+  double focusMargin = 0.05;
+  // Let the nodes on internal interfaces (between elements of different entities, and on
+  // lower-dimensional cells inside the domain) move too, as NekMesh does for a mesh without
+  // CAD: this can untangle elements with two faces on a curved interface, but the interface
+  // no longer follows its geometry exactly.
+  bool freeInterfaces = false;
+
+  // Throws ParameterError naming the offending option.
+  void validate() const;
+};
+
+// The state after one sweep.
+struct IterationRecord {
+  int iteration = 0;
+  double worst = 0.0;  // certified scaled Jacobian, mesh-wide minimum
+  std::size_t invalid = 0;
+  std::size_t undecided = 0;
+  double maxDisplacement = 0.0;  // largest node move of the sweep
+  double seconds = 0.0;          // since the optimiser started
+};
+
+struct OptimiserResult {
+  Functional functional = Functional::Hyperelastic;
+  int iterations = 0;  // sweeps done
+  bool converged = false;
+  bool cancelled = false;
+  int keptIteration = 0;                       // the sweep whose state was returned (0: the input)
+  double worstBefore = 0.0, worstAfter = 0.0;  // certified scaled Jacobian
+  // min J / max J over each element's nodes, mesh-wide minimum: the measure NekMesh reports.
+  double nodalWorstBefore = 0.0, nodalWorstAfter = 0.0;
+  std::size_t invalidBefore = 0, invalidAfter = 0;
+  std::size_t undecidedBefore = 0, undecidedAfter = 0;
+  std::size_t freeNodes = 0, colours = 0, regionElements = 0;
+  double setupSeconds = 0.0;  // colouring, ideal elements, initial quality
+  double sweepSeconds = 0.0;  // node updates only
+  double seconds = 0.0;       // everything, including the quality checks
+  std::vector<IterationRecord> history;
+};
+
+// Receives the state after each sweep; may ask to stop (the best state so far is kept).
+class OptimiserObserver {
+ public:
+  virtual ~OptimiserObserver() = default;
+  virtual void iterationFinished(const IterationRecord& /*record*/) {}
+  virtual bool cancelRequested() { return false; }
+};
+
+// Optimises `mesh` in place. Supports triangles and quadrilaterals (dim 2) and tetrahedra,
+// prisms and hexahedra (dim 3) of orders 1..10. Throws ParameterError for bad options or
+// unsupported cells.
+OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
+                             OptimiserObserver* observer = nullptr);
+
+// The energy of one element and its gradient and Hessian with respect to the coordinates of
+// node `local`, assembled as the optimiser assembles them (same quadrature). `x`: the node
+// coordinates at the optimiser's working nodes (ReferenceElement::get(type, order,
+// NodeSet::Optimal), Gmsh order); `ideal`: the vertices of the straight-sided ideal element.
+// 2D cells use the x and y columns. Exposed for the tests.
+struct NodeEnergy {
+  double value = 0.0;
+  Eigen::VectorXd gradient;
+  Eigen::MatrixXd hessian;
+};
+NodeEnergy elementNodeEnergy(CellType type, int order, Functional functional,
+                             const Eigen::MatrixXd& ideal, const Eigen::MatrixXd& x, int local,
+                             double eps);
+
+// min over the mesh of (min J / max J over each element's nodes).
+double nodalScaledJacobian(const Mesh& mesh, int threads = 1);
+
+}  // namespace homesh

@@ -1,0 +1,350 @@
+// The optimiser: analytic derivatives against finite differences, stationarity of the ideal
+// state, boundary detection, order change, and NekMesh's own regression cases.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "core/error.hpp"
+#include "curving/order_elevation.hpp"
+#include "element/reference_element.hpp"
+#include "io/mesh_readers.hpp"
+#include "optimise/mesh_topology.hpp"
+#include "optimise/optimiser.hpp"
+#include "quality/mesh_quality.hpp"
+
+namespace homesh {
+namespace {
+
+const Functional kAll[] = {Functional::LinearElastic, Functional::Hyperelastic, Functional::Winslow,
+                           Functional::Distortion};
+
+// Relative error of b against a, with an absolute floor for values near zero.
+double relError(double a, double b, double scale) {
+  return std::abs(a - b) / std::max({std::abs(a), std::abs(b), scale});
+}
+
+template <int D>
+void checkDensityDerivatives(Functional f, double eps, bool inverted, std::mt19937& rng) {
+  using Mat = Eigen::Matrix<double, D, D>;
+  using Vec = Eigen::Matrix<double, D, 1>;
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  Mat F = Mat::Identity();
+  for (int i = 0; i < D; ++i)
+    for (int j = 0; j < D; ++j) F(i, j) += u(rng);
+  if (inverted) F.row(0) *= -1.0;
+  Vec a;
+  for (int i = 0; i < D; ++i) a[i] = 1.0 + u(rng);
+  Vec g;
+  Mat H;
+  const double w0 = energyDensityDerivatives<D>(f, F, a, eps, g, H);
+  ASSERT_NEAR(w0, energyDensity<D>(f, F, eps), 1e-12 * std::abs(w0));
+  const double h = 1e-5;
+  for (int m = 0; m < D; ++m) {
+    Vec e = Vec::Zero();
+    e[m] = h;
+    Vec gp, gm;
+    Mat hp, hm;
+    const double wp = energyDensityDerivatives<D>(f, F + e * a.transpose(), a, eps, gp, hp);
+    const double wm = energyDensityDerivatives<D>(f, F - e * a.transpose(), a, eps, gm, hm);
+    EXPECT_LT(relError(g[m], (wp - wm) / (2 * h), g.norm()), 1e-6)
+        << functionalName(f) << " D=" << D << " gradient " << m;
+    for (int l = 0; l < D; ++l)
+      EXPECT_LT(relError(H(l, m), (gp[l] - gm[l]) / (2 * h), H.norm()), 1e-6)
+          << functionalName(f) << " D=" << D << " Hessian " << l << "," << m;
+  }
+}
+
+TEST(Functional, DensityDerivativesMatchFiniteDifferences) {
+  std::mt19937 rng(7);
+  for (const Functional f : kAll)
+    for (int trial = 0; trial < 20; ++trial) {
+      checkDensityDerivatives<2>(f, 1e-10, false, rng);
+      checkDensityDerivatives<3>(f, 1e-10, false, rng);
+      // Regularised on an inverted point: the untangling regime.
+      checkDensityDerivatives<2>(f, 0.3, true, rng);
+      checkDensityDerivatives<3>(f, 0.3, true, rng);
+    }
+}
+
+TEST(Functional, NamesRoundTripAndUnknownNamesAreRefused) {
+  for (const Functional f : kAll) EXPECT_EQ(parseFunctional(functionalName(f)), f);
+  EXPECT_EQ(parseFunctional("Linear-Elastic"), Functional::LinearElastic);
+  EXPECT_THROW(parseFunctional("elastic"), ParameterError);
+}
+
+// Nodes of an element at the optimiser's working node set, mapped by x -> A x + t plus a
+// random perturbation of size `noise`; the ideal is the unperturbed reference element.
+struct TestElement {
+  Eigen::MatrixXd ideal, x;
+};
+
+TestElement makeElement(CellType type, int order, const Eigen::Matrix3d& A,
+                        const Eigen::Vector3d& t, double noise, std::mt19937& rng) {
+  const ReferenceElement& ref = ReferenceElement::get(type, order, NodeSet::Optimal);
+  const ReferenceElement& lin = ReferenceElement::get(type, 1);
+  const int d = ref.dim();
+  auto place = [&](const Eigen::MatrixXd& xi) {
+    Eigen::MatrixXd p = Eigen::MatrixXd::Zero(xi.rows(), 3);
+    p.leftCols(d) = xi;
+    return Eigen::MatrixXd((p * A.transpose()).rowwise() + t.transpose());
+  };
+  TestElement e;
+  e.ideal = place(lin.nodes());
+  e.x = place(ref.nodes());
+  std::uniform_real_distribution<double> u(-noise, noise);
+  for (int i = 0; i < e.x.rows(); ++i)
+    for (int c = 0; c < d; ++c) e.x(i, c) += u(rng);
+  return e;
+}
+
+TEST(Optimiser, ElementGradientAndHessianMatchFiniteDifferences) {
+  std::mt19937 rng(11);
+  const Eigen::Matrix3d A = Eigen::Matrix3d::Identity();
+  for (const CellType type : {CellType::Triangle, CellType::Quadrilateral, CellType::Tetrahedron,
+                              CellType::Prism, CellType::Hexahedron})
+    for (const int order : {1, 2, 4, 6})
+      for (const Functional f : kAll) {
+        // Perturbed well inside validity (a tenth of the node spacing), where W is smooth.
+        const TestElement e =
+            makeElement(type, order, A, Eigen::Vector3d(0.2, -0.1, 0.3), 0.1 / order, rng);
+        const int d = cellDimension(type);
+        const int n = static_cast<int>(e.x.rows());
+        for (const int local : {0, n / 2, n - 1}) {
+          const NodeEnergy at = elementNodeEnergy(type, order, f, e.ideal, e.x, local, 1e-10);
+          // Fourth-order central differences: truncation ~h^4, rounding ~1e-16 / h.
+          const double h = 1e-5;
+          auto shifted = [&](int m, double by) {
+            Eigen::MatrixXd y = e.x;
+            y(local, m) += by;
+            return elementNodeEnergy(type, order, f, e.ideal, y, local, 1e-10);
+          };
+          for (int m = 0; m < d; ++m) {
+            const NodeEnergy p1 = shifted(m, h), m1 = shifted(m, -h);
+            const NodeEnergy p2 = shifted(m, 2 * h), m2 = shifted(m, -2 * h);
+            const std::string what = cellShortName(type) + " P" + std::to_string(order) + " " +
+                                     functionalName(f) + " node " + std::to_string(local);
+            const double dE = (8 * (p1.value - m1.value) - (p2.value - m2.value)) / (12 * h);
+            EXPECT_LT(relError(at.gradient[m], dE, 1e-3 * at.hessian.norm()), 1e-6) << what;
+            for (int l = 0; l < d; ++l) {
+              const double dG =
+                  (8 * (p1.gradient[l] - m1.gradient[l]) - (p2.gradient[l] - m2.gradient[l])) /
+                  (12 * h);
+              EXPECT_LT(relError(at.hessian(l, m), dG, at.hessian.norm()), 1e-6) << what;
+            }
+          }
+        }
+      }
+}
+
+TEST(Optimiser, RotatedOrTranslatedIdealElementHasZeroGradient) {
+  std::mt19937 rng(3);
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d R2 = Eigen::AngleAxisd(1.1, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  for (const CellType type : {CellType::Triangle, CellType::Quadrilateral, CellType::Tetrahedron,
+                              CellType::Prism, CellType::Hexahedron})
+    for (const int order : {1, 3, 5}) {
+      const bool planar = cellDimension(type) == 2;
+      for (const Functional f :
+           {Functional::LinearElastic, Functional::Hyperelastic, Functional::Distortion}) {
+        // The ideal element itself moved rigidly: F is a rotation at every point, where
+        // dW/dF = 0 for these three functionals.
+        TestElement e = makeElement(type, order, Eigen::Matrix3d::Identity(),
+                                    Eigen::Vector3d::Zero(), 0.0, rng);
+        const Eigen::Matrix3d rot = planar ? R2 : R;
+        e.x = (e.x * rot.transpose()).rowwise() + Eigen::RowVector3d(5.0, -3.0, 2.0);
+        for (int local = 0; local < e.x.rows(); ++local) {
+          const NodeEnergy at = elementNodeEnergy(type, order, f, e.ideal, e.x, local, 1e-10);
+          EXPECT_LT(at.gradient.norm(), 1e-10 * std::max(1.0, at.hessian.norm()))
+              << cellShortName(type) << " P" << order << " " << functionalName(f);
+        }
+      }
+    }
+}
+
+Mesh twoTetrahedra(int entityOfSecond) {
+  Mesh m;
+  const double p[5][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+  for (const auto& q : p) m.addNode(q, 3, 1, NAN, NAN);
+  ElementBlock b;
+  b.type = CellType::Tetrahedron;
+  b.nodes = {0, 1, 2, 3, 1, 2, 3, 4};
+  b.entity = {1, entityOfSecond};
+  // The second must be positively oriented: (2-1) x (3-1) . (4-1) > 0.
+  m.blocks.push_back(b);
+  return m;
+}
+
+TEST(MeshTopology, BoundaryAndInterfaceNodes) {
+  for (const int order : {1, 3}) {
+    Mesh lin = twoTetrahedra(1);
+    const Mesh m = order == 1 ? lin : elevateOrder(lin, order, nullptr);
+    const std::vector<const ElementBlock*> blocks{&m.blocks[0]};
+    const std::vector<char> b = boundaryNodes(m.numNodes(), blocks);
+    // Every node of two tets glued on one face is on the outer boundary except the nodes
+    // strictly inside the shared face and inside each tet.
+    std::size_t inner = 0;
+    for (const char c : b) inner += c == 0 ? 1 : 0;
+    const std::size_t faceInterior = order == 3 ? 1 : 0;  // one face node at P3, no cell node
+    EXPECT_EQ(inner, faceInterior) << "order " << order;
+  }
+  Mesh two = elevateOrder(twoTetrahedra(2), 3, nullptr);
+  const std::vector<const ElementBlock*> blocks{&two.blocks[0]};
+  const std::vector<char> withInterfaces = boundaryNodes(two.numNodes(), blocks, true);
+  const std::vector<char> without = boundaryNodes(two.numNodes(), blocks, false);
+  std::size_t a = 0, c = 0;
+  for (std::size_t i = 0; i < two.numNodes(); ++i) {
+    a += withInterfaces[i] == 0 ? 1 : 0;
+    c += without[i] == 0 ? 1 : 0;
+  }
+  EXPECT_EQ(a, 0U);  // the shared face separates two entities: its node is fixed
+  EXPECT_EQ(c, 1U);
+}
+
+TEST(ChangeOrder, RaisingKeepsTheGeometryAndLoweringInterpolatesIt) {
+  const std::string path =
+      std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/optimiser/varopti_cube_sphere.msh";
+  const Mesh p4 = readMesh(path);
+  const Mesh p3 = changeOrder(p4, 3, nullptr);
+  EXPECT_EQ(p3.order, 3);
+  EXPECT_EQ(p3.numElements(), p4.numElements());
+  // A conforming P3 tet mesh has V + 2E + F nodes; every vertex keeps its coordinates.
+  for (std::size_t i = 0; i < 8; ++i) {
+    bool found = false;
+    for (std::size_t j = 0; j < p3.numNodes() && !found; ++j)
+      found = p3.xyz[3 * j] == p4.xyz[3 * i] && p3.xyz[3 * j + 1] == p4.xyz[3 * i + 1] &&
+              p3.xyz[3 * j + 2] == p4.xyz[3 * i + 2];
+    EXPECT_TRUE(found) << "corner " << i;
+  }
+  // Raising P3 to P6 represents the same polynomial map: the volumes agree.
+  const Mesh p6 = changeOrder(p3, 6, nullptr);
+  const QualitySummary q3 = evaluateQuality(p3), q6 = evaluateQuality(p6);
+  EXPECT_NEAR(q3.scaled.min, q6.scaled.min, 2e-3);
+  EXPECT_EQ(q6.invalid, 0U);
+}
+
+std::string peer(const char* name) {
+  return std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/optimiser/" + name;
+}
+
+// NekMesh's regression test: varopti:hyperelastic:maxiter=5:nq=4 expects 0.6664 (+-2e-2) at
+// the nodes; we require at least 0.666 and report the certified value beside it.
+TEST(OptimiserPeer, CubeSphereOrder3FiveIterations) {
+  Mesh mesh = changeOrder(readMesh(peer("varopti_cube_sphere.msh")), 3, nullptr);
+  OptimiserOptions options;
+  options.maxIterations = 5;
+  options.threads = 2;
+  const OptimiserResult r = optimiseMesh(mesh, options);
+  EXPECT_EQ(r.iterations, 5);
+  EXPECT_GE(r.nodalWorstAfter, 0.666);
+  EXPECT_GE(r.worstAfter, 0.666);
+  EXPECT_EQ(r.invalidAfter, 0U);
+  const QualitySummary q = evaluateQuality(mesh);
+  EXPECT_NEAR(q.scaled.min, r.worstAfter, 1e-12);
+  std::printf(
+      "cube-sphere P3, 5 iterations: worst at nodes %.4f, certified %.4f (NekMesh 0.6664)\n",
+      r.nodalWorstAfter, r.worstAfter);
+}
+
+TEST(OptimiserPeer, NacaLinearElasticFiveIterations) {
+  Mesh mesh = readMesh(peer("varopti_naca.msh"));
+  ASSERT_EQ(mesh.dim, 2);
+  const std::vector<double> before = mesh.xyz;
+  OptimiserOptions options;
+  options.functional = Functional::LinearElastic;
+  options.maxIterations = 5;
+  const OptimiserResult r = optimiseMesh(mesh, options);
+  EXPECT_GE(r.nodalWorstAfter, 0.8726);
+  EXPECT_GT(r.worstAfter, r.worstBefore);
+  // The mesh stays in its plane.
+  for (std::size_t i = 0; i < mesh.numNodes(); ++i)
+    EXPECT_EQ(mesh.xyz[3 * i + 2], before[3 * i + 2]);
+  std::printf("naca P3, 5 iterations: worst at nodes %.4f, certified %.4f (NekMesh 0.8726)\n",
+              r.nodalWorstAfter, r.worstAfter);
+}
+
+TEST(OptimiserPeer, CubeSphereOrder4ConvergesAbove0757AndKeepsTheBoundary) {
+  Mesh mesh = readMesh(peer("varopti_cube_sphere.msh"));
+  const Mesh input = mesh;
+  OptimiserOptions options;
+  options.maxIterations = 60;
+  options.threads = 2;
+  const OptimiserResult r = optimiseMesh(mesh, options);
+  EXPECT_GE(r.worstAfter, 0.757);
+  EXPECT_GE(r.nodalWorstAfter, 0.757);
+  // Nodes on the boundary (the cube's faces and the sphere) did not move.
+  std::vector<const ElementBlock*> cells;
+  for (const ElementBlock& b : input.blocks)
+    if (cellDimension(b.type) == 3) cells.push_back(&b);
+  const std::vector<char> boundary = boundaryNodes(input.numNodes(), cells);
+  std::size_t fixed = 0;
+  for (std::size_t i = 0; i < input.numNodes(); ++i)
+    if (boundary[i] != 0) {
+      ++fixed;
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(mesh.xyz[3 * i + c], input.xyz[3 * i + c]);
+    }
+  EXPECT_GT(fixed, 1000U);
+}
+
+TEST(Optimiser, ResultDoesNotDependOnTheNumberOfThreads) {
+  Mesh a = readMesh(peer("varopti_cube_sphere.msh"));
+  Mesh b = a;
+  OptimiserOptions options;
+  options.maxIterations = 3;
+  options.threads = 1;
+  optimiseMesh(a, options);
+  options.threads = 2;
+  optimiseMesh(b, options);
+  EXPECT_EQ(a.xyz, b.xyz);
+}
+
+TEST(Optimiser, NeverReturnsAWorseMesh) {
+  // An optimal mesh (a single straight tetrahedron has no free node; two glued ones one face
+  // node at P3): any run must return it no worse.
+  Mesh mesh = elevateOrder(twoTetrahedra(1), 3, nullptr);
+  const QualitySummary before = evaluateQuality(mesh);
+  OptimiserOptions options;
+  options.maxIterations = 10;
+  for (const Functional f : kAll) {
+    options.functional = f;
+    Mesh m = mesh;
+    const OptimiserResult r = optimiseMesh(m, options);
+    EXPECT_GE(r.worstAfter, r.worstBefore);
+    EXPECT_LE(r.invalidAfter, r.invalidBefore);
+    EXPECT_GE(evaluateQuality(m).scaled.min, before.scaled.min);
+  }
+}
+
+TEST(Optimiser, RegionRestrictsTheMovingNodes) {
+  Mesh mesh = readMesh(peer("varopti_cube_sphere.msh"));
+  OptimiserOptions options;
+  options.maxIterations = 2;
+  options.regionThreshold = 0.5;
+  options.regionLayers = 1;
+  const OptimiserResult r = optimiseMesh(mesh, options);
+  EXPECT_GT(r.regionElements, 0U);
+  EXPECT_LT(r.regionElements, mesh.numElements());
+  EXPECT_GT(r.worstAfter, r.worstBefore);
+  Mesh all = readMesh(peer("varopti_cube_sphere.msh"));
+  options.regionThreshold.reset();
+  EXPECT_GT(optimiseMesh(all, options).freeNodes, r.freeNodes);
+}
+
+TEST(Optimiser, BadOptionsAreRefused) {
+  Mesh mesh = elevateOrder(twoTetrahedra(1), 2, nullptr);
+  OptimiserOptions options;
+  options.maxIterations = -1;
+  EXPECT_THROW(optimiseMesh(mesh, options), ParameterError);
+  options = {};
+  options.threads = 0;
+  EXPECT_THROW(optimiseMesh(mesh, options), ParameterError);
+  options = {};
+  options.regionThreshold = 1.5;
+  EXPECT_THROW(optimiseMesh(mesh, options), ParameterError);
+}
+
+}  // namespace
+}  // namespace homesh
