@@ -118,8 +118,10 @@ class HighOrderMesh:
         ``maxiter`` sweeps at most; stops earlier when no node moves more than ``tolerance``
         times the mean element size. ``region``: move only nodes near elements whose scaled
         Jacobian is below it (with ``layers`` layers of neighbours). ``focus``: extra passes
-        over the worst elements' nodes after each sweep. Boundary nodes (and nodes on
-        interfaces between volumes unless ``free_interfaces``) stay fixed.
+        over the worst elements' nodes after each sweep. On a mesh made from CAD, nodes on CAD
+        curves and faces slide on them (CAD vertices stay); on a mesh read from a file,
+        boundary nodes (and nodes on interfaces between volumes unless ``free_interfaces``)
+        stay fixed.
 
         The mesh kept is never worse than before in worst scaled Jacobian or invalid count.
         Returns a dict: functional, iterations, converged, kept_iteration, worst_before,
@@ -205,7 +207,8 @@ def load(path):
     return HighOrderMesh(core)
 
 
-def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None):
+def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
+         optimise=0):
     """Meshes a CAD shape with curved elements of the given order.
 
     shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
@@ -218,12 +221,15 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
               (:class:`CancelledError`).
     name      how error messages call a shape given as an object or BRep text (for example
               the FreeCAD object's label); default "the shape".
+    optimise  > 0: after curving, at most this many sweeps of the variational optimiser
+              (hyperelastic; boundary nodes slide on the CAD), stage "optimise".
 
     Raises ParameterError, FileError, CadError, MeshingError or CancelledError.
     """
     order = _check_int("order", order)
     threads = _check_int("threads", threads)
     verbosity = _check_int("verbosity", verbosity)
+    optimise = _check_int("optimise", optimise)
     if size is not None:
         if isinstance(size, bool) or not isinstance(size, numbers.Real):
             raise ParameterError("size must be a positive number, got %r" % (size,))
@@ -238,13 +244,13 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
         if shape.isNull():
             raise ParameterError("%s is null (empty)" % label)
         core = _core.mesh_brep(shape.exportBrepToString(), label, order, size, threads,
-                               verbosity, progress)
+                               verbosity, progress, optimise)
     elif isinstance(shape, (str, os.PathLike)):
         text = os.fspath(shape)
         if "\n" in text and "CASCADE Topology" in text[:200]:
-            core = _core.mesh_brep(text, label, order, size, threads, verbosity, progress)
+            core = _core.mesh_brep(text, label, order, size, threads, verbosity, progress, optimise)
         else:
-            core = _core.mesh_file(text, order, size, threads, verbosity, progress)
+            core = _core.mesh_file(text, order, size, threads, verbosity, progress, optimise)
     else:
         raise ParameterError(
             "shape must be a Part.Shape, a CAD file path or BRep text, got %s"

@@ -108,9 +108,18 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
     cmd.size = parseNumber(o, v);
     if (!(*cmd.size > 0.0)) throw UsageError{"--size must be a positive length, got " + v};
   });
+  bool optimise = false;
+  std::optional<int> maxiter;
+  table.flag({"--optimise", "--optimize"}, [&optimise] { optimise = true; });
+  table.value({"--maxiter", "-n"}, [&maxiter](const std::string& o, const std::string& v) {
+    maxiter = parseInteger(o, v);
+    if (*maxiter < 1) throw UsageError{"--maxiter must be >= 1, got " + v};
+  });
   table.flag({"--verbose", "-v"}, [&cmd] { ++cmd.verbosity; });
   table.flag({"-vv"}, [&cmd] { cmd.verbosity += 2; });
   cmd.input = onlyInput(table.parse(args, 1, "mesh"), "mesh", "an INPUT CAD file");
+  if (maxiter && !optimise) throw UsageError{"--maxiter needs --optimise"};
+  if (optimise) cmd.optimiseIterations = maxiter.value_or(100);
   return cmd;
 }
 
@@ -224,6 +233,9 @@ placed on the CAD at order P.
 options:
   -p, --order P       polynomial order, 1..10 (default 4)
   -s, --size H        target element size (default: bounding-box diagonal / 20)
+      --optimise      curve the interior with the variational optimiser (hyperelastic),
+                      boundary nodes sliding on the CAD curves and faces
+  -n, --maxiter N     at most N optimiser sweeps (default 100)
   -o, --output FILE   write the mesh: .msh (Gmsh 4.1), .vtu (VTK), .xml (Nektar++); repeatable
       --binary        binary MSH, raw appended VTU data
       --compressed    compressed Nektar++ XML (B64Z-LittleEndian)

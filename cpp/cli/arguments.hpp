@@ -26,7 +26,8 @@ struct MeshCommand {
   std::string input;
   int order = 4;
   std::optional<double> size;
-  int verbosity = 0;  // -v: 1, -vv: 2
+  int verbosity = 0;           // -v: 1, -vv: 2
+  int optimiseIterations = 0;  // --optimise: 100, --maxiter N
   CommonOptions common;
 };
 

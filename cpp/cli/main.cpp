@@ -64,6 +64,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
   options.size = cmd.size;
   options.threads = c.threads;
   options.verbosity = cmd.verbosity;
+  options.optimiseIterations = cmd.optimiseIterations;
   checkOutputs(c);
   StderrProgress progress;
   homesh::PipelineObserver* observer = c.quiet ? nullptr : &progress;

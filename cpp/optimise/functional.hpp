@@ -21,6 +21,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
 
 namespace homesh {
 
@@ -42,48 +43,41 @@ struct Psi {
   double v = 0, s = 0, r = 0, ss = 0, sr = 0, rr = 0;
 };
 
-template <int D>
-Psi psi(Functional f, double S, double r) {
+// Compile-time functional: the optimiser's inner loops are instantiated per functional, so
+// this inlines without a branch per point.
+template <int D, Functional F>
+Psi psi(double S, double r) {
   Psi p;
-  const double inf = std::numeric_limits<double>::infinity();
   if (!(r > 0.0)) {
-    p.v = inf;  // an inverted point without regularisation: an infinite barrier
+    p.v = std::numeric_limits<double>::infinity();  // inverted, unregularised: a barrier
     return p;
   }
-  switch (f) {
-    case Functional::Hyperelastic: {
-      const double l = std::log(r);
-      p.v = 0.5 * kMu * (S - D) - kMu * l + 0.5 * kBulk * l * l;
-      p.s = 0.5 * kMu;
-      p.r = (-kMu + kBulk * l) / r;
-      p.rr = (kMu + kBulk * (1.0 - l)) / (r * r);
-      break;
-    }
-    case Functional::LinearElastic: {
-      const double l = std::log(r);
-      p.v = 0.5 * kBulk * l * l + kMu * S;
-      p.s = kMu;
-      p.r = kBulk * l / r;
-      p.rr = kBulk * (1.0 - l) / (r * r);
-      break;
-    }
-    case Functional::Winslow:
-      p.v = S / r;
-      p.s = 1.0 / r;
-      p.sr = -1.0 / (r * r);
-      p.r = -S / (r * r);
-      p.rr = 2.0 * S / (r * r * r);
-      break;
-    case Functional::Distortion: {
-      constexpr double e = 2.0 / D;
-      const double rp = D == 2 ? r : std::cbrt(r * r);  // r^(2/d)
-      p.v = S / (D * rp);
-      p.s = 1.0 / (D * rp);
-      p.sr = -e / (D * rp * r);
-      p.r = -e * S / (D * rp * r);
-      p.rr = e * (e + 1.0) * S / (D * rp * r * r);
-      break;
-    }
+  if constexpr (F == Functional::Hyperelastic) {
+    const double l = std::log(r);
+    p.v = 0.5 * kMu * (S - D) - kMu * l + 0.5 * kBulk * l * l;
+    p.s = 0.5 * kMu;
+    p.r = (-kMu + kBulk * l) / r;
+    p.rr = (kMu + kBulk * (1.0 - l)) / (r * r);
+  } else if constexpr (F == Functional::LinearElastic) {
+    const double l = std::log(r);
+    p.v = 0.5 * kBulk * l * l + kMu * S;
+    p.s = kMu;
+    p.r = kBulk * l / r;
+    p.rr = kBulk * (1.0 - l) / (r * r);
+  } else if constexpr (F == Functional::Winslow) {
+    p.v = S / r;
+    p.s = 1.0 / r;
+    p.sr = -1.0 / (r * r);
+    p.r = -S / (r * r);
+    p.rr = 2.0 * S / (r * r * r);
+  } else {
+    constexpr double e = 2.0 / D;
+    const double rp = D == 2 ? r : std::cbrt(r * r);  // r^(2/d)
+    p.v = S / (D * rp);
+    p.s = 1.0 / (D * rp);
+    p.sr = -e / (D * rp * r);
+    p.r = -e * S / (D * rp * r);
+    p.rr = e * (e + 1.0) * S / (D * rp * r * r);
   }
   return p;
 }
@@ -115,8 +109,20 @@ Eigen::Matrix<double, D, D> cofactor(const Eigen::Matrix<double, D, D>& F) {
   return c;
 }
 
-inline bool usesStrain(Functional f) {
-  return f == Functional::LinearElastic;
+// Calls fn(std::integral_constant<Functional, f>()) for the runtime value f.
+template <class Fn>
+decltype(auto) dispatch(Functional f, Fn&& fn) {
+  switch (f) {
+    case Functional::LinearElastic:
+      return fn(std::integral_constant<Functional, Functional::LinearElastic>());
+    case Functional::Hyperelastic:
+      return fn(std::integral_constant<Functional, Functional::Hyperelastic>());
+    case Functional::Winslow:
+      return fn(std::integral_constant<Functional, Functional::Winslow>());
+    case Functional::Distortion:
+      break;
+  }
+  return fn(std::integral_constant<Functional, Functional::Distortion>());
 }
 
 }  // namespace functional_detail
@@ -136,24 +142,30 @@ inline Regularised regularise(double J, double eps) {
 }
 
 // W(F).
-template <int D>
-double energyDensity(Functional f, const Eigen::Matrix<double, D, D>& F, double eps) {
+template <int D, Functional Fn>
+double energyDensity(const Eigen::Matrix<double, D, D>& F, double eps) {
   using namespace functional_detail;
   const double J = determinant<D>(F);
   double S = 0;
-  if (usesStrain(f)) {
+  if constexpr (Fn == Functional::LinearElastic) {
     Eigen::Matrix<double, D, D> E = 0.5 * (F.transpose() * F);
     E.diagonal().array() -= 0.5;
     S = E.squaredNorm();
   } else {
     S = F.squaredNorm();
   }
-  return psi<D>(f, S, regularise(J, eps).r).v;
+  return psi<D, Fn>(S, regularise(J, eps).r).v;
+}
+
+template <int D>
+double energyDensity(Functional f, const Eigen::Matrix<double, D, D>& F, double eps) {
+  return functional_detail::dispatch(
+      f, [&](auto fn) { return energyDensity<D, decltype(fn)::value>(F, eps); });
 }
 
 // W(F) and its gradient and Hessian with respect to delta, where F(delta) = F + delta a^T.
-template <int D>
-double energyDensityDerivatives(Functional f, const Eigen::Matrix<double, D, D>& F,
+template <int D, Functional Fn>
+double energyDensityDerivatives(const Eigen::Matrix<double, D, D>& F,
                                 const Eigen::Matrix<double, D, 1>& a, double eps,
                                 Eigen::Matrix<double, D, 1>& gradient,
                                 Eigen::Matrix<double, D, D>& hessian) {
@@ -167,7 +179,7 @@ double energyDensityDerivatives(Functional f, const Eigen::Matrix<double, D, D>&
   double S = 0;
   Vec dS;
   Mat ddS;
-  if (usesStrain(f)) {
+  if constexpr (Fn == Functional::LinearElastic) {
     Mat E = 0.5 * (F.transpose() * F);
     E.diagonal().array() -= 0.5;
     S = E.squaredNorm();
@@ -180,7 +192,7 @@ double energyDensityDerivatives(Functional f, const Eigen::Matrix<double, D, D>&
     ddS = Mat::Identity() * (2.0 * aa);
   }
   const Regularised reg = regularise(J, eps);
-  const Psi p = psi<D>(f, S, reg.r);
+  const Psi p = psi<D, Fn>(S, reg.r);
   const double pj = p.r * reg.dr;
   const double pjj = p.rr * reg.dr * reg.dr + p.r * reg.ddr;
   const double psj = p.sr * reg.dr;
@@ -188,6 +200,16 @@ double energyDensityDerivatives(Functional f, const Eigen::Matrix<double, D, D>&
   hessian = p.ss * (dS * dS.transpose()) + psj * (dS * g.transpose() + g * dS.transpose()) +
             pjj * (g * g.transpose()) + p.s * ddS;
   return p.v;
+}
+
+template <int D>
+double energyDensityDerivatives(Functional f, const Eigen::Matrix<double, D, D>& F,
+                                const Eigen::Matrix<double, D, 1>& a, double eps,
+                                Eigen::Matrix<double, D, 1>& gradient,
+                                Eigen::Matrix<double, D, D>& hessian) {
+  return functional_detail::dispatch(f, [&](auto fn) {
+    return energyDensityDerivatives<D, decltype(fn)::value>(F, a, eps, gradient, hessian);
+  });
 }
 
 }  // namespace homesh

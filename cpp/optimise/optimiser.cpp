@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <string>
 
+#include "cad/cad_model.hpp"
 #include "core/error.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
@@ -24,6 +26,8 @@ void OptimiserOptions::validate() const {
     throw ParameterError("maxiter must be >= 0, got " + std::to_string(maxIterations));
   if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
     throw ParameterError("tolerance must be a finite number >= 0");
+  if (!(stall >= 0.0) || !std::isfinite(stall))
+    throw ParameterError("stall must be a finite number >= 0");
   if (threads < 1 || threads > 1024)
     throw ParameterError("threads must be between 1 and 1024, got " + std::to_string(threads));
   if (regionThreshold && !(*regionThreshold > 0.0 && *regionThreshold <= 1.0))
@@ -55,8 +59,9 @@ constexpr NodeSet kWorkingSet = NodeSet::Optimal;
 
 // The energy's quadrature: exact to degree 2P - 1 (per variable on boxes), enough for the
 // polynomial part of W on a straight-sided ideal element. (Higher degrees changed the worst
-// value after five sweeps by less than 0.004; adding the nodes as sample points, to see folds
-// at vertices and edges, did not untangle more elements.)
+// value after five sweeps by less than 0.004; degree P + 1 halves the time but lost 0.18 of it
+// on NekMesh's cube-sphere and left the sphere in a box tangled; adding the nodes as sample
+// points, to see folds at vertices and edges, did not untangle more elements.)
 QuadratureRule energyRule(CellType type, int order) {
   return quadratureRule(type, std::max(1, 2 * order - 1));
 }
@@ -92,8 +97,13 @@ class Optimiser {
   using Mat = Eigen::Matrix<double, D, D>;
   using Vec = Eigen::Matrix<double, D, 1>;
 
-  Optimiser(Mesh& mesh, const OptimiserOptions& options, OptimiserObserver* observer)
-      : mesh_(mesh), options_(options), observer_(observer) {}
+  Optimiser(Mesh& mesh, const OptimiserOptions& options, OptimiserObserver* observer,
+            const CadModel* cad)
+      : mesh_(mesh),
+        options_(options),
+        observer_(observer),
+        cad_(cad),
+        converting_(cad == nullptr) {}
 
   OptimiserResult run() {
     const auto t0 = Clock::now();
@@ -118,13 +128,13 @@ class Optimiser {
     chooseFreeNodes();
     colour();
     for (std::size_t i = 0; i < all.size(); ++i)
-      if (touched_[i]) changed_.push_back(i);
+      if (touched_[i] != 0) changed_.push_back(i);
     computeGradients();
     result_.setupSeconds = since(t0);
 
     IterationRecord best = before;
-    std::vector<double> bestXyz;  // empty: the input (mesh_.xyz is the current state)
-    const std::vector<double> input = mesh_.xyz;
+    std::vector<double> bestXyz, bestParam;  // empty: the input
+    const std::vector<double> input = mesh_.xyz, inputParam = mesh_.nodeCadParam;
     for (int it = 1; it <= options_.maxIterations && !free_.empty(); ++it) {
       if (observer_ != nullptr && observer_->cancelRequested()) {
         result_.cancelled = true;
@@ -142,13 +152,23 @@ class Optimiser {
       if (acceptable(record, before) && better(record, best)) {
         best = record;
         bestXyz = mesh_.xyz;
+        bestParam = mesh_.nodeCadParam;
       }
       if (moved <= options_.tolerance * meanSize_) {
         result_.converged = true;
         break;
       }
+      const double previous = result_.history.size() > 1
+                                  ? result_.history[result_.history.size() - 2].worst
+                                  : before.worst;
+      if (options_.stall > 0.0 && record.invalid + record.undecided == 0 &&
+          record.worst - previous < options_.stall) {
+        result_.converged = true;
+        break;
+      }
     }
     mesh_.xyz = bestXyz.empty() ? input : bestXyz;
+    mesh_.nodeCadParam = bestXyz.empty() ? inputParam : bestParam;
     result_.keptIteration = best.iteration;
     result_.worstAfter = best.worst;
     result_.invalidAfter = best.invalid;
@@ -162,6 +182,14 @@ class Optimiser {
   Mesh& mesh_;
   const OptimiserOptions& options_;
   OptimiserObserver* observer_;
+  const CadModel* cad_;  // null: boundary nodes stay fixed
+  // Without CAD the optimiser moves the nodes of the well-conditioned set (kWorkingSet); with
+  // CAD it moves the mesh's own (equispaced) nodes, the ones that lie on the CAD.
+  const bool converting_;
+  std::vector<CadModel> cadPerThread_;  // evaluation caches are per thread
+  std::vector<std::uint8_t> slide_;     // per node: 1 on a CAD curve, 2 on a CAD face, else 0
+  std::map<int, ParameterRange> curveRange_;
+  std::map<int, SurfaceBounds> faceRange_;
   OptimiserResult result_;
 
   Eigen::Matrix<double, D, 3> frame_;  // rows: the coordinate axes (in 2D, of the plane)
@@ -213,7 +241,8 @@ class Optimiser {
       b.cells = &cells;
       b.nodes = cells.nodesPerElement();
       b.affine = cells.type == CellType::Triangle || cells.type == CellType::Tetrahedron;
-      const ReferenceElement& ref = ReferenceElement::get(cells.type, cells.order, kWorkingSet);
+      const ReferenceElement& ref = ReferenceElement::get(
+          cells.type, cells.order, converting_ ? kWorkingSet : NodeSet::Equispaced);
       const ReferenceElement& equi = ReferenceElement::get(cells.type, cells.order);
       b.toWorking = equi.valuesAt(ref.nodes());
       b.toEquispaced = ref.valuesAt(equi.nodes());
@@ -267,6 +296,7 @@ class Optimiser {
   // The same polynomial maps through the working node set's nodes (shared nodes get the same
   // value from every element: the trace on a shared face depends on the face's nodes only).
   void convertToWorkingSet() {
+    if (!converting_) return;
     std::vector<Vec> working = position_;
     for (const Block<D>& b : blocks_)
       for (std::size_t e = 0; e < b.cells->count(); ++e) {
@@ -335,6 +365,7 @@ class Optimiser {
     const std::vector<char> in = region();
     result_.regionElements =
         static_cast<std::size_t>(std::count(in.begin(), in.end(), static_cast<char>(1)));
+    chooseSlidingNodes(boundary);
     touched_.assign(totalElements_, 0);
     for (std::size_t node = 0; node < mesh_.numNodes(); ++node) {
       if (boundary[node] != 0 || incidenceStart_[node] == incidenceStart_[node + 1]) continue;
@@ -347,6 +378,33 @@ class Optimiser {
         touched_[globalIndex(incidence_[k])] = 1;
     }
     result_.freeNodes = free_.size();
+  }
+
+  // With CAD: nodes on a CAD curve (face, in 3D) move along it in t ((u, v)), nodes inside the
+  // domain move freely, CAD vertices stay; nodes without a CAD record keep the topological rule.
+  void chooseSlidingNodes(std::vector<char>& boundary) {
+    slide_.assign(mesh_.numNodes(), 0);
+    if (cad_ == nullptr) return;
+    for (std::size_t node = 0; node < mesh_.numNodes(); ++node) {
+      const int dim = mesh_.nodeCadDim[node];
+      const int index = mesh_.nodeCadIndex[node];
+      if (index <= 0) continue;
+      const double p0 = mesh_.nodeCadParam[2 * node], p1 = mesh_.nodeCadParam[2 * node + 1];
+      if (dim == 0) {
+        boundary[node] = 1;
+      } else if (dim == 1 && std::isfinite(p0) && index <= cad_->numEdges() &&
+                 !cad_->isDegenerated(index)) {
+        slide_[node] = 1;
+        boundary[node] = 0;
+        if (curveRange_.count(index) == 0) curveRange_[index] = cad_->edgeRange(index);
+      } else if (dim == 2 && D == 3 && std::isfinite(p0) && std::isfinite(p1) &&
+                 index <= cad_->numFaces()) {
+        slide_[node] = 2;
+        boundary[node] = 0;
+        if (faceRange_.count(index) == 0) faceRange_[index] = cad_->faceBounds(index);
+      }
+    }
+    for (int t = 0; t < options_.threads; ++t) cadPerThread_.push_back(cad_->clone());
   }
 
   // Greedy colouring of the free nodes: two nodes sharing an element get different colours.
@@ -384,9 +442,10 @@ class Optimiser {
 
   // F at every quadrature point of every element that contains a free node.
   void computeGradients() {
+    const std::size_t* changed = changed_.data();
 #pragma omp parallel for num_threads(options_.threads) schedule(dynamic, 16)
     for (std::int64_t i = 0; i < static_cast<std::int64_t>(changed_.size()); ++i) {
-      const std::size_t g = changed_[i];
+      const std::size_t g = changed[i];
       const auto bi = static_cast<std::size_t>(
           std::upper_bound(blockOffset_.begin(), blockOffset_.end(), g) - blockOffset_.begin() - 1);
       Block<D>& b = blocks_[bi];
@@ -409,6 +468,12 @@ class Optimiser {
 
   // One Newton step on one node; returns the distance it moved.
   double visit(std::int64_t node, std::vector<PointRef>& pts) {
+    return functional_detail::dispatch(
+        options_.functional, [&](auto fn) { return visitWith<decltype(fn)::value>(node, pts); });
+  }
+
+  template <Functional Fn>
+  double visitWith(std::int64_t node, std::vector<PointRef>& pts) {
     pts.clear();
     double jmin = std::numeric_limits<double>::infinity();
     for (std::size_t k = incidenceStart_[node]; k < incidenceStart_[node + 1]; ++k) {
@@ -424,18 +489,18 @@ class Optimiser {
       }
     }
     const double eps = jmin < 0.0 ? std::sqrt(1e-8 + 0.04 * jmin * jmin) : 1e-10;
-    const Functional f = options_.functional;
     double e0 = 0.0;
     Vec grad = Vec::Zero();
     Mat hess = Mat::Zero();
     Vec g;
     Mat h;
     for (const PointRef& p : pts) {
-      e0 += p.w * energyDensityDerivatives<D>(f, *p.F, p.a, eps, g, h);
+      e0 += p.w * energyDensityDerivatives<D, Fn>(*p.F, p.a, eps, g, h);
       grad += p.w * g;
       hess += p.w * h;
     }
     if (!std::isfinite(e0) || !grad.allFinite() || !hess.allFinite()) return 0.0;
+    if (slide_[node] != 0) return slide<Fn>(node, pts, eps, e0, grad, hess);
     // Shift the Hessian to be positive definite.
     Eigen::SelfAdjointEigenSolver<Mat> eig;
     eig.computeDirect(hess, Eigen::EigenvaluesOnly);
@@ -452,11 +517,79 @@ class Optimiser {
       const Vec d = alpha * step;
       double e1 = 0.0;
       for (const PointRef& p : pts) {
-        e1 += p.w * energyDensity<D>(f, *p.F + d * p.a.transpose(), eps);
+        e1 += p.w * energyDensity<D, Fn>(*p.F + d * p.a.transpose(), eps);
         if (!(e1 <= e0 + 1e300)) break;  // infinite or NaN: an inverted trial point
       }
       if (e1 <= e0 + kArmijo * alpha * slope) {
         position_[node] += d;
+        for (const PointRef& p : pts) *p.F += d * p.a.transpose();
+        return d.norm();
+      }
+    }
+    return 0.0;
+  }
+
+  // A Newton step of a node on a CAD curve (face) in its parameter t ((u, v)): the chain rule
+  // through the curve's (surface's) first and second derivatives, then a backtracking line
+  // search whose trial points are evaluated on the CAD, so the node never leaves it.
+  template <Functional Fn>
+  double slide(std::int64_t node, const std::vector<PointRef>& pts, double eps, double e0,
+               const Vec& grad, const Mat& hess) {
+    const int n = slide_[node];  // parameters
+    const int entity = mesh_.nodeCadIndex[node];
+    const CadModel& cad = cadPerThread_[static_cast<std::size_t>(omp_get_thread_num())];
+    double* param = &mesh_.nodeCadParam[2 * node];
+    Eigen::Matrix<double, D, Eigen::Dynamic> jac(D, n);
+    Eigen::MatrixXd h(n, n);
+    if (n == 1) {
+      const CurveDerivatives c = cad.evaluateCurve(entity, param[0]);
+      jac.col(0) = frame_ * c.d1;
+      h(0, 0) = jac.col(0).dot(hess * jac.col(0)) + grad.dot(frame_ * c.d2);
+    } else {
+      const SurfaceDerivatives s = cad.evaluateSurface(entity, param[0], param[1]);
+      jac.col(0) = frame_ * s.du;
+      jac.col(1) = frame_ * s.dv;
+      h = jac.transpose() * hess * jac;
+      h(0, 0) += grad.dot(frame_ * s.duu);
+      h(1, 1) += grad.dot(frame_ * s.dvv);
+      h(0, 1) += grad.dot(frame_ * s.duv);
+      h(1, 0) = h(0, 1);
+    }
+    const Eigen::VectorXd g = jac.transpose() * grad;
+    if (!g.allFinite() || !h.allFinite()) return 0.0;
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(h, Eigen::EigenvaluesOnly);
+    const double lmin = eig.eigenvalues().minCoeff();
+    const double lmax = eig.eigenvalues().cwiseAbs().maxCoeff();
+    if (!(lmax > 0.0)) return 0.0;
+    const double floor = 1e-8 * lmax;
+    if (lmin < floor) h.diagonal().array() += floor - lmin;
+    const Eigen::VectorXd step = -h.ldlt().solve(g);
+    const double slope = g.dot(step);
+    if (!(slope < 0.0) || !step.allFinite()) return 0.0;
+    double alpha = 1.0;
+    for (int ls = 0; ls < kLineSearchSteps; ++ls, alpha *= 0.5) {
+      double trial[2] = {param[0], param[1]};
+      Vec x;
+      if (n == 1) {
+        const ParameterRange& r = curveRange_.at(entity);
+        trial[0] = std::clamp(param[0] + alpha * step[0], r.first, r.last);
+        x = frame_ * cad.evaluateCurve(entity, trial[0]).point;
+      } else {
+        const SurfaceBounds& b = faceRange_.at(entity);
+        trial[0] = std::clamp(param[0] + alpha * step[0], b.uMin, b.uMax);
+        trial[1] = std::clamp(param[1] + alpha * step[1], b.vMin, b.vMax);
+        x = frame_ * cad.evaluateSurface(entity, trial[0], trial[1]).point;
+      }
+      const Vec d = x - position_[node];
+      double e1 = 0.0;
+      for (const PointRef& p : pts) {
+        e1 += p.w * energyDensity<D, Fn>(*p.F + d * p.a.transpose(), eps);
+        if (!(e1 <= e0 + 1e300)) break;
+      }
+      if (e1 <= e0 + kArmijo * alpha * slope) {
+        position_[node] = x;
+        param[0] = trial[0];
+        if (n == 2) param[1] = trial[1];
         for (const PointRef& p : pts) *p.F += d * p.a.transpose();
         return d.norm();
       }
@@ -521,14 +654,22 @@ class Optimiser {
 
   // The free nodes' equispaced positions into mesh_.xyz (in 2D only their in-plane part moves).
   void writeBack() {
+    const std::int64_t* freeNodes = free_.data();
 #pragma omp parallel for num_threads(options_.threads) schedule(static)
     for (std::int64_t i = 0; i < static_cast<std::int64_t>(free_.size()); ++i) {
-      const std::int64_t node = free_[i];
-      const Incidence& inc = incidence_[incidenceStart_[node]];
-      const Block<D>& b = blocks_[inc.block];
-      const std::int64_t* v = b.cells->element(inc.element);
-      Vec x = Vec::Zero();
-      for (int j = 0; j < b.nodes; ++j) x += b.toEquispaced(inc.local, j) * position_[v[j]];
+      const std::int64_t node = freeNodes[i];
+      Vec x = position_[node];
+      if (converting_) {
+        const Incidence& inc = incidence_[incidenceStart_[node]];
+        const Block<D>& b = blocks_[inc.block];
+        const std::int64_t* v = b.cells->element(inc.element);
+        x.setZero();
+        for (int j = 0; j < b.nodes; ++j) x += b.toEquispaced(inc.local, j) * position_[v[j]];
+      } else if constexpr (D == 3) {
+        for (int c = 0; c < 3; ++c) mesh_.xyz[3 * node + c] = x[c];  // exactly the CAD point
+        start_[node] = x;
+        continue;
+      }
       const Eigen::Vector3d d = frame_.transpose() * (x - start_[node]);
       for (int c = 0; c < 3; ++c) mesh_.xyz[3 * node + c] += d[c];
       start_[node] = x;
@@ -580,11 +721,11 @@ class Optimiser {
 }  // namespace
 
 OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
-                             OptimiserObserver* observer) {
+                             OptimiserObserver* observer, const CadModel* cad) {
   options.validate();
   mesh.checkConsistency();
-  if (mesh.dim == 3) return Optimiser<3>(mesh, options, observer).run();
-  if (mesh.dim == 2) return Optimiser<2>(mesh, options, observer).run();
+  if (mesh.dim == 3) return Optimiser<3>(mesh, options, observer, cad).run();
+  if (mesh.dim == 2) return Optimiser<2>(mesh, options, observer, cad).run();
   throw ParameterError("the optimiser needs a 2D or 3D mesh, got dimension " +
                        std::to_string(mesh.dim));
 }

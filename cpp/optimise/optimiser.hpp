@@ -10,8 +10,8 @@
 // one colour never share an element; the nodes of a colour are moved in parallel, colours in
 // sequence, so the result does not depend on the number of threads.
 //
-// Free nodes are those not on the mesh's boundary (faces in 3D, edges in 2D, of exactly one
-// element), not on an interface between elements of different entities and not on a
+// Without CAD, free nodes are those not on the mesh's boundary (faces in 3D, edges in 2D, of
+// exactly one element), not on an interface between elements of different entities and not on a
 // lower-dimensional cell of the mesh; the others stay fixed. With a region threshold, only the
 // nodes of elements whose scaled Jacobian is below it, grown by `regionLayers` layers of
 // neighbours, move.
@@ -34,11 +34,16 @@
 
 namespace homesh {
 
+class CadModel;
+
 struct OptimiserOptions {
   Functional functional = Functional::Hyperelastic;
   int maxIterations = 100;  // sweeps, >= 0
   // Stop when a sweep moves no node by more than tolerance x the mean element size.
   double tolerance = 1e-6;
+  // > 0: also stop once every element is proven valid and a sweep raised the worst scaled
+  // Jacobian by less than this (the mesh is valid and no longer improving much).
+  double stall = 0.0;
   int threads = 1;
   // Work only around elements whose certified scaled Jacobian is below this (in (0, 1]).
   std::optional<double> regionThreshold;
@@ -94,10 +99,12 @@ class OptimiserObserver {
 };
 
 // Optimises `mesh` in place. Supports triangles and quadrilaterals (dim 2) and tetrahedra,
-// prisms and hexahedra (dim 3) of orders 1..10. Throws ParameterError for bad options or
-// unsupported cells.
+// prisms and hexahedra (dim 3) of orders 1..10. With `cad` (the model the mesh's node records
+// refer to), nodes on a CAD curve slide along it in t and, in 3D, nodes on a CAD face slide on
+// it in (u, v), staying exactly on the CAD (their parameters are updated); CAD vertices stay.
+// Throws ParameterError for bad options or unsupported cells.
 OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
-                             OptimiserObserver* observer = nullptr);
+                             OptimiserObserver* observer = nullptr, const CadModel* cad = nullptr);
 
 // The energy of one element and its gradient and Hessian with respect to the coordinates of
 // node `local`, assembled as the optimiser assembles them (same quadrature). `x`: the node

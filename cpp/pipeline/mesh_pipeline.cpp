@@ -23,6 +23,9 @@ void MeshingOptions::validate() const {
   if (threads < 1 || threads > kMaxThreads)
     throw ParameterError("threads must be from 1 to " + std::to_string(kMaxThreads) + ", got " +
                          std::to_string(threads));
+  if (optimiseIterations < 0)
+    throw ParameterError("optimiser iterations must be >= 0, got " +
+                         std::to_string(optimiseIterations));
 }
 
 double defaultMeshSize(const CadModel& cad) {
@@ -92,6 +95,16 @@ void checkHighOrderMemory(const Mesh& linear, int order) {
   }
 }
 
+// Forwards the pipeline's cancel request to the optimiser (checked before every sweep).
+class OptimiserCancel : public OptimiserObserver {
+ public:
+  explicit OptimiserCancel(PipelineObserver* observer) : observer_(observer) {}
+  bool cancelRequested() override { return observer_ != nullptr && observer_->cancelRequested(); }
+
+ private:
+  PipelineObserver* observer_;
+};
+
 }  // namespace
 
 MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
@@ -114,6 +127,18 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   StageClock highOrder("high_order", result.timings, observer);
   result.mesh = elevateOrder(linearMesh, options.order, result.cad.get());
   highOrder.done();
+
+  if (options.optimiseIterations > 0) {
+    StageClock optimise("optimise", result.timings, observer);
+    OptimiserOptions o;
+    o.maxIterations = options.optimiseIterations;
+    o.stall = 1e-3;  // valid and no longer improving: stop early
+    o.threads = options.threads;
+    OptimiserCancel cancel(observer);
+    result.optimiser = optimiseMesh(result.mesh, o, &cancel, result.cad.get());
+    if (result.optimiser->cancelled) throw CancelledError("cancelled during optimise");
+    optimise.done();
+  }
 
   StageClock quality("quality", result.timings, observer);
   result.quality = evaluateQuality(result.mesh, options.threads);

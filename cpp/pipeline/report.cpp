@@ -108,6 +108,7 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
   json.value("nodes", result.mesh.numNodes());
   appendCounts(json, result.mesh);
   appendQuality(json, result.mesh, result.quality);
+  if (result.optimiser) appendOptimiser(json, *result.optimiser);
   json.beginObject("timings_s");
   for (const auto& [stage, s] : result.timings.seconds) json.value(stage, s);
   json.endObject();

@@ -262,7 +262,8 @@ class PyMesh {
     OptimiserResult record;
     {
       const ReleaseGil nogil;
-      record = optimiseMesh(copy.mesh, options);
+      // A mesh made from CAD keeps it: boundary nodes slide on their curves and faces.
+      record = optimiseMesh(copy.mesh, options, nullptr, copy.cad.get());
       copy.quality = evaluateQuality(copy.mesh, threads);
     }
     JsonWriter json;
@@ -275,8 +276,10 @@ class PyMesh {
   std::shared_ptr<const MeshResult> result_;  // immutable: safe to read without the GIL
 };
 
-MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity) {
+MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity,
+                           int optimise) {
   MeshingOptions options;
+  options.optimiseIterations = optimise;
   options.order = order;
   if (!size.is_none()) options.size = bp::extract<double>(size);
   options.threads = threads;
@@ -298,15 +301,15 @@ PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::o
 }
 
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
-                int verbosity, bp::object progress) {
-  return runPipeline(CadSource::file(path), makeOptions(order, size, threads, verbosity),
+                int verbosity, bp::object progress, int optimise) {
+  return runPipeline(CadSource::file(path), makeOptions(order, size, threads, verbosity, optimise),
                      std::move(progress));
 }
 
 PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
-                int threads, int verbosity, bp::object progress) {
-  return runPipeline(CadSource::brepText(text, name), makeOptions(order, size, threads, verbosity),
-                     std::move(progress));
+                int threads, int verbosity, bp::object progress, int optimise) {
+  return runPipeline(CadSource::brepText(text, name),
+                     makeOptions(order, size, threads, verbosity, optimise), std::move(progress));
 }
 
 // Rebuilds a mesh (without CAD) from the arrays PyMesh exposes, and evaluates its quality.
@@ -447,10 +450,10 @@ BOOST_PYTHON_MODULE(_core) {
 
   bp::def("mesh_file", &meshFile,
           (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
-           bp::arg("verbosity"), bp::arg("progress")));
+           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0));
   bp::def("mesh_brep", &meshBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
-           bp::arg("verbosity"), bp::arg("progress")));
+           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0));
   bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("threads") = 1));
   bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
   bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));

@@ -76,6 +76,12 @@ class HighOrderMeshProxy:
             obj.addProperty("App::PropertyLength", "Size", "Mesh",
                             "Target element size; 0 chooses a twentieth of the bounding-box "
                             "diagonal")
+        if "OptimiserIterations" not in have:
+            obj.addProperty("App::PropertyIntegerConstraint", "OptimiserIterations", "Mesh",
+                            "Most sweeps of the variational optimiser after curving (0: none; "
+                            "it stops earlier once the mesh is valid and no longer improving); "
+                            "boundary nodes slide on the CAD")
+            obj.OptimiserIterations = (20, 0, 1000, 1)
         if "MeshData" not in have:
             obj.addProperty("App::PropertyFileIncluded", "MeshData", "Result",
                             "The curved mesh, stored in the document")
@@ -106,7 +112,7 @@ class HighOrderMeshProxy:
         progress = _Progress(obj.Label)
         try:
             mesh = homesh.mesh(shape, order=obj.Order, size=size, progress=progress,
-                               name=obj.Part.Label)
+                               name=obj.Part.Label, optimise=obj.OptimiserIterations)
         except homesh.HOMeshError as e:
             FreeCAD.Console.PrintError("HOMesh: %s: %s\n" % (obj.Label, e))
             raise

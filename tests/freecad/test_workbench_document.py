@@ -75,6 +75,30 @@ class HighOrderMeshObject(unittest.TestCase):
         self.assertGreater(obj.NumNodes, n2)
         self.assertEqual(homesh.freecad.get_mesh(obj).order, 4)
 
+    def test_optimiser_improves_the_worst_element_and_keeps_the_boundary_on_the_cad(self):
+        part = box_with_hole(self.doc)
+        obj = homesh.freecad.make_high_order_mesh(self.doc, part, order=4, size=1.0)
+        self.assertEqual(obj.OptimiserIterations, 20)
+        obj.OptimiserIterations = 0
+        self.doc.recompute()
+        plain = obj.MinScaledJacobian
+        plain_nodes = homesh.freecad.get_mesh(obj).nodes.copy()
+        obj.OptimiserIterations = 20
+        self.doc.recompute()
+        self.assertTrue(obj.isValid())
+        self.assertGreater(obj.MinScaledJacobian, plain)
+        self.assertEqual(obj.InvalidElements, 0)
+        mesh = homesh.freecad.get_mesh(obj)
+        # Nodes on the hole's cylinder (radius from the fixture) stay on it.
+        moved = np.linalg.norm(mesh.nodes - plain_nodes, axis=1) > 1e-9
+        self.assertGreater(int(moved.sum()), 100)
+        on_face = mesh.node_cad_dim == 2
+        self.assertTrue(np.any(moved & on_face), "face nodes slide")
+        radius = lambda x: np.hypot(x[:, 0] - 2.0, x[:, 1] - 2.0)
+        on_hole = np.abs(radius(plain_nodes) - 1.0) < 1e-7
+        self.assertGreater(int((on_hole & moved).sum()), 10)
+        np.testing.assert_allclose(radius(mesh.nodes[on_hole]), 1.0, atol=1e-7)
+
     def test_order_is_constrained(self):
         part = box_with_hole(self.doc)
         obj = homesh.freecad.make_high_order_mesh(self.doc, part)

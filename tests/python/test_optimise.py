@@ -142,3 +142,30 @@ def test_optimise_errors(homesh_bin, tmp_path):
     assert r.returncode == 2 and "--maxiter" in r.stderr
     r = run([homesh_bin, "optimise", str(NACA), "--region", "0"])
     assert r.returncode == 2 and "--region" in r.stderr
+
+
+def test_python_optimise_slides_on_the_cad(data):
+    from homesh import mesh as make_mesh
+    m = make_mesh(str(data / "sphere.brep"), order=4, size=0.5)
+    before = m.quality()["min"]
+    record = m.optimise(maxiter=5, threads=2)
+    assert record["worst_after"] > before
+    on_cad = m.node_cad_dim < 3
+    assert on_cad.sum() > 500
+    radii = np.linalg.norm(m.nodes[on_cad], axis=1)
+    assert np.abs(radii - 1.0).max() < 1e-7
+    assert not np.array_equal(m.nodes[on_cad], make_mesh(str(data / "sphere.brep"), order=4,
+                                                         size=0.5).nodes[on_cad])
+
+
+def test_mesh_command_with_optimise(homesh_bin, data, tmp_path):
+    report = tmp_path / "r.json"
+    r = run([homesh_bin, "mesh", str(data / "sphere.brep"), "--order", "4", "--size", "0.5",
+             "--optimise", "-n", "5", "--report", str(report), "-q"])
+    assert r.returncode == 0, r.stderr
+    rep = json.loads(report.read_text())
+    assert rep["optimiser"]["iterations"] == 5
+    assert "optimise" in rep["timings_s"]
+    assert rep["quality"]["scaled_jacobian"]["min"] == pytest.approx(rep["optimiser"]["worst_after"])
+    r = run([homesh_bin, "mesh", str(data / "sphere.brep"), "-n", "5"])
+    assert r.returncode == 2 and "--optimise" in r.stderr

@@ -77,3 +77,52 @@ TEST(MeshPipeline, ObserverCanCancelBetweenStages) {
 
 }  // namespace
 }  // namespace homesh
+
+namespace homesh {
+namespace {
+
+// The optimiser inside the pipeline: boundary nodes slide on the CAD and stay on it, their
+// recorded parameters follow them, and the worst element improves.
+TEST(MeshPipeline, OptimiserSlidesBoundaryNodesOnTheCad) {
+  for (const bool isSphere : {true, false}) {
+    MeshingOptions options;
+    options.order = 4;
+    options.size = isSphere ? 0.5 : 0.4;
+    options.threads = 2;
+    options.optimiseIterations = 5;
+    const TopoDS_Shape shape = isSphere ? test::sphere(1.0) : test::torus(2.0, 0.6);
+    const MeshResult r = runMeshPipeline(CadSource::brepText(test::brepText(shape)), options);
+    ASSERT_TRUE(r.optimiser.has_value());
+    EXPECT_GE(r.optimiser->iterations, 1);  // may stop early once valid and stalled
+    EXPECT_LE(r.optimiser->iterations, 5);
+    std::printf("%s: worst %.4f -> %.4f, invalid %zu -> %zu\n", isSphere ? "sphere" : "torus",
+                r.optimiser->worstBefore, r.optimiser->worstAfter, r.optimiser->invalidBefore,
+                r.optimiser->invalidAfter);
+    EXPECT_GT(r.optimiser->worstAfter, r.optimiser->worstBefore + 0.03);
+    EXPECT_EQ(r.optimiser->invalidAfter, 0U);
+    EXPECT_EQ(r.quality.scaled.min, r.optimiser->worstAfter);
+    const Mesh& m = r.mesh;
+    std::size_t onFaces = 0;
+    for (std::size_t i = 0; i < m.numNodes(); ++i) {
+      const Eigen::Vector3d x(m.xyz[3 * i], m.xyz[3 * i + 1], m.xyz[3 * i + 2]);
+      if (m.nodeCadDim[i] == 2) {
+        ++onFaces;
+        const SurfaceDerivatives s = r.cad->evaluateSurface(
+            m.nodeCadIndex[i], m.nodeCadParam[2 * i], m.nodeCadParam[2 * i + 1]);
+        ASSERT_LT((s.point - x).norm(), 1e-12) << "node " << i;
+      } else if (m.nodeCadDim[i] == 1) {
+        const CurveDerivatives c = r.cad->evaluateCurve(m.nodeCadIndex[i], m.nodeCadParam[2 * i]);
+        ASSERT_LT((c.point - x).norm(), 1e-12) << "node " << i;
+      }
+      if (isSphere && m.nodeCadDim[i] < 3) {
+        ASSERT_NEAR(x.norm(), 1.0, 1e-7);
+      }
+    }
+    EXPECT_GT(onFaces, 500U);
+    const std::string json = meshReportJson(r, "shape");
+    EXPECT_NE(json.find("\"optimiser\""), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace homesh
