@@ -116,8 +116,12 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
   return json.str();
 }
 
-std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
-                              const std::string& input) {
+namespace {
+
+// The report of a mesh file: input, dimension, order, counts, quality, and the optimiser's
+// record when there is one.
+std::string fileReportJson(const Mesh& mesh, const QualitySummary& quality,
+                           const OptimiserResult* optimiser, const std::string& input) {
   JsonWriter json;
   json.beginObject();
   json.value("input", input);
@@ -126,8 +130,16 @@ std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
   json.value("nodes", mesh.numNodes());
   appendCounts(json, mesh);
   appendQuality(json, mesh, quality);
+  if (optimiser != nullptr) appendOptimiser(json, *optimiser);
   json.endObject();
   return json.str();
+}
+
+}  // namespace
+
+std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
+                              const std::string& input) {
+  return fileReportJson(mesh, quality, nullptr, input);
 }
 
 void appendOptimiser(JsonWriter& json, const OptimiserResult& r) {
@@ -168,17 +180,7 @@ void appendOptimiser(JsonWriter& json, const OptimiserResult& r) {
 
 std::string optimiseReportJson(const Mesh& mesh, const QualitySummary& quality,
                                const OptimiserResult& result, const std::string& input) {
-  JsonWriter json;
-  json.beginObject();
-  json.value("input", input);
-  json.value("dimension", mesh.dim);
-  json.value("order", mesh.order);
-  json.value("nodes", mesh.numNodes());
-  appendCounts(json, mesh);
-  appendQuality(json, mesh, quality);
-  appendOptimiser(json, result);
-  json.endObject();
-  return json.str();
+  return fileReportJson(mesh, quality, &result, input);
 }
 
 }  // namespace homesh
