@@ -170,16 +170,19 @@ OptimiseCommand parseOptimise(const std::vector<std::string>& args) {
     if (!(*cmd.regionThreshold > 0.0 && *cmd.regionThreshold <= 1.0))
       throw UsageError{"--region must be a scaled Jacobian in (0, 1], got " + v};
   });
-  table.value({"--layers"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.regionLayers = parseInteger(o, v);
-    if (cmd.regionLayers < 0) throw UsageError{"--layers must be >= 0, got " + v};
-  });
   table.value({"--focus"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.focusPasses = parseInteger(o, v);
     if (cmd.focusPasses < 0) throw UsageError{"--focus must be >= 0, got " + v};
   });
   table.flag({"--free-interfaces"}, [&cmd] { cmd.freeInterfaces = true; });
+  bool layers = false;
+  table.value({"--layers"}, [&cmd, &layers](const std::string& o, const std::string& v) {
+    cmd.regionLayers = parseInteger(o, v);
+    layers = true;
+    if (cmd.regionLayers < 0) throw UsageError{"--layers must be >= 0, got " + v};
+  });
   cmd.input = onlyInput(table.parse(args, 1, "optimise"), "optimise", "an INPUT mesh file");
+  if (layers && !cmd.regionThreshold) throw UsageError{"--layers needs --region"};
   return cmd;
 }
 
@@ -285,7 +288,8 @@ options:
   -f, --functional F  hyperelastic (default), linearelastic, winslow, distortion
   -n, --maxiter N     at most N sweeps (default 100)
       --tolerance T   stop when no node moves more than T x the mean element size (1e-6)
-  -p, --order P       first re-interpolate the mesh at order P (1..10)
+  -p, --order P       first re-interpolate the mesh at order P (1..10); "never worse" then
+                      compares with the re-interpolated mesh
       --region Q      move only nodes near elements with scaled Jacobian below Q
       --layers K      ... and K layers of neighbours around them (default 2)
       --focus K       after each sweep, K more passes over the nodes of the elements within

@@ -181,9 +181,11 @@ int runOptimise(const homesh::OptimiseCommand& cmd) {
                  "-> %zu\n",
                  r.worstBefore, r.worstAfter, r.nodalWorstBefore, r.nodalWorstAfter,
                  r.invalidBefore, r.invalidAfter);
-    if (r.keptIteration != r.iterations)
-      std::fprintf(stderr, "homesh: kept the state of %s%d, the best no worse than the input\n",
-                   r.keptIteration == 0 ? "the input, iteration " : "iteration ", r.keptIteration);
+    if (r.keptIteration == 0 && r.iterations > 0)
+      std::fprintf(stderr, "homesh: kept the input: no iteration was at least as good\n");
+    else if (r.keptIteration != r.iterations)
+      std::fprintf(stderr, "homesh: kept iteration %d (the best no worse than the input)\n",
+                   r.keptIteration);
   }
   for (const std::string& path : c.outputs) {
     homesh::writeMesh(mesh, path, homesh::qualityFields(q), writeOptions(c));

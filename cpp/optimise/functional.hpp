@@ -3,10 +3,12 @@
 //
 // F = (dx/dxi)(dx_I/dxi)^-1 is the deformation gradient from the straight-sided (ideal) element
 // to the curved one, J = det F, and J_r = (J + sqrt(J^2 + 4 eps^2)) / 2 the regularised
-// determinant that stays positive on tangled elements (eps > 0 only where a patch is inverted).
+// determinant that stays positive on tangled elements (eps sizeable only where a patch is
+// inverted, 1e-10 otherwise).
 // With mu = 1 / (2 (1 + nu)), K = 1 / (3 (1 - 2 nu)), nu = 0.4 and d the dimension:
 //   linear elastic  W = (K/2) (ln J_r)^2 + mu |E|^2,   E = (F^T F - I) / 2
-//   hyperelastic    W = (mu/2) (|F|^2 - d) - mu ln J_r + (K/2) (ln J_r)^2
+//   hyperelastic    W = (mu/2) (|F|^2 - d) - mu ln J_r + (K/2) (ln J_r)^2   (DESIGN.md writes 3
+//                   for d; a constant, it changes nothing)
 //   Winslow         W = |F|^2 / J_r
 //   distortion      W = |F|^2 / (d J_r^(2/d))
 // Every W is psi(S, J_r) with S = |F|^2 or |E|^2, so one chain rule serves all four.

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <limits>
 #include <map>
 #include <string>
@@ -103,7 +104,7 @@ class Optimiser {
         options_(options),
         observer_(observer),
         cad_(cad),
-        converting_(cad == nullptr) {}
+        converting_(cad == nullptr && !options.regionThreshold) {}
 
   OptimiserResult run() {
     const auto t0 = Clock::now();
@@ -135,37 +136,43 @@ class Optimiser {
     IterationRecord best = before;
     std::vector<double> bestXyz, bestParam;  // empty: the input
     const std::vector<double> input = mesh_.xyz, inputParam = mesh_.nodeCadParam;
-    for (int it = 1; it <= options_.maxIterations && !free_.empty(); ++it) {
-      if (observer_ != nullptr && observer_->cancelRequested()) {
-        result_.cancelled = true;
-        break;
+    try {
+      for (int it = 1; it <= options_.maxIterations && !free_.empty(); ++it) {
+        if (observer_ != nullptr && observer_->cancelRequested()) {
+          result_.cancelled = true;
+          break;
+        }
+        const auto s0 = Clock::now();
+        const double moved = sweep();
+        result_.sweepSeconds += since(s0);
+        writeBack();
+        evaluate(changed_);
+        const IterationRecord record = summarise(it, moved, t0);
+        result_.history.push_back(record);
+        result_.iterations = it;
+        if (observer_ != nullptr) observer_->iterationFinished(record);
+        if (acceptable(record, before) && better(record, best)) {
+          best = record;
+          bestXyz = mesh_.xyz;
+          bestParam = mesh_.nodeCadParam;
+        }
+        if (moved <= options_.tolerance * meanSize_) {
+          result_.converged = true;
+          break;
+        }
+        const double previous = result_.history.size() > 1
+                                    ? result_.history[result_.history.size() - 2].worst
+                                    : before.worst;
+        if (options_.stall > 0.0 && record.invalid + record.undecided == 0 &&
+            record.worst - previous < options_.stall) {
+          result_.converged = true;
+          break;
+        }
       }
-      const auto s0 = Clock::now();
-      const double moved = sweep();
-      result_.sweepSeconds += since(s0);
-      writeBack();
-      evaluate(changed_);
-      const IterationRecord record = summarise(it, moved, t0);
-      result_.history.push_back(record);
-      result_.iterations = it;
-      if (observer_ != nullptr) observer_->iterationFinished(record);
-      if (acceptable(record, before) && better(record, best)) {
-        best = record;
-        bestXyz = mesh_.xyz;
-        bestParam = mesh_.nodeCadParam;
-      }
-      if (moved <= options_.tolerance * meanSize_) {
-        result_.converged = true;
-        break;
-      }
-      const double previous = result_.history.size() > 1
-                                  ? result_.history[result_.history.size() - 2].worst
-                                  : before.worst;
-      if (options_.stall > 0.0 && record.invalid + record.undecided == 0 &&
-          record.worst - previous < options_.stall) {
-        result_.converged = true;
-        break;
-      }
+    } catch (...) {
+      mesh_.xyz = input;  // never leave a half-optimised mesh behind
+      mesh_.nodeCadParam = inputParam;
+      throw;
     }
     mesh_.xyz = bestXyz.empty() ? input : bestXyz;
     mesh_.nodeCadParam = bestXyz.empty() ? inputParam : bestParam;
@@ -275,6 +282,7 @@ class Optimiser {
           if (q < idealPoints) {
             if (!(std::abs(det) > 0.0))
               throw ParameterError("element " + std::to_string(totalElements_ + e) +
+                                   " (0-based, in block order)"
                                    " has a degenerate straight-sided shape (zero volume): "
                                    "the optimiser cannot measure its distortion");
             b.idealInvT[e * idealPoints + q] = ideal.inverse().transpose();
@@ -404,7 +412,8 @@ class Optimiser {
         if (faceRange_.count(index) == 0) faceRange_[index] = cad_->faceBounds(index);
       }
     }
-    for (int t = 0; t < options_.threads; ++t) cadPerThread_.push_back(cad_->clone());
+    if (std::any_of(slide_.begin(), slide_.end(), [](std::uint8_t k) { return k != 0; }))
+      for (int t = 0; t < options_.threads; ++t) cadPerThread_.push_back(cad_->clone());
   }
 
   // Greedy colouring of the free nodes: two nodes sharing an element get different colours.
@@ -538,6 +547,17 @@ class Optimiser {
     const int n = slide_[node];  // parameters
     const int entity = mesh_.nodeCadIndex[node];
     const CadModel& cad = cadPerThread_[static_cast<std::size_t>(omp_get_thread_num())];
+    try {
+      return slideOn<Fn>(cad, node, n, entity, pts, eps, e0, grad, hess);
+    } catch (const CadError&) {
+      return 0.0;  // the CAD cannot be evaluated there (a degenerate point): the node stays
+    }
+  }
+
+  template <Functional Fn>
+  double slideOn(const CadModel& cad, std::int64_t node, int n, int entity,
+                 const std::vector<PointRef>& pts, double eps, double e0, const Vec& grad,
+                 const Mat& hess) {
     double* param = &mesh_.nodeCadParam[2 * node];
     Eigen::Matrix<double, D, Eigen::Dynamic> jac(D, n);
     Eigen::MatrixXd h(n, n);
@@ -598,8 +618,11 @@ class Optimiser {
   }
 
   // One Newton step on each of `nodes` (grouped by colour: starts[c]..starts[c+1]).
+  // An exception must not leave an OpenMP region (that terminates the process, and FreeCAD with
+  // it): the first one is kept and rethrown after the region.
   double relax(const std::vector<std::int64_t>& nodes, const std::vector<std::size_t>& starts) {
     double moved = 0.0;
+    std::exception_ptr failure;
     const std::int64_t colours = static_cast<std::int64_t>(starts.size()) - 1;
 #pragma omp parallel num_threads(options_.threads) reduction(max : moved)
     {
@@ -608,9 +631,17 @@ class Optimiser {
         const auto lo = static_cast<std::int64_t>(starts[c]);
         const auto hi = static_cast<std::int64_t>(starts[c + 1]);
 #pragma omp for schedule(dynamic, 8)
-        for (std::int64_t i = lo; i < hi; ++i) moved = std::max(moved, visit(nodes[i], pts));
+        for (std::int64_t i = lo; i < hi; ++i) {
+          try {
+            moved = std::max(moved, visit(nodes[i], pts));
+          } catch (...) {
+#pragma omp critical(homesh_optimiser_failure)
+            if (!failure) failure = std::current_exception();
+          }
+        }
       }
     }
+    if (failure) std::rethrow_exception(failure);
     return moved;
   }
 
@@ -686,12 +717,20 @@ class Optimiser {
     }
     // Build the shared Bezier tables once before the threads need them.
     for (const Block<D>& b : blocks_) elementJacobianBounds(mesh_, *b.cells, 0);
+    std::exception_ptr failure;
 #pragma omp parallel for num_threads(options_.threads) schedule(dynamic, 16)
     for (std::int64_t i = 0; i < static_cast<std::int64_t>(elements.size()); ++i) {
-      const JacobianBounds bounds = elementJacobianBounds(mesh_, *where[i].first, where[i].second);
-      scaled_[elements[i]] = bounds.scaledJacobian();
-      validity_[elements[i]] = bounds.validity;
+      try {
+        const JacobianBounds bounds =
+            elementJacobianBounds(mesh_, *where[i].first, where[i].second);
+        scaled_[elements[i]] = bounds.scaledJacobian();
+        validity_[elements[i]] = bounds.validity;
+      } catch (...) {
+#pragma omp critical(homesh_optimiser_failure)
+        if (!failure) failure = std::current_exception();
+      }
     }
+    if (failure) std::rethrow_exception(failure);
   }
 
   IterationRecord summarise(int iteration, double moved, Clock::time_point t0) const {
@@ -782,17 +821,24 @@ double nodalScaledJacobian(const Mesh& mesh, int threads) {
     const JacobianSampler sampler(ref, ref.nodes());
     const int n = block.nodesPerElement();
     double blockWorst = 1.0;
+    std::exception_ptr failure;
 #pragma omp parallel for num_threads(threads) reduction(min : blockWorst)
     for (std::int64_t e = 0; e < static_cast<std::int64_t>(block.count()); ++e) {
-      NodeCoordinates x(n, 3);
-      const std::int64_t* v = block.element(static_cast<std::size_t>(e));
-      for (int i = 0; i < n; ++i)
-        for (int c = 0; c < 3; ++c) x(i, c) = mesh.xyz[3 * v[i] + c];
-      Eigen::VectorXd j;
-      sampler.jacobians(x, mesh.dim == 2 ? &normal : nullptr, j);
-      const double hi = j.maxCoeff();
-      blockWorst = std::min(blockWorst, hi > 0.0 ? j.minCoeff() / hi : -1.0);
+      try {
+        NodeCoordinates x(n, 3);
+        const std::int64_t* v = block.element(static_cast<std::size_t>(e));
+        for (int i = 0; i < n; ++i)
+          for (int c = 0; c < 3; ++c) x(i, c) = mesh.xyz[3 * v[i] + c];
+        Eigen::VectorXd j;
+        sampler.jacobians(x, mesh.dim == 2 ? &normal : nullptr, j);
+        const double hi = j.maxCoeff();
+        blockWorst = std::min(blockWorst, hi > 0.0 ? j.minCoeff() / hi : -1.0);
+      } catch (...) {
+#pragma omp critical(homesh_optimiser_failure)
+        if (!failure) failure = std::current_exception();
+      }
     }
+    if (failure) std::rethrow_exception(failure);
     worst = std::min(worst, blockWorst);
   }
   return worst;

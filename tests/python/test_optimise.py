@@ -142,6 +142,8 @@ def test_optimise_errors(homesh_bin, tmp_path):
     assert r.returncode == 2 and "--maxiter" in r.stderr
     r = run([homesh_bin, "optimise", str(NACA), "--region", "0"])
     assert r.returncode == 2 and "--region" in r.stderr
+    r = run([homesh_bin, "optimise", str(NACA), "--layers", "3"])
+    assert r.returncode == 2 and "--layers needs --region" in r.stderr
 
 
 def test_python_optimise_slides_on_the_cad(data):
