@@ -7,13 +7,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <exception>
 #include <limits>
 #include <map>
 #include <string>
 
 #include "cad/cad_model.hpp"
 #include "core/error.hpp"
+#include "core/first_failure.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 #include "optimise/mesh_topology.hpp"
@@ -119,6 +119,8 @@ class Optimiser {
     validity_.resize(totalElements_);
     std::vector<std::size_t> all(totalElements_);
     for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+    // Build the shared Bezier tables once before the threads need them.
+    for (const Block<D>& b : blocks_) elementJacobianBounds(mesh_, *b.cells, 0);
     evaluate(all);
     const IterationRecord before = summarise(0, 0.0, t0);
     result_.worstBefore = before.worst;
@@ -128,8 +130,6 @@ class Optimiser {
 
     chooseFreeNodes();
     colour();
-    for (std::size_t i = 0; i < all.size(); ++i)
-      if (touched_[i] != 0) changed_.push_back(i);
     computeGradients();
     result_.setupSeconds = since(t0);
 
@@ -145,8 +145,6 @@ class Optimiser {
         const auto s0 = Clock::now();
         const double moved = sweep();
         result_.sweepSeconds += since(s0);
-        writeBack();
-        evaluate(changed_);
         const IterationRecord record = summarise(it, moved, t0);
         result_.history.push_back(record);
         result_.iterations = it;
@@ -190,8 +188,10 @@ class Optimiser {
   const OptimiserOptions& options_;
   OptimiserObserver* observer_;
   const CadModel* cad_;  // null: boundary nodes stay fixed
-  // Without CAD the optimiser moves the nodes of the well-conditioned set (kWorkingSet); with
-  // CAD it moves the mesh's own (equispaced) nodes, the ones that lie on the CAD.
+  // Without CAD the optimiser moves the nodes of the well-conditioned set (kWorkingSet). With
+  // CAD it moves the mesh's own (equispaced) nodes, the ones that lie on the CAD, and so it does
+  // with a region, where a fixed node of an element at the region's edge would otherwise change
+  // its equispaced position with its free neighbours' working nodes.
   const bool converting_;
   std::vector<CadModel> cadPerThread_;  // evaluation caches are per thread
   std::vector<std::uint8_t> slide_;     // per node: 1 on a CAD curve, 2 on a CAD face, else 0
@@ -212,7 +212,6 @@ class Optimiser {
 
   std::vector<double> scaled_;
   std::vector<Validity> validity_;
-  std::vector<char> touched_;         // element contains a free node
   std::vector<std::size_t> changed_;  // elements to re-check after a sweep
   std::vector<std::int64_t> free_;    // free nodes, grouped by colour
   std::vector<std::size_t> colourStart_;
@@ -339,6 +338,13 @@ class Optimiser {
     return blockOffset_[inc.block] + inc.element;
   }
 
+  // The block and the element within it of global element g.
+  std::pair<std::size_t, std::size_t> locate(std::size_t g) const {
+    const auto bi = static_cast<std::size_t>(
+        std::upper_bound(blockOffset_.begin(), blockOffset_.end(), g) - blockOffset_.begin() - 1);
+    return {bi, g - blockOffset_[bi]};
+  }
+
   // Elements whose nodes may move: all, or the poor ones and `regionLayers` layers around them.
   std::vector<char> region() {
     std::vector<char> in(totalElements_, 1);
@@ -374,7 +380,7 @@ class Optimiser {
     result_.regionElements =
         static_cast<std::size_t>(std::count(in.begin(), in.end(), static_cast<char>(1)));
     chooseSlidingNodes(boundary);
-    touched_.assign(totalElements_, 0);
+    std::vector<char> touched(totalElements_, 0);  // the element contains a free node
     for (std::size_t node = 0; node < mesh_.numNodes(); ++node) {
       if (boundary[node] != 0 || incidenceStart_[node] == incidenceStart_[node + 1]) continue;
       bool inRegion = false;
@@ -383,9 +389,11 @@ class Optimiser {
       if (!inRegion) continue;
       free_.push_back(static_cast<std::int64_t>(node));
       for (std::size_t k = incidenceStart_[node]; k < incidenceStart_[node + 1]; ++k)
-        touched_[globalIndex(incidence_[k])] = 1;
+        touched[globalIndex(incidence_[k])] = 1;
     }
     result_.freeNodes = free_.size();
+    for (std::size_t i = 0; i < totalElements_; ++i)
+      if (touched[i] != 0) changed_.push_back(i);
   }
 
   // With CAD: nodes on a CAD curve (face, in 3D) move along it in t ((u, v)), nodes inside the
@@ -454,11 +462,8 @@ class Optimiser {
     const std::size_t* changed = changed_.data();
 #pragma omp parallel for num_threads(options_.threads) schedule(dynamic, 16)
     for (std::int64_t i = 0; i < static_cast<std::int64_t>(changed_.size()); ++i) {
-      const std::size_t g = changed[i];
-      const auto bi = static_cast<std::size_t>(
-          std::upper_bound(blockOffset_.begin(), blockOffset_.end(), g) - blockOffset_.begin() - 1);
+      const auto [bi, e] = locate(changed[i]);
       Block<D>& b = blocks_[bi];
-      const std::size_t e = g - blockOffset_[bi];
       const std::int64_t* v = b.cells->element(e);
       for (int q = 0; q < b.points; ++q) {
         Mat dx = Mat::Zero();
@@ -474,6 +479,42 @@ class Optimiser {
     Vec a;
     double w;
   };
+
+  // The Newton step -H^-1 g with H shifted to be positive definite (smallest eigenvalue at least
+  // 1e-8 of the largest), and its slope g . step; false when there is no descent direction.
+  template <class M, class V>
+  static bool newtonStep(M h, const V& g, V& step, double& slope) {
+    Eigen::SelfAdjointEigenSolver<M> eig;
+    if constexpr (M::RowsAtCompileTime == Eigen::Dynamic) {
+      eig.compute(h, Eigen::EigenvaluesOnly);
+    } else {
+      eig.computeDirect(h, Eigen::EigenvaluesOnly);
+    }
+    const double lmin = eig.eigenvalues().minCoeff();
+    const double lmax = eig.eigenvalues().cwiseAbs().maxCoeff();
+    if (!(lmax > 0.0)) return false;
+    const double floor = 1e-8 * lmax;
+    if (lmin < floor) h.diagonal().array() += floor - lmin;
+    step = -h.ldlt().solve(g);
+    slope = g.dot(step);
+    return slope < 0.0 && step.allFinite();
+  }
+
+  // The patch energy after moving the node by d (stops summing once it is infinite or NaN: an
+  // inverted trial point).
+  template <Functional Fn>
+  static double energyAfter(const std::vector<PointRef>& pts, const Vec& d, double eps, double e0) {
+    double e1 = 0.0;
+    for (const PointRef& p : pts) {
+      e1 += p.w * energyDensity<D, Fn>(*p.F + d * p.a.transpose(), eps);
+      if (!(e1 <= e0 + 1e300)) break;
+    }
+    return e1;
+  }
+
+  static void applyMove(const std::vector<PointRef>& pts, const Vec& d) {
+    for (const PointRef& p : pts) *p.F += d * p.a.transpose();
+  }
 
   // One Newton step on one node; returns the distance it moved.
   double visit(std::int64_t node, std::vector<PointRef>& pts) {
@@ -510,28 +551,15 @@ class Optimiser {
     }
     if (!std::isfinite(e0) || !grad.allFinite() || !hess.allFinite()) return 0.0;
     if (slide_[node] != 0) return slide<Fn>(node, pts, eps, e0, grad, hess);
-    // Shift the Hessian to be positive definite.
-    Eigen::SelfAdjointEigenSolver<Mat> eig;
-    eig.computeDirect(hess, Eigen::EigenvaluesOnly);
-    const double lmin = eig.eigenvalues().minCoeff();
-    const double lmax = eig.eigenvalues().cwiseAbs().maxCoeff();
-    if (!(lmax > 0.0)) return 0.0;
-    const double floor = 1e-8 * lmax;
-    if (lmin < floor) hess.diagonal().array() += floor - lmin;
-    const Vec step = -hess.ldlt().solve(grad);
-    const double slope = grad.dot(step);
-    if (!(slope < 0.0) || !step.allFinite()) return 0.0;
+    Vec step;
+    double slope = 0.0;
+    if (!newtonStep(hess, grad, step, slope)) return 0.0;
     double alpha = 1.0;
     for (int ls = 0; ls < kLineSearchSteps; ++ls, alpha *= 0.5) {
       const Vec d = alpha * step;
-      double e1 = 0.0;
-      for (const PointRef& p : pts) {
-        e1 += p.w * energyDensity<D, Fn>(*p.F + d * p.a.transpose(), eps);
-        if (!(e1 <= e0 + 1e300)) break;  // infinite or NaN: an inverted trial point
-      }
-      if (e1 <= e0 + kArmijo * alpha * slope) {
+      if (energyAfter<Fn>(pts, d, eps, e0) <= e0 + kArmijo * alpha * slope) {
         position_[node] += d;
-        for (const PointRef& p : pts) *p.F += d * p.a.transpose();
+        applyMove(pts, d);
         return d.norm();
       }
     }
@@ -577,15 +605,9 @@ class Optimiser {
     }
     const Eigen::VectorXd g = jac.transpose() * grad;
     if (!g.allFinite() || !h.allFinite()) return 0.0;
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(h, Eigen::EigenvaluesOnly);
-    const double lmin = eig.eigenvalues().minCoeff();
-    const double lmax = eig.eigenvalues().cwiseAbs().maxCoeff();
-    if (!(lmax > 0.0)) return 0.0;
-    const double floor = 1e-8 * lmax;
-    if (lmin < floor) h.diagonal().array() += floor - lmin;
-    const Eigen::VectorXd step = -h.ldlt().solve(g);
-    const double slope = g.dot(step);
-    if (!(slope < 0.0) || !step.allFinite()) return 0.0;
+    Eigen::VectorXd step;
+    double slope = 0.0;
+    if (!newtonStep(h, g, step, slope)) return 0.0;
     double alpha = 1.0;
     for (int ls = 0; ls < kLineSearchSteps; ++ls, alpha *= 0.5) {
       double trial[2] = {param[0], param[1]};
@@ -601,16 +623,11 @@ class Optimiser {
         x = frame_ * cad.evaluateSurface(entity, trial[0], trial[1]).point;
       }
       const Vec d = x - position_[node];
-      double e1 = 0.0;
-      for (const PointRef& p : pts) {
-        e1 += p.w * energyDensity<D, Fn>(*p.F + d * p.a.transpose(), eps);
-        if (!(e1 <= e0 + 1e300)) break;
-      }
-      if (e1 <= e0 + kArmijo * alpha * slope) {
+      if (energyAfter<Fn>(pts, d, eps, e0) <= e0 + kArmijo * alpha * slope) {
         position_[node] = x;
         param[0] = trial[0];
         if (n == 2) param[1] = trial[1];
-        for (const PointRef& p : pts) *p.F += d * p.a.transpose();
+        applyMove(pts, d);
         return d.norm();
       }
     }
@@ -618,11 +635,9 @@ class Optimiser {
   }
 
   // One Newton step on each of `nodes` (grouped by colour: starts[c]..starts[c+1]).
-  // An exception must not leave an OpenMP region (that terminates the process, and FreeCAD with
-  // it): the first one is kept and rethrown after the region.
   double relax(const std::vector<std::int64_t>& nodes, const std::vector<std::size_t>& starts) {
     double moved = 0.0;
-    std::exception_ptr failure;
+    FirstFailure failure;
     const std::int64_t colours = static_cast<std::int64_t>(starts.size()) - 1;
 #pragma omp parallel num_threads(options_.threads) reduction(max : moved)
     {
@@ -635,13 +650,12 @@ class Optimiser {
           try {
             moved = std::max(moved, visit(nodes[i], pts));
           } catch (...) {
-#pragma omp critical(homesh_optimiser_failure)
-            if (!failure) failure = std::current_exception();
+            failure.capture();
           }
         }
       }
     }
-    if (failure) std::rethrow_exception(failure);
+    failure.rethrow();
     return moved;
   }
 
@@ -650,11 +664,12 @@ class Optimiser {
   // the mesh; a global sweep moves them only as fast as Gauss-Seidel spreads the change, and the
   // focused passes cost a fraction of a sweep (on NekMesh's cube-sphere at order 4, two passes
   // take the worst value after five iterations from 0.714 to 0.757 for 25 % more time).
+  // Leaves mesh_.xyz and the certified quality up to date.
   double sweep() {
     const double moved = relax(free_, colourStart_);
+    writeBack();
+    evaluate(changed_);
     if (options_.focusPasses > 0) {
-      writeBack();
-      evaluate(changed_);
       const double worst = *std::min_element(scaled_.begin(), scaled_.end());
       std::vector<std::vector<std::int64_t>> groups(result_.colours);
       std::vector<char> seen(mesh_.numNodes(), 0);
@@ -677,6 +692,16 @@ class Optimiser {
         starts.push_back(focus.size());
       }
       for (int p = 0; p < options_.focusPasses; ++p) relax(focus, starts);
+      writeBack();
+      // Only the elements around the focused nodes changed since the check above.
+      std::vector<char> near(totalElements_, 0);
+      for (const std::int64_t node : focus)
+        for (std::size_t k = incidenceStart_[node]; k < incidenceStart_[node + 1]; ++k)
+          near[globalIndex(incidence_[k])] = 1;
+      std::vector<std::size_t> recheck;
+      for (std::size_t i = 0; i < totalElements_; ++i)
+        if (near[i] != 0) recheck.push_back(i);
+      evaluate(recheck);
     }
     // Rounding accumulates in the incrementally updated F: refresh it from the nodes.
     computeGradients();
@@ -707,30 +732,22 @@ class Optimiser {
     }
   }
 
+  // Certified quality of the given elements (global indices) into scaled_ and validity_.
   void evaluate(const std::vector<std::size_t>& elements) {
-    std::vector<std::pair<const ElementBlock*, std::size_t>> where(elements.size());
-    for (std::size_t i = 0; i < elements.size(); ++i) {
-      const std::size_t g = elements[i];
-      const auto bi = static_cast<std::size_t>(
-          std::upper_bound(blockOffset_.begin(), blockOffset_.end(), g) - blockOffset_.begin() - 1);
-      where[i] = {blocks_[bi].cells, g - blockOffset_[bi]};
-    }
-    // Build the shared Bezier tables once before the threads need them.
-    for (const Block<D>& b : blocks_) elementJacobianBounds(mesh_, *b.cells, 0);
-    std::exception_ptr failure;
+    FirstFailure failure;
+    const std::size_t* list = elements.data();  // an index loop: OpenMP splits it
 #pragma omp parallel for num_threads(options_.threads) schedule(dynamic, 16)
     for (std::int64_t i = 0; i < static_cast<std::int64_t>(elements.size()); ++i) {
       try {
-        const JacobianBounds bounds =
-            elementJacobianBounds(mesh_, *where[i].first, where[i].second);
-        scaled_[elements[i]] = bounds.scaledJacobian();
-        validity_[elements[i]] = bounds.validity;
+        const auto [bi, e] = locate(list[i]);
+        const JacobianBounds bounds = elementJacobianBounds(mesh_, *blocks_[bi].cells, e);
+        scaled_[list[i]] = bounds.scaledJacobian();
+        validity_[list[i]] = bounds.validity;
       } catch (...) {
-#pragma omp critical(homesh_optimiser_failure)
-        if (!failure) failure = std::current_exception();
+        failure.capture();
       }
     }
-    if (failure) std::rethrow_exception(failure);
+    failure.rethrow();
   }
 
   IterationRecord summarise(int iteration, double moved, Clock::time_point t0) const {
@@ -821,7 +838,7 @@ double nodalScaledJacobian(const Mesh& mesh, int threads) {
     const JacobianSampler sampler(ref, ref.nodes());
     const int n = block.nodesPerElement();
     double blockWorst = 1.0;
-    std::exception_ptr failure;
+    FirstFailure failure;
 #pragma omp parallel for num_threads(threads) reduction(min : blockWorst)
     for (std::int64_t e = 0; e < static_cast<std::int64_t>(block.count()); ++e) {
       try {
@@ -834,11 +851,10 @@ double nodalScaledJacobian(const Mesh& mesh, int threads) {
         const double hi = j.maxCoeff();
         blockWorst = std::min(blockWorst, hi > 0.0 ? j.minCoeff() / hi : -1.0);
       } catch (...) {
-#pragma omp critical(homesh_optimiser_failure)
-        if (!failure) failure = std::current_exception();
+        failure.capture();
       }
     }
-    if (failure) std::rethrow_exception(failure);
+    failure.rethrow();
     worst = std::min(worst, blockWorst);
   }
   return worst;

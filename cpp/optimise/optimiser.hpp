@@ -85,7 +85,7 @@ struct OptimiserResult {
   std::size_t undecidedBefore = 0, undecidedAfter = 0;
   std::size_t freeNodes = 0, colours = 0, regionElements = 0;
   double setupSeconds = 0.0;  // colouring, ideal elements, initial quality
-  double sweepSeconds = 0.0;  // the sweeps with their focused passes (no final quality check)
+  double sweepSeconds = 0.0;  // the sweeps with their focused passes and quality checks
   double seconds = 0.0;       // everything, including the quality checks
   std::vector<IterationRecord> history;
 };
