@@ -41,6 +41,15 @@ Topology tetTopology(const Mesh& linear) {
   return {linear.numNodes(), edges.size(), faces.size(), tets.count()};
 }
 
+// Where node n of tetrahedron t sits on the straight-sided element through its vertices.
+Eigen::Vector3d straightPosition(const Mesh& mesh, const std::int64_t* t,
+                                 const ReferenceElement& ref, int n) {
+  const Eigen::Vector3d x0 = nodePoint(mesh, t[0]);
+  Eigen::Matrix3d a;
+  for (int k = 0; k < 3; ++k) a.col(k) = nodePoint(mesh, t[k + 1]) - x0;
+  return x0 + a * ref.nodes().row(n).transpose();
+}
+
 class SphereOrders : public ::testing::TestWithParam<int> {};
 
 TEST_P(SphereOrders, NodesAreSharedAndBoundaryNodesLieOnTheSphere) {
@@ -79,14 +88,10 @@ TEST_P(SphereOrders, NodesAreSharedAndBoundaryNodesLieOnTheSphere) {
   std::size_t interior = 0;
   for (std::size_t e = 0; e < tets.count(); ++e) {
     const std::int64_t* t = tets.element(e);
-    const Eigen::Vector3d x0 = nodePoint(mesh, t[0]);
-    Eigen::Matrix3d a;
-    for (int k = 0; k < 3; ++k) a.col(k) = nodePoint(mesh, t[k + 1]) - x0;
     for (int n = 0; n < ref.numNodes(); ++n) {
       if (mesh.nodeCadDim[t[n]] != 3) continue;
       ++interior;
-      EXPECT_NEAR((nodePoint(mesh, t[n]) - (x0 + a * ref.nodes().row(n).transpose())).norm(), 0.0,
-                  1e-12);
+      EXPECT_NEAR((nodePoint(mesh, t[n]) - straightPosition(mesh, t, ref, n)).norm(), 0.0, 1e-12);
     }
   }
   if (order >= 2) {
@@ -116,13 +121,8 @@ TEST(OrderElevation, WithoutCadTheElementsStayStraight) {
   const ReferenceElement& ref = ReferenceElement::get(CellType::Tetrahedron, 5);
   for (std::size_t e = 0; e < tets.count(); ++e) {
     const std::int64_t* t = tets.element(e);
-    const Eigen::Vector3d x0 = nodePoint(mesh, t[0]);
-    Eigen::Matrix3d a;
-    for (int k = 0; k < 3; ++k) a.col(k) = nodePoint(mesh, t[k + 1]) - x0;
-    for (int n = 0; n < ref.numNodes(); ++n) {
-      const Eigen::Vector3d expected = x0 + a * ref.nodes().row(n).transpose();
-      EXPECT_NEAR((nodePoint(mesh, t[n]) - expected).norm(), 0.0, 1e-12);
-    }
+    for (int n = 0; n < ref.numNodes(); ++n)
+      EXPECT_NEAR((nodePoint(mesh, t[n]) - straightPosition(mesh, t, ref, n)).norm(), 0.0, 1e-12);
   }
   const QualitySummary q = evaluateQuality(mesh);
   // The certified bound sits below 1 by the proven rounding margin only.
