@@ -3,6 +3,7 @@
 #include <BRepAdaptor_Curve.hxx>
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepBndLib.hxx>
+#include <BRepBuilderAPI_Transform.hxx>
 #include <BRepLProp_SLProps.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
@@ -206,6 +207,20 @@ CadModel CadModel::clone() const {
   auto impl = std::make_unique<Impl>();
   impl->shape = impl_->shape;
   impl->source = impl_->source;
+  return CadModel(std::move(impl));
+}
+
+CadModel CadModel::scaled(double factor) const {
+  if (!(factor > 0.0) || !std::isfinite(factor))
+    throw ParameterError("CAD scale factor must be a positive number");
+  auto impl = std::make_unique<Impl>();
+  impl->source = impl_->source;
+  impl->shape = withOcctErrors("scaling " + impl_->source, [&] {
+    gp_Trsf scale;
+    scale.SetScale(gp_Pnt(0.0, 0.0, 0.0), factor);
+    BRepBuilderAPI_Transform transform(impl_->shape, scale, true);
+    return transform.Shape();
+  });
   return CadModel(std::move(impl));
 }
 

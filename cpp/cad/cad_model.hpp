@@ -68,6 +68,10 @@ class CadModel {
   CadModel& operator=(CadModel&& other) noexcept;
   ~CadModel();
 
+  // The model scaled by `factor` about the origin (a unit change: 0.001 turns millimetres into
+  // metres). Numbering and names are kept. Throws ParameterError for a factor that is not > 0.
+  CadModel scaled(double factor) const;
+
   // A copy sharing the (immutable) shape with fresh evaluation caches, for another thread.
   CadModel clone() const;
 

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cad/model_dimension.hpp"
 #include "cad/occt_access.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
@@ -45,28 +46,6 @@ void checkSize(const CadModel& cad, double size, int dim) {
         << std::setprecision(1) << estimate << " elements";
     throw ParameterError(msg.str());
   }
-}
-
-// 3 for a model with solids; 2 for planar faces in one plane; CadError otherwise.
-int meshDimension(const CadModel& cad, Eigen::Vector3d& normal) {
-  if (cad.numSolids() > 0) return 3;
-  const std::string hint =
-      ": HOMesh meshes solids, or planar faces in one plane (2D); a closed shell must be made a "
-      "solid first (FreeCAD: Part > Convert to solid)";
-  for (int f = 1; f <= cad.numFaces(); ++f)
-    if (!cad.isPlanar(f))
-      throw CadError(cad.sourceName() + " has no solid and " + cadEntityName(2, f) +
-                     " is not planar" + hint);
-  const auto [origin, n] = cad.plane(1);
-  const double tol = 1e-7 * cad.boundingDiagonal();
-  for (int f = 2; f <= cad.numFaces(); ++f) {
-    const auto [o, m] = cad.plane(f);
-    if (std::abs(n.dot(m)) < 1.0 - 1e-9 || std::abs(n.dot(o - origin)) > tol)
-      throw CadError(cad.sourceName() + " has no solid and its faces are not in one plane (" +
-                     cadEntityName(2, f) + " is not in the plane of Face1)" + hint);
-  }
-  normal = n;
-  return 2;
 }
 
 struct NodeTable {
@@ -181,8 +160,14 @@ void orientPlanarMesh(Mesh& mesh, ElementBlock& tris) {
 
 Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
   Eigen::Vector3d normal(0.0, 0.0, 1.0);
-  const int dim = meshDimension(cad, normal);
-  checkSize(cad, options.size, dim);
+  const int dim = modelMeshDimension(cad, normal);
+  const bool field = static_cast<bool>(options.sizeField);
+  if (field) {
+    if (!(options.minSize > 0.0) || !(options.maxSize >= options.minSize))
+      throw ParameterError("a size field needs bounds 0 < minSize <= maxSize");
+  } else {
+    checkSize(cad, options.size, dim);
+  }
 
   Mesh mesh;
   mesh.dim = dim;
@@ -201,17 +186,26 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
     gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
     gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
     gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeMax", size);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", field ? options.maxSize : size);
+    gmsh::option::setNumber("Mesh.MeshSizeMin", field ? options.minSize : 0.0);
     gmsh::option::setNumber("Mesh.ElementOrder", 1);
-    gmsh::model::mesh::setSizeCallback([size](int, int, double, double, double) { return size; });
+    if (field) {
+      const SizeField& f = options.sizeField;
+      gmsh::model::mesh::setSizeCallback(
+          [&f](int, int, double x, double y, double z) { return f(Eigen::Vector3d(x, y, z)); });
+    } else {
+      gmsh::model::mesh::setSizeCallback([size](int, int, double, double, double) { return size; });
+    }
     try {
       gmsh::model::mesh::generate(dim);
     } catch (const std::string& message) {
-      throw MeshingError("Gmsh could not mesh " + cad.sourceName() + " with size " +
-                         formatNumber(size) + ": " + message +
-                         (message.find("No elements") != std::string::npos
-                              ? " (the size may be too large for a thin part)"
-                              : ""));
+      throw MeshingError(
+          "Gmsh could not mesh " + cad.sourceName() +
+          (field ? std::string(" with the sizing field") : " with size " + formatNumber(size)) +
+          ": " + message +
+          (message.find("No elements") != std::string::npos
+               ? " (the size may be too large for a thin part)"
+               : ""));
     }
 
     NodeTable table;

@@ -119,8 +119,11 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   result.options = options;
 
   StageClock linear("linear", result.timings, observer);
-  const Mesh linearMesh =
-      generateLinearMesh(*result.cad, {*options.size, options.threads, options.verbosity});
+  LinearMeshOptions linearOptions;
+  linearOptions.size = *options.size;
+  linearOptions.threads = options.threads;
+  linearOptions.verbosity = options.verbosity;
+  const Mesh linearMesh = generateLinearMesh(*result.cad, linearOptions);
   linear.done();
 
   checkHighOrderMemory(linearMesh, options.order);

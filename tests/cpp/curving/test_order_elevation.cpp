@@ -56,7 +56,7 @@ TEST_P(SphereOrders, NodesAreSharedAndBoundaryNodesLieOnTheSphere) {
   const int order = GetParam();
   const double radius = 1.0;
   const CadModel cad = test::toModel(test::sphere(radius));
-  const Mesh linear = generateLinearMesh(cad, {0.45, 1, 0});
+  const Mesh linear = generateLinearMesh(cad, LinearMeshOptions::uniform(0.45));
   const Mesh mesh = elevateOrder(linear, order, &cad);
   ASSERT_EQ(mesh.order, order);
 
@@ -115,7 +115,7 @@ INSTANTIATE_TEST_SUITE_P(Orders1To6, SphereOrders, ::testing::Range(1, 7));
 
 TEST(OrderElevation, WithoutCadTheElementsStayStraight) {
   const CadModel cad = test::toModel(test::boxWithHole());
-  const Mesh linear = generateLinearMesh(cad, {0.8, 1, 0});
+  const Mesh linear = generateLinearMesh(cad, LinearMeshOptions::uniform(0.8));
   const Mesh mesh = elevateOrder(linear, 5, nullptr);
   const ElementBlock& tets = mesh.blocks[0];
   const ReferenceElement& ref = ReferenceElement::get(CellType::Tetrahedron, 5);
@@ -133,7 +133,7 @@ TEST(OrderElevation, WithoutCadTheElementsStayStraight) {
 TEST(OrderElevation, CurvedCylinderKeepsValidElements) {
   const double r = 1.0;
   const CadModel cad = test::toModel(test::cylinder(r, 2.0));
-  const Mesh mesh = elevateOrder(generateLinearMesh(cad, {0.4, 1, 0}), 4, &cad);
+  const Mesh mesh = elevateOrder(generateLinearMesh(cad, LinearMeshOptions::uniform(0.4)), 4, &cad);
   for (std::size_t i = 0; i < mesh.numNodes(); ++i) {
     if (mesh.nodeCadDim[i] != 1) continue;
     const Eigen::Vector3d x = nodePoint(mesh, i);
@@ -148,7 +148,7 @@ TEST(OrderElevation, CurvedCylinderKeepsValidElements) {
 
 TEST(OrderElevation, RejectsBadOrders) {
   const CadModel cad = test::toModel(test::box(1, 1, 1));
-  const Mesh linear = generateLinearMesh(cad, {0.5, 1, 0});
+  const Mesh linear = generateLinearMesh(cad, LinearMeshOptions::uniform(0.5));
   EXPECT_THROW(elevateOrder(linear, 0, &cad), ParameterError);
   EXPECT_THROW(elevateOrder(linear, 11, &cad), ParameterError);
   const Mesh quadratic = elevateOrder(linear, 2, &cad);

@@ -31,13 +31,13 @@ namespace {
 
 Mesh curvedBoxWithHole(int order) {
   const CadModel cad = test::toModel(test::boxWithHole());
-  return elevateOrder(generateLinearMesh(cad, {0.9, 1, 0}), order, &cad);
+  return elevateOrder(generateLinearMesh(cad, LinearMeshOptions::uniform(0.9)), order, &cad);
 }
 
 Mesh curvedPlate(int order) {  // 2D: a planar face with a hole is not needed, a disc will do
   const TopoDS_Shape face = BRepBuilderAPI_MakeFace(gp_Pln(gp::Origin(), gp::DZ()), -2, 2, -1, 1);
   const CadModel cad = test::toModel(face);
-  return elevateOrder(generateLinearMesh(cad, {0.6, 1, 0}), order, &cad);
+  return elevateOrder(generateLinearMesh(cad, LinearMeshOptions::uniform(0.6)), order, &cad);
 }
 
 void expectSameMesh(const Mesh& a, const Mesh& b, double tol) {
@@ -269,7 +269,7 @@ TEST(MshWriter, GmshOpensOurFilesAtEveryOrder) {
   const auto dir = test::tempDir();
   const std::string path = (dir / "ours.msh").string();
   const CadModel cad = test::toModel(test::sphere(1.0));
-  const Mesh linear = generateLinearMesh(cad, {0.8, 1, 0});
+  const Mesh linear = generateLinearMesh(cad, LinearMeshOptions::uniform(0.8));
   for (int order = 1; order <= 10; ++order) {  // tetrahedra, triangles, lines
     writeMesh(elevateOrder(linear, order, &cad), path, {}, {order % 2 == 0, false});
     const Mesh mesh = readMsh(path);

@@ -24,7 +24,7 @@ namespace {
 
 Mesh curvedBoxWithHole(int order) {
   const CadModel cad = test::toModel(test::boxWithHole());
-  return elevateOrder(generateLinearMesh(cad, {0.9, 1, 0}), order, &cad);
+  return elevateOrder(generateLinearMesh(cad, LinearMeshOptions::uniform(0.9)), order, &cad);
 }
 
 std::vector<CellField> fieldFor(const Mesh& mesh) {

@@ -54,7 +54,7 @@ void expectParametersReproduceNodes(const Mesh& mesh, const CadModel& cad, doubl
 // records the right SolidN), and every node's parameters reproduce it.
 void expectSolidsFilled(const TopoDS_Shape& shape, double size) {
   const CadModel cad = test::toModel(shape);
-  const Mesh mesh = generateLinearMesh(cad, {size, 1, 0});
+  const Mesh mesh = generateLinearMesh(cad, LinearMeshOptions::uniform(size));
   std::map<int, double> volumeBySolid;
   const ElementBlock& tets = mesh.blocks[0];
   for (std::size_t e = 0; e < tets.count(); ++e)
@@ -72,7 +72,7 @@ void expectSolidsFilled(const TopoDS_Shape& shape, double size) {
 
 TEST(LinearMesher, BoxWithHoleGivesPositiveTetsFillingTheVolume) {
   const CadModel cad = test::toModel(test::boxWithHole());
-  const Mesh mesh = generateLinearMesh(cad, {0.5, 1, 0});
+  const Mesh mesh = generateLinearMesh(cad, LinearMeshOptions::uniform(0.5));
   ASSERT_EQ(mesh.dim, 3);
   const ElementBlock& tets = mesh.blocks[0];
   ASSERT_EQ(tets.type, CellType::Tetrahedron);
@@ -146,7 +146,7 @@ TEST(LinearMesher, PlanarFaceGivesOrientedTriangles) {
   const gp_Pln plane(gp_Pnt(1, 2, 3), gp_Dir(1, 1, 1));
   const TopoDS_Shape face = BRepBuilderAPI_MakeFace(plane, -2.0, 2.0, -1.0, 1.0).Shape();
   const CadModel cad = test::toModel(face);
-  const Mesh mesh = generateLinearMesh(cad, {0.25, 1, 0});
+  const Mesh mesh = generateLinearMesh(cad, LinearMeshOptions::uniform(0.25));
   ASSERT_EQ(mesh.dim, 2);
   const Eigen::Vector3d n(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
   EXPECT_NEAR(std::abs(n.dot(Eigen::Vector3d(1, 1, 1).normalized())), 1.0, 1e-12);
@@ -178,15 +178,16 @@ TEST(LinearMesher, RejectsWhatItCannotMesh) {
   ASSERT_GT(lateral, 0);
   const CadModel curved = test::toModel(faces(lateral));
   try {
-    generateLinearMesh(curved, {0.5, 1, 0});
+    generateLinearMesh(curved, LinearMeshOptions::uniform(0.5));
     FAIL();
   } catch (const CadError& e) {
     EXPECT_NE(std::string(e.what()).find("Face1"), std::string::npos);
   }
   const CadModel cube = test::toModel(test::box(1, 1, 1));
-  EXPECT_THROW(generateLinearMesh(cube, {0.0, 1, 0}), ParameterError);
-  EXPECT_THROW(generateLinearMesh(cube, {-1.0, 1, 0}), ParameterError);
-  EXPECT_THROW(generateLinearMesh(cube, {1e-5, 1, 0}), ParameterError);  // ~1e16 elements
+  EXPECT_THROW(generateLinearMesh(cube, LinearMeshOptions::uniform(0.0)), ParameterError);
+  EXPECT_THROW(generateLinearMesh(cube, LinearMeshOptions::uniform(-1.0)), ParameterError);
+  EXPECT_THROW(generateLinearMesh(cube, LinearMeshOptions::uniform(1e-5)),
+               ParameterError);  // ~1e16 elements
 }
 
 }  // namespace

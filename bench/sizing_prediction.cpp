@@ -1,0 +1,121 @@
+// Sizing octree benchmark: for each case, the time to build the octree and predict the element
+// count against the time Gmsh takes to make the linear mesh from it (in the same process), and
+// the predicted against the actual element count.
+//
+//   bench_sizing_prediction [--threads N] CASE...
+//   CASE = CAD:MIN:MAX:EPS[:SCALE]  (sizes from curvature; MIN == MAX gives a uniform size;
+//          SCALE 0.001 reads a millimetre CAD in metres, as NekMesh does)
+//
+// Prints one line per case and, with --calibrate, the fitted densities of the prediction model
+// (see cpp/sizing/element_count.hpp) by least squares over all cases.
+#include <Eigen/Dense>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cad/cad_model.hpp"
+#include "linear/linear_mesher.hpp"
+#include "sizing/element_count.hpp"
+#include "sizing/sizing_octree.hpp"
+
+namespace {
+
+double seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+struct Case {
+  std::string cad;
+  homesh::SizingParameters params;
+  double scale = 1.0;  // 0.001: the CAD is in millimetres and the sizes in metres (NekMesh)
+};
+
+Case parseCase(const std::string& text) {
+  Case c;
+  std::vector<std::string> parts;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ':');) parts.push_back(item);
+  if (parts.size() != 4 && parts.size() != 5)
+    throw std::runtime_error("case must be CAD:MIN:MAX:EPS[:SCALE], got " + text);
+  if (parts.size() == 5) c.scale = std::stod(parts[4]);
+  c.cad = parts[0];
+  c.params.minDelta = std::stod(parts[1]);
+  c.params.maxDelta = std::stod(parts[2]);
+  c.params.eps = std::stod(parts[3]);
+  return c;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    int threads = 1;
+    bool calibrate = false, gradientTerm = false;
+    std::vector<Case> cases;
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (a == "--threads" && i + 1 < argc)
+        threads = std::atoi(argv[++i]);
+      else if (a == "--calibrate")
+        calibrate = true;
+      else if (a == "--gradient-term")
+        gradientTerm = true;
+      else
+        cases.push_back(parseCase(a));
+    }
+    std::vector<Eigen::Vector3d> rows;
+    std::vector<double> actual;
+    std::printf("%-28s %8s %8s %9s %9s %9s %7s %7s\n", "case", "leaves", "octree_s", "predict_s",
+                "mesh_s", "predicted", "actual", "ratio");
+    for (const Case& c : cases) {
+      const homesh::CadModel cad = homesh::CadModel::fromFile(c.cad).scaled(c.scale);
+      auto t0 = std::chrono::steady_clock::now();
+      const homesh::SizingOctree tree = homesh::SizingOctree::build(cad, c.params);
+      const double octreeSeconds = seconds(t0);
+      t0 = std::chrono::steady_clock::now();
+      const homesh::ElementCountPrediction p = homesh::predictElementCount(tree);
+      const double predictSeconds = seconds(t0);
+      homesh::LinearMeshOptions options;
+      options.threads = threads;
+      options.sizeField = [&tree](const Eigen::Vector3d& x) { return tree.delta(x); };
+      options.minSize = c.params.minDelta;
+      options.maxSize = c.params.maxDelta;
+      t0 = std::chrono::steady_clock::now();
+      const homesh::Mesh mesh = homesh::generateLinearMesh(cad, options);
+      const double meshSeconds = seconds(t0);
+      const double n = static_cast<double>(mesh.numElements());
+      const std::string name = c.cad.substr(c.cad.find_last_of('/') + 1) + ":" +
+                               std::to_string(c.params.maxDelta).substr(0, 6);
+      std::printf("%-28s %8zu %8.3f %9.3f %9.3f %9.0f %7.0f %7.3f  (octree+predict / mesh %.3f)\n",
+                  name.c_str(), tree.numLeaves(), octreeSeconds, predictSeconds, meshSeconds,
+                  p.elements, n, p.elements / n, (octreeSeconds + predictSeconds) / meshSeconds);
+      std::printf(
+          "    volume integral %.6g, boundary integral %.6g, gradient integral %.6g, domain %.6g\n",
+          p.volumeIntegral, p.boundaryIntegral, p.gradientIntegral, p.domainMeasure);
+      rows.emplace_back(p.volumeIntegral, p.boundaryIntegral, p.gradientIntegral);
+      actual.push_back(n);
+    }
+    if (calibrate && rows.size() >= 2) {
+      // Relative least squares: minimise sum ((a V + b B) / N - 1)^2.
+      const int terms = gradientTerm ? 3 : 2;
+      Eigen::MatrixXd A(rows.size(), terms);
+      Eigen::VectorXd y = Eigen::VectorXd::Ones(rows.size());
+      for (std::size_t i = 0; i < rows.size(); ++i)
+        A.row(i) = rows[i].head(terms).transpose() / actual[i];
+      const Eigen::VectorXd ab = A.colPivHouseholderQr().solve(y);
+      std::printf("fit: volume density %.4f, boundary density %.4f, gradient density %.4f\n", ab[0],
+                  ab[1], terms == 3 ? ab[2] : 0.0);
+      for (std::size_t i = 0; i < rows.size(); ++i)
+        std::printf("    case %zu: fitted/actual %.3f\n", i + 1,
+                    rows[i].head(terms).dot(ab) / actual[i]);
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_sizing_prediction: %s\n", e.what());
+    return 1;
+  }
+}

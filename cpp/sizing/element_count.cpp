@@ -1,0 +1,72 @@
+#include "sizing/element_count.hpp"
+
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "sizing/sizing_octree.hpp"
+
+namespace homesh {
+namespace {
+
+// The densities of the model in element_count.hpp for Gmsh 4.8 (3D: Delaunay with its default
+// optimisation; 2D: Frontal-Delaunay) driven by our size callback. Fitted by least squares with
+// `bench_sizing_prediction --calibrate [--gradient-term]` on cases that are not the NekMesh
+// peer cases the acceptance checks (bench/README.md lists them):
+//  - 3D, uniform sizes on tests/data/sphere.brep, box_hole.step and examples/bracket.step
+//    (1 200 to 41 000 tets, fitted/actual 0.97 to 1.03). The gradient term is not significant
+//    in 3D on the graded cases we have (its fit is small and changes sign), so it is left out.
+//  - 2D, uniform and graded sizes on the peer aerofoil and T106 geometries with parameters other
+//    than the peer cases' (fitted/actual 0.98 to 1.02); a regular triangle gives 4/sqrt(3) = 2.31.
+constexpr double kVolumeDensity3 = 4.14;
+constexpr double kBoundaryDensity3 = 1.33;
+constexpr double kGradientDensity3 = 0.0;
+constexpr double kAreaDensity2 = 2.309;
+constexpr double kBoundaryDensity2 = 0.465;
+constexpr double kGradientDensity2 = 1.41;
+
+}  // namespace
+
+ElementCountPrediction predictElementCount(const SizingOctree& tree) {
+  ElementCountPrediction out;
+  out.dim = tree.dim();
+  const int d = out.dim;
+  // One pass over the leaves for both domain integrals.
+  double volume = 0.0, gradient = 0.0;
+  const std::int64_t leaves = static_cast<std::int64_t>(tree.numLeaves());
+  const bool withGradient = (d == 3 ? kGradientDensity3 : kGradientDensity2) != 0.0;
+#pragma omp parallel reduction(+ : volume, gradient)
+  {
+    std::vector<SizingOctree::QuadraturePoint> points;
+#pragma omp for schedule(dynamic, 256)
+    for (std::int64_t i = 0; i < leaves; ++i) {
+      tree.leafQuadrature(static_cast<std::size_t>(i), points, withGradient);
+      for (const SizingOctree::QuadraturePoint& q : points) {
+        const double h = tree.delta(q.x);
+        const double density = q.weight / (d == 3 ? h * h * h : h * h);
+        volume += density;
+        gradient += density * q.gradient;
+      }
+    }
+  }
+  out.volumeIntegral = volume;
+  out.gradientIntegral = gradient;
+  out.domainMeasure = tree.domainMeasure();
+  const std::vector<BoundarySample>& samples = tree.samples();
+  double boundary = 0.0;
+#pragma omp parallel for reduction(+ : boundary) schedule(static)
+  for (std::int64_t i = 0; i < static_cast<std::int64_t>(samples.size()); ++i) {
+    const BoundarySample& s = samples[static_cast<std::size_t>(i)];
+    const double h = tree.delta(s.x);
+    boundary += (s.internal ? 2.0 : 1.0) * s.weight / (d == 3 ? h * h : h);
+  }
+  out.boundaryIntegral = boundary;
+  out.elements =
+      d == 3
+          ? kVolumeDensity3 * volume + kBoundaryDensity3 * boundary + kGradientDensity3 * gradient
+          : kAreaDensity2 * volume + kBoundaryDensity2 * boundary + kGradientDensity2 * gradient;
+  return out;
+}
+
+}  // namespace homesh

@@ -1,0 +1,130 @@
+// The sizing octree: the mesh size field delta(x) of a CAD model (DESIGN.md section 2).
+//
+// Built once from the CAD and the SizingParameters: curvature samples and user sources set the
+// sizes of the octants they fall in; octants are divided until each is no larger than its size
+// (and boundary octants no larger than maxDelta), neighbours differ by at most one level (2:1
+// balance), sizes are graded outward (|delta_i - delta_j| <= gradation * distance between
+// centres, propagated shortest-path fashion from the sized octants) and every leaf is classified
+// inside, outside or on the boundary of the domain (with the fraction of it inside).
+//
+// A 2D (planar) model gets a quadtree in the model's plane; everything else is the same.
+//
+// delta(x) interpolates the leaf sizes (multilinearly between corner values, each the mean of the
+// leaves meeting at that corner), clamps to [minDelta, maxDelta] and takes the minimum with the
+// sources containing x. It is const and allocation-free: any number of threads may query one
+// octree at once.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "sizing/boundary_sampling.hpp"
+#include "sizing/sizing_parameters.hpp"
+
+namespace homesh {
+
+class CadModel;
+
+struct OctreeStatistics {
+  std::size_t leaves = 0, insideLeaves = 0, boundaryLeaves = 0, outsideLeaves = 0;
+  int maxLevel = 0;
+  std::size_t boundarySamples = 0, sizedSamples = 0;
+  double smallestDelta = 0.0;  // over leaves that are not outside
+  double buildSeconds = 0.0;
+};
+
+class SizingOctree {
+ public:
+  enum class Location : std::uint8_t { Outside, Boundary, Inside };
+
+  struct Leaf {
+    Eigen::Vector3d centre;  // model coordinates
+    double halfWidth = 0.0;
+    int level = 0;
+    double delta = 0.0;  // the leaf's size after gradation
+    Location location = Location::Outside;
+    double insideFraction = 0.0;  // of its volume (area in 2D)
+  };
+
+  // Throws ParameterError (bad parameters), CadError (no solid and not planar, OCCT failure).
+  static SizingOctree build(const CadModel& cad, const SizingParameters& params);
+
+  // The size at x (model coordinates). Thread-safe.
+  double delta(const Eigen::Vector3d& x) const;
+
+  int dim() const { return dim_; }
+  const SizingParameters& parameters() const { return params_; }
+  const OctreeStatistics& statistics() const { return stats_; }
+  std::size_t numLeaves() const { return leaves_.size(); }
+  Leaf leaf(std::size_t i) const;
+  // Leaves sharing a face (an edge in 2D) with leaf i.
+  std::vector<std::size_t> leafNeighbours(std::size_t i) const;
+  // The boundary samples the octree was built from (model coordinates).
+  const std::vector<BoundarySample>& samples() const { return samples_; }
+
+  // A point of the rule that integrates over the domain: position (model coordinates), weight,
+  // and the norm of the gradient of the leaf's interpolated size there.
+  struct QuadraturePoint {
+    Eigen::Vector3d x;
+    double weight = 0.0;
+    double gradient = 0.0;
+  };
+
+  // Volume (area in 2D) of the domain as the octree sees it.
+  double domainMeasure() const;
+
+  // The points integrating over the inside part of leaf i (their weights sum to its inside
+  // volume or area): a 2-point Gauss rule per axis inside, the inside sub-cells'
+  // centres on the boundary, none outside. The gradients are left 0 unless `withGradient`.
+  void leafQuadrature(std::size_t i, std::vector<QuadraturePoint>& points,
+                      bool withGradient = true) const;
+
+  // Where the mesh plane is (2D): origin and unit normal; for 3D: zero and +z.
+  Eigen::Vector3d planeOrigin() const { return origin_; }
+  Eigen::Vector3d planeNormal() const { return axes_.col(2); }
+
+ private:
+  struct Node {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // local coordinates
+    double half = 0.0;
+    std::int32_t firstChild = -1;
+    std::int32_t level = 0;
+    std::array<std::int32_t, 3> index{0, 0, 0};  // integer position at its level
+  };
+  struct LeafData {
+    std::int32_t node = 0;
+    double delta = 0.0;
+    Location location = Location::Outside;
+    float insideFraction = 0.0f;
+    std::array<float, 8> corner{};         // sizes at the corners, bit k of the index for axis k
+    std::vector<std::uint8_t> insideMask;  // boundary leaves: which sub-cells are inside
+  };
+
+  Eigen::Vector3d toLocal(const Eigen::Vector3d& x) const {
+    return axes_.transpose() * (x - origin_);
+  }
+  Eigen::Vector3d toModel(const Eigen::Vector3d& q) const { return origin_ + axes_ * q; }
+  std::int32_t findLeafNode(const Eigen::Vector3d& q) const;
+  double interpolate(const LeafData& leaf, const Eigen::Vector3d& q) const;
+  double gradientNorm(const LeafData& leaf, const Eigen::Vector3d& q) const;
+  int children() const { return 1 << dim_; }
+  int subdivisions() const { return dim_ == 3 ? 3 : 6; }  // sub-cells per axis for boundary leaves
+
+  friend class OctreeBuilder;
+
+  int dim_ = 3;
+  SizingParameters params_;
+  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d axes_ = Eigen::Matrix3d::Identity();  // columns: local x, y, z (normal in 2D)
+  std::vector<Node> nodes_;
+  std::vector<LeafData> leaves_;
+  std::vector<std::int32_t> leafOfNode_;  // node -> leaf index, -1 for internal nodes
+  std::vector<std::int64_t> neighbourStart_;
+  std::vector<std::int32_t> neighbours_;
+  std::vector<BoundarySample> samples_;
+  OctreeStatistics stats_;
+};
+
+}  // namespace homesh

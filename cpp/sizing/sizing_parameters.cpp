@@ -1,0 +1,37 @@
+#include "sizing/sizing_parameters.hpp"
+
+#include <cmath>
+
+#include "core/error.hpp"
+#include "core/format.hpp"
+
+namespace homesh {
+namespace {
+
+bool positive(double x) {
+  return x > 0.0 && std::isfinite(x);
+}
+
+}  // namespace
+
+void SizingParameters::validate() const {
+  if (!positive(minDelta))
+    throw ParameterError("MinDelta must be a positive number, got " + formatNumber(minDelta));
+  if (!positive(maxDelta))
+    throw ParameterError("MaxDelta must be a positive number, got " + formatNumber(maxDelta));
+  if (minDelta > maxDelta)
+    throw ParameterError("MinDelta (" + formatNumber(minDelta) + ") must not exceed MaxDelta (" +
+                         formatNumber(maxDelta) + ")");
+  if (!(eps > 0.0 && eps <= 1.0))
+    throw ParameterError("EPS must lie in (0, 1], got " + formatNumber(eps));
+  if (!positive(gradation))
+    throw ParameterError("the gradation must be a positive number, got " + formatNumber(gradation));
+  for (std::size_t i = 0; i < sources.size(); ++i)
+    sources[i].validate("refinement source " + std::to_string(i + 1));
+}
+
+double chordSize(double radius, double eps) {
+  return 2.0 * radius * std::sqrt(eps * (2.0 - eps));
+}
+
+}  // namespace homesh

@@ -1,0 +1,29 @@
+// What the user asks of the automatic mesh sizing (DESIGN.md section 2).
+//
+// The sizing field delta(x) is the target edge length at x: curvature-driven near the CAD
+// (the chord of a circle of radius R = 1/max|k| whose sagitta is EPS * R), graded away from it by
+// at most `gradation` per unit distance, clamped to [minDelta, maxDelta], and refined further by
+// the user's sources.
+#pragma once
+
+#include <vector>
+
+#include "sizing/refinement_source.hpp"
+
+namespace homesh {
+
+struct SizingParameters {
+  double minDelta = 0.0;   // smallest size curvature may ask for (> 0)
+  double maxDelta = 0.0;   // size far from curved boundaries (>= minDelta)
+  double eps = 0.1;        // sagitta relative to the radius of curvature, 0 < eps <= 1
+  double gradation = 0.2;  // largest |d delta / d x| (> 0)
+  std::vector<RefinementSource> sources;
+
+  // Throws ParameterError naming the offending parameter.
+  void validate() const;
+};
+
+// The curvature-to-size rule: delta = 2 R sqrt(eps (2 - eps)) for radius of curvature R.
+double chordSize(double radius, double eps);
+
+}  // namespace homesh
