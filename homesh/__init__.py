@@ -23,7 +23,7 @@ from ._core import (  # noqa: F401  (re-exported)
     ParameterError,
     __version__,
 )
-from .api import BoundaryBlock, HighOrderMesh, load, mesh, read  # noqa: F401
+from .api import BoundaryBlock, HighOrderMesh, load, mesh, predict, read  # noqa: F401
 
 __all__ = [
     "BoundaryBlock",
@@ -36,5 +36,6 @@ __all__ = [
     "ParameterError",
     "load",
     "mesh",
+    "predict",
     "read",
 ]

@@ -207,14 +207,82 @@ def load(path):
     return HighOrderMesh(core)
 
 
+def _sizing(min_delta, max_delta, eps, sources):
+    """The sizing dict the core takes, or None when nothing was asked (automatic sizing)."""
+    if min_delta is None and max_delta is None and eps is None and not sources:
+        return None
+    out = {}
+    for key, value in (("min_delta", min_delta), ("max_delta", max_delta), ("eps", eps)):
+        if value is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            raise ParameterError("%s must be a positive number, got %r" % (key, value))
+        if not float(value) > 0.0:
+            raise ParameterError("%s must be a positive number, got %g" % (key, value))
+        out[key] = float(value)
+    checked = []
+    for i, src in enumerate(sources or ()):
+        if not isinstance(src, dict) or "kind" not in src:
+            raise ParameterError(
+                "source %d must be a dict with 'kind' (segment, sphere, box or curve), got %r"
+                % (i + 1, src))
+        checked.append(dict(src))
+    out["sources"] = checked
+    return out
+
+
+def _cad_source(shape, name):
+    """('brep', text, label) or ('file', path, path) for a shape, path or BRep text."""
+    label = str(name) if name else "the shape"
+    if hasattr(shape, "exportBrepToString"):
+        if shape.isNull():
+            raise ParameterError("%s is null (empty)" % label)
+        return "brep", shape.exportBrepToString(), label
+    if isinstance(shape, (str, os.PathLike)):
+        text = os.fspath(shape)
+        if "\n" in text and "CASCADE Topology" in text[:200]:
+            return "brep", text, label
+        return "file", text, text
+    raise ParameterError(
+        "shape must be a Part.Shape, a CAD file path or BRep text, got %s" % type(shape).__name__)
+
+
+def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_octree=None,
+            name=None):
+    """The element count the linear mesh of a CAD shape will have, without making it.
+
+    Builds the sizing octree (curvature sizes between min_delta and max_delta with sagitta
+    ratio eps, graded by 0.2; None: automatic, see ``homesh mesh --help``) and integrates it.
+    sources: refinement regions, dicts such as ``{"kind": "sphere", "a": (0, 0, 0),
+    "radius": 1, "delta": 0.05}``, ``{"kind": "segment", "a": ..., "b": ..., "radius": ...,
+    "delta": ...}``, ``{"kind": "box", "a": lo, "b": hi, "delta": ...}`` or ``{"kind":
+    "curve", "edge": 3, "radius": ..., "delta": ...}``. write_octree: a .vtu path for the
+    octree's leaves and sizes.
+
+    Returns the report as a dict: "predicted_elements", "dimension" and "sizing" (parameters,
+    integrals and octree statistics).
+    """
+    sizing = _sizing(min_delta, max_delta, eps, sources)
+    octree = "" if write_octree is None else os.fspath(write_octree)
+    kind, value, label = _cad_source(shape, name)
+    if kind == "brep":
+        text = _core.predict_brep(value, label, sizing, octree)
+    else:
+        text = _core.predict_file(value, sizing, octree)
+    return json.loads(text)
+
+
 def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
-         optimise=0):
+         optimise=0, min_delta=None, max_delta=None, eps=None, sources=()):
     """Meshes a CAD shape with curved elements of the given order.
 
     shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
               a .step/.stp/.iges/.igs/.brep/.brp file, or BRep text.
     order     polynomial order, 1..10.
-    size      target element size (a positive length); None: bounding-box diagonal / 20.
+    size      a uniform target element size (a positive length) instead of the sizing octree.
+    min_delta, max_delta, eps, sources
+              sizing octree parameters, as for :func:`predict`; all None (and no size):
+              automatic sizing. ``report()`` then has "predicted_elements" and "sizing".
     threads   threads the core may use.
     progress  optional ``callable(stage, seconds)``: called with ``seconds=None`` when a stage
               starts and with its duration when it ends. Raising inside it cancels the job
@@ -238,23 +306,17 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
             raise ParameterError("size must be a positive length, got %g" % size)
     if progress is not None and not callable(progress):
         raise ParameterError("progress must be callable")
+    sizing = _sizing(min_delta, max_delta, eps, sources)
+    if size is not None and sizing is not None:
+        raise ParameterError("give either size (uniform) or the sizing octree parameters")
 
-    label = str(name) if name else "the shape"
-    if hasattr(shape, "exportBrepToString"):
-        if shape.isNull():
-            raise ParameterError("%s is null (empty)" % label)
-        core = _core.mesh_brep(shape.exportBrepToString(), label, order, size, threads,
-                               verbosity, progress, optimise)
-    elif isinstance(shape, (str, os.PathLike)):
-        text = os.fspath(shape)
-        if "\n" in text and "CASCADE Topology" in text[:200]:
-            core = _core.mesh_brep(text, label, order, size, threads, verbosity, progress, optimise)
-        else:
-            core = _core.mesh_file(text, order, size, threads, verbosity, progress, optimise)
+    kind, value, label = _cad_source(shape, name)
+    if kind == "brep":
+        core = _core.mesh_brep(value, label, order, size, threads, verbosity, progress, optimise,
+                               sizing)
     else:
-        raise ParameterError(
-            "shape must be a Part.Shape, a CAD file path or BRep text, got %s"
-            % type(shape).__name__)
+        core = _core.mesh_file(value, order, size, threads, verbosity, progress, optimise,
+                               sizing)
     return HighOrderMesh(core)
 
 

@@ -88,6 +88,77 @@ void addCommon(OptionTable& table, CommonOptions& c, bool outputs, bool report) 
     table.value({"--report"}, [&c](const std::string&, const std::string& v) { c.report = v; });
 }
 
+// "a,b,c,..." as exactly n numbers.
+std::vector<double> parseList(const std::string& option, const std::string& text, std::size_t n,
+                              const char* layout) {
+  std::vector<double> values;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    try {
+      values.push_back(parseNumber(option, item));
+    } catch (const UsageError&) {
+      throw UsageError{option + " expects " + layout + ", got '" + text + "'"};
+    }
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (values.size() != n)
+    throw UsageError{option + " expects " + layout + " (" + std::to_string(n) + " numbers), got '" +
+                     text + "'"};
+  return values;
+}
+
+void addSizing(OptionTable& table, SizingFlags& f) {
+  const auto positive = [](const std::string& o, const std::string& v) {
+    const double x = parseNumber(o, v);
+    if (!(x > 0.0)) throw UsageError{o + " must be a positive number, got " + v};
+    return x;
+  };
+  table.value({"--min-delta"}, [&f, positive](const std::string& o, const std::string& v) {
+    f.minDelta = positive(o, v);
+  });
+  table.value({"--max-delta"}, [&f, positive](const std::string& o, const std::string& v) {
+    f.maxDelta = positive(o, v);
+  });
+  table.value({"--eps"}, [&f](const std::string& o, const std::string& v) {
+    f.eps = parseNumber(o, v);
+    if (!(*f.eps > 0.0 && *f.eps <= 1.0)) throw UsageError{"--eps must lie in (0, 1], got " + v};
+  });
+  const auto check = [](const std::string& o, const RefinementSource& s) {
+    try {
+      s.validate(o);
+    } catch (const Error& e) {
+      throw UsageError{e.what()};
+    }
+    return s;
+  };
+  table.value({"--refine-line"}, [&f, check](const std::string& o, const std::string& v) {
+    const auto x = parseList(o, v, 8, "X1,Y1,Z1,X2,Y2,Z2,R,D");
+    f.sources.push_back(
+        check(o, RefinementSource::segment({x[0], x[1], x[2]}, {x[3], x[4], x[5]}, x[6], x[7])));
+  });
+  table.value({"--refine-sphere"}, [&f, check](const std::string& o, const std::string& v) {
+    const auto x = parseList(o, v, 5, "X,Y,Z,R,D");
+    f.sources.push_back(check(o, RefinementSource::sphere({x[0], x[1], x[2]}, x[3], x[4])));
+  });
+  table.value({"--refine-box"}, [&f, check](const std::string& o, const std::string& v) {
+    const auto x = parseList(o, v, 7, "X0,Y0,Z0,X1,Y1,Z1,D");
+    f.sources.push_back(
+        check(o, RefinementSource::box({x[0], x[1], x[2]}, {x[3], x[4], x[5]}, x[6])));
+  });
+  table.value({"--refine-curve"}, [&f, check](const std::string& o, const std::string& v) {
+    const auto x = parseList(o, v, 3, "EDGE,R,D");
+    if (x[0] < 1 || x[0] != std::floor(x[0]))
+      throw UsageError{o + ": the edge number must be a whole number >= 1, got '" + v + "'"};
+    f.sources.push_back(check(o, RefinementSource::curve(static_cast<int>(x[0]), x[1], x[2])));
+  });
+  table.value({"--write-octree"},
+              [&f](const std::string&, const std::string& v) { f.writeOctree = v; });
+}
+
 std::string onlyInput(const std::vector<std::string>& positional, const std::string& command,
                       const char* what) {
   if (positional.empty()) throw UsageError{"'homesh " + command + "' needs " + what};
@@ -102,12 +173,14 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   addCommon(table, cmd.common, true, true);
   table.value({"--order", "-p"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.order = parseInteger(o, v);
-    if (cmd.order < 1 || cmd.order > 10) throw UsageError{"--order must be from 1 to 10, got " + v};
+    if (*cmd.order < 1 || *cmd.order > 10)
+      throw UsageError{"--order must be from 1 to 10, got " + v};
   });
   table.value({"--size", "-s"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.size = parseNumber(o, v);
     if (!(*cmd.size > 0.0)) throw UsageError{"--size must be a positive length, got " + v};
   });
+  addSizing(table, cmd.sizing);
   bool optimise = false;
   std::optional<int> maxiter;
   table.flag({"--optimise", "--optimize"}, [&optimise] { optimise = true; });
@@ -117,9 +190,24 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   });
   table.flag({"--verbose", "-v"}, [&cmd] { ++cmd.verbosity; });
   table.flag({"-vv"}, [&cmd] { cmd.verbosity += 2; });
-  cmd.input = onlyInput(table.parse(args, 1, "mesh"), "mesh", "an INPUT CAD file");
+  cmd.input = onlyInput(table.parse(args, 1, "mesh"), "mesh", "an INPUT CAD or .mcf file");
   if (maxiter && !optimise) throw UsageError{"--maxiter needs --optimise"};
+  if (cmd.size && (cmd.sizing.anyDelta() || !cmd.sizing.sources.empty()))
+    throw UsageError{
+        "--size (uniform) cannot be combined with the octree's --min-delta, "
+        "--max-delta, --eps or --refine-*"};
+  if (cmd.size && cmd.sizing.writeOctree)
+    throw UsageError{"--write-octree needs octree sizing, not --size"};
   if (optimise) cmd.optimiseIterations = maxiter.value_or(100);
+  return cmd;
+}
+
+PredictCommand parsePredict(const std::vector<std::string>& args) {
+  PredictCommand cmd;
+  OptionTable table;
+  addCommon(table, cmd.common, false, true);
+  addSizing(table, cmd.sizing);
+  cmd.input = onlyInput(table.parse(args, 1, "predict"), "predict", "an INPUT CAD or .mcf file");
   return cmd;
 }
 
@@ -202,7 +290,8 @@ ParsedCommand parseCommandLine(const std::vector<std::string>& args) {
     return parsed;
   }
   const bool optimise = first == "optimise" || first == "optimize";
-  if (first != "mesh" && first != "quality" && first != "convert" && !optimise)
+  if (first != "mesh" && first != "predict" && first != "quality" && first != "convert" &&
+      !optimise)
     throw UsageError{"unknown command '" + first + "'"};
   for (std::size_t i = 1; i < args.size(); ++i)
     if (args[i] == "-h" || args[i] == "--help") {
@@ -212,6 +301,9 @@ ParsedCommand parseCommandLine(const std::vector<std::string>& args) {
   if (first == "mesh") {
     parsed.kind = ParsedCommand::Kind::Mesh;
     parsed.mesh = parseMesh(args);
+  } else if (first == "predict") {
+    parsed.kind = ParsedCommand::Kind::Predict;
+    parsed.predict = parsePredict(args);
   } else if (first == "quality") {
     parsed.kind = ParsedCommand::Kind::Quality;
     parsed.quality = parseQuality(args);
@@ -231,11 +323,27 @@ std::string usageText(const std::string& topic) {
 
 Meshes a CAD model (.step .stp .iges .igs .brep .brp) with curved elements of order P:
 a linear tetrahedral mesh (triangles for planar faces) whose boundary nodes are then
-placed on the CAD at order P.
+placed on the CAD at order P. INPUT may be a NekMesh case (.mcf): its CAD (read in metres,
+as NekMesh does, or the NACA aerofoil of CADFile "NNNN"), MinDelta, MaxDelta, EPS,
+REFINEMENT lines and Order are used; the options below override them.
+
+Sizes come from the sizing octree: curvature-driven (a chord deviates from the CAD by at
+most EPS x the radius of curvature), between MinDelta and MaxDelta, graded by 0.2 per unit
+length away from curved boundaries. Without sizes: MaxDelta = bounding-box diagonal / 20,
+MinDelta = MaxDelta / 20, EPS = 0.05.
 
 options:
-  -p, --order P       polynomial order, 1..10 (default 4)
-  -s, --size H        target element size (default: bounding-box diagonal / 20)
+  -p, --order P       polynomial order, 1..10 (default 4, or the .mcf's Order)
+      --max-delta D   largest size (sets octree sizing; --min-delta defaults to D / 20,
+                      --eps to 0.05 unless a .mcf gives them)
+      --min-delta D   smallest size curvature may ask for
+      --eps E         sagitta / radius of curvature, 0 < E <= 1
+      --refine-line X1,Y1,Z1,X2,Y2,Z2,R,D    size at most D within R of a segment
+      --refine-sphere X,Y,Z,R,D             size at most D within a sphere
+      --refine-box X0,Y0,Z0,X1,Y1,Z1,D      size at most D within a box
+      --refine-curve N,R,D                  size at most D within R of CAD edge N
+      --write-octree FILE.vtu               the octree's leaves with their sizes
+  -s, --size H        a uniform size instead of the octree
       --optimise      curve the interior with the variational optimiser (hyperelastic),
                       boundary nodes sliding on the CAD curves and faces
   -n, --maxiter N     at most N optimiser sweeps (default 100)
@@ -248,6 +356,21 @@ options:
   -q, --quiet         print nothing but errors
 
 exit status: 0 success, 1 failure (file, CAD or meshing), 2 bad command line or parameter
+)";
+  if (topic == "predict")
+    return R"(usage: homesh predict INPUT [options]
+
+Builds the sizing octree of a CAD model or NekMesh case (.mcf) and prints the number of
+elements (tetrahedra, or triangles for planar faces) the linear mesh will have, with the
+octree's statistics, without making the mesh.
+
+options:
+      --max-delta D, --min-delta D, --eps E, --refine-line ..., --refine-sphere ...,
+      --refine-box ..., --refine-curve ...   as for 'homesh mesh'
+      --write-octree FILE.vtu   the octree's leaves with their sizes (ParaView)
+      --report FILE   write the JSON report ("-" for standard output)
+  -j, --threads N     threads (default 1)
+  -q, --quiet         print nothing but errors
 )";
   if (topic == "quality")
     return R"(usage: homesh quality INPUT [options]
@@ -306,7 +429,8 @@ options:
   return R"(usage: homesh COMMAND [options]
 
 commands:
-  mesh INPUT      CAD file to curved high-order mesh (homesh mesh --help)
+  mesh INPUT      CAD file or NekMesh .mcf to curved high-order mesh (homesh mesh --help)
+  predict INPUT   predicted element count and sizing octree (homesh predict --help)
   quality INPUT   certified quality of a mesh file (homesh quality --help)
   convert INPUT   mesh file to another format (homesh convert --help)
   optimise INPUT  curve the interior of a mesh file (homesh optimise --help)

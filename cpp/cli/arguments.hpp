@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "sizing/refinement_source.hpp"
+
 namespace homesh {
 
 // Thrown for malformed command lines; main() prints it with the usage hint and exits 2.
@@ -22,10 +24,19 @@ struct CommonOptions {
   bool compressed = false;            // Nektar++ XML compressed sections
 };
 
+// Sizing flags shared by `mesh` and `predict`: they override a .mcf's values.
+struct SizingFlags {
+  std::optional<double> minDelta, maxDelta, eps;
+  std::vector<RefinementSource> sources;   // --refine-line, -sphere, -box, -curve
+  std::optional<std::string> writeOctree;  // --write-octree FILE.vtu
+  bool anyDelta() const { return minDelta || maxDelta || eps; }
+};
+
 struct MeshCommand {
   std::string input;
-  int order = 4;
+  std::optional<int> order;  // unset: the .mcf's Order, else 4
   std::optional<double> size;
+  SizingFlags sizing;
   int verbosity = 0;           // -v: 1, -vv: 2
   int optimiseIterations = 0;  // --optimise: 100, --maxiter N
   CommonOptions common;
@@ -34,6 +45,12 @@ struct MeshCommand {
 struct QualityCommand {
   std::string input;
   bool strict = false;  // exit status 3 if an element is invalid or undecided
+  CommonOptions common;
+};
+
+struct PredictCommand {
+  std::string input;
+  SizingFlags sizing;
   CommonOptions common;
 };
 
@@ -56,9 +73,10 @@ struct OptimiseCommand {
 };
 
 struct ParsedCommand {
-  enum class Kind { Help, Version, Mesh, Quality, Convert, Optimise } kind = Kind::Help;
+  enum class Kind { Help, Version, Mesh, Predict, Quality, Convert, Optimise } kind = Kind::Help;
   std::string helpTopic;  // "" or a command name
   MeshCommand mesh;
+  PredictCommand predict;
   QualityCommand quality;
   ConvertCommand convert;
   OptimiseCommand optimise;

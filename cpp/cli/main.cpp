@@ -17,8 +17,10 @@
 #include "io/mesh_readers.hpp"
 #include "io/mesh_writers.hpp"
 #include "optimise/optimiser.hpp"
+#include "pipeline/case_setup.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
+#include "sizing/octree_export.hpp"
 
 namespace {
 
@@ -57,30 +59,91 @@ homesh::WriteOptions writeOptions(const homesh::CommonOptions& c) {
   return w;
 }
 
+// The case from INPUT (CAD file or .mcf) with the command line's sizing flags applied over it.
+homesh::CaseSetup setupWithFlags(const std::string& input, const homesh::SizingFlags& flags,
+                                 const std::optional<double>& size, bool quiet) {
+  homesh::CaseSetup setup = homesh::setupCase(input);
+  if (!quiet)
+    for (const std::string& notice : setup.notices)
+      std::fprintf(stderr, "homesh: note: %s\n", notice.c_str());
+  if (size) {
+    setup.options.size = size;
+    setup.options.sizing.reset();
+  } else if (flags.anyDelta() || !flags.sources.empty()) {
+    homesh::SizingParameters p = setup.options.sizing.value_or(homesh::SizingParameters{});
+    if (flags.minDelta) p.minDelta = *flags.minDelta;
+    if (flags.maxDelta) p.maxDelta = *flags.maxDelta;
+    if (flags.eps) p.eps = *flags.eps;
+    p.sources.insert(p.sources.end(), flags.sources.begin(), flags.sources.end());
+    setup.options.sizing = p;
+  }
+  if (flags.writeOctree) homesh::checkParentFolder(*flags.writeOctree);
+  return setup;
+}
+
+void printPrediction(const homesh::SizingResult& s, int dim) {
+  const homesh::OctreeStatistics& st = s.octree->statistics();
+  const homesh::SizingParameters& p = s.octree->parameters();
+  std::fprintf(stderr,
+               "homesh: sizing octree: MinDelta %g, MaxDelta %g, EPS %g, %zu sources; %zu leaves "
+               "(%zu inside, %zu boundary), depth %d, %zu boundary samples (%zu curved), "
+               "smallest size %g, %.3f s\n",
+               p.minDelta, p.maxDelta, p.eps, p.sources.size(), st.leaves, st.insideLeaves,
+               st.boundaryLeaves, st.maxLevel, st.boundarySamples, st.sizedSamples,
+               st.smallestDelta, s.seconds);
+  std::fprintf(stderr, "homesh: predicted %.0f %s (%s %g)\n", s.prediction.elements,
+               dim == 3 ? "tetrahedra" : "triangles", dim == 3 ? "domain volume" : "domain area",
+               s.prediction.domainMeasure);
+}
+
 int runMesh(const homesh::MeshCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
-  homesh::MeshingOptions options;
-  options.order = cmd.order;
-  options.size = cmd.size;
+  checkOutputs(c);
+  homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.sizing, cmd.size, c.quiet);
+  homesh::MeshingOptions& options = setup.options;
+  if (cmd.order) options.order = *cmd.order;
   options.threads = c.threads;
   options.verbosity = cmd.verbosity;
   options.optimiseIterations = cmd.optimiseIterations;
-  checkOutputs(c);
   StderrProgress progress;
   homesh::PipelineObserver* observer = c.quiet ? nullptr : &progress;
-  homesh::MeshResult result =
-      homesh::runMeshPipeline(homesh::CadSource::file(cmd.input), options, observer);
+  homesh::MeshResult result = homesh::runMeshPipeline(setup.source, options, observer);
+  if (cmd.sizing.writeOctree && result.sizing)
+    homesh::writeOctree(*result.sizing->octree, *cmd.sizing.writeOctree);
   if (!c.outputs.empty()) homesh::writeMeshOutputs(result, c.outputs, writeOptions(c), observer);
   if (!c.quiet) {
+    if (result.sizing) printPrediction(*result.sizing, result.mesh.dim);
     std::fprintf(stderr,
                  "homesh: %zu nodes, %zu elements of order %d; scaled Jacobian min %.4f mean "
                  "%.4f; %zu invalid\n",
                  result.mesh.numNodes(), result.mesh.numElements(), result.mesh.order,
                  result.quality.scaled.min, result.quality.scaled.mean, result.quality.invalid);
+    if (cmd.sizing.writeOctree)
+      std::fprintf(stderr, "homesh: wrote %s\n", cmd.sizing.writeOctree->c_str());
     for (const std::string& path : c.outputs)
       std::fprintf(stderr, "homesh: wrote %s\n", path.c_str());
   }
   if (c.report) writeReport(*c.report, homesh::meshReportJson(result, cmd.input));
+  return 0;
+}
+
+int runPredict(const homesh::PredictCommand& cmd) {
+  const homesh::CommonOptions& c = cmd.common;
+  checkOutputs(c);
+  homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.sizing, std::nullopt, c.quiet);
+  const homesh::CadModel cad = setup.source.load();
+  const homesh::SizingParameters params =
+      homesh::completeSizing(setup.options.sizing.value_or(homesh::defaultSizing(cad)), cad);
+  const homesh::SizingResult s = homesh::runSizing(cad, params);
+  if (cmd.sizing.writeOctree) homesh::writeOctree(*s.octree, *cmd.sizing.writeOctree);
+  const bool toStdout = c.report && *c.report == "-";
+  if (!c.quiet) {
+    printPrediction(s, s.octree->dim());
+    if (cmd.sizing.writeOctree)
+      std::fprintf(stderr, "homesh: wrote %s\n", cmd.sizing.writeOctree->c_str());
+  }
+  if (!toStdout) std::printf("%.0f\n", s.prediction.elements);
+  if (c.report) writeReport(*c.report, homesh::predictReportJson(s, cmd.input));
   return 0;
 }
 
@@ -211,6 +274,8 @@ int main(int argc, char** argv) {
         return 0;
       case homesh::ParsedCommand::Kind::Mesh:
         return runMesh(parsed.mesh);
+      case homesh::ParsedCommand::Kind::Predict:
+        return runPredict(parsed.predict);
       case homesh::ParsedCommand::Kind::Quality:
         return runQuality(parsed.quality);
       case homesh::ParsedCommand::Kind::Convert:

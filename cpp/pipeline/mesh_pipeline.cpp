@@ -1,5 +1,6 @@
 #include "pipeline/mesh_pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -26,6 +27,15 @@ void MeshingOptions::validate() const {
   if (optimiseIterations < 0)
     throw ParameterError("optimiser iterations must be >= 0, got " +
                          std::to_string(optimiseIterations));
+  if (size && sizing)
+    throw ParameterError(
+        "give either a uniform size or the sizing parameters (MinDelta, MaxDelta, EPS), not both");
+  if (sizing) {
+    SizingParameters check = *sizing;  // automatic values are checked once known
+    if (check.maxDelta == 0.0) check.maxDelta = std::max(1.0, check.minDelta);
+    if (check.minDelta == 0.0) check.minDelta = check.maxDelta;
+    check.validate();
+  }
 }
 
 double defaultMeshSize(const CadModel& cad) {
@@ -33,7 +43,49 @@ double defaultMeshSize(const CadModel& cad) {
 }
 
 CadModel CadSource::load() const {
-  return kind == Kind::File ? CadModel::fromFile(value) : CadModel::fromBrepText(value, name);
+  switch (kind) {
+    case Kind::File: {
+      CadModel cad = CadModel::fromFile(value);
+      return scale == 1.0 ? std::move(cad) : cad.scaled(scale);
+    }
+    case Kind::BrepText:
+      return CadModel::fromBrepText(value, name);
+    case Kind::Naca:
+      break;
+  }
+  return makeNacaDomain(naca);
+}
+
+SizingParameters defaultSizing(const CadModel& cad) {
+  SizingParameters p;
+  p.maxDelta = defaultMeshSize(cad);
+  p.minDelta = p.maxDelta / 20.0;
+  p.eps = 0.05;
+  return p;
+}
+
+SizingParameters completeSizing(SizingParameters p, const CadModel& cad) {
+  if (p.maxDelta == 0.0) p.maxDelta = defaultMeshSize(cad);
+  if (p.minDelta == 0.0) p.minDelta = p.maxDelta / 20.0;
+  return p;
+}
+
+SizingResult runSizing(const CadModel& cad, const SizingParameters& params) {
+  const auto start = std::chrono::steady_clock::now();
+  SizingResult r;
+  r.octree = std::make_shared<const SizingOctree>(SizingOctree::build(cad, params));
+  r.prediction = predictElementCount(*r.octree);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (r.prediction.elements > kMaxPredictedElements) {
+    std::ostringstream msg;
+    msg.precision(3);
+    msg << "the sizes (MinDelta " << params.minDelta << ", MaxDelta " << params.maxDelta << ", EPS "
+        << params.eps << ") would make about " << r.prediction.elements << " elements for "
+        << cad.sourceName() << ": too many (at most " << kMaxPredictedElements
+        << "); use larger MinDelta, MaxDelta or EPS";
+    throw ParameterError(msg.str());
+  }
+  return r;
 }
 
 void StageTimings::add(const std::string& stage, double s) {
@@ -115,14 +167,27 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   StageClock cad("cad", result.timings, observer);
   result.cad = std::make_shared<const CadModel>(source.load());
   cad.done();
-  if (!options.size) options.size = defaultMeshSize(*result.cad);
+  if (!options.size && !options.sizing) options.sizing = defaultSizing(*result.cad);
+  if (options.sizing) options.sizing = completeSizing(*options.sizing, *result.cad);
   result.options = options;
 
-  StageClock linear("linear", result.timings, observer);
   LinearMeshOptions linearOptions;
-  linearOptions.size = *options.size;
   linearOptions.threads = options.threads;
   linearOptions.verbosity = options.verbosity;
+  if (options.sizing) {
+    StageClock sizing("sizing", result.timings, observer);
+    result.sizing = runSizing(*result.cad, *options.sizing);
+    sizing.done();
+    const SizingOctree& octree = *result.sizing->octree;
+    linearOptions.sizeField = [&octree](const Eigen::Vector3d& x) { return octree.delta(x); };
+    linearOptions.maxSize = options.sizing->maxDelta;
+    linearOptions.minSize = options.sizing->minDelta;
+    for (const RefinementSource& src : octree.parameters().sources)
+      linearOptions.minSize = std::min(linearOptions.minSize, src.delta);
+  } else {
+    linearOptions.size = *options.size;
+  }
+  StageClock linear("linear", result.timings, observer);
   const Mesh linearMesh = generateLinearMesh(*result.cad, linearOptions);
   linear.done();
 

@@ -14,20 +14,26 @@
 #include <vector>
 
 #include "cad/cad_model.hpp"
+#include "cad/naca_aerofoil.hpp"
 #include "core/mesh.hpp"
 #include "io/mesh_writers.hpp"
 #include "optimise/optimiser.hpp"
 #include "quality/mesh_quality.hpp"
+#include "sizing/element_count.hpp"
+#include "sizing/sizing_octree.hpp"
 
 namespace homesh {
 
 inline constexpr int kMaxThreads = 1024;
 
 struct MeshingOptions {
-  int order = 4;               // polynomial order, 1..10
-  std::optional<double> size;  // target edge length (> 0); unset: defaultMeshSize(cad)
-  int threads = 1;             // threads the stages may use, 1..kMaxThreads
-  int verbosity = 0;           // 0 silent; 1 Gmsh's warnings; 2 Gmsh's information
+  int order = 4;  // polynomial order, 1..10
+  // Sizes: a uniform target edge length (> 0), or the sizing octree (sizing/sizing_octree.hpp);
+  // with neither, the octree with defaultSizing(cad).
+  std::optional<double> size;
+  std::optional<SizingParameters> sizing;  // 0 deltas: automatic (completeSizing)
+  int threads = 1;                         // threads the stages may use, 1..kMaxThreads
+  int verbosity = 0;                       // 0 silent; 1 Gmsh's warnings; 2 Gmsh's information
   // > 0: after elevation, at most this many sweeps of the variational optimiser (hyperelastic,
   // boundary nodes sliding on the CAD; optimise/optimiser.hpp), stopping earlier once the mesh
   // is proven valid and a sweep raises its worst scaled Jacobian by less than 0.001.
@@ -40,14 +46,50 @@ struct MeshingOptions {
 // A uniform size giving a coarse mesh: a twentieth of the bounding-box diagonal.
 double defaultMeshSize(const CadModel& cad);
 
+// Automatic sizing for a model given no sizes: MaxDelta = defaultMeshSize, MinDelta =
+// MaxDelta / 20, EPS = 0.05 (a chord deviates from an arc by a twentieth of its radius).
+SizingParameters defaultSizing(const CadModel& cad);
+
+// `p` with an automatic (0) maxDelta set to defaultMeshSize and an automatic minDelta to
+// min(maxDelta / 20, ...) so that it never exceeds maxDelta.
+SizingParameters completeSizing(SizingParameters p, const CadModel& cad);
+
+// The sizing octree of a model and the element count it predicts.
+struct SizingResult {
+  std::shared_ptr<const SizingOctree> octree;
+  ElementCountPrediction prediction;
+  double seconds = 0.0;  // octree and prediction
+};
+
+// Throws ParameterError (bad parameters, or a prediction above kMaxPredictedElements: sizes
+// far too small for the model) or CadError.
+inline constexpr double kMaxPredictedElements = 5e7;
+SizingResult runSizing(const CadModel& cad, const SizingParameters& params);
+
 // Where the CAD comes from.
 struct CadSource {
-  enum class Kind { File, BrepText } kind = Kind::File;
-  std::string value;  // a path, or BRep text
-  std::string name;   // for BRep text: what to call it in messages (e.g. the FreeCAD label)
-  static CadSource file(std::string path) { return {Kind::File, std::move(path), {}}; }
+  enum class Kind { File, BrepText, Naca } kind = Kind::File;
+  std::string value;   // a path, or BRep text
+  std::string name;    // for BRep text: what to call it in messages (e.g. the FreeCAD label)
+  double scale = 1.0;  // applied after loading a file: 0.001 reads a STEP in metres (NekMesh)
+  NacaDomain naca;     // for Kind::Naca
+  static CadSource file(std::string path) {
+    CadSource s;
+    s.value = std::move(path);
+    return s;
+  }
   static CadSource brepText(std::string text, std::string name = "the shape") {
-    return {Kind::BrepText, std::move(text), std::move(name)};
+    CadSource s;
+    s.kind = Kind::BrepText;
+    s.value = std::move(text);
+    s.name = std::move(name);
+    return s;
+  }
+  static CadSource nacaDomain(NacaDomain d) {
+    CadSource s;
+    s.kind = Kind::Naca;
+    s.naca = std::move(d);
+    return s;
   }
   CadModel load() const;
 };
@@ -74,6 +116,7 @@ struct MeshResult {
   Mesh mesh;
   QualitySummary quality;
   std::optional<OptimiserResult> optimiser;  // when the optimiser ran
+  std::optional<SizingResult> sizing;        // when the sizes came from the octree
   StageTimings timings;
   MeshingOptions options;
 };

@@ -98,6 +98,51 @@ void appendQuality(JsonWriter& json, const Mesh& mesh, const QualitySummary& q) 
   json.endObject();
 }
 
+void appendSizing(JsonWriter& json, const SizingResult& sizing) {
+  const SizingOctree& octree = *sizing.octree;
+  const SizingParameters& p = octree.parameters();
+  const OctreeStatistics& s = octree.statistics();
+  const ElementCountPrediction& e = sizing.prediction;
+  json.beginObject("sizing");
+  json.value("method", "octree");
+  json.value("min_delta", p.minDelta);
+  json.value("max_delta", p.maxDelta);
+  json.value("eps", p.eps);
+  json.value("gradation", p.gradation);
+  json.beginArray("sources");
+  for (const RefinementSource& src : p.sources) json.value("", src.describe());
+  json.endArray();
+  json.value("predicted_elements", static_cast<std::size_t>(std::llround(e.elements)));
+  json.value("domain_measure", e.domainMeasure);
+  json.value("volume_integral", e.volumeIntegral);
+  json.value("boundary_integral", e.boundaryIntegral);
+  json.value("gradient_integral", e.gradientIntegral);
+  json.beginObject("octree");
+  json.value("leaves", s.leaves);
+  json.value("inside_leaves", s.insideLeaves);
+  json.value("boundary_leaves", s.boundaryLeaves);
+  json.value("outside_leaves", s.outsideLeaves);
+  json.value("max_level", s.maxLevel);
+  json.value("boundary_samples", s.boundarySamples);
+  json.value("curvature_samples", s.sizedSamples);
+  json.value("smallest_delta", s.smallestDelta);
+  json.endObject();
+  json.value("seconds", sizing.seconds);
+  json.endObject();
+}
+
+std::string predictReportJson(const SizingResult& sizing, const std::string& input) {
+  JsonWriter json;
+  json.beginObject();
+  json.value("input", input);
+  json.value("dimension", sizing.octree->dim());
+  json.value("predicted_elements",
+             static_cast<std::size_t>(std::llround(sizing.prediction.elements)));
+  appendSizing(json, sizing);
+  json.endObject();
+  return json.str();
+}
+
 std::string meshReportJson(const MeshResult& result, const std::string& input) {
   JsonWriter json;
   json.beginObject();
@@ -107,6 +152,11 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
   json.value("size", result.options.size.value_or(0.0));
   json.value("nodes", result.mesh.numNodes());
   appendCounts(json, result.mesh);
+  if (result.sizing) {
+    json.value("predicted_elements",
+               static_cast<std::size_t>(std::llround(result.sizing->prediction.elements)));
+    appendSizing(json, *result.sizing);
+  }
   appendQuality(json, result.mesh, result.quality);
   if (result.optimiser) appendOptimiser(json, *result.optimiser);
   json.beginObject("timings_s");

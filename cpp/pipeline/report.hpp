@@ -24,7 +24,14 @@ const char* validityName(Validity v);
 // Appends "elements" (cells of the mesh dimension by type) and "boundary" (lower cells).
 void appendCounts(JsonWriter& json, const Mesh& mesh);
 
-// The report of `homesh mesh`: input, order, size, counts, quality, timings.
+// Appends "sizing": the parameters, the prediction and the octree's statistics.
+void appendSizing(JsonWriter& json, const SizingResult& sizing);
+
+// The report of `homesh predict`: input, dimension, "predicted_elements" and "sizing".
+std::string predictReportJson(const SizingResult& sizing, const std::string& input);
+
+// The report of `homesh mesh`: input, order, size, counts, "predicted_elements" and "sizing"
+// (octree sizing), quality, timings.
 std::string meshReportJson(const MeshResult& result, const std::string& input);
 
 // The report of `homesh quality`: input, order, counts, quality.

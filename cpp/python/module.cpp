@@ -22,6 +22,7 @@
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
 #include "quality/element_measure.hpp"
+#include "sizing/octree_export.hpp"
 
 namespace bp = boost::python;
 namespace np = boost::python::numpy;
@@ -276,15 +277,86 @@ class PyMesh {
   std::shared_ptr<const MeshResult> result_;  // immutable: safe to read without the GIL
 };
 
+Eigen::Vector3d pointFrom(const bp::object& p, const std::string& what) {
+  if (bp::len(p) != 3) throw ParameterError(what + " must be three numbers");
+  return {bp::extract<double>(p[0]), bp::extract<double>(p[1]), bp::extract<double>(p[2])};
+}
+
+// Sizing parameters from a dict {"min_delta", "max_delta", "eps": numbers (0 or missing:
+// automatic), "sources": [{"kind": "segment" | "sphere" | "box" | "curve", "a", "b", "radius",
+// "delta", "edge"}, ...]}. homesh/api.py validates the types first.
+SizingParameters sizingFrom(const bp::dict& d) {
+  SizingParameters p;
+  const auto number = [&d](const char* key, double fallback) {
+    const bp::object value = d.get(key);
+    return value.is_none() ? fallback : static_cast<double>(bp::extract<double>(value));
+  };
+  p.minDelta = number("min_delta", 0.0);
+  p.maxDelta = number("max_delta", 0.0);
+  p.eps = number("eps", p.eps);
+  if (d.has_key("sources")) {
+    const bp::object list = d["sources"];
+    for (bp::ssize_t i = 0; i < bp::len(list); ++i) {
+      const bp::dict src = bp::extract<bp::dict>(list[i]);
+      const std::string kind = bp::extract<std::string>(src.get("kind", ""));
+      const std::string which = "source " + std::to_string(i + 1);
+      const double radius = bp::extract<double>(src.get("radius", 0.0));
+      const double delta = bp::extract<double>(src.get("delta", 0.0));
+      if (kind == "segment")
+        p.sources.push_back(RefinementSource::segment(
+            pointFrom(src["a"], which + " a"), pointFrom(src["b"], which + " b"), radius, delta));
+      else if (kind == "sphere")
+        p.sources.push_back(
+            RefinementSource::sphere(pointFrom(src["a"], which + " centre"), radius, delta));
+      else if (kind == "box")
+        p.sources.push_back(RefinementSource::box(pointFrom(src["a"], which + " a"),
+                                                  pointFrom(src["b"], which + " b"), delta));
+      else if (kind == "curve")
+        p.sources.push_back(
+            RefinementSource::curve(bp::extract<int>(src.get("edge", 0)), radius, delta));
+      else
+        throw ParameterError(which + ": kind must be segment, sphere, box or curve, got '" + kind +
+                             "'");
+    }
+  }
+  return p;
+}
+
 MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity,
-                           int optimise) {
+                           int optimise, const bp::object& sizing = bp::object()) {
   MeshingOptions options;
   options.optimiseIterations = optimise;
   options.order = order;
   if (!size.is_none()) options.size = bp::extract<double>(size);
+  if (!sizing.is_none()) options.sizing = sizingFrom(bp::extract<bp::dict>(sizing));
   options.threads = threads;
   options.verbosity = verbosity;
   return options;
+}
+
+// The sizing octree and prediction of a CAD source: the JSON report of `homesh predict`,
+// and the octree's leaves written to `octreePath` when it is not empty.
+std::string predict(const CadSource& source, const bp::object& sizing,
+                    const std::string& octreePath, const std::string& input) {
+  const SizingParameters requested =
+      sizing.is_none() ? SizingParameters{} : sizingFrom(bp::extract<bp::dict>(sizing));
+  const ReleaseGil nogil;
+  const CadModel cad = source.load();
+  const SizingParameters params =
+      completeSizing(sizing.is_none() ? defaultSizing(cad) : requested, cad);
+  const SizingResult result = runSizing(cad, params);
+  if (!octreePath.empty()) writeOctree(*result.octree, octreePath);
+  return predictReportJson(result, input);
+}
+
+std::string predictFile(const std::string& path, const bp::object& sizing,
+                        const std::string& octreePath) {
+  return predict(CadSource::file(path), sizing, octreePath, path);
+}
+
+std::string predictBrep(const std::string& text, const std::string& name, const bp::object& sizing,
+                        const std::string& octreePath) {
+  return predict(CadSource::brepText(text, name), sizing, octreePath, name);
 }
 
 PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::object progress) {
@@ -301,15 +373,18 @@ PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::o
 }
 
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
-                int verbosity, bp::object progress, int optimise) {
-  return runPipeline(CadSource::file(path), makeOptions(order, size, threads, verbosity, optimise),
+                int verbosity, bp::object progress, int optimise, const bp::object& sizing) {
+  return runPipeline(CadSource::file(path),
+                     makeOptions(order, size, threads, verbosity, optimise, sizing),
                      std::move(progress));
 }
 
 PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
-                int threads, int verbosity, bp::object progress, int optimise) {
+                int threads, int verbosity, bp::object progress, int optimise,
+                const bp::object& sizing) {
   return runPipeline(CadSource::brepText(text, name),
-                     makeOptions(order, size, threads, verbosity, optimise), std::move(progress));
+                     makeOptions(order, size, threads, verbosity, optimise, sizing),
+                     std::move(progress));
 }
 
 // Rebuilds a mesh (without CAD) from the arrays PyMesh exposes, and evaluates its quality.
@@ -448,12 +523,19 @@ BOOST_PYTHON_MODULE(_core) {
       .def("report_json", &PyMesh::reportJson)
       .def("optimise", &PyMesh::optimise);
 
-  bp::def("mesh_file", &meshFile,
-          (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
-           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0));
+  bp::def(
+      "mesh_file", &meshFile,
+      (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"), bp::arg("verbosity"),
+       bp::arg("progress"), bp::arg("optimise") = 0, bp::arg("sizing") = bp::object()));
   bp::def("mesh_brep", &meshBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
-           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0));
+           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
+           bp::arg("sizing") = bp::object()));
+  bp::def("predict_file", &predictFile,
+          (bp::arg("path"), bp::arg("sizing") = bp::object(), bp::arg("octree_path") = ""));
+  bp::def("predict_brep", &predictBrep,
+          (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
+           bp::arg("octree_path") = ""));
   bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("threads") = 1));
   bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
   bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));

@@ -15,6 +15,7 @@
 #include "cad/model_dimension.hpp"
 #include "cad/occt_access.hpp"
 #include "core/error.hpp"
+#include "core/format.hpp"
 
 namespace homesh {
 namespace {
@@ -23,7 +24,11 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kMaxLevel = 20;  // corner keys pack 21 bits per axis
 constexpr int kMinLevel = 2;
 constexpr std::size_t kMaxCandidates = 32;
-constexpr int kGroupVotes = 15;  // boundary samples judging a boundary leaf's sub-cells
+constexpr int kGroupVotes = 15;
+// About 1 GB of octree: sizes that need more are refused (they would also make far more
+// elements than a machine can hold).
+constexpr std::size_t kMaxNodes =
+    10'000'000;  // boundary samples judging a boundary leaf's sub-cells
 
 gp_Pnt toGp(const Eigen::Vector3d& p) {
   return {p.x(), p.y(), p.z()};
@@ -119,6 +124,11 @@ class OctreeBuilder {
     if (d == 2) root.centre.z() = 0.0;
     root.half = 0.5 * extent * 1.001 + 1e-9 * cad_.boundingDiagonal();
     t_.nodes_.push_back(root);
+    // Leaves within the model's box are at most 2 maxDelta wide.
+    double cells = 1.0;
+    for (int k = 0; k < d; ++k)
+      cells *= std::max(1.0, (hi[k] - lo[k]) / (2.0 * t_.params_.maxDelta));
+    if (cells > double(kMaxNodes)) tooLarge();
   }
 
   Eigen::Vector3d halfVector(const SizingOctree::Node& n) const {
@@ -154,7 +164,17 @@ class OctreeBuilder {
     return nearModel && side > 2.0 * p.maxDelta;
   }
 
+  [[noreturn]] void tooLarge() const {
+    const SizingParameters& p = t_.params_;
+    throw ParameterError("MinDelta " + formatNumber(p.minDelta) + " and MaxDelta " +
+                         formatNumber(p.maxDelta) + " are too small for " + cad_.sourceName() +
+                         " (bounding-box diagonal " + formatNumber(cad_.boundingDiagonal()) +
+                         "): the sizing octree would need more than " + std::to_string(kMaxNodes) +
+                         " cells");
+  }
+
   void split(std::int32_t n) {
+    if (t_.nodes_.size() > kMaxNodes) tooLarge();
     const std::int32_t first = static_cast<std::int32_t>(t_.nodes_.size());
     const Eigen::Vector3d parentCentre = t_.nodes_[n].centre;
     const double h = 0.5 * t_.nodes_[n].half;

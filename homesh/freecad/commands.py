@@ -4,6 +4,14 @@ import FreeCAD
 import FreeCADGui
 
 from . import resources
+from .objects import is_sizing
+
+
+def _selected_sizing_object():
+    selection = FreeCADGui.Selection.getSelection()
+    if len(selection) == 1 and is_sizing(selection[0]) and selection[0].Part is not None:
+        return selection[0]
+    return None
 
 
 def _selected_shape_object():
@@ -18,14 +26,55 @@ def _selected_shape_object():
 
 
 class CommandHighOrderMesh:
-    """Creates a HighOrderMesh of the selected shape and recomputes it."""
+    """Creates a HighOrderMesh of the selected shape (or of the selected Sizing object's shape,
+    sized by it) and recomputes it."""
 
     def GetResources(self):
         return {
             "Pixmap": resources.icon("homesh_mesh.svg"),
             "MenuText": "High-order mesh",
             "ToolTip": "Mesh the selected shape with curved high-order elements "
-                       "(boundary nodes on the CAD)",
+                       "(boundary nodes on the CAD); with a Mesh sizing object selected, "
+                       "mesh its shape with that sizing",
+        }
+
+    def IsActive(self):
+        return FreeCAD.ActiveDocument is not None and (
+            _selected_shape_object() is not None or _selected_sizing_object() is not None)
+
+    def Activated(self):
+        sizing = _selected_sizing_object()
+        part = sizing.Part if sizing is not None else _selected_shape_object()
+        if part is None:
+            FreeCAD.Console.PrintError(
+                "HOMesh: select one object with a shape (or a Mesh sizing object) first\n")
+            return
+        doc = FreeCAD.ActiveDocument
+        doc.openTransaction("High-order mesh")
+        try:
+            FreeCADGui.addModule("homesh.freecad")
+            sizing_arg = ("" if sizing is None else
+                          ", sizing=App.ActiveDocument.getObject(%r)" % sizing.Name)
+            FreeCADGui.doCommand(
+                "_mesh = homesh.freecad.make_high_order_mesh("
+                "App.ActiveDocument, App.ActiveDocument.getObject(%r)%s)" % (part.Name, sizing_arg))
+            FreeCADGui.doCommand("Gui.ActiveDocument.getObject(%r).Visibility = False" % part.Name)
+            FreeCADGui.doCommand("App.ActiveDocument.recompute()")
+        finally:
+            doc.commitTransaction()
+
+
+class CommandSizing:
+    """Creates a Sizing object (automatic sizing, predicted element count) for the selected
+    shape and recomputes it."""
+
+    def GetResources(self):
+        return {
+            "Pixmap": resources.icon("homesh_sizing.svg"),
+            "MenuText": "Mesh sizing",
+            "ToolTip": "Add a sizing octree for the selected shape (sizes from its curvature "
+                       "between MinDelta and MaxDelta, refinement spheres) and predict the "
+                       "element count; link it from a high-order mesh's Sizing property",
         }
 
     def IsActive(self):
@@ -37,16 +86,16 @@ class CommandHighOrderMesh:
             FreeCAD.Console.PrintError("HOMesh: select one object with a shape first\n")
             return
         doc = FreeCAD.ActiveDocument
-        doc.openTransaction("High-order mesh")
+        doc.openTransaction("Mesh sizing")
         try:
             FreeCADGui.addModule("homesh.freecad")
             FreeCADGui.doCommand(
-                "_mesh = homesh.freecad.make_high_order_mesh("
+                "_sizing = homesh.freecad.make_sizing("
                 "App.ActiveDocument, App.ActiveDocument.getObject(%r))" % part.Name)
-            FreeCADGui.doCommand("Gui.ActiveDocument.getObject(%r).Visibility = False" % part.Name)
             FreeCADGui.doCommand("App.ActiveDocument.recompute()")
         finally:
             doc.commitTransaction()
 
 
 FreeCADGui.addCommand("HOMesh_HighOrderMesh", CommandHighOrderMesh())
+FreeCADGui.addCommand("HOMesh_Sizing", CommandSizing())

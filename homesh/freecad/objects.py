@@ -1,8 +1,10 @@
-"""The HighOrderMesh document object: properties, recompute and persistence.
+"""The HighOrderMesh and Sizing document objects: properties, recompute and persistence.
 
-The proxy only holds properties and runs the core; drawing lives in viewproviders.py. The curved
+The proxies only hold properties and run the core; drawing lives in viewproviders.py. The curved
 mesh is stored inside the .FCStd as a compressed array file (property MeshData), so reopening a
-document shows and exports the mesh without recomputing it.
+document shows and exports the mesh without recomputing it. A Sizing object holds the sizing
+octree's parameters (MinDelta, MaxDelta, Eps, refinement spheres) and predicts the element count;
+a HighOrderMesh whose Sizing property links to it meshes with that octree.
 """
 
 import os
@@ -12,20 +14,24 @@ import tempfile
 import FreeCAD
 
 TYPE_HIGH_ORDER_MESH = "HOMesh::HighOrderMesh"
+TYPE_SIZING = "HOMesh::Sizing"
 
 _RESULT_PROPERTIES = ("NumNodes", "NumElements", "MinScaledJacobian", "InvalidElements")
 
 
-def make_high_order_mesh(doc, part, order=4, size=0.0, name="HighOrderMesh"):
+def make_high_order_mesh(doc, part, order=4, size=0.0, name="HighOrderMesh", sizing=None):
     """Adds a HighOrderMesh object meshing ``part`` (a document object with a Shape).
 
-    ``size`` 0 means automatic (bounding-box diagonal / 20). The caller recomputes.
+    ``size`` 0 means automatic: the sizing octree of ``sizing`` (a Sizing object, see
+    :func:`make_sizing`) if given, else a uniform bounding-box diagonal / 20. The caller
+    recomputes.
     """
     obj = doc.addObject("App::FeaturePython", name)
     HighOrderMeshProxy(obj)
     obj.Part = part
     obj.Order = order
     obj.Size = size
+    obj.Sizing = sizing
     if FreeCAD.GuiUp:
         from .viewproviders import ViewProviderHighOrderMesh
         ViewProviderHighOrderMesh(obj.ViewObject)
@@ -74,8 +80,12 @@ class HighOrderMeshProxy:
             obj.Order = (4, 1, 10, 1)
         if "Size" not in have:
             obj.addProperty("App::PropertyLength", "Size", "Mesh",
-                            "Target element size; 0 chooses a twentieth of the bounding-box "
-                            "diagonal")
+                            "Uniform target element size; 0: the Sizing object's octree if "
+                            "Sizing is set, else a twentieth of the bounding-box diagonal")
+        if "Sizing" not in have:
+            obj.addProperty("App::PropertyLink", "Sizing", "Mesh",
+                            "Optional HOMesh Sizing object whose octree (MinDelta, MaxDelta, "
+                            "Eps, refinement spheres) sizes the elements when Size is 0")
         if "OptimiserIterations" not in have:
             obj.addProperty("App::PropertyIntegerConstraint", "OptimiserIterations", "Mesh",
                             "Most sweeps of the variational optimiser after curving (0: none; "
@@ -109,10 +119,16 @@ class HighOrderMeshProxy:
         if shape is None or shape.isNull():
             raise ValueError("%s: %s has no shape" % (obj.Label, obj.Part.Label))
         size = obj.Size.Value if obj.Size.Value > 0 else None
+        sizing = {}
+        if size is None and obj.Sizing is not None:
+            if not is_sizing(obj.Sizing):
+                raise ValueError("%s: Sizing must link to a HOMesh Sizing object, not %s"
+                                 % (obj.Label, obj.Sizing.Label))
+            sizing = sizing_arguments(obj.Sizing)
         progress = _Progress(obj.Label)
         try:
             mesh = homesh.mesh(shape, order=obj.Order, size=size, progress=progress,
-                               name=obj.Part.Label, optimise=obj.OptimiserIterations)
+                               name=obj.Part.Label, optimise=obj.OptimiserIterations, **sizing)
         except homesh.HOMeshError as e:
             FreeCAD.Console.PrintError("HOMesh: %s: %s\n" % (obj.Label, e))
             raise
@@ -143,6 +159,166 @@ class HighOrderMeshProxy:
 
     def __setstate__(self, state):
         self.mesh = None
+
+    def dumps(self):
+        return self.__getstate__()
+
+    def loads(self, state):
+        self.__setstate__(state)
+
+
+def make_sizing(doc, part, min_delta=0.0, max_delta=0.0, eps=0.05, name="Sizing"):
+    """Adds a Sizing object for ``part`` (a document object with a Shape): the sizing octree's
+    parameters and its predicted element count.
+
+    ``min_delta`` / ``max_delta`` 0 mean automatic (max: bounding-box diagonal / 20, min: max /
+    20). Refinement spheres go in RefinementSpheres (centres), RefinementRadii and
+    RefinementDeltas (parallel lists). The caller recomputes.
+    """
+    obj = doc.addObject("App::FeaturePython", name)
+    SizingProxy(obj)
+    obj.Part = part
+    obj.MinDelta = min_delta
+    obj.MaxDelta = max_delta
+    obj.Eps = eps
+    if FreeCAD.GuiUp:
+        from .viewproviders import ViewProviderSizing
+        ViewProviderSizing(obj.ViewObject)
+    return obj
+
+
+def is_sizing(obj):
+    """Whether ``obj`` is a HOMesh Sizing object."""
+    return getattr(getattr(obj, "Proxy", None), "Type", None) == TYPE_SIZING
+
+
+def sizing_arguments(obj):
+    """The keyword arguments of :func:`homesh.predict` / :func:`homesh.mesh` that a Sizing
+    object stands for: min_delta, max_delta (None when automatic), eps and sources.
+
+    Raises ValueError naming the object and the property when a parameter is out of range.
+    """
+    min_delta = obj.MinDelta.Value
+    max_delta = obj.MaxDelta.Value
+    eps = obj.Eps
+    if not 0.0 < eps <= 1.0:
+        raise ValueError("%s: Eps must lie in (0, 1], got %g" % (obj.Label, eps))
+    if min_delta > 0 and max_delta > 0 and min_delta > max_delta:
+        raise ValueError("%s: MinDelta (%g) must not exceed MaxDelta (%g)"
+                         % (obj.Label, min_delta, max_delta))
+    centres, radii, deltas = obj.RefinementSpheres, obj.RefinementRadii, obj.RefinementDeltas
+    if not len(centres) == len(radii) == len(deltas):
+        raise ValueError("%s: RefinementSpheres, RefinementRadii and RefinementDeltas must have "
+                         "the same length, got %d, %d and %d"
+                         % (obj.Label, len(centres), len(radii), len(deltas)))
+    sources = []
+    for i, (centre, radius, delta) in enumerate(zip(centres, radii, deltas)):
+        for prop, value in (("RefinementRadii", radius), ("RefinementDeltas", delta)):
+            if not value > 0:
+                raise ValueError("%s: %s[%d] must be positive, got %g"
+                                 % (obj.Label, prop, i, value))
+        sources.append({"kind": "sphere", "a": (centre.x, centre.y, centre.z),
+                        "radius": float(radius), "delta": float(delta)})
+    return {"min_delta": min_delta if min_delta > 0 else None,
+            "max_delta": max_delta if max_delta > 0 else None,
+            "eps": float(eps), "sources": sources}
+
+
+class SizingProxy:
+    """Proxy of an App::FeaturePython holding the sizing octree's parameters for its ``Part``;
+    recomputing predicts the element count (:func:`homesh.predict`).
+
+    A failed prediction or a bad parameter leaves the message in Status, zero outputs, and the
+    object marked as failed (the exception goes to FreeCAD's recompute, which reports it).
+    """
+
+    Type = TYPE_SIZING
+    GRADATION = 0.2  # fixed in the core: sizes change by at most 0.2 per unit distance
+
+    def __init__(self, obj):
+        obj.Proxy = self
+        self.add_properties(obj)
+
+    @staticmethod
+    def add_properties(obj):
+        """Adds missing properties and makes the outputs read-only; safe to call again."""
+        have = obj.PropertiesList
+        if "Part" not in have:
+            obj.addProperty("App::PropertyLink", "Part", "Sizing", "Shape whose sizing this is")
+        if "MinDelta" not in have:
+            obj.addProperty("App::PropertyLength", "MinDelta", "Sizing",
+                            "Smallest element size (at high curvature); 0: MaxDelta / 20")
+        if "MaxDelta" not in have:
+            obj.addProperty("App::PropertyLength", "MaxDelta", "Sizing",
+                            "Largest element size; 0: bounding-box diagonal / 20")
+        if "Eps" not in have:
+            obj.addProperty("App::PropertyFloat", "Eps", "Sizing",
+                            "Sagitta ratio, 0 < Eps <= 1: on a surface of curvature radius R "
+                            "the size is 2 R sqrt(Eps (2 - Eps))")
+            obj.Eps = 0.05
+        if "Gradation" not in have:
+            obj.addProperty("App::PropertyFloat", "Gradation", "Sizing",
+                            "Most change of size per unit distance (fixed)")
+            obj.Gradation = SizingProxy.GRADATION
+        if "RefinementSpheres" not in have:
+            obj.addProperty("App::PropertyVectorList", "RefinementSpheres", "Refinement",
+                            "Centres of refinement spheres: inside sphere i the size is at most "
+                            "RefinementDeltas[i]")
+        if "RefinementRadii" not in have:
+            obj.addProperty("App::PropertyFloatList", "RefinementRadii", "Refinement",
+                            "Radius of each refinement sphere (same length as "
+                            "RefinementSpheres)")
+        if "RefinementDeltas" not in have:
+            obj.addProperty("App::PropertyFloatList", "RefinementDeltas", "Refinement",
+                            "Element size inside each refinement sphere (same length as "
+                            "RefinementSpheres)")
+        for prop, kind, doc in (
+                ("PredictedElements", "App::PropertyInteger",
+                 "Predicted number of linear elements (0 after a failure)"),
+                ("OctreeLeaves", "App::PropertyInteger", "Leaves of the sizing octree"),
+                ("SmallestSize", "App::PropertyLength", "Smallest size in the octree"),
+                ("Status", "App::PropertyString",
+                 "Summary of the last prediction, or why it failed")):
+            if prop not in have:
+                obj.addProperty(kind, prop, "Result", doc)
+        for prop in ("Gradation", "PredictedElements", "OctreeLeaves", "SmallestSize", "Status"):
+            obj.setEditorMode(prop, 1)  # read-only
+
+    def onDocumentRestored(self, obj):
+        self.add_properties(obj)
+
+    def execute(self, obj):
+        import homesh
+        try:
+            if obj.Part is None:
+                raise ValueError("%s: no shape (set its Part property)" % obj.Label)
+            shape = getattr(obj.Part, "Shape", None)
+            if shape is None or shape.isNull():
+                raise ValueError("%s: %s has no shape" % (obj.Label, obj.Part.Label))
+            report = homesh.predict(shape, name=obj.Part.Label, **sizing_arguments(obj))
+        except (ValueError, homesh.HOMeshError) as e:
+            obj.PredictedElements = 0
+            obj.OctreeLeaves = 0
+            obj.SmallestSize = 0
+            obj.Status = "Failed: %s" % e
+            FreeCAD.Console.PrintError("HOMesh: %s: %s\n" % (obj.Label, e))
+            raise
+        sizing = report["sizing"]
+        octree = sizing["octree"]
+        obj.PredictedElements = int(report["predicted_elements"])
+        obj.OctreeLeaves = int(octree["leaves"])
+        obj.SmallestSize = float(octree["smallest_delta"])
+        obj.Gradation = float(sizing.get("gradation", SizingProxy.GRADATION))
+        obj.Status = ("%d elements predicted (sizes %.4g to %.4g, %d octree leaves)"
+                      % (obj.PredictedElements, sizing["min_delta"], sizing["max_delta"],
+                         obj.OctreeLeaves))
+        FreeCAD.Console.PrintMessage("HOMesh: %s: %s\n" % (obj.Label, obj.Status))
+
+    def __getstate__(self):
+        return {"Type": self.Type}
+
+    def __setstate__(self, state):
+        return None
 
     def dumps(self):
         return self.__getstate__()

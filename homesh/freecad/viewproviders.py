@@ -1,6 +1,6 @@
-"""View provider of the HighOrderMesh object: the curved boundary surface coloured by element
-quality, with the curved element edges drawn on top (Coin3D scene built from
-tessellation.surface_and_edges)."""
+"""View providers. HighOrderMesh: the curved boundary surface coloured by element quality, with
+the curved element edges drawn on top (Coin3D scene built from tessellation.surface_and_edges).
+Sizing: nothing in the 3D view, only its icon."""
 
 from . import resources
 
@@ -99,8 +99,34 @@ class ViewProviderHighOrderMesh:
         return resources.icon("homesh_mesh.svg")
 
     def claimChildren(self):
-        part = getattr(self.Object, "Part", None)
-        return [part] if part is not None else []
+        return [child for child in (getattr(self.Object, "Part", None),
+                                    getattr(self.Object, "Sizing", None))
+                if child is not None]
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+
+class ViewProviderSizing:
+    """A Sizing object draws nothing; the view provider gives its tree icon."""
+
+    def __init__(self, vobj):
+        vobj.Proxy = self
+
+    def attach(self, vobj):
+        self.Object = vobj.Object
+
+    def getIcon(self):
+        return resources.icon("homesh_sizing.svg")
 
     def __getstate__(self):
         return None

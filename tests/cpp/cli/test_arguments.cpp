@@ -35,9 +35,56 @@ TEST(Arguments, MeshWithEveryOption) {
 
 TEST(Arguments, Defaults) {
   const ParsedCommand p = parse({"mesh", "part.brep"});
-  EXPECT_EQ(p.mesh.order, 4);
+  EXPECT_FALSE(p.mesh.order.has_value());  // 4, or the .mcf's Order
   EXPECT_FALSE(p.mesh.size.has_value());
+  EXPECT_FALSE(p.mesh.sizing.anyDelta());
   EXPECT_TRUE(p.mesh.common.outputs.empty());
+}
+
+TEST(Arguments, SizingAndPredict) {
+  const ParsedCommand p =
+      parse({"predict", "case.mcf", "--max-delta", "0.5", "--eps", "0.1", "--refine-sphere",
+             "0,0,1,0.5,0.01", "--refine-line", "0,0,0,1,0,0,0.1,0.02", "--refine-box",
+             "0,0,0,1,1,1,0.2", "--refine-curve", "3,0.1,0.05", "--write-octree", "o.vtu"});
+  ASSERT_EQ(p.kind, ParsedCommand::Kind::Predict);
+  EXPECT_EQ(p.predict.input, "case.mcf");
+  EXPECT_DOUBLE_EQ(p.predict.sizing.maxDelta.value_or(0.0), 0.5);
+  EXPECT_FALSE(p.predict.sizing.minDelta.has_value());
+  EXPECT_DOUBLE_EQ(p.predict.sizing.eps.value_or(0.0), 0.1);
+  ASSERT_EQ(p.predict.sizing.sources.size(), 4u);
+  EXPECT_EQ(p.predict.sizing.sources[0].kind, RefinementSource::Kind::Sphere);
+  EXPECT_DOUBLE_EQ(p.predict.sizing.sources[0].delta, 0.01);
+  EXPECT_EQ(p.predict.sizing.sources[1].kind, RefinementSource::Kind::Segment);
+  EXPECT_EQ(p.predict.sizing.sources[2].kind, RefinementSource::Kind::Box);
+  EXPECT_EQ(p.predict.sizing.sources[3].edge, 3);
+  EXPECT_EQ(p.predict.sizing.writeOctree.value_or(""), "o.vtu");
+  const ParsedCommand m = parse({"mesh", "a.step", "--min-delta", "0.01", "-p", "2"});
+  EXPECT_EQ(m.mesh.order.value_or(0), 2);
+  EXPECT_DOUBLE_EQ(m.mesh.sizing.minDelta.value_or(0.0), 0.01);
+}
+
+TEST(Arguments, BadSizingFlagsNameTheProblem) {
+  const auto message = [](const std::vector<std::string>& args) {
+    try {
+      parse(args);
+    } catch (const UsageError& e) {
+      return e.message;
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message({"predict", "a.step", "--eps", "2"}).find("--eps"), std::string::npos);
+  EXPECT_NE(message({"predict", "a.step", "--max-delta", "-1"}).find("--max-delta"),
+            std::string::npos);
+  EXPECT_NE(message({"predict", "a.step", "--refine-sphere", "0,0,1"}).find("X,Y,Z,R,D"),
+            std::string::npos);
+  EXPECT_NE(message({"predict", "a.step", "--refine-sphere", "0,0,1,-1,0.1"}).find("radius"),
+            std::string::npos);
+  EXPECT_NE(message({"predict", "a.step", "--refine-box", "1,1,1,0,0,0,0.1"}).find("corner"),
+            std::string::npos);
+  EXPECT_NE(message({"predict", "a.step", "--refine-curve", "2.5,0.1,0.1"}).find("edge"),
+            std::string::npos);
+  EXPECT_NE(message({"mesh", "a.step", "--size", "1", "--max-delta", "1"}).find("--size"),
+            std::string::npos);
 }
 
 TEST(Arguments, QualityAndConvert) {

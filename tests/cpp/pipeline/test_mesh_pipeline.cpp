@@ -44,13 +44,17 @@ TEST(MeshPipeline, RunsEveryStageAndReports) {
   EXPECT_NE(json.find("\"tet\": " + std::to_string(result.mesh.numElements())), std::string::npos);
 }
 
-TEST(MeshPipeline, DefaultSizeIsATwentiethOfTheDiagonal) {
+TEST(MeshPipeline, DefaultSizingIsTheOctreeWithATwentiethOfTheDiagonal) {
   MeshingOptions options;
   options.order = 1;
   const MeshResult result =
       runMeshPipeline(CadSource::brepText(test::brepText(test::box(2, 2, 1))), options);
-  ASSERT_TRUE(result.options.size.has_value());
-  EXPECT_NEAR(*result.options.size, 3.0 / 20.0, 1e-12);
+  EXPECT_FALSE(result.options.size.has_value());
+  ASSERT_TRUE(result.options.sizing.has_value());
+  EXPECT_NEAR(result.options.sizing->maxDelta, 3.0 / 20.0, 1e-12);
+  EXPECT_NEAR(result.options.sizing->minDelta, 3.0 / 400.0, 1e-12);
+  ASSERT_TRUE(result.sizing.has_value());
+  EXPECT_GT(result.sizing->prediction.elements, 0.0);
 }
 
 TEST(MeshPipeline, BadParametersFailBeforeReadingTheCad) {

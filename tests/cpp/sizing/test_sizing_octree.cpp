@@ -1,0 +1,223 @@
+// The sizing octree: sizes from curvature, grading, balance, classification, sources, and a
+// query that many threads may use at once.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include "core/error.hpp"
+#include "sizing/element_count.hpp"
+#include "sizing/octree_export.hpp"
+#include "sizing/sizing_octree.hpp"
+#include "test_support.hpp"
+
+namespace homesh {
+namespace {
+
+SizingParameters params(double minDelta, double maxDelta, double eps) {
+  SizingParameters p;
+  p.minDelta = minDelta;
+  p.maxDelta = maxDelta;
+  p.eps = eps;
+  return p;
+}
+
+TEST(SizingOctree, ChordSizeIsTheChordOfTheSagitta) {
+  // A chord of length c on a circle of radius R has sagitta R - sqrt(R^2 - c^2/4) = eps R.
+  for (const double eps : {0.01, 0.1, 0.5, 1.0}) {
+    const double c = chordSize(2.0, eps);
+    EXPECT_NEAR(2.0 - std::sqrt(4.0 - c * c / 4.0), eps * 2.0, 1e-12);
+  }
+}
+
+TEST(SizingOctree, SphereSurfaceGetsTheCurvatureSize) {
+  const CadModel cad = test::toModel(test::sphere(1.0));
+  const SizingParameters p = params(0.01, 1.0, 0.02);
+  const SizingOctree tree = SizingOctree::build(cad, p);
+  const double expected = chordSize(1.0, 0.02);  // 0.398
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n;
+  for (int i = 0; i < 200; ++i) {
+    const Eigen::Vector3d x = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
+    // Corner averaging may raise the size by the gradation over half a leaf.
+    EXPECT_GE(tree.delta(x), expected * 0.999);
+    EXPECT_LE(tree.delta(x), expected * 1.25) << x.transpose();
+  }
+  // Far inside, the size grows by at most the gradation.
+  EXPECT_LE(tree.delta(Eigen::Vector3d::Zero()), expected + 0.2 * 1.0 + 1e-9);
+  EXPECT_GT(tree.delta(Eigen::Vector3d::Zero()), expected);
+}
+
+TEST(SizingOctree, GradationAndBalanceHoldBetweenNeighbours) {
+  const CadModel cad = CadModel::fromFile(std::string(HOMESH_SHARED_DIR) +
+                                          "/peer-cases/nekmesh/meshgen/3d_sphere.stp")
+                           .scaled(0.001);
+  const SizingOctree tree = SizingOctree::build(cad, params(0.04, 0.2, 0.02));
+  std::size_t pairs = 0;
+  for (std::size_t i = 0; i < tree.numLeaves(); ++i) {
+    const SizingOctree::Leaf a = tree.leaf(i);
+    for (const std::size_t j : tree.leafNeighbours(i)) {
+      const SizingOctree::Leaf b = tree.leaf(j);
+      EXPECT_LE(std::abs(a.level - b.level), 1);
+      EXPECT_LE(std::abs(a.delta - b.delta), 0.2 * (a.centre - b.centre).norm() + 1e-12);
+      ++pairs;
+    }
+  }
+  EXPECT_GT(pairs, tree.numLeaves());
+  // Sizes really vary: curvature near the sphere, MaxDelta far away.
+  EXPECT_LT(tree.statistics().smallestDelta, 0.11);
+  EXPECT_DOUBLE_EQ(tree.delta(Eigen::Vector3d(2.9, 0.9, 0.7)), 0.2);
+}
+
+TEST(SizingOctree, QueryIsThreadSafe) {
+  const CadModel cad = test::toModel(test::torus(2.0, 0.5));
+  const SizingOctree tree = SizingOctree::build(cad, params(0.02, 0.5, 0.05));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  std::vector<Eigen::Vector3d> points(20011);  // prime: every walk below is a permutation
+  for (auto& p : points) p = {u(rng), u(rng), 0.3 * u(rng)};
+  std::vector<double> serial(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) serial[i] = tree.delta(points[i]);
+  constexpr int kThreads = 8;
+  std::vector<std::vector<double>> results(kThreads, std::vector<double>(points.size()));
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t)
+    threads.emplace_back([&, t] {
+      // Each thread walks the points in its own order.
+      for (std::size_t k = 0; k < points.size(); ++k) {
+        const std::size_t i = (k * (2 * t + 1) + t) % points.size();
+        results[t][i] = tree.delta(points[i]);
+      }
+    });
+  for (std::thread& t : threads) t.join();
+  for (int t = 0; t < kThreads; ++t) EXPECT_EQ(results[t], serial) << "thread " << t;
+}
+
+TEST(SizingOctree, ClassifiesTheDomainVolume) {
+  // Box 4 x 4 x 2 with a through hole of radius 1: 32 - 2 pi.
+  const CadModel boxHole =
+      CadModel::fromFile(std::string(HOMESH_SOURCE_DIR) + "/tests/data/box_hole.step");
+  for (const double size : {0.25, 0.5, 1.0}) {
+    const SizingOctree tree = SizingOctree::build(boxHole, params(size, size, 0.1));
+    EXPECT_NEAR(tree.domainMeasure(), 32.0 - 2.0 * M_PI, 0.02 * (32.0 - 2.0 * M_PI)) << size;
+  }
+  const CadModel ball = test::toModel(test::sphere(1.0));
+  const SizingOctree tree = SizingOctree::build(ball, params(0.05, 0.3, 0.05));
+  EXPECT_NEAR(tree.domainMeasure(), 4.0 / 3.0 * M_PI, 0.01 * 4.0 / 3.0 * M_PI);
+  std::size_t inside = 0, boundary = 0, outside = 0;
+  for (std::size_t i = 0; i < tree.numLeaves(); ++i) {
+    const SizingOctree::Leaf l = tree.leaf(i);
+    const double r = l.centre.norm(), reach = l.halfWidth * std::sqrt(3.0);
+    if (l.location == SizingOctree::Location::Inside) {
+      ++inside;
+      EXPECT_LT(r - reach, 1.0);
+    } else if (l.location == SizingOctree::Location::Outside) {
+      ++outside;
+      EXPECT_GT(r + reach, 1.0);
+    } else {
+      ++boundary;
+      EXPECT_LT(std::abs(r - 1.0), 2.0 * reach);
+    }
+  }
+  EXPECT_GT(inside, 0u);
+  EXPECT_GT(boundary, 0u);
+  EXPECT_GT(outside, 0u);
+}
+
+TEST(SizingOctree, SourcesRefineTheirRegion) {
+  const CadModel cad = test::toModel(test::box(4.0, 4.0, 4.0));
+  SizingParameters p = params(0.1, 1.0, 0.1);
+  p.sources.push_back(RefinementSource::sphere({1.0, 1.0, 1.0}, 0.5, 0.05));
+  p.sources.push_back(RefinementSource::segment({0.5, 3.0, 2.0}, {3.5, 3.0, 2.0}, 0.3, 0.08));
+  p.sources.push_back(RefinementSource::box({2.5, 0.5, 0.5}, {3.5, 1.5, 1.5}, 0.2));
+  const SizingOctree tree = SizingOctree::build(cad, p);
+  EXPECT_LE(tree.delta({1.0, 1.2, 1.1}), 0.05);
+  EXPECT_LE(tree.delta({2.0, 3.1, 2.1}), 0.08);
+  EXPECT_LE(tree.delta({3.0, 1.0, 1.4}), 0.2);
+  // Graded away from the sphere source, and not refined far from every source.
+  const double near = tree.delta({1.0, 1.0, 1.8}), far = tree.delta({1.0, 1.0, 3.5});
+  EXPECT_LT(near, far);
+  EXPECT_LE(near, 0.05 + 0.2 * 0.3 + 0.1);
+  // Everywhere else the size grows away from the sources by the gradation.
+  EXPECT_NEAR(tree.delta({3.8, 0.2, 3.8}), 0.2 + 0.2 * std::sqrt(0.09 + 0.09 + 2.3 * 2.3), 0.15);
+  // Refined leaves make the prediction grow.
+  const double refined = predictElementCount(tree).elements;
+  const double plain =
+      predictElementCount(SizingOctree::build(cad, params(0.1, 1.0, 0.1))).elements;
+  EXPECT_GT(refined, 1.5 * plain);
+}
+
+TEST(SizingOctree, CurveSourceFollowsTheEdge) {
+  const CadModel cad = test::toModel(test::cylinder(1.0, 2.0));
+  SizingParameters p = params(0.05, 0.5, 0.5);
+  // The circle at z = 0: find its edge.
+  int circle = 0;
+  for (int e = 1; e <= cad.numEdges(); ++e)
+    if (!cad.isDegenerated(e)) {
+      const ParameterRange r = cad.edgeRange(e);
+      const Eigen::Vector3d a = cad.evaluateCurve(e, r.first).point;
+      const Eigen::Vector3d m = cad.evaluateCurve(e, 0.5 * (r.first + r.last)).point;
+      if (std::abs(a.z()) < 1e-9 && std::abs(m.z()) < 1e-9) circle = e;
+    }
+  ASSERT_GT(circle, 0);
+  p.sources.push_back(RefinementSource::curve(circle, 0.1, 0.02));
+  const SizingOctree tree = SizingOctree::build(cad, p);
+  for (int k = 0; k < 16; ++k) {
+    const double t = 2.0 * M_PI * k / 16.0;
+    EXPECT_LE(tree.delta({std::cos(t), std::sin(t), 0.0}), 0.02) << k;
+  }
+  EXPECT_GT(tree.delta({0.0, 0.0, 1.5}), 0.1);
+  EXPECT_THROW(SizingOctree::build(cad,
+                                   [&] {
+                                     SizingParameters bad = params(0.05, 0.5, 0.5);
+                                     bad.sources.push_back(RefinementSource::curve(99, 0.1, 0.02));
+                                     return bad;
+                                   }()),
+               CadError);
+}
+
+TEST(SizingOctree, RejectsBadParameters) {
+  const CadModel cad = test::toModel(test::box(1.0, 1.0, 1.0));
+  EXPECT_THROW(SizingOctree::build(cad, params(0.0, 1.0, 0.1)), ParameterError);
+  EXPECT_THROW(SizingOctree::build(cad, params(0.5, 0.1, 0.1)), ParameterError);
+  EXPECT_THROW(SizingOctree::build(cad, params(0.1, 1.0, 0.0)), ParameterError);
+  EXPECT_THROW(SizingOctree::build(cad, params(0.1, 1.0, 1.5)), ParameterError);
+  SizingParameters p = params(0.1, 1.0, 0.1);
+  p.sources.push_back(RefinementSource::sphere({0, 0, 0}, -1.0, 0.1));
+  try {
+    SizingOctree::build(cad, p);
+    FAIL();
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("refinement source 1"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("radius"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SizingOctree, LeavesExportToAMesh) {
+  const CadModel cad = test::toModel(test::sphere(1.0));
+  const SizingOctree tree = SizingOctree::build(cad, params(0.05, 0.5, 0.05));
+  const OctreeMesh m = octreeLeavesMesh(tree);
+  const std::size_t notOutside = tree.statistics().insideLeaves + tree.statistics().boundaryLeaves;
+  ASSERT_EQ(m.mesh.numElements(), notOutside);
+  ASSERT_EQ(m.fields.size(), 4u);
+  EXPECT_EQ(m.fields[0].name, "delta");
+  // The hexahedra tile the non-outside leaves: their volumes add up.
+  double volume = 0.0;
+  for (std::size_t i = 0; i < tree.numLeaves(); ++i) {
+    const SizingOctree::Leaf l = tree.leaf(i);
+    if (l.location != SizingOctree::Location::Outside) volume += std::pow(2.0 * l.halfWidth, 3);
+  }
+  const ElementBlock& hexes = m.mesh.blocks[0];
+  double fromMesh = 0.0;
+  for (std::size_t e = 0; e < hexes.count(); ++e) {
+    const std::int64_t* n = hexes.element(e);
+    const Eigen::Vector3d a(&m.mesh.xyz[3 * n[0]]), b(&m.mesh.xyz[3 * n[6]]);
+    fromMesh += std::abs((b - a).prod());
+  }
+  EXPECT_NEAR(fromMesh, volume, 1e-9 * volume);
+}
+
+}  // namespace
+}  // namespace homesh

@@ -1,0 +1,176 @@
+// Linear meshes made from the sizing octree: NekMesh's peer cases (.mcf), prediction against
+// the actual count, element sizes against the specification, EPS halving, several solids.
+#include <gtest/gtest.h>
+
+#include <BOPAlgo_Builder.hxx>
+#include <BRepBuilderAPI_Transform.hxx>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "pipeline/case_setup.hpp"
+#include "pipeline/mesh_pipeline.hpp"
+#include "test_support.hpp"
+
+namespace homesh {
+namespace {
+
+std::string peerCase(const std::string& name) {
+  return std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/meshgen/" + name + ".mcf";
+}
+
+MeshResult meshCase(const std::string& name, int order = 1) {
+  CaseSetup setup = setupCase(peerCase(name));
+  setup.options.order = order;
+  return runMeshPipeline(setup.source, setup.options);
+}
+
+const ElementBlock& boundaryBlock(const Mesh& mesh) {
+  for (const ElementBlock& b : mesh.blocks)
+    if (cellDimension(b.type) == mesh.dim - 1) return b;
+  throw Error("no boundary block");
+}
+
+// Fraction of the boundary edges (of triangles on CAD faces in 3D, lines on curves in 2D)
+// whose length / delta(midpoint) lies in [0.5, 1.5].
+double fractionOfEdgesWithinSpec(const Mesh& mesh, const SizingOctree& octree) {
+  const ElementBlock& b = boundaryBlock(mesh);
+  const int nv = cellNumVertices(b.type);
+  std::size_t good = 0, total = 0;
+  for (std::size_t e = 0; e < b.count(); ++e) {
+    const std::int64_t* n = b.element(e);
+    for (int k = 0; k < (nv == 2 ? 1 : 3); ++k) {
+      const Eigen::Vector3d p = test::nodePoint(mesh, n[k]);
+      const Eigen::Vector3d q = test::nodePoint(mesh, n[(k + 1) % nv]);
+      const double ratio = (p - q).norm() / octree.delta(0.5 * (p + q));
+      good += ratio >= 0.5 && ratio <= 1.5;
+      ++total;
+    }
+  }
+  return double(good) / double(total);
+}
+
+class PeerCase : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(PeerCase, PredictionWithinTenPercentAndSizesFollowTheSpecification) {
+  const MeshResult r = meshCase(GetParam());
+  ASSERT_TRUE(r.sizing.has_value());
+  const double predicted = r.sizing->prediction.elements;
+  const double actual = static_cast<double>(r.mesh.numElements());
+  RecordProperty("predicted", std::to_string(predicted));
+  RecordProperty("actual", std::to_string(actual));
+  EXPECT_NEAR(predicted / actual, 1.0, 0.10) << predicted << " predicted, " << actual << " made";
+  EXPECT_GE(fractionOfEdgesWithinSpec(r.mesh, *r.sizing->octree), 0.90);
+  // Every boundary node keeps its CAD entity.
+  const ElementBlock& b = boundaryBlock(r.mesh);
+  for (const std::int64_t n : b.nodes) {
+    ASSERT_LE(r.mesh.nodeCadDim[n], r.mesh.dim - 1);
+    ASSERT_GT(r.mesh.nodeCadIndex[n], 0);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(NekMeshMeshgen, PeerCase,
+                         ::testing::Values("3d_sphere", "3d_bl_cyl", "2d_bl_aerofoil", "2d_bl_t106",
+                                           "2d_bl_naca0012"));
+
+TEST(SizingPipeline, HalvingEpsRefinesTheSphereAsTheChordFormulaPredicts) {
+  // Boundary triangles on the sphere's (curved) faces: their number scales with 1/delta^2, and
+  // delta = 2 R sqrt(eps (2 - eps)) there (R = 0.25 m; both sizes lie within [MinDelta, MaxDelta]).
+  const auto sphereTriangles = [](double eps) {
+    CaseSetup setup = setupCase(peerCase("3d_sphere"));
+    setup.options.order = 1;
+    setup.options.sizing->eps = eps;
+    const MeshResult r = runMeshPipeline(setup.source, setup.options);
+    const CadModel& cad = *r.cad;
+    const ElementBlock& b = boundaryBlock(r.mesh);
+    std::size_t count = 0;
+    for (std::size_t e = 0; e < b.count(); ++e) count += !cad.isPlanar(b.entity[e]);
+    return static_cast<double>(count);
+  };
+  const double coarse = sphereTriangles(0.02), fine = sphereTriangles(0.01);
+  const double expected = std::pow(chordSize(0.25, 0.02) / chordSize(0.25, 0.01), 2.0);  // 1.99
+  EXPECT_GT(chordSize(0.25, 0.01), 0.04);  // above MinDelta: the formula, not the clamp, decides
+  EXPECT_NEAR(fine / coarse, expected, 0.15 * expected) << coarse << " -> " << fine;
+}
+
+TEST(SizingPipeline, SeveralSolidsWithAnInternalFace) {
+  // Two boxes sharing a face (general fuse keeps both solids and the shared face once).
+  BOPAlgo_Builder builder;
+  builder.AddArgument(test::box(1.0, 1.0, 1.0));
+  gp_Trsf shift;
+  shift.SetTranslation(gp_Vec(1.0, 0.0, 0.0));
+  builder.AddArgument(BRepBuilderAPI_Transform(test::box(1.0, 1.0, 1.0), shift, true).Shape());
+  builder.Perform();
+  ASSERT_FALSE(builder.HasErrors());
+  const CadModel cad = test::toModel(builder.Shape());
+  ASSERT_EQ(cad.numSolids(), 2);
+  SizingParameters p;
+  p.minDelta = 0.1;
+  p.maxDelta = 0.2;
+  const SizingResult s = runSizing(cad, p);
+  EXPECT_NEAR(s.prediction.domainMeasure, 2.0, 0.02);
+  MeshingOptions options;
+  options.order = 1;
+  options.sizing = p;
+  const MeshResult r =
+      runMeshPipeline(CadSource::brepText(test::brepText(builder.Shape())), options);
+  const double actual = static_cast<double>(r.mesh.numElements());
+  EXPECT_NEAR(r.sizing->prediction.elements / actual, 1.0, 0.10);
+  // Tetrahedra in both solids.
+  std::vector<int> perSolid(3, 0);
+  for (const std::int32_t s2 : r.mesh.blocks[0].entity) ++perSolid[s2];
+  EXPECT_GT(perSolid[1], 0);
+  EXPECT_GT(perSolid[2], 0);
+}
+
+TEST(SizingPipeline, McfSetupReadsTheCaseInMetres) {
+  const CaseSetup s = setupCase(peerCase("3d_sphere"));
+  EXPECT_TRUE(s.fromMcf);
+  EXPECT_EQ(s.options.order, 4);
+  ASSERT_TRUE(s.options.sizing.has_value());
+  EXPECT_DOUBLE_EQ(s.options.sizing->minDelta, 0.04);
+  EXPECT_DOUBLE_EQ(s.options.sizing->maxDelta, 0.2);
+  EXPECT_DOUBLE_EQ(s.options.sizing->eps, 0.02);
+  EXPECT_DOUBLE_EQ(s.source.scale, 0.001);
+  const CadModel cad = s.source.load();
+  EXPECT_NEAR(cad.boundingDiagonal(), std::sqrt(16.0 + 4.0 + 0.75 * 0.75), 1e-6);
+  // SurfaceOptimiser is NekMesh's and not ours: reported, not silently ignored.
+  ASSERT_FALSE(s.notices.empty());
+  EXPECT_NE(s.notices[0].find("SurfaceOptimiser"), std::string::npos);
+  const CaseSetup naca = setupCase(peerCase("2d_bl_naca0012"));
+  EXPECT_EQ(naca.source.kind, CadSource::Kind::Naca);
+  EXPECT_EQ(naca.source.naca.digits, "0012");
+  EXPECT_DOUBLE_EQ(naca.source.naca.aoaDegrees, 15.0);
+}
+
+TEST(SizingPipeline, AutomaticSizingWithoutParameters) {
+  MeshingOptions options;
+  options.order = 1;
+  const MeshResult r =
+      runMeshPipeline(CadSource::brepText(test::brepText(test::sphere(1.0))), options);
+  ASSERT_TRUE(r.sizing.has_value());
+  EXPECT_NEAR(r.sizing->octree->parameters().maxDelta, r.cad->boundingDiagonal() / 20.0, 1e-12);
+  EXPECT_NEAR(r.sizing->prediction.elements / double(r.mesh.numElements()), 1.0, 0.15);
+  MeshingOptions both = options;
+  both.size = 0.3;
+  both.sizing = SizingParameters{};
+  EXPECT_THROW(runMeshPipeline(CadSource::brepText(test::brepText(test::sphere(1.0))), both),
+               ParameterError);
+}
+
+TEST(SizingPipeline, RefusesSizesTooSmallForTheModel) {
+  SizingParameters p;
+  p.minDelta = 1e-4;
+  p.maxDelta = 1e-4;
+  const CadModel cad = test::toModel(test::box(1.0, 1.0, 1.0));
+  try {
+    runSizing(cad, p);
+    FAIL();
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("too small"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace homesh
