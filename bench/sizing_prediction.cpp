@@ -2,9 +2,10 @@
 // count against the time Gmsh takes to make the linear mesh from it (in the same process), and
 // the predicted against the actual element count.
 //
-//   bench_sizing_prediction [--threads N] CASE...
-//   CASE = CAD:MIN:MAX:EPS[:SCALE]  (sizes from curvature; MIN == MAX gives a uniform size;
-//          SCALE 0.001 reads a millimetre CAD in metres, as NekMesh does)
+//   bench_sizing_prediction [--threads N] [--calibrate [--gradient-term]] [CASE...]
+//   CASE = a NekMesh .mcf, or CAD:MIN:MAX:EPS[:SCALE] (sizes from curvature; MIN == MAX gives
+//          a uniform size; SCALE 0.001 reads a millimetre CAD in metres, as NekMesh does).
+//   Without cases: the five NekMesh meshgen peer cases (../shared/peer-cases/nekmesh/meshgen).
 //
 // Prints one line per case and, with --calibrate, the fitted densities of the prediction model
 // (see cpp/sizing/element_count.hpp) by least squares over all cases.
@@ -19,6 +20,7 @@
 
 #include "cad/cad_model.hpp"
 #include "linear/linear_mesher.hpp"
+#include "pipeline/case_setup.hpp"
 #include "sizing/element_count.hpp"
 #include "sizing/sizing_octree.hpp"
 
@@ -29,20 +31,26 @@ double seconds(std::chrono::steady_clock::time_point since) {
 }
 
 struct Case {
-  std::string cad;
+  std::string name;
+  homesh::CadSource source;
   homesh::SizingParameters params;
-  double scale = 1.0;  // 0.001: the CAD is in millimetres and the sizes in metres (NekMesh)
 };
 
 Case parseCase(const std::string& text) {
+  if (text.size() > 4 && text.substr(text.size() - 4) == ".mcf") {
+    const homesh::CaseSetup setup = homesh::setupCase(text);
+    if (!setup.options.sizing) throw std::runtime_error(text + " has no MinDelta/MaxDelta/EPS");
+    return {text.substr(text.find_last_of('/') + 1), setup.source, *setup.options.sizing};
+  }
   Case c;
   std::vector<std::string> parts;
   std::stringstream in(text);
   for (std::string item; std::getline(in, item, ':');) parts.push_back(item);
   if (parts.size() != 4 && parts.size() != 5)
     throw std::runtime_error("case must be CAD:MIN:MAX:EPS[:SCALE], got " + text);
-  if (parts.size() == 5) c.scale = std::stod(parts[4]);
-  c.cad = parts[0];
+  c.source = homesh::CadSource::file(parts[0]);
+  if (parts.size() == 5) c.source.scale = std::stod(parts[4]);
+  c.name = parts[0].substr(parts[0].find_last_of('/') + 1) + ":" + parts[2];
   c.params.minDelta = std::stod(parts[1]);
   c.params.maxDelta = std::stod(parts[2]);
   c.params.eps = std::stod(parts[3]);
@@ -67,12 +75,17 @@ int main(int argc, char** argv) {
       else
         cases.push_back(parseCase(a));
     }
+    if (cases.empty())
+      for (const char* peer :
+           {"3d_sphere", "3d_bl_cyl", "2d_bl_aerofoil", "2d_bl_t106", "2d_bl_naca0012"})
+        cases.push_back(parseCase(std::string(HOMESH_SOURCE_DIR) +
+                                  "/../shared/peer-cases/nekmesh/meshgen/" + peer + ".mcf"));
     std::vector<Eigen::Vector3d> rows;
     std::vector<double> actual;
     std::printf("%-28s %8s %8s %9s %9s %9s %7s %7s\n", "case", "leaves", "octree_s", "predict_s",
                 "mesh_s", "predicted", "actual", "ratio");
     for (const Case& c : cases) {
-      const homesh::CadModel cad = homesh::CadModel::fromFile(c.cad).scaled(c.scale);
+      const homesh::CadModel cad = c.source.load();
       auto t0 = std::chrono::steady_clock::now();
       const homesh::SizingOctree tree = homesh::SizingOctree::build(cad, c.params);
       const double octreeSeconds = seconds(t0);
@@ -88,10 +101,8 @@ int main(int argc, char** argv) {
       const homesh::Mesh mesh = homesh::generateLinearMesh(cad, options);
       const double meshSeconds = seconds(t0);
       const double n = static_cast<double>(mesh.numElements());
-      const std::string name = c.cad.substr(c.cad.find_last_of('/') + 1) + ":" +
-                               std::to_string(c.params.maxDelta).substr(0, 6);
       std::printf("%-28s %8zu %8.3f %9.3f %9.3f %9.0f %7.0f %7.3f  (octree+predict / mesh %.3f)\n",
-                  name.c_str(), tree.numLeaves(), octreeSeconds, predictSeconds, meshSeconds,
+                  c.name.c_str(), tree.numLeaves(), octreeSeconds, predictSeconds, meshSeconds,
                   p.elements, n, p.elements / n, (octreeSeconds + predictSeconds) / meshSeconds);
       std::printf(
           "    volume integral %.6g, boundary integral %.6g, gradient integral %.6g, domain %.6g\n",

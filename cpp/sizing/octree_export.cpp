@@ -52,7 +52,7 @@ OctreeMesh octreeLeavesMesh(const SizingOctree& octree) {
                                     {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
   for (std::size_t i = 0; i < octree.numLeaves(); ++i) {
     const SizingOctree::Leaf leaf = octree.leaf(i);
-    if (leaf.location == SizingOctree::Location::Outside) continue;
+    if (!(leaf.insideFraction > 0.0)) continue;
     const Eigen::Vector3d ez = dim == 3 ? Eigen::Vector3d(Eigen::Vector3d::UnitZ())
                                         : Eigen::Vector3d(Eigen::Vector3d::Zero());
     for (int c = 0; c < (dim == 3 ? 8 : 4); ++c) {

@@ -1,5 +1,5 @@
 // The sizing octree as a mesh, so that a user can see in ParaView why the mesh is fine where it
-// is: one hexahedron per leaf (a quadrilateral in 2D) that is not outside the domain, with the
+// is: one hexahedron per leaf (a quadrilateral in 2D) that is at least partly inside, with the
 // cell fields "delta" (the leaf's graded size), "inside_fraction", "level" and "location"
 // (2 inside, 1 boundary).
 #pragma once

@@ -418,7 +418,8 @@ class OctreeBuilder {
         ++inside;
       }
     }
-    leaf.location = SizingOctree::Location::Boundary;
+    // Near the boundary but wholly outside (the samples reach a little beyond their leaf).
+    leaf.location = inside > 0 ? SizingOctree::Location::Boundary : SizingOctree::Location::Outside;
     leaf.insideFraction = static_cast<float>(inside) / static_cast<float>(cells);
   }
 

@@ -203,11 +203,11 @@ TEST(SizingOctree, LeavesExportToAMesh) {
   ASSERT_EQ(m.mesh.numElements(), notOutside);
   ASSERT_EQ(m.fields.size(), 4u);
   EXPECT_EQ(m.fields[0].name, "delta");
-  // The hexahedra tile the non-outside leaves: their volumes add up.
+  // The hexahedra tile the leaves that are not outside: their volumes add up.
   double volume = 0.0;
   for (std::size_t i = 0; i < tree.numLeaves(); ++i) {
     const SizingOctree::Leaf l = tree.leaf(i);
-    if (l.location != SizingOctree::Location::Outside) volume += std::pow(2.0 * l.halfWidth, 3);
+    if (l.insideFraction > 0.0) volume += std::pow(2.0 * l.halfWidth, 3);
   }
   const ElementBlock& hexes = m.mesh.blocks[0];
   double fromMesh = 0.0;

@@ -1,0 +1,115 @@
+"""Automatic sizing from the command line and Python: NekMesh .mcf cases, `homesh predict`,
+the octree written to VTU, command-line flags over .mcf values, clear errors."""
+
+import json
+import shutil
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+from conftest import ROOT, run
+
+MESHGEN = ROOT.parent / "shared" / "peer-cases" / "nekmesh" / "meshgen"
+
+
+def _report(result):
+    assert result.returncode == 0, result.stderr
+    return json.loads(result.stdout)
+
+
+@pytest.mark.parametrize("case", ["3d_bl_cyl", "2d_bl_t106", "2d_bl_naca0012"])
+def test_mcf_case_meshes_with_its_prediction(homesh_bin, tmp_path, case):
+    msh = tmp_path / (case + ".msh")
+    result = run([homesh_bin, "mesh", MESHGEN / (case + ".mcf"), "--order", "2", "-o", msh,
+                  "--report", "-"])
+    report = _report(result)
+    cells = report["elements"]["tet"] + report["elements"]["tri"]
+    assert report["predicted_elements"] == report["sizing"]["predicted_elements"]
+    assert abs(report["predicted_elements"] / cells - 1.0) <= 0.10
+    assert report["sizing"]["octree"]["leaves"] > 0
+    # The boundary layer is not made yet: said, not silently dropped.
+    assert "boundary layers are not made yet" in result.stderr
+    mesh = meshio.read(msh)
+    kind = "tetra10" if case.startswith("3d") else "triangle6"
+    assert sum(len(b.data) for b in mesh.cells if b.type == kind) == cells
+
+
+def test_predict_prints_the_count_and_writes_the_octree(homesh_bin, tmp_path):
+    octree = tmp_path / "octree.vtu"
+    report_path = tmp_path / "predict.json"
+    result = run([homesh_bin, "predict", MESHGEN / "3d_sphere.mcf", "--write-octree", octree,
+                  "--report", report_path])
+    assert result.returncode == 0, result.stderr
+    report = json.loads(report_path.read_text())
+    assert int(result.stdout.strip()) == report["predicted_elements"]
+    assert "SurfaceOptimiser is not supported yet" in result.stderr
+    assert report["dimension"] == 3
+    sizing = report["sizing"]
+    assert (sizing["min_delta"], sizing["max_delta"], sizing["eps"]) == (0.04, 0.2, 0.02)
+    # The sphere's curvature size: 2 R sqrt(eps (2 - eps)) with R = 0.25 m (the CAD in metres).
+    assert sizing["octree"]["smallest_delta"] < 0.25 * 2 * np.sqrt(0.02 * 1.98) * 1.01
+    leaves = meshio.read(octree)
+    delta = leaves.cell_data["delta"][0]
+    assert sizing["octree"]["inside_leaves"] <= len(delta)
+    assert len(delta) <= sizing["octree"]["inside_leaves"] + sizing["octree"]["boundary_leaves"]
+    assert delta.min() >= 0.04 - 1e-12 and delta.max() <= 0.2 + 1e-12
+    fraction = leaves.cell_data["inside_fraction"][0]
+    assert np.all((fraction > 0) & (fraction <= 1))
+
+
+def test_flags_override_the_mcf(homesh_bin):
+    base = _report(run([homesh_bin, "predict", MESHGEN / "3d_bl_cyl.mcf", "--report", "-",
+                        "-q"]))
+    finer = _report(run([homesh_bin, "predict", MESHGEN / "3d_bl_cyl.mcf", "--max-delta", "0.1",
+                         "--report", "-", "-q"]))
+    assert finer["sizing"]["max_delta"] == 0.1
+    assert finer["sizing"]["min_delta"] == 0.03  # still the .mcf's
+    # Halving MaxDelta far from curved walls: about 8 times the elements.
+    assert 5 < finer["predicted_elements"] / base["predicted_elements"] < 9
+    refined = _report(run([homesh_bin, "predict", MESHGEN / "3d_bl_cyl.mcf", "--refine-line",
+                           "0.1,0,0.25,1.5,0,0.25,0.15,0.03", "--report", "-", "-q"]))
+    assert refined["sizing"]["sources"] == ["segment (0.1, 0, 0.25)-(1.5, 0, 0.25) radius 0.15 "
+                                            "delta 0.03"]
+    assert refined["predicted_elements"] > 1.5 * base["predicted_elements"]
+
+
+def test_plain_cad_gets_automatic_sizing(homesh_bin, data):
+    report = _report(run([homesh_bin, "mesh", data / "box_hole.step", "--order", "1",
+                          "--report", "-", "-q"]))
+    assert report["sizing"]["max_delta"] == pytest.approx(report["sizing"]["min_delta"] * 20)
+    assert abs(report["predicted_elements"] / report["elements"]["tet"] - 1) < 0.15
+
+
+def test_bad_cases_name_the_problem(homesh_bin, tmp_path):
+    mcf = tmp_path / "bad.mcf"
+    mcf.write_text((MESHGEN / "3d_sphere.mcf").read_text().replace('"0.02"', '"abc"'))
+    result = run([homesh_bin, "predict", mcf])
+    assert result.returncode == 2
+    assert "EPS" in result.stderr and "abc" in result.stderr
+    missing = tmp_path / "missing.mcf"
+    missing.write_text((MESHGEN / "3d_sphere.mcf").read_text())  # its STEP is not beside it
+    result = run([homesh_bin, "mesh", missing])
+    assert result.returncode == 1
+    assert "3d_sphere.stp" in result.stderr
+    result = run([homesh_bin, "predict", MESHGEN / "3d_sphere.mcf", "--min-delta", "1e-5",
+                  "--max-delta", "1e-5"])
+    assert result.returncode == 2
+    assert "too small" in result.stderr
+
+
+def test_python_predict_matches_the_mesh(data):
+    import homesh
+
+    report = homesh.predict(data / "sphere.brep", min_delta=0.05, max_delta=0.2, eps=0.05)
+    mesh = homesh.mesh(data / "sphere.brep", order=1, min_delta=0.05, max_delta=0.2, eps=0.05)
+    meshed = mesh.report()
+    assert meshed["predicted_elements"] == report["predicted_elements"]
+    assert abs(report["predicted_elements"] / meshed["elements"]["tet"] - 1) < 0.10
+    with pytest.raises(homesh.ParameterError, match="eps"):
+        homesh.predict(data / "sphere.brep", eps=-1)
+    with pytest.raises(homesh.ParameterError, match="size"):
+        homesh.mesh(data / "sphere.brep", size=0.3, max_delta=0.3)
+    with pytest.raises(homesh.ParameterError, match="kind"):
+        homesh.predict(data / "sphere.brep", sources=[{"kind": "cone"}])
