@@ -480,28 +480,72 @@ class OctreeBuilder {
     t_.stats_.smallestDelta = std::isfinite(smallest) ? smallest : p.maxDelta;
   }
 
-  // Corner sizes: the mean of the sizes of the leaves that have that corner.
+  // Corner sizes: the mean of the sizes of the leaves that have that corner; then, where a
+  // corner of small leaves lies on a face or edge of a larger leaf (a hanging corner), the
+  // larger leaf's interpolation there, so that delta(x) is continuous across the two.
   void setCorners() {
     const int top = t_.stats_.maxLevel;
+    const int corners = t_.children();
     std::unordered_map<std::uint64_t, std::pair<double, int>> sums;
     sums.reserve(t_.leaves_.size() * 4);
-    const auto key = [&](const SizingOctree::Node& node, int c) {
-      std::int64_t idx[3] = {0, 0, 0};
+    const auto index = [&](const SizingOctree::Node& node, int c) {
+      std::array<std::int64_t, 3> idx{0, 0, 0};
       for (int k = 0; k < t_.dim_; ++k)
         idx[k] = (std::int64_t{node.index[k]} + ((c >> k) & 1)) << (top - node.level);
+      return idx;
+    };
+    const auto key = [&](const SizingOctree::Node& node, int c) {
+      const auto idx = index(node, c);
       return cornerKey(idx[0], idx[1], idx[2]);
     };
     for (const SizingOctree::LeafData& leaf : t_.leaves_)
-      for (int c = 0; c < t_.children(); ++c) {
+      for (int c = 0; c < corners; ++c) {
         auto& slot = sums[key(t_.nodes_[leaf.node], c)];
         slot.first += leaf.delta;
         ++slot.second;
       }
     for (SizingOctree::LeafData& leaf : t_.leaves_)
-      for (int c = 0; c < t_.children(); ++c) {
+      for (int c = 0; c < corners; ++c) {
         const auto& slot = sums[key(t_.nodes_[leaf.node], c)];
         leaf.corner[c] = static_cast<float>(slot.first / slot.second);
       }
+    // Hanging corners: a leaf's corners on the face it shares with a larger face neighbour that
+    // are not that neighbour's corners. (A corner on the edge of a larger leaf that is only an
+    // edge neighbour is not looked at: with faces balanced that is rare, and the jump small.)
+    const SizingOctree::Node& root = t_.nodes_[0];
+    const double unit = 2.0 * root.half / double(std::int64_t{1} << top);
+    std::unordered_map<std::uint64_t, float> hanging;
+    for (std::size_t i = 0; i < t_.leaves_.size(); ++i) {
+      const SizingOctree::Node& node = t_.nodes_[t_.leaves_[i].node];
+      for (std::int64_t nb = t_.neighbourStart_[i]; nb < t_.neighbourStart_[i + 1]; ++nb) {
+        const SizingOctree::LeafData& larger = t_.leaves_[t_.neighbours_[nb]];
+        const SizingOctree::Node& other = t_.nodes_[larger.node];
+        if (other.level >= node.level) continue;
+        // The axis across the shared face: where the centres are a half-width sum apart.
+        int axis = 0;
+        for (int k = 1; k < t_.dim_; ++k)
+          if (std::abs(other.centre[k] - node.centre[k]) >
+              std::abs(other.centre[axis] - node.centre[axis]))
+            axis = k;
+        const int side = other.centre[axis] > node.centre[axis] ? 1 : 0;
+        for (int c = 0; c < corners; ++c) {
+          if (((c >> axis) & 1) != side) continue;
+          const auto idx = index(node, c);
+          const std::uint64_t k = cornerKey(idx[0], idx[1], idx[2]);
+          bool shared = false;
+          for (int oc = 0; oc < corners && !shared; ++oc) shared = key(other, oc) == k;
+          if (shared || hanging.count(k)) continue;
+          Eigen::Vector3d p = root.centre;
+          for (int d = 0; d < t_.dim_; ++d) p[d] += -root.half + double(idx[d]) * unit;
+          hanging[k] = static_cast<float>(t_.interpolate(larger, p));
+        }
+      }
+    }
+    if (hanging.empty()) return;
+    for (SizingOctree::LeafData& leaf : t_.leaves_)
+      for (int c = 0; c < corners; ++c)
+        if (const auto it = hanging.find(key(t_.nodes_[leaf.node], c)); it != hanging.end())
+          leaf.corner[c] = it->second;
   }
 
   const CadModel& cad_;

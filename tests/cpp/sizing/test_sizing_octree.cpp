@@ -66,6 +66,17 @@ TEST(SizingOctree, GradationAndBalanceHoldBetweenNeighbours) {
     }
   }
   EXPECT_GT(pairs, tree.numLeaves());
+  // The query is continuous, also across leaves of different sizes (hanging corners take the
+  // larger leaf's value): finite differences stay near the gradation everywhere.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> ux(-0.99, 2.99), uy(-0.99, 0.99), uz(0.01, 0.74);
+  double steepest = 0.0;
+  for (int i = 0; i < 20000; ++i) {
+    const Eigen::Vector3d x(ux(rng), uy(rng), uz(rng));
+    const Eigen::Vector3d h = 1e-7 * Eigen::Vector3d(uy(rng), uy(rng), uy(rng));
+    steepest = std::max(steepest, std::abs(tree.delta(x + h) - tree.delta(x)) / h.norm());
+  }
+  EXPECT_LT(steepest, 1.5);
   // Sizes really vary: curvature near the sphere, MaxDelta far away.
   EXPECT_LT(tree.statistics().smallestDelta, 0.11);
   EXPECT_DOUBLE_EQ(tree.delta(Eigen::Vector3d(2.9, 0.9, 0.7)), 0.2);
