@@ -220,14 +220,46 @@ def _sizing(min_delta, max_delta, eps, sources):
         if not float(value) > 0.0:
             raise ParameterError("%s must be a positive number, got %g" % (key, value))
         out[key] = float(value)
-    checked = []
-    for i, src in enumerate(sources or ()):
-        if not isinstance(src, dict) or "kind" not in src:
-            raise ParameterError(
-                "source %d must be a dict with 'kind' (segment, sphere, box or curve), got %r"
-                % (i + 1, src))
-        checked.append(dict(src))
-    out["sources"] = checked
+    out["sources"] = [_source(i + 1, src) for i, src in enumerate(sources or ())]
+    return out
+
+
+_SOURCE_FIELDS = {"segment": ("a", "b", "radius", "delta"), "sphere": ("a", "radius", "delta"),
+                  "box": ("a", "b", "delta"), "curve": ("edge", "radius", "delta")}
+
+
+def _source(number, src):
+    """A refinement source dict checked field by field (messages name the source and field)."""
+    if not isinstance(src, dict) or src.get("kind") not in _SOURCE_FIELDS:
+        raise ParameterError(
+            "source %d must be a dict with 'kind' segment, sphere, box or curve, got %r"
+            % (number, src))
+    kind = src["kind"]
+    out = {"kind": kind}
+    for field in _SOURCE_FIELDS[kind]:
+        if field not in src:
+            raise ParameterError("source %d (%s) needs '%s'" % (number, kind, field))
+        value = src[field]
+        if field in ("a", "b"):
+            try:
+                point = tuple(float(x) for x in value)
+            except (TypeError, ValueError):
+                point = ()
+            if len(point) != 3:
+                raise ParameterError("source %d (%s): '%s' must be three numbers, got %r"
+                                     % (number, kind, field, value))
+            out[field] = point
+        elif field == "edge":
+            if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
+                raise ParameterError("source %d (curve): 'edge' must be an edge number >= 1, "
+                                     "got %r" % (number, value))
+            out[field] = int(value)
+        else:
+            if (isinstance(value, bool) or not isinstance(value, numbers.Real)
+                    or not float(value) > 0.0):
+                raise ParameterError("source %d (%s): '%s' must be a positive number, got %r"
+                                     % (number, kind, field, value))
+            out[field] = float(value)
     return out
 
 
@@ -248,7 +280,7 @@ def _cad_source(shape, name):
 
 
 def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_octree=None,
-            name=None):
+            name=None, threads=1):
     """The element count the linear mesh of a CAD shape will have, without making it.
 
     Builds the sizing octree (curvature sizes between min_delta and max_delta with sagitta
@@ -257,18 +289,20 @@ def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_o
     "radius": 1, "delta": 0.05}``, ``{"kind": "segment", "a": ..., "b": ..., "radius": ...,
     "delta": ...}``, ``{"kind": "box", "a": lo, "b": hi, "delta": ...}`` or ``{"kind":
     "curve", "edge": 3, "radius": ..., "delta": ...}``. write_octree: a .vtu path for the
-    octree's leaves and sizes.
+    octree's leaves and sizes. shape may be a NekMesh .mcf path: its CAD (in metres) and,
+    unless given here, its sizes are used (likewise in :func:`mesh`).
 
     Returns the report as a dict: "predicted_elements", "dimension" and "sizing" (parameters,
     integrals and octree statistics).
     """
     sizing = _sizing(min_delta, max_delta, eps, sources)
+    threads = _check_int("threads", threads)
     octree = "" if write_octree is None else os.fspath(write_octree)
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
-        text = _core.predict_brep(value, label, sizing, octree)
+        text = _core.predict_brep(value, label, sizing, octree, threads)
     else:
-        text = _core.predict_file(value, sizing, octree)
+        text = _core.predict_file(value, sizing, octree, threads)
     return json.loads(text)
 
 

@@ -77,7 +77,10 @@ homesh::CaseSetup setupWithFlags(const std::string& input, const homesh::SizingF
     p.sources.insert(p.sources.end(), flags.sources.begin(), flags.sources.end());
     setup.options.sizing = p;
   }
-  if (flags.writeOctree) homesh::checkParentFolder(*flags.writeOctree);
+  if (flags.writeOctree) {
+    homesh::checkMeshOutputPath(*flags.writeOctree);
+    setup.options.octreeOutput = *flags.writeOctree;
+  }
   return setup;
 }
 
@@ -108,8 +111,6 @@ int runMesh(const homesh::MeshCommand& cmd) {
   StderrProgress progress;
   homesh::PipelineObserver* observer = c.quiet ? nullptr : &progress;
   homesh::MeshResult result = homesh::runMeshPipeline(setup.source, options, observer);
-  if (cmd.sizing.writeOctree && result.sizing)
-    homesh::writeOctree(*result.sizing->octree, *cmd.sizing.writeOctree);
   if (!c.outputs.empty()) homesh::writeMeshOutputs(result, c.outputs, writeOptions(c), observer);
   if (!c.quiet) {
     if (result.sizing) printPrediction(*result.sizing, result.mesh.dim);
@@ -132,9 +133,9 @@ int runPredict(const homesh::PredictCommand& cmd) {
   checkOutputs(c);
   homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.sizing, std::nullopt, c.quiet);
   const homesh::CadModel cad = setup.source.load();
-  const homesh::SizingParameters params =
-      homesh::completeSizing(setup.options.sizing.value_or(homesh::defaultSizing(cad)), cad);
-  const homesh::SizingResult s = homesh::runSizing(cad, params);
+  homesh::checkMeshDimension(cad, setup.options.expectedDimension);
+  const homesh::SizingResult s =
+      homesh::runSizing(cad, homesh::resolveSizing(setup.options.sizing, cad), c.threads);
   if (cmd.sizing.writeOctree) homesh::writeOctree(*s.octree, *cmd.sizing.writeOctree);
   const bool toStdout = c.report && *c.report == "-";
   if (!c.quiet) {

@@ -43,6 +43,7 @@ CaseSetup setupCase(const std::string& input) {
     setup.source.scale = 0.001;  // NekMesh reads CAD in metres; OCCT gives millimetres
   }
   if (mcf.order) setup.options.order = *mcf.order;
+  setup.options.expectedDimension = mcf.is2D() ? 2 : 3;
   const int given =
       int(mcf.minDelta.has_value()) + int(mcf.maxDelta.has_value()) + int(mcf.eps.has_value());
   if (given != 0 && given != 3)

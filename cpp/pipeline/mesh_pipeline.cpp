@@ -9,10 +9,12 @@
 
 #include <unistd.h>
 
+#include "cad/model_dimension.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "curving/order_elevation.hpp"
 #include "linear/linear_mesher.hpp"
+#include "sizing/octree_export.hpp"
 
 namespace homesh {
 
@@ -27,6 +29,8 @@ void MeshingOptions::validate() const {
   if (optimiseIterations < 0)
     throw ParameterError("optimiser iterations must be >= 0, got " +
                          std::to_string(optimiseIterations));
+  if (size && !octreeOutput.empty())
+    throw ParameterError("writing the sizing octree needs octree sizing, not a uniform size");
   if (size && sizing)
     throw ParameterError(
         "give either a uniform size or the sizing parameters (MinDelta, MaxDelta, EPS), not both");
@@ -65,16 +69,31 @@ SizingParameters defaultSizing(const CadModel& cad) {
 }
 
 SizingParameters completeSizing(SizingParameters p, const CadModel& cad) {
-  if (p.maxDelta == 0.0) p.maxDelta = defaultMeshSize(cad);
+  if (p.maxDelta == 0.0) p.maxDelta = std::max(defaultMeshSize(cad), p.minDelta);
   if (p.minDelta == 0.0) p.minDelta = p.maxDelta / 20.0;
   return p;
 }
 
-SizingResult runSizing(const CadModel& cad, const SizingParameters& params) {
+SizingParameters resolveSizing(const std::optional<SizingParameters>& requested,
+                               const CadModel& cad) {
+  return completeSizing(requested.value_or(defaultSizing(cad)), cad);
+}
+
+void checkMeshDimension(const CadModel& cad, std::optional<int> expected) {
+  if (!expected) return;
+  Eigen::Vector3d normal;
+  const int dim = modelMeshDimension(cad, normal);
+  if (dim != *expected)
+    throw ParameterError("MeshType asks for a " + std::to_string(*expected) + "D mesh but " +
+                         cad.sourceName() +
+                         (dim == 3 ? " has solids (a 3D mesh)" : " is planar faces (a 2D mesh)"));
+}
+
+SizingResult runSizing(const CadModel& cad, const SizingParameters& params, int threads) {
   const auto start = std::chrono::steady_clock::now();
   SizingResult r;
-  r.octree = std::make_shared<const SizingOctree>(SizingOctree::build(cad, params));
-  r.prediction = predictElementCount(*r.octree);
+  r.octree = std::make_shared<const SizingOctree>(SizingOctree::build(cad, params, threads));
+  r.prediction = predictElementCount(*r.octree, threads);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (r.prediction.elements > kMaxPredictedElements) {
     std::ostringstream msg;
@@ -167,8 +186,8 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   StageClock cad("cad", result.timings, observer);
   result.cad = std::make_shared<const CadModel>(source.load());
   cad.done();
-  if (!options.size && !options.sizing) options.sizing = defaultSizing(*result.cad);
-  if (options.sizing) options.sizing = completeSizing(*options.sizing, *result.cad);
+  checkMeshDimension(*result.cad, options.expectedDimension);
+  if (!options.size) options.sizing = resolveSizing(options.sizing, *result.cad);
   result.options = options;
 
   LinearMeshOptions linearOptions;
@@ -176,7 +195,8 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   linearOptions.verbosity = options.verbosity;
   if (options.sizing) {
     StageClock sizing("sizing", result.timings, observer);
-    result.sizing = runSizing(*result.cad, *options.sizing);
+    result.sizing = runSizing(*result.cad, *options.sizing, options.threads);
+    if (!options.octreeOutput.empty()) writeOctree(*result.sizing->octree, options.octreeOutput);
     sizing.done();
     const SizingOctree& octree = *result.sizing->octree;
     linearOptions.sizeField = [&octree](const Eigen::Vector3d& x) { return octree.delta(x); };

@@ -32,6 +32,8 @@ struct MeshingOptions {
   // with neither, the octree with defaultSizing(cad).
   std::optional<double> size;
   std::optional<SizingParameters> sizing;  // 0 deltas: automatic (completeSizing)
+  std::optional<int> expectedDimension;    // 2 or 3 (a .mcf's MeshType): checked on the CAD
+  std::string octreeOutput;                // when set: the octree's leaves, written after sizing
   int threads = 1;                         // threads the stages may use, 1..kMaxThreads
   int verbosity = 0;                       // 0 silent; 1 Gmsh's warnings; 2 Gmsh's information
   // > 0: after elevation, at most this many sweeps of the variational optimiser (hyperelastic,
@@ -50,9 +52,17 @@ double defaultMeshSize(const CadModel& cad);
 // MaxDelta / 20, EPS = 0.05 (a chord deviates from an arc by a twentieth of its radius).
 SizingParameters defaultSizing(const CadModel& cad);
 
-// `p` with an automatic (0) maxDelta set to defaultMeshSize and an automatic minDelta to
-// min(maxDelta / 20, ...) so that it never exceeds maxDelta.
+// `p` with an automatic (0) maxDelta set to defaultMeshSize (or minDelta if that is larger)
+// and an automatic minDelta to maxDelta / 20.
 SizingParameters completeSizing(SizingParameters p, const CadModel& cad);
+
+// The sizes to use: `requested` completed, or defaultSizing when nothing was requested.
+SizingParameters resolveSizing(const std::optional<SizingParameters>& requested,
+                               const CadModel& cad);
+
+// Throws ParameterError when `expected` (2 or 3, from a .mcf's MeshType) is set and the model
+// gets the other kind of mesh (cad/model_dimension.hpp).
+void checkMeshDimension(const CadModel& cad, std::optional<int> expected);
 
 // The sizing octree of a model and the element count it predicts.
 struct SizingResult {
@@ -64,7 +74,7 @@ struct SizingResult {
 // Throws ParameterError (bad parameters, or a prediction above kMaxPredictedElements: sizes
 // far too small for the model) or CadError.
 inline constexpr double kMaxPredictedElements = 5e7;
-SizingResult runSizing(const CadModel& cad, const SizingParameters& params);
+SizingResult runSizing(const CadModel& cad, const SizingParameters& params, int threads = 1);
 
 // Where the CAD comes from.
 struct CadSource {

@@ -19,6 +19,7 @@
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 #include "io/mesh_readers.hpp"
+#include "pipeline/case_setup.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
 #include "quality/element_measure.hpp"
@@ -336,27 +337,34 @@ MeshingOptions makeOptions(int order, const bp::object& size, int threads, int v
 
 // The sizing octree and prediction of a CAD source: the JSON report of `homesh predict`,
 // and the octree's leaves written to `octreePath` when it is not empty.
-std::string predict(const CadSource& source, const bp::object& sizing,
-                    const std::string& octreePath, const std::string& input) {
-  const SizingParameters requested =
-      sizing.is_none() ? SizingParameters{} : sizingFrom(bp::extract<bp::dict>(sizing));
+// The sizes asked from Python, else those of a .mcf case (if the input is one).
+std::optional<SizingParameters> requestedSizing(const bp::object& sizing, const CaseSetup& setup) {
+  if (!sizing.is_none()) return sizingFrom(bp::extract<bp::dict>(sizing));
+  return setup.options.sizing;
+}
+
+std::string predict(const CaseSetup& setup, const bp::object& sizing, const std::string& octreePath,
+                    const std::string& input, int threads) {
+  const std::optional<SizingParameters> requested = requestedSizing(sizing, setup);
   const ReleaseGil nogil;
-  const CadModel cad = source.load();
-  const SizingParameters params =
-      completeSizing(sizing.is_none() ? defaultSizing(cad) : requested, cad);
-  const SizingResult result = runSizing(cad, params);
+  const CadModel cad = setup.source.load();
+  checkMeshDimension(cad, setup.options.expectedDimension);
+  const SizingResult result = runSizing(cad, resolveSizing(requested, cad), threads);
   if (!octreePath.empty()) writeOctree(*result.octree, octreePath);
   return predictReportJson(result, input);
 }
 
+// A CAD file or a NekMesh .mcf case (pipeline/case_setup.hpp).
 std::string predictFile(const std::string& path, const bp::object& sizing,
-                        const std::string& octreePath) {
-  return predict(CadSource::file(path), sizing, octreePath, path);
+                        const std::string& octreePath, int threads) {
+  return predict(setupCase(path), sizing, octreePath, path, threads);
 }
 
 std::string predictBrep(const std::string& text, const std::string& name, const bp::object& sizing,
-                        const std::string& octreePath) {
-  return predict(CadSource::brepText(text, name), sizing, octreePath, name);
+                        const std::string& octreePath, int threads) {
+  CaseSetup setup;
+  setup.source = CadSource::brepText(text, name);
+  return predict(setup, sizing, octreePath, name, threads);
 }
 
 PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::object progress) {
@@ -372,11 +380,14 @@ PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::o
   return PyMesh(std::move(*result));
 }
 
+// A CAD file or a NekMesh .mcf case: a case's CAD and sizes (unless given here) are used.
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
                 int verbosity, bp::object progress, int optimise, const bp::object& sizing) {
-  return runPipeline(CadSource::file(path),
-                     makeOptions(order, size, threads, verbosity, optimise, sizing),
-                     std::move(progress));
+  const CaseSetup setup = setupCase(path);
+  MeshingOptions options = makeOptions(order, size, threads, verbosity, optimise, sizing);
+  if (!options.size && !options.sizing) options.sizing = setup.options.sizing;
+  options.expectedDimension = setup.options.expectedDimension;
+  return runPipeline(setup.source, options, std::move(progress));
 }
 
 PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
@@ -532,10 +543,11 @@ BOOST_PYTHON_MODULE(_core) {
            bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
            bp::arg("sizing") = bp::object()));
   bp::def("predict_file", &predictFile,
-          (bp::arg("path"), bp::arg("sizing") = bp::object(), bp::arg("octree_path") = ""));
+          (bp::arg("path"), bp::arg("sizing") = bp::object(), bp::arg("octree_path") = "",
+           bp::arg("threads") = 1));
   bp::def("predict_brep", &predictBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
-           bp::arg("octree_path") = ""));
+           bp::arg("octree_path") = "", bp::arg("threads") = 1));
   bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("threads") = 1));
   bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
   bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));

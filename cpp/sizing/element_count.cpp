@@ -1,10 +1,12 @@
 #include "sizing/element_count.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include <Eigen/Geometry>
 
+#include "core/first_failure.hpp"
 #include "sizing/sizing_octree.hpp"
 
 namespace homesh {
@@ -28,7 +30,8 @@ constexpr double kGradientDensity2 = 1.41;
 
 }  // namespace
 
-ElementCountPrediction predictElementCount(const SizingOctree& tree) {
+ElementCountPrediction predictElementCount(const SizingOctree& tree, int threads) {
+  threads = std::max(1, threads);
   ElementCountPrediction out;
   out.dim = tree.dim();
   const int d = out.dim;
@@ -36,12 +39,18 @@ ElementCountPrediction predictElementCount(const SizingOctree& tree) {
   double volume = 0.0, gradient = 0.0;
   const std::int64_t leaves = static_cast<std::int64_t>(tree.numLeaves());
   const bool withGradient = (d == 3 ? kGradientDensity3 : kGradientDensity2) != 0.0;
-#pragma omp parallel reduction(+ : volume, gradient)
+  FirstFailure failure;  // an allocation failure must not leave the parallel region
+#pragma omp parallel num_threads(threads) reduction(+ : volume, gradient)
   {
     std::vector<SizingOctree::QuadraturePoint> points;
 #pragma omp for schedule(dynamic, 256)
     for (std::int64_t i = 0; i < leaves; ++i) {
-      tree.leafQuadrature(static_cast<std::size_t>(i), points, withGradient);
+      try {
+        tree.leafQuadrature(static_cast<std::size_t>(i), points, withGradient);
+      } catch (...) {
+        failure.capture();
+        continue;
+      }
       for (const SizingOctree::QuadraturePoint& q : points) {
         const double h = tree.delta(q.x);
         const double density = q.weight / (d == 3 ? h * h * h : h * h);
@@ -50,12 +59,13 @@ ElementCountPrediction predictElementCount(const SizingOctree& tree) {
       }
     }
   }
+  failure.rethrow();
   out.volumeIntegral = volume;
   out.gradientIntegral = gradient;
   out.domainMeasure = tree.domainMeasure();
   const std::vector<BoundarySample>& samples = tree.samples();
   double boundary = 0.0;
-#pragma omp parallel for reduction(+ : boundary) schedule(static)
+#pragma omp parallel for num_threads(threads) reduction(+ : boundary) schedule(static)
   for (std::int64_t i = 0; i < static_cast<std::int64_t>(samples.size()); ++i) {
     const BoundarySample& s = samples[static_cast<std::size_t>(i)];
     const double h = tree.delta(s.x);

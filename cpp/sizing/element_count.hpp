@@ -32,6 +32,7 @@ struct ElementCountPrediction {
   double elements = 0.0;          // the predicted number of tetrahedra (triangles in 2D)
 };
 
-ElementCountPrediction predictElementCount(const SizingOctree& tree);
+// Uses up to `threads` threads.
+ElementCountPrediction predictElementCount(const SizingOctree& tree, int threads = 1);
 
 }  // namespace homesh

@@ -17,17 +17,11 @@ OctreeMesh octreeLeavesMesh(const SizingOctree& octree) {
   const int dim = octree.dim();
   mesh.dim = dim;
   mesh.order = 1;
-  const Eigen::Vector3d normal = octree.planeNormal();
+  const Eigen::Matrix3d& axes = octree.axes();
+  const Eigen::Vector3d normal = axes.col(2);
   mesh.planeNormal = {normal.x(), normal.y(), normal.z()};
   // Leaf corners in model coordinates, shared between leaves (keyed by their rounded position).
-  Eigen::Vector3d e0 = Eigen::Vector3d::UnitX(), e1 = Eigen::Vector3d::UnitY();
-  if (dim == 2) {
-    const int least = normal.cwiseAbs().minCoeff() == std::abs(normal.x())   ? 0
-                      : normal.cwiseAbs().minCoeff() == std::abs(normal.y()) ? 1
-                                                                             : 2;
-    e0 = normal.cross(Eigen::Vector3d::Unit(least)).normalized();
-    e1 = normal.cross(e0);
-  }
+  const Eigen::Vector3d e0 = axes.col(0), e1 = axes.col(1);
   double smallest = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < octree.numLeaves(); ++i)
     smallest = std::min(smallest, octree.leaf(i).halfWidth);

@@ -3,7 +3,6 @@
 #include <BRepClass3d_SolidClassifier.hxx>
 #include <BRepClass_FaceClassifier.hxx>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <queue>
@@ -15,6 +14,7 @@
 #include "cad/model_dimension.hpp"
 #include "cad/occt_access.hpp"
 #include "core/error.hpp"
+#include "core/first_failure.hpp"
 #include "core/format.hpp"
 
 namespace homesh {
@@ -44,7 +44,8 @@ std::uint64_t cornerKey(std::int64_t i, std::int64_t j, std::int64_t k) {
 // Builds a SizingOctree in stages; see sizing_octree.hpp for what each stage guarantees.
 class OctreeBuilder {
  public:
-  OctreeBuilder(const CadModel& cad, SizingOctree& tree) : cad_(cad), t_(tree) {}
+  OctreeBuilder(const CadModel& cad, SizingOctree& tree, int threads)
+      : cad_(cad), t_(tree), threads_(std::max(1, threads)) {}
 
   void run() {
     prepareFrame();
@@ -166,8 +167,15 @@ class OctreeBuilder {
 
   [[noreturn]] void tooLarge() const {
     const SizingParameters& p = t_.params_;
-    throw ParameterError("MinDelta " + formatNumber(p.minDelta) + " and MaxDelta " +
-                         formatNumber(p.maxDelta) + " are too small for " + cad_.sourceName() +
+    std::string culprit = "MinDelta " + formatNumber(p.minDelta) + " and MaxDelta " +
+                          formatNumber(p.maxDelta) + " are";
+    for (std::size_t i = 0; i < p.sources.size(); ++i)
+      if (p.sources[i].delta < p.minDelta) {
+        culprit =
+            "refinement source " + std::to_string(i + 1) + " (" + p.sources[i].describe() + ") is";
+        break;
+      }
+    throw ParameterError(culprit + " too small for " + cad_.sourceName() +
                          " (bounding-box diagonal " + formatNumber(cad_.boundingDiagonal()) +
                          "): the sizing octree would need more than " + std::to_string(kMaxNodes) +
                          " cells");
@@ -204,9 +212,11 @@ class OctreeBuilder {
         const Eigen::Vector3d d = (samples_[s].x - child.centre).cwiseAbs() - half;
         if (d.head(t_.dim_).maxCoeff() <= 0.5 * samples_[s].spacing) cc.samples.push_back(s);
       }
+      // In 2D the model lies in the plane z = 0 of the local frame: only that slice counts.
       const Eigen::Vector3d centre = t_.toModel(child.centre);
+      const Eigen::Vector3d slice(child.half, child.half, t_.dim_ == 3 ? child.half : 0.0);
       for (const std::int32_t s : parentContent.sources)
-        if (t_.params_.sources[s].mayMeetBox(centre, t_.axes_.cwiseAbs() * halfVector(child)))
+        if (t_.params_.sources[s].mayMeetBox(centre, t_.axes_.cwiseAbs() * slice))
           cc.sources.push_back(s);
     }
   }
@@ -367,23 +377,29 @@ class OctreeBuilder {
                                 ? votesIn > votesOut
                                 : insideModel(t_.nodes_[t_.leaves_[start].node].centre));
     }
-    // Each leaf is judged on its own: no exceptions can arise below (plain arithmetic).
-#pragma omp parallel
+    // Each leaf is judged on its own, in parallel (an allocation failure is carried out).
+    FirstFailure failure;
+#pragma omp parallel num_threads(threads_)
     {
       std::vector<std::int32_t> near;
 #pragma omp for schedule(dynamic, 64)
       for (std::int64_t n = 0; n < static_cast<std::int64_t>(nLeaves); ++n) {
-        const std::size_t i = static_cast<std::size_t>(n);
-        SizingOctree::LeafData& leaf = t_.leaves_[i];
-        if (boundary[i]) {
-          classifyBoundaryLeaf(leaf, near);
-        } else {
-          const bool in = groupInside[group[i]];
-          leaf.location = in ? SizingOctree::Location::Inside : SizingOctree::Location::Outside;
-          leaf.insideFraction = in ? 1.0f : 0.0f;
+        try {
+          const std::size_t i = static_cast<std::size_t>(n);
+          SizingOctree::LeafData& leaf = t_.leaves_[i];
+          if (boundary[i]) {
+            classifyBoundaryLeaf(leaf, near);
+          } else {
+            const bool in = groupInside[group[i]];
+            leaf.location = in ? SizingOctree::Location::Inside : SizingOctree::Location::Outside;
+            leaf.insideFraction = in ? 1.0f : 0.0f;
+          }
+        } catch (...) {
+          failure.capture();
         }
       }
     }
+    failure.rethrow();
   }
 
   // Sub-cells of a boundary leaf, judged by the nearest boundary sample.
@@ -510,60 +526,68 @@ class OctreeBuilder {
         leaf.corner[c] = static_cast<float>(slot.first / slot.second);
       }
     // Hanging corners: a leaf's corners on the face it shares with a larger face neighbour that
-    // are not that neighbour's corners. (A corner on the edge of a larger leaf that is only an
-    // edge neighbour is not looked at: with faces balanced that is rare, and the jump small.)
+    // are not that neighbour's corners take the neighbour's interpolated value. Levels are
+    // done from coarse to fine, so that a larger leaf's own hanging corners are settled before
+    // its values are passed on. (A corner on the edge of a larger leaf that is only an edge
+    // neighbour is not looked at: with faces balanced that is rare, and the jump small.)
     const SizingOctree::Node& root = t_.nodes_[0];
     const double unit = 2.0 * root.half / double(std::int64_t{1} << top);
+    std::vector<std::vector<std::size_t>> byLevel(static_cast<std::size_t>(top) + 1);
+    for (std::size_t i = 0; i < t_.leaves_.size(); ++i)
+      byLevel[t_.nodes_[t_.leaves_[i].node].level].push_back(i);
     std::unordered_map<std::uint64_t, float> hanging;
-    for (std::size_t i = 0; i < t_.leaves_.size(); ++i) {
-      const SizingOctree::Node& node = t_.nodes_[t_.leaves_[i].node];
-      for (std::int64_t nb = t_.neighbourStart_[i]; nb < t_.neighbourStart_[i + 1]; ++nb) {
-        const SizingOctree::LeafData& larger = t_.leaves_[t_.neighbours_[nb]];
-        const SizingOctree::Node& other = t_.nodes_[larger.node];
-        if (other.level >= node.level) continue;
-        // The axis across the shared face: where the centres are a half-width sum apart.
-        int axis = 0;
-        for (int k = 1; k < t_.dim_; ++k)
-          if (std::abs(other.centre[k] - node.centre[k]) >
-              std::abs(other.centre[axis] - node.centre[axis]))
-            axis = k;
-        const int side = other.centre[axis] > node.centre[axis] ? 1 : 0;
-        for (int c = 0; c < corners; ++c) {
-          if (((c >> axis) & 1) != side) continue;
-          const auto idx = index(node, c);
-          const std::uint64_t k = cornerKey(idx[0], idx[1], idx[2]);
-          bool shared = false;
-          for (int oc = 0; oc < corners && !shared; ++oc) shared = key(other, oc) == k;
-          if (shared || hanging.count(k)) continue;
-          Eigen::Vector3d p = root.centre;
-          for (int d = 0; d < t_.dim_; ++d) p[d] += -root.half + double(idx[d]) * unit;
-          hanging[k] = static_cast<float>(t_.interpolate(larger, p));
+    for (const std::vector<std::size_t>& level : byLevel) {
+      std::unordered_map<std::uint64_t, float> found;
+      for (const std::size_t i : level) {
+        const SizingOctree::Node& node = t_.nodes_[t_.leaves_[i].node];
+        for (std::int64_t nb = t_.neighbourStart_[i]; nb < t_.neighbourStart_[i + 1]; ++nb) {
+          const SizingOctree::LeafData& larger = t_.leaves_[t_.neighbours_[nb]];
+          const SizingOctree::Node& other = t_.nodes_[larger.node];
+          if (other.level >= node.level) continue;
+          // The axis across the shared face: where the centres are farthest apart.
+          int axis = 0;
+          for (int k = 1; k < t_.dim_; ++k)
+            if (std::abs(other.centre[k] - node.centre[k]) >
+                std::abs(other.centre[axis] - node.centre[axis]))
+              axis = k;
+          const int side = other.centre[axis] > node.centre[axis] ? 1 : 0;
+          for (int c = 0; c < corners; ++c) {
+            if (((c >> axis) & 1) != side) continue;
+            const auto idx = index(node, c);
+            const std::uint64_t k = cornerKey(idx[0], idx[1], idx[2]);
+            bool shared = false;
+            for (int oc = 0; oc < corners && !shared; ++oc) shared = key(other, oc) == k;
+            if (shared || found.count(k) || hanging.count(k)) continue;
+            Eigen::Vector3d p = root.centre;
+            for (int d = 0; d < t_.dim_; ++d) p[d] += -root.half + double(idx[d]) * unit;
+            found[k] = static_cast<float>(t_.interpolate(larger, p));
+          }
         }
       }
+      if (found.empty()) continue;
+      // Every leaf with such a corner (this level and finer) takes the value now.
+      for (SizingOctree::LeafData& leaf : t_.leaves_)
+        for (int c = 0; c < corners; ++c)
+          if (const auto it = found.find(key(t_.nodes_[leaf.node], c)); it != found.end())
+            leaf.corner[c] = it->second;
+      hanging.insert(found.begin(), found.end());
     }
-    if (hanging.empty()) return;
-    for (SizingOctree::LeafData& leaf : t_.leaves_)
-      for (int c = 0; c < corners; ++c)
-        if (const auto it = hanging.find(key(t_.nodes_[leaf.node], c)); it != hanging.end())
-          leaf.corner[c] = it->second;
   }
 
   const CadModel& cad_;
   SizingOctree& t_;
+  int threads_;
   std::vector<BoundarySample> samples_;  // local coordinates
   std::vector<Content> content_;         // per node; emptied when split
   Eigen::Vector3d geometryLo_, geometryHi_;
 };
 
-SizingOctree SizingOctree::build(const CadModel& cad, const SizingParameters& params) {
+SizingOctree SizingOctree::build(const CadModel& cad, const SizingParameters& params, int threads) {
   params.validate();
-  const auto start = std::chrono::steady_clock::now();
   SizingOctree tree;
   tree.params_ = params;
   tree.params_.sources = resolveCurveSources(params.sources, cad);
-  OctreeBuilder(cad, tree).run();
-  tree.stats_.buildSeconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  OctreeBuilder(cad, tree, threads).run();
   return tree;
 }
 

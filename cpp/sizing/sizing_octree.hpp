@@ -32,7 +32,6 @@ struct OctreeStatistics {
   int maxLevel = 0;
   std::size_t boundarySamples = 0, sizedSamples = 0;
   double smallestDelta = 0.0;  // over leaves that are not outside
-  double buildSeconds = 0.0;
 };
 
 class SizingOctree {
@@ -48,8 +47,9 @@ class SizingOctree {
     double insideFraction = 0.0;  // of its volume (area in 2D)
   };
 
-  // Throws ParameterError (bad parameters), CadError (no solid and not planar, OCCT failure).
-  static SizingOctree build(const CadModel& cad, const SizingParameters& params);
+  // Uses up to `threads` threads. Throws ParameterError (bad parameters, sizes too small for
+  // the model), CadError (no solid and not planar, OCCT failure).
+  static SizingOctree build(const CadModel& cad, const SizingParameters& params, int threads = 1);
 
   // The size at x (model coordinates). Thread-safe.
   double delta(const Eigen::Vector3d& x) const;
@@ -81,9 +81,9 @@ class SizingOctree {
   void leafQuadrature(std::size_t i, std::vector<QuadraturePoint>& points,
                       bool withGradient = true) const;
 
-  // Where the mesh plane is (2D): origin and unit normal; for 3D: zero and +z.
-  Eigen::Vector3d planeOrigin() const { return origin_; }
-  Eigen::Vector3d planeNormal() const { return axes_.col(2); }
+  // The octree's axes in model coordinates (columns): x, y and, in 2D, the model plane's unit
+  // normal as the third; the identity in 3D.
+  const Eigen::Matrix3d& axes() const { return axes_; }
 
  private:
   struct Node {

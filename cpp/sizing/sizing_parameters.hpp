@@ -13,9 +13,10 @@
 namespace homesh {
 
 struct SizingParameters {
+  // 0 for minDelta or maxDelta: automatic (completeSizing in pipeline/mesh_pipeline.hpp).
   double minDelta = 0.0;   // smallest size curvature may ask for (> 0)
   double maxDelta = 0.0;   // size far from curved boundaries (>= minDelta)
-  double eps = 0.1;        // sagitta relative to the radius of curvature, 0 < eps <= 1
+  double eps = 0.05;       // sagitta relative to the radius of curvature, 0 < eps <= 1
   double gradation = 0.2;  // largest |d delta / d x| (> 0)
   std::vector<RefinementSource> sources;
 

@@ -23,8 +23,8 @@ def make_high_order_mesh(doc, part, order=4, size=0.0, name="HighOrderMesh", siz
     """Adds a HighOrderMesh object meshing ``part`` (a document object with a Shape).
 
     ``size`` 0 means automatic: the sizing octree of ``sizing`` (a Sizing object, see
-    :func:`make_sizing`) if given, else a uniform bounding-box diagonal / 20. The caller
-    recomputes.
+    :func:`make_sizing`) if given, else the automatic sizing octree (MaxDelta a twentieth of the
+    bounding-box diagonal, MinDelta a twentieth of that, EPS 0.05). The caller recomputes.
     """
     obj = doc.addObject("App::FeaturePython", name)
     HighOrderMeshProxy(obj)
@@ -58,7 +58,24 @@ def get_mesh(obj):
     return mesh
 
 
-class HighOrderMeshProxy:
+class _Proxy:
+    """Persistence of the proxies: only their type (FreeCAD 0.20 uses __getstate__, 0.21+
+    dumps)."""
+
+    def __getstate__(self):
+        return {"Type": self.Type}
+
+    def __setstate__(self, state):
+        return None
+
+    def dumps(self):
+        return self.__getstate__()
+
+    def loads(self, state):
+        self.__setstate__(state)
+
+
+class HighOrderMeshProxy(_Proxy):
     """Proxy of an App::FeaturePython that meshes its ``Part`` with curved elements."""
 
     Type = TYPE_HIGH_ORDER_MESH
@@ -81,7 +98,7 @@ class HighOrderMeshProxy:
         if "Size" not in have:
             obj.addProperty("App::PropertyLength", "Size", "Mesh",
                             "Uniform target element size; 0: the Sizing object's octree if "
-                            "Sizing is set, else a twentieth of the bounding-box diagonal")
+                            "Sizing is set, else the automatic sizing octree")
         if "Sizing" not in have:
             obj.addProperty("App::PropertyLink", "Sizing", "Mesh",
                             "Optional HOMesh Sizing object whose octree (MinDelta, MaxDelta, "
@@ -152,19 +169,8 @@ class HighOrderMeshProxy:
             "%d invalid\n" % (obj.Label, mesh.num_nodes, mesh.num_elements, mesh.order,
                               quality["min"], quality["invalid_elements"]))
 
-    # Persistence: the proxy has no state of its own (FreeCAD 0.20 uses __getstate__, 0.21+
-    # dumps).
-    def __getstate__(self):
-        return {"Type": self.Type}
-
     def __setstate__(self, state):
         self.mesh = None
-
-    def dumps(self):
-        return self.__getstate__()
-
-    def loads(self, state):
-        self.__setstate__(state)
 
 
 def make_sizing(doc, part, min_delta=0.0, max_delta=0.0, eps=0.05, name="Sizing"):
@@ -224,7 +230,7 @@ def sizing_arguments(obj):
             "eps": float(eps), "sources": sources}
 
 
-class SizingProxy:
+class SizingProxy(_Proxy):
     """Proxy of an App::FeaturePython holding the sizing octree's parameters for its ``Part``;
     recomputing predicts the element count (:func:`homesh.predict`).
 
@@ -313,18 +319,6 @@ class SizingProxy:
                       % (obj.PredictedElements, sizing["min_delta"], sizing["max_delta"],
                          obj.OctreeLeaves))
         FreeCAD.Console.PrintMessage("HOMesh: %s: %s\n" % (obj.Label, obj.Status))
-
-    def __getstate__(self):
-        return {"Type": self.Type}
-
-    def __setstate__(self, state):
-        return None
-
-    def dumps(self):
-        return self.__getstate__()
-
-    def loads(self, state):
-        self.__setstate__(state)
 
 
 class _Progress:

@@ -7,7 +7,24 @@ from . import resources
 DISPLAY_MODES = ["Surface with edges", "Surface", "Wireframe"]
 
 
-class ViewProviderHighOrderMesh:
+class _Stateless:
+    """View providers keep nothing in the document (FreeCAD 0.20 uses __getstate__, 0.21+
+    dumps)."""
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+
+class ViewProviderHighOrderMesh(_Stateless):
     def __init__(self, vobj):
         vobj.Proxy = self
         self.add_properties(vobj)
@@ -103,20 +120,8 @@ class ViewProviderHighOrderMesh:
                                     getattr(self.Object, "Sizing", None))
                 if child is not None]
 
-    def __getstate__(self):
-        return None
 
-    def __setstate__(self, state):
-        return None
-
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
-
-
-class ViewProviderSizing:
+class ViewProviderSizing(_Stateless):
     """A Sizing object draws nothing; the view provider gives its tree icon."""
 
     def __init__(self, vobj):
@@ -127,18 +132,6 @@ class ViewProviderSizing:
 
     def getIcon(self):
         return resources.icon("homesh_sizing.svg")
-
-    def __getstate__(self):
-        return None
-
-    def __setstate__(self, state):
-        return None
-
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
 
 
 def _set_points(field, array):

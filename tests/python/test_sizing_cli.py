@@ -113,3 +113,34 @@ def test_python_predict_matches_the_mesh(data):
         homesh.mesh(data / "sphere.brep", size=0.3, max_delta=0.3)
     with pytest.raises(homesh.ParameterError, match="kind"):
         homesh.predict(data / "sphere.brep", sources=[{"kind": "cone"}])
+    with pytest.raises(homesh.ParameterError, match="source 1 .sphere.: 'radius'"):
+        homesh.predict(data / "sphere.brep",
+                       sources=[{"kind": "sphere", "a": (0, 0, 0), "radius": "x", "delta": 1}])
+    with pytest.raises(homesh.ParameterError, match="needs 'a'"):
+        homesh.predict(data / "sphere.brep", sources=[{"kind": "sphere", "radius": 1, "delta": 1}])
+
+
+def test_python_reads_mcf_cases():
+    import homesh
+
+    case = MESHGEN / "2d_bl_t106.mcf"
+    report = homesh.predict(case, threads=2)
+    assert report["sizing"]["min_delta"] == 0.01 and report["sizing"]["max_delta"] == 0.5
+    mesh = homesh.mesh(case, order=2)
+    made = mesh.report()
+    assert made["predicted_elements"] == report["predicted_elements"]
+    assert abs(made["predicted_elements"] / made["elements"]["tri"] - 1) <= 0.10
+
+
+def test_case_and_octree_output_are_checked_first(homesh_bin, tmp_path):
+    shutil.copy(MESHGEN / "3d_sphere.stp", tmp_path)
+    wrong = tmp_path / "wrong.mcf"
+    wrong.write_text((MESHGEN / "3d_sphere.mcf").read_text().replace('VALUE="3D"', 'VALUE="2D"'))
+    result = run([homesh_bin, "mesh", wrong, "-q"])
+    assert result.returncode == 2
+    assert "MeshType asks for a 2D mesh" in result.stderr and "has solids" in result.stderr
+    result = run([homesh_bin, "mesh", MESHGEN / "3d_sphere.mcf", "--write-octree",
+                  tmp_path / "octree.txt"])
+    assert result.returncode == 1  # as for any bad output path
+    assert "octree.txt" in result.stderr and "unknown mesh format" in result.stderr
+    assert "sizing" not in result.stderr  # refused before any stage ran
