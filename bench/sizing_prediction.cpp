@@ -87,10 +87,10 @@ int main(int argc, char** argv) {
     for (const Case& c : cases) {
       const homesh::CadModel cad = c.source.load();
       auto t0 = std::chrono::steady_clock::now();
-      const homesh::SizingOctree tree = homesh::SizingOctree::build(cad, c.params);
+      const homesh::SizingOctree tree = homesh::SizingOctree::build(cad, c.params, threads);
       const double octreeSeconds = seconds(t0);
       t0 = std::chrono::steady_clock::now();
-      const homesh::ElementCountPrediction p = homesh::predictElementCount(tree);
+      const homesh::ElementCountPrediction p = homesh::predictElementCount(tree, threads);
       const double predictSeconds = seconds(t0);
       homesh::LinearMeshOptions options;
       options.threads = threads;
@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
       t0 = std::chrono::steady_clock::now();
       const homesh::Mesh mesh = homesh::generateLinearMesh(cad, options);
       const double meshSeconds = seconds(t0);
-      const double n = static_cast<double>(mesh.numElements());
+      const auto n = static_cast<double>(mesh.numElements());
       std::printf("%-28s %8zu %8.3f %9.3f %9.3f %9.0f %7.0f %7.3f  (octree+predict / mesh %.3f)\n",
                   c.name.c_str(), tree.numLeaves(), octreeSeconds, predictSeconds, meshSeconds,
                   p.elements, n, p.elements / n, (octreeSeconds + predictSeconds) / meshSeconds);

@@ -55,7 +55,7 @@ struct Naca {
   gp_Pnt surface(double x, bool upper) const {
     const double yt = (upper ? 1.0 : -1.0) * thickness(x);
     const double theta = std::atan(camberSlope(x));
-    return gp_Pnt(x - yt * std::sin(theta), camber(x) + yt * std::cos(theta), 0.0);
+    return {x - yt * std::sin(theta), camber(x) + yt * std::cos(theta), 0.0};
   }
 };
 
@@ -81,7 +81,7 @@ Naca parseDigits(const std::string& digits) {
 // Rotation by -AOA about the origin.
 gp_Pnt rotate(const gp_Pnt& p, double aoaRadians) {
   const double c = std::cos(aoaRadians), s = std::sin(aoaRadians);
-  return gp_Pnt(c * p.X() + s * p.Y(), -s * p.X() + c * p.Y(), 0.0);
+  return {c * p.X() + s * p.Y(), -s * p.X() + c * p.Y(), 0.0};
 }
 
 // Spline parameters b of the samples: x = (1 - cos b) / 2 clusters them at both edges, and the
@@ -121,6 +121,7 @@ std::vector<double> splineParameters(const Naca& n) {
 std::vector<std::pair<double, gp_Pnt>> samples(const Naca& n, bool upper, double aoa) {
   const std::vector<double> betas = splineParameters(n);
   std::vector<std::pair<double, gp_Pnt>> out;
+  out.reserve(betas.size());
   for (const double b : betas) out.emplace_back(b, n.surface(0.5 * (1.0 - std::cos(b)), upper));
   out.front().second = gp_Pnt(0.0, 0.0, 0.0);  // the edges exactly, shared by both surfaces
   out.back().second = gp_Pnt(1.0, 0.0, 0.0);

@@ -100,7 +100,11 @@ std::vector<double> parseList(const std::string& option, const std::string& text
     try {
       values.push_back(parseNumber(option, item));
     } catch (const UsageError&) {
-      throw UsageError{option + " expects " + layout + ", got '" + text + "'"};
+      std::string message = option;
+      message += " expects ";
+      message += layout;
+      message += ", got '" + text + "'";
+      throw UsageError{message};
     }
     if (comma == std::string::npos) break;
     start = comma + 1;

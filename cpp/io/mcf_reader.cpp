@@ -7,7 +7,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
+#include <string>
+#include <string_view>
 #include <system_error>
 #include <utility>
 
@@ -17,6 +20,13 @@
 
 namespace homesh {
 namespace {
+
+// Concatenates its arguments in one buffer (no temporaries per '+').
+std::string cat(std::initializer_list<std::string_view> parts) {
+  std::string out;
+  for (const std::string_view p : parts) out += p;
+  return out;
+}
 
 namespace fs = std::filesystem;
 
@@ -78,7 +88,7 @@ std::optional<std::vector<double>> toNumbers(const std::string& text) {
   std::size_t i = 0;
   bool needNumber = false;  // just after a comma
   while (true) {
-    while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i])) != 0) ++i;
     if (i == text.size()) break;
     if (text[i] == ',') {
       if (out.empty() || needNumber) return std::nullopt;
@@ -87,7 +97,8 @@ std::optional<std::vector<double>> toNumbers(const std::string& text) {
       continue;
     }
     std::size_t j = i;
-    while (j < text.size() && text[j] != ',' && !std::isspace(static_cast<unsigned char>(text[j])))
+    while (j < text.size() && text[j] != ',' &&
+           std::isspace(static_cast<unsigned char>(text[j])) == 0)
       ++j;
     const auto v = toDouble(text.substr(i, j - i));
     if (!v) return std::nullopt;
@@ -139,7 +150,7 @@ void Reader::unknownKey(const std::string& section, const std::string& key,
   std::string line = "unknown " + section + " key '" + excerpt(key) + "' is ignored";
   for (const auto& k : known) {
     if (lower(k) == lower(key)) {
-      notice(line + "; did you mean '" + k + "'? (keys are case-sensitive)");
+      notice(cat({line, "; did you mean '", k, "'? (keys are case-sensitive)"}));
       return;
     }
   }
@@ -156,7 +167,7 @@ void Reader::unknownKey(const std::string& section, const std::string& key,
     if (name == section) continue;
     for (const auto& k : keys) {
       if (lower(k) == lower(key)) {
-        notice(line + "; '" + k + "' belongs in " + name);
+        notice(cat({line, "; '", k, "' belongs in ", name}));
         return;
       }
     }
@@ -260,7 +271,8 @@ void Reader::readBoolParameters(const XmlElement& section) {
 RefinementLine Reader::readLine(const XmlElement& line, const std::string& where) {
   static const std::vector<std::string> kCompact = {"X1", "X2", "R", "D"};
   static const std::vector<std::string> kSplit = {"X1", "Y1", "Z1", "X2", "Y2", "Z2", "R", "D"};
-  const bool split = line.child("Y1") || line.child("Z1") || line.child("Y2") || line.child("Z2");
+  const bool split = line.child("Y1") != nullptr || line.child("Z1") != nullptr ||
+                     line.child("Y2") != nullptr || line.child("Z2") != nullptr;
   const auto& tags = split ? kSplit : kCompact;
   for (const auto& child : line.children) {
     if (!contains(kSplit, child->name))
@@ -271,15 +283,15 @@ RefinementLine Reader::readLine(const XmlElement& line, const std::string& where
   std::map<std::string, std::string> text;
   for (const auto& tag : tags) {
     const XmlElement* e = line.child(tag);
-    if (e == nullptr) fail(where + " has no <" + tag + ">");
+    if (e == nullptr) fail(cat({where, " has no <", tag, ">"}));
     text[tag] = e->text;
   }
   RefinementLine r;
   if (split) {
     for (int k = 0; k < 3; ++k) {
       const std::string a = std::string(1, "XYZ"[k]);
-      r.x1[k] = number(text[a + "1"], where + " " + a + "1");
-      r.x2[k] = number(text[a + "2"], where + " " + a + "2");
+      r.x1[k] = number(text[a + "1"], cat({where, " ", a, "1"}));
+      r.x2[k] = number(text[a + "2"], cat({where, " ", a, "2"}));
     }
   } else {
     for (const char* tag : {"X1", "X2"}) {

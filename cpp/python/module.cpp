@@ -315,9 +315,13 @@ SizingParameters sizingFrom(const bp::dict& d) {
       else if (kind == "curve")
         p.sources.push_back(
             RefinementSource::curve(bp::extract<int>(src.get("edge", 0)), radius, delta));
-      else
-        throw ParameterError(which + ": kind must be segment, sphere, box or curve, got '" + kind +
-                             "'");
+      else {
+        std::string message = which;
+        message += ": kind must be segment, sphere, box or curve, got '";
+        message += kind;
+        message += "'";
+        throw ParameterError(message);
+      }
     }
   }
   return p;

@@ -209,7 +209,7 @@ void sampleCurve(const CadModel& cad, int edge, bool reversed, const Eigen::Vect
       s.spacing = speed * dt;
       s.internal = internal;
       s.cadIndex = edge;
-      if (normal) {
+      if (normal != nullptr) {
         // The face lies on the left of its oriented edges, seen from its oriented normal.
         const Eigen::Vector3d tangent = (reversed ? -d.d1 : d.d1) / speed;
         s.outward = tangent.cross(*normal).normalized();

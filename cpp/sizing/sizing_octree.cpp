@@ -23,7 +23,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kMaxLevel = 20;  // corner keys pack 21 bits per axis
 constexpr int kMinLevel = 2;
-constexpr std::size_t kMaxCandidates = 32;
+constexpr std::size_t kMaxCandidates = 24;
 constexpr int kGroupVotes = 15;
 // About 1 GB of octree: sizes that need more are refused (they would also make far more
 // elements than a machine can hold).
@@ -32,6 +32,11 @@ constexpr std::size_t kMaxNodes =
 
 gp_Pnt toGp(const Eigen::Vector3d& p) {
   return {p.x(), p.y(), p.z()};
+}
+
+// Bit k of c as a bool: the side along axis k of child or corner c.
+bool bit(int c, int k) {
+  return ((c >> k) & 1) != 0;
 }
 
 std::uint64_t cornerKey(std::int64_t i, std::int64_t j, std::int64_t k) {
@@ -183,7 +188,7 @@ class OctreeBuilder {
 
   void split(std::int32_t n) {
     if (t_.nodes_.size() > kMaxNodes) tooLarge();
-    const std::int32_t first = static_cast<std::int32_t>(t_.nodes_.size());
+    const auto first = static_cast<std::int32_t>(t_.nodes_.size());
     const Eigen::Vector3d parentCentre = t_.nodes_[n].centre;
     const double h = 0.5 * t_.nodes_[n].half;
     const int parentLevel = t_.nodes_[n].level;
@@ -195,23 +200,32 @@ class OctreeBuilder {
       child.half = h;
       child.centre = parentCentre;
       for (int k = 0; k < t_.dim_; ++k) {
-        const int bit = (c >> k) & 1;
-        child.centre[k] += bit ? h : -h;
-        child.index[k] = 2 * parentIndex[k] + bit;
+        const bool on = bit(c, k);
+        child.centre[k] += on ? h : -h;
+        child.index[k] = 2 * parentIndex[k] + (on ? 1 : 0);
       }
       t_.nodes_.push_back(child);
     }
     Content parentContent = std::move(content_[n]);
     content_[n] = Content{};
     content_.resize(t_.nodes_.size());
+    // A sample goes to every child within half its spacing: per axis, the low side, the high
+    // side or both (it already lies within that reach of the parent).
+    for (const std::int32_t s : parentContent.samples) {
+      const double reach = 0.5 * samples_[s].spacing;
+      int low = 0, high = 0;
+      for (int k = 0; k < t_.dim_; ++k) {
+        const double x = samples_[s].x[k] - parentCentre[k];
+        if (x <= reach) low |= 1 << k;
+        if (x >= -reach) high |= 1 << k;
+      }
+      for (int c = 0; c < t_.children(); ++c)
+        if ((c & ~high) == 0 && (~c & ~low & (t_.children() - 1)) == 0)
+          content_[first + c].samples.push_back(s);
+    }
     for (int c = 0; c < t_.children(); ++c) {
       const SizingOctree::Node& child = t_.nodes_[first + c];
-      const Eigen::Vector3d half = halfVector(child);
       Content& cc = content_[first + c];
-      for (const std::int32_t s : parentContent.samples) {
-        const Eigen::Vector3d d = (samples_[s].x - child.centre).cwiseAbs() - half;
-        if (d.head(t_.dim_).maxCoeff() <= 0.5 * samples_[s].spacing) cc.samples.push_back(s);
-      }
       // In 2D the model lies in the plane z = 0 of the local frame: only that slice counts.
       const Eigen::Vector3d centre = t_.toModel(child.centre);
       const Eigen::Vector3d slice(child.half, child.half, t_.dim_ == 3 ? child.half : 0.0);
@@ -229,7 +243,7 @@ class OctreeBuilder {
     for (int l = 1; l <= level && t_.nodes_[n].firstChild >= 0; ++l) {
       int c = 0;
       for (int k = 0; k < t_.dim_; ++k)
-        if ((index[k] >> (level - l)) & 1) c |= 1 << k;
+        if (((index[k] >> (level - l)) & 1) != 0) c |= 1 << k;
       n = t_.nodes_[n].firstChild + c;
     }
     return n;
@@ -239,8 +253,7 @@ class OctreeBuilder {
   void balance() {
     for (;;) {
       std::vector<std::int32_t> marked;
-      for (std::int32_t n = 0; n < static_cast<std::int32_t>(t_.nodes_.size()); ++n) {
-        const SizingOctree::Node& node = t_.nodes_[n];
+      for (const SizingOctree::Node& node : t_.nodes_) {
         if (node.firstChild >= 0 || node.level <= kMinLevel) continue;
         for (int k = 0; k < t_.dim_; ++k)
           for (const int step : {-1, 1}) {
@@ -350,7 +363,7 @@ class OctreeBuilder {
     std::vector<std::int32_t> candidates;
     for (std::size_t start = 0; start < nLeaves; ++start) {
       if (boundary[start] || group[start] >= 0) continue;
-      const std::int32_t g = static_cast<std::int32_t>(groupInside.size());
+      const auto g = static_cast<std::int32_t>(groupInside.size());
       int votesIn = 0, votesOut = 0;
       std::vector<std::size_t> stack{start};
       group[start] = g;
@@ -358,7 +371,7 @@ class OctreeBuilder {
         const std::size_t i = stack.back();
         stack.pop_back();
         for (std::int64_t k = t_.neighbourStart_[i]; k < t_.neighbourStart_[i + 1]; ++k) {
-          const std::size_t j = static_cast<std::size_t>(t_.neighbours_[k]);
+          const auto j = static_cast<std::size_t>(t_.neighbours_[k]);
           if (boundary[j]) {
             if (votesIn + votesOut < kGroupVotes) {
               candidates.clear();
@@ -385,7 +398,7 @@ class OctreeBuilder {
 #pragma omp for schedule(dynamic, 64)
       for (std::int64_t n = 0; n < static_cast<std::int64_t>(nLeaves); ++n) {
         try {
-          const std::size_t i = static_cast<std::size_t>(n);
+          const auto i = static_cast<std::size_t>(n);
           SizingOctree::LeafData& leaf = t_.leaves_[i];
           if (boundary[i]) {
             classifyBoundaryLeaf(leaf, near);
@@ -536,9 +549,9 @@ class OctreeBuilder {
     for (std::size_t i = 0; i < t_.leaves_.size(); ++i)
       byLevel[t_.nodes_[t_.leaves_[i].node].level].push_back(i);
     std::unordered_map<std::uint64_t, float> hanging;
-    for (const std::vector<std::size_t>& level : byLevel) {
+    for (std::size_t level = 0; level < byLevel.size(); ++level) {
       std::unordered_map<std::uint64_t, float> found;
-      for (const std::size_t i : level) {
+      for (const std::size_t i : byLevel[level]) {
         const SizingOctree::Node& node = t_.nodes_[t_.leaves_[i].node];
         for (std::int64_t nb = t_.neighbourStart_[i]; nb < t_.neighbourStart_[i + 1]; ++nb) {
           const SizingOctree::LeafData& larger = t_.leaves_[t_.neighbours_[nb]];
@@ -557,7 +570,7 @@ class OctreeBuilder {
             const std::uint64_t k = cornerKey(idx[0], idx[1], idx[2]);
             bool shared = false;
             for (int oc = 0; oc < corners && !shared; ++oc) shared = key(other, oc) == k;
-            if (shared || found.count(k) || hanging.count(k)) continue;
+            if (shared || found.count(k) != 0 || hanging.count(k) != 0) continue;
             Eigen::Vector3d p = root.centre;
             for (int d = 0; d < t_.dim_; ++d) p[d] += -root.half + double(idx[d]) * unit;
             found[k] = static_cast<float>(t_.interpolate(larger, p));
@@ -565,11 +578,15 @@ class OctreeBuilder {
         }
       }
       if (found.empty()) continue;
-      // Every leaf with such a corner (this level and finer) takes the value now.
-      for (SizingOctree::LeafData& leaf : t_.leaves_)
-        for (int c = 0; c < corners; ++c)
-          if (const auto it = found.find(key(t_.nodes_[leaf.node], c)); it != found.end())
-            leaf.corner[c] = it->second;
+      // Every leaf with such a corner takes the value now: this level and finer ones (a coarser
+      // leaf with that corner would have found it first).
+      for (std::size_t finer = level; finer < byLevel.size(); ++finer)
+        for (const std::size_t i : byLevel[finer]) {
+          SizingOctree::LeafData& leaf = t_.leaves_[i];
+          for (int c = 0; c < corners; ++c)
+            if (const auto it = found.find(key(t_.nodes_[leaf.node], c)); it != found.end())
+              leaf.corner[c] = it->second;
+        }
       hanging.insert(found.begin(), found.end());
     }
   }
@@ -611,7 +628,7 @@ double SizingOctree::interpolate(const LeafData& leaf, const Eigen::Vector3d& q)
   double value = 0.0;
   for (int c = 0; c < children(); ++c) {
     double w = 1.0;
-    for (int k = 0; k < dim_; ++k) w *= ((c >> k) & 1) ? t[k] : 1.0 - t[k];
+    for (int k = 0; k < dim_; ++k) w *= bit(c, k) ? t[k] : 1.0 - t[k];
     value += w * leaf.corner[c];
   }
   return value;
@@ -665,9 +682,9 @@ double SizingOctree::gradientNorm(const LeafData& leaf, const Eigen::Vector3d& q
   for (int axis = 0; axis < dim_; ++axis) {
     double g = 0.0;
     for (int c = 0; c < children(); ++c) {
-      double w = ((c >> axis) & 1) ? 1.0 : -1.0;
+      double w = bit(c, axis) ? 1.0 : -1.0;
       for (int k = 0; k < dim_; ++k)
-        if (k != axis) w *= ((c >> k) & 1) ? t[k] : 1.0 - t[k];
+        if (k != axis) w *= bit(c, k) ? t[k] : 1.0 - t[k];
       g += w * leaf.corner[c];
     }
     g /= 2.0 * node.half;
@@ -690,7 +707,7 @@ void SizingOctree::leafQuadrature(std::size_t i, std::vector<QuadraturePoint>& p
     const double g = node.half / std::sqrt(3.0);
     for (int c = 0; c < children(); ++c) {
       Eigen::Vector3d q = node.centre;
-      for (int k = 0; k < dim_; ++k) q[k] += ((c >> k) & 1) ? g : -g;
+      for (int k = 0; k < dim_; ++k) q[k] += bit(c, k) ? g : -g;
       add(q, measure / children());
     }
     return;
@@ -698,7 +715,7 @@ void SizingOctree::leafQuadrature(std::size_t i, std::vector<QuadraturePoint>& p
   const int s = subdivisions();
   const int cells = static_cast<int>(leaf.insideMask.size());
   for (int c = 0; c < cells; ++c) {
-    if (!leaf.insideMask[c]) continue;
+    if (leaf.insideMask[c] == 0) continue;
     Eigen::Vector3d q = node.centre;
     int rest = c;
     for (int k = 0; k < dim_; ++k) {

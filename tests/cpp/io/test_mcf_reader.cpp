@@ -189,8 +189,8 @@ TEST(McfReader, ResolvesTheCadPathAgainstTheMcfFolder) {
   fs::create_directories(dir / "cases");
   const auto write = [&](const std::string& cad) {
     std::ofstream(dir / "cases" / "c.mcf")
-        << "<NEKTAR><MESHING><INFORMATION><I PROPERTY=\"CADFile\" VALUE=\"" << cad
-        << "\"/><I PROPERTY=\"MeshType\" VALUE=\"3D\"/></INFORMATION></MESHING></NEKTAR>";
+        << R"(<NEKTAR><MESHING><INFORMATION><I PROPERTY="CADFile" VALUE=")" << cad
+        << R"("/><I PROPERTY="MeshType" VALUE="3D"/></INFORMATION></MESHING></NEKTAR>)";
     return (dir / "cases" / "c.mcf").string();
   };
   EXPECT_EQ(readMcfFile(write("part.stp")).cadFile, (dir / "cases" / "part.stp").string());
@@ -209,7 +209,7 @@ TEST(McfReader, ResolvesTheCadPathAgainstTheMcfFolder) {
 
 TEST(McfReader, ReadsRefinementLinesInBothForms) {
   const std::string path =
-      writeMcf(withParameters("<P PARAM=\"MinDelta\" VALUE=\"0.01\"/>") +
+      writeMcf(withParameters(R"(<P PARAM="MinDelta" VALUE="0.01"/>)") +
                "<REFINEMENT>"
                "<LINE><X1>0 0.5 1</X1><X2>1, 2,3</X2><R>0.25</R><D>0.01</D></LINE>"
                "<LINE><X1>-1</X1><Y1>-2</Y1><Z1>-3</Z1><X2>4</X2><Y2>5</Y2><Z2>6</Z2>"
@@ -303,8 +303,8 @@ TEST(McfReader, RejectsMissingAndBadValues) {
 
 TEST(McfReader, ChecksBoundaryLayerAndNacaRequirements) {
   const auto info = [](const std::string& cad, const std::string& type) {
-    return "<INFORMATION><I PROPERTY=\"CADFile\" VALUE=\"" + cad +
-           "\"/><I PROPERTY=\"MeshType\" VALUE=\"" + type + "\"/></INFORMATION>";
+    return R"(<INFORMATION><I PROPERTY="CADFile" VALUE=")" + cad +
+           R"("/><I PROPERTY="MeshType" VALUE=")" + type + R"("/></INFORMATION>)";
   };
   EXPECT_ERROR_HAS(writeMcf(info("a.stp", "3DBndLayer") +
                             "<PARAMETERS><P PARAM=\"BndLayerSurfaces\" VALUE=\"1\"/></PARAMETERS>"),
@@ -323,7 +323,7 @@ TEST(McfReader, ChecksBoundaryLayerAndNacaRequirements) {
                             "</PARAMETERS>"),
                    "PARAMETERS Xmax is given twice");
   const McfCase naca = readMcfFile(writeMcf(info("2412", "2D") + "<PARAMETERS>" + box +
-                                            "<P PARAM=\"AOA\" VALUE=\"-5\"/>" + "</PARAMETERS>"));
+                                            R"(<P PARAM="AOA" VALUE="-5"/>)" + "</PARAMETERS>"));
   EXPECT_EQ(*naca.nacaDigits, "2412");
   EXPECT_DOUBLE_EQ(*naca.aoa, -5.0);
 }

@@ -121,6 +121,7 @@ TEST(SizingOctree, QueryIsThreadSafe) {
   constexpr int kThreads = 8;
   std::vector<std::vector<double>> results(kThreads, std::vector<double>(points.size()));
   std::vector<std::thread> threads;
+  threads.reserve(kThreads);
   for (int t = 0; t < kThreads; ++t)
     threads.emplace_back([&, t] {
       // Each thread walks the points in its own order.

@@ -44,7 +44,7 @@ double fractionOfEdgesWithinSpec(const Mesh& mesh, const SizingOctree& octree) {
       const Eigen::Vector3d p = test::nodePoint(mesh, n[k]);
       const Eigen::Vector3d q = test::nodePoint(mesh, n[(k + 1) % nv]);
       const double ratio = (p - q).norm() / octree.delta(0.5 * (p + q));
-      good += ratio >= 0.5 && ratio <= 1.5;
+      good += (ratio >= 0.5 && ratio <= 1.5) ? 1 : 0;
       ++total;
     }
   }
@@ -57,7 +57,7 @@ TEST_P(PeerCase, PredictionWithinTenPercentAndSizesFollowTheSpecification) {
   const MeshResult r = meshCase(GetParam());
   ASSERT_TRUE(r.sizing.has_value());
   const double predicted = r.sizing->prediction.elements;
-  const double actual = static_cast<double>(r.mesh.numElements());
+  const auto actual = static_cast<double>(r.mesh.numElements());
   RecordProperty("predicted", std::to_string(predicted));
   RecordProperty("actual", std::to_string(actual));
   EXPECT_NEAR(predicted / actual, 1.0, 0.10) << predicted << " predicted, " << actual << " made";
@@ -85,7 +85,7 @@ TEST(SizingPipeline, HalvingEpsRefinesTheSphereAsTheChordFormulaPredicts) {
     const CadModel& cad = *r.cad;
     const ElementBlock& b = boundaryBlock(r.mesh);
     std::size_t count = 0;
-    for (std::size_t e = 0; e < b.count(); ++e) count += !cad.isPlanar(b.entity[e]);
+    for (std::size_t e = 0; e < b.count(); ++e) count += cad.isPlanar(b.entity[e]) ? 0 : 1;
     return static_cast<double>(count);
   };
   const double coarse = sphereTriangles(0.02), fine = sphereTriangles(0.01);
@@ -115,7 +115,7 @@ TEST(SizingPipeline, SeveralSolidsWithAnInternalFace) {
   options.sizing = p;
   const MeshResult r =
       runMeshPipeline(CadSource::brepText(test::brepText(builder.Shape())), options);
-  const double actual = static_cast<double>(r.mesh.numElements());
+  const auto actual = static_cast<double>(r.mesh.numElements());
   EXPECT_NEAR(r.sizing->prediction.elements / actual, 1.0, 0.10);
   // Tetrahedra in both solids.
   std::vector<int> perSolid(3, 0);
