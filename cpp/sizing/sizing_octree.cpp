@@ -620,11 +620,17 @@ std::int32_t SizingOctree::findLeafNode(const Eigen::Vector3d& q) const {
   return n;
 }
 
-double SizingOctree::interpolate(const LeafData& leaf, const Eigen::Vector3d& q) const {
-  const Node& node = nodes_[leaf.node];
-  double t[3] = {0.0, 0.0, 0.0};
+std::array<double, 3> SizingOctree::leafCoordinates(const Node& node,
+                                                    const Eigen::Vector3d& q) const {
+  std::array<double, 3> t{0.0, 0.0, 0.0};
   for (int k = 0; k < dim_; ++k)
     t[k] = std::clamp((q[k] - node.centre[k] + node.half) / (2.0 * node.half), 0.0, 1.0);
+  return t;
+}
+
+double SizingOctree::interpolate(const LeafData& leaf, const Eigen::Vector3d& q) const {
+  const Node& node = nodes_[leaf.node];
+  const std::array<double, 3> t = leafCoordinates(node, q);
   double value = 0.0;
   for (int c = 0; c < children(); ++c) {
     double w = 1.0;
@@ -675,9 +681,7 @@ double SizingOctree::domainMeasure() const {
 
 double SizingOctree::gradientNorm(const LeafData& leaf, const Eigen::Vector3d& q) const {
   const Node& node = nodes_[leaf.node];
-  double t[3] = {0.0, 0.0, 0.0};
-  for (int k = 0; k < dim_; ++k)
-    t[k] = std::clamp((q[k] - node.centre[k] + node.half) / (2.0 * node.half), 0.0, 1.0);
+  const std::array<double, 3> t = leafCoordinates(node, q);
   double g2 = 0.0;
   for (int axis = 0; axis < dim_; ++axis) {
     double g = 0.0;

@@ -107,6 +107,8 @@ class SizingOctree {
   }
   Eigen::Vector3d toModel(const Eigen::Vector3d& q) const { return origin_ + axes_ * q; }
   std::int32_t findLeafNode(const Eigen::Vector3d& q) const;
+  // q's position in the node's box, 0..1 per axis (clamped).
+  std::array<double, 3> leafCoordinates(const Node& node, const Eigen::Vector3d& q) const;
   double interpolate(const LeafData& leaf, const Eigen::Vector3d& q) const;
   double gradientNorm(const LeafData& leaf, const Eigen::Vector3d& q) const;
   int children() const { return 1 << dim_; }
