@@ -20,7 +20,6 @@
 #include "pipeline/case_setup.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
-#include "sizing/octree_export.hpp"
 
 namespace {
 
@@ -132,11 +131,8 @@ int runPredict(const homesh::PredictCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
   checkOutputs(c);
   homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.sizing, std::nullopt, c.quiet);
-  const homesh::CadModel cad = setup.source.load();
-  homesh::checkMeshDimension(cad, setup.options.expectedDimension);
-  const homesh::SizingResult s =
-      homesh::runSizing(cad, homesh::resolveSizing(setup.options.sizing, cad), c.threads);
-  if (cmd.sizing.writeOctree) homesh::writeOctree(*s.octree, *cmd.sizing.writeOctree);
+  setup.options.threads = c.threads;
+  const homesh::SizingResult s = homesh::runSizingStage(setup.source, setup.options);
   const bool toStdout = c.report && *c.report == "-";
   if (!c.quiet) {
     printPrediction(s, s.octree->dim());

@@ -161,6 +161,7 @@ void orientPlanarMesh(Mesh& mesh, ElementBlock& tris) {
 Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
   Eigen::Vector3d normal(0.0, 0.0, 1.0);
   const int dim = modelMeshDimension(cad, normal);
+  // A uniform size is the constant field (no lower bound, as before fields existed).
   const bool field = static_cast<bool>(options.sizeField);
   if (field) {
     if (!(options.minSize > 0.0) || !(options.maxSize >= options.minSize))
@@ -168,6 +169,11 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
   } else {
     checkSize(cad, options.size, dim);
   }
+  const double size = options.size;
+  const SizeField sizeAt =
+      field ? options.sizeField : [size](const Eigen::Vector3d&) { return size; };
+  const double minSize = field ? options.minSize : 0.0;
+  const double maxSize = field ? options.maxSize : size;
 
   Mesh mesh;
   mesh.dim = dim;
@@ -182,20 +188,15 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
     gmsh::model::occ::synchronize();
     const GmshEntityMap entities = GmshEntityMap::build(cad);
 
-    const double size = options.size;
     gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
     gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
     gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeMax", field ? options.maxSize : size);
-    gmsh::option::setNumber("Mesh.MeshSizeMin", field ? options.minSize : 0.0);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", maxSize);
+    gmsh::option::setNumber("Mesh.MeshSizeMin", minSize);
     gmsh::option::setNumber("Mesh.ElementOrder", 1);
-    if (field) {
-      const SizeField& f = options.sizeField;
-      gmsh::model::mesh::setSizeCallback(
-          [&f](int, int, double x, double y, double z) { return f(Eigen::Vector3d(x, y, z)); });
-    } else {
-      gmsh::model::mesh::setSizeCallback([size](int, int, double, double, double) { return size; });
-    }
+    gmsh::model::mesh::setSizeCallback([&sizeAt](int, int, double x, double y, double z) {
+      return sizeAt(Eigen::Vector3d(x, y, z));
+    });
     try {
       gmsh::model::mesh::generate(dim);
     } catch (const std::string& message) {

@@ -79,6 +79,14 @@ SizingParameters resolveSizing(const std::optional<SizingParameters>& requested,
   return completeSizing(requested.value_or(defaultSizing(cad)), cad);
 }
 
+SizingResult runSizingStage(const CadSource& source, const MeshingOptions& options) {
+  const CadModel cad = source.load();
+  checkMeshDimension(cad, options.expectedDimension);
+  SizingResult result = runSizing(cad, resolveSizing(options.sizing, cad), options.threads);
+  if (!options.octreeOutput.empty()) writeOctree(*result.octree, options.octreeOutput);
+  return result;
+}
+
 void checkMeshDimension(const CadModel& cad, std::optional<int> expected) {
   if (!expected) return;
   Eigen::Vector3d normal;

@@ -104,6 +104,11 @@ struct CadSource {
   CadModel load() const;
 };
 
+// The sizing stage alone (`homesh predict`): loads the CAD, checks options.expectedDimension,
+// builds the octree from resolveSizing(options.sizing) on options.threads and predicts, and
+// writes options.octreeOutput when set. Throws as runMeshPipeline's first stages.
+SizingResult runSizingStage(const CadSource& source, const MeshingOptions& options);
+
 // Wall-clock seconds per stage, in the order the stages ran.
 struct StageTimings {
   std::vector<std::pair<std::string, double>> seconds;

@@ -23,7 +23,6 @@
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
 #include "quality/element_measure.hpp"
-#include "sizing/octree_export.hpp"
 
 namespace bp = boost::python;
 namespace np = boost::python::numpy;
@@ -341,21 +340,13 @@ MeshingOptions makeOptions(int order, const bp::object& size, int threads, int v
 
 // The sizing octree and prediction of a CAD source: the JSON report of `homesh predict`,
 // and the octree's leaves written to `octreePath` when it is not empty.
-// The sizes asked from Python, else those of a .mcf case (if the input is one).
-std::optional<SizingParameters> requestedSizing(const bp::object& sizing, const CaseSetup& setup) {
-  if (!sizing.is_none()) return sizingFrom(bp::extract<bp::dict>(sizing));
-  return setup.options.sizing;
-}
-
-std::string predict(const CaseSetup& setup, const bp::object& sizing, const std::string& octreePath,
+std::string predict(CaseSetup setup, const bp::object& sizing, const std::string& octreePath,
                     const std::string& input, int threads) {
-  const std::optional<SizingParameters> requested = requestedSizing(sizing, setup);
+  if (!sizing.is_none()) setup.options.sizing = sizingFrom(bp::extract<bp::dict>(sizing));
+  setup.options.octreeOutput = octreePath;
+  setup.options.threads = threads;
   const ReleaseGil nogil;
-  const CadModel cad = setup.source.load();
-  checkMeshDimension(cad, setup.options.expectedDimension);
-  const SizingResult result = runSizing(cad, resolveSizing(requested, cad), threads);
-  if (!octreePath.empty()) writeOctree(*result.octree, octreePath);
-  return predictReportJson(result, input);
+  return predictReportJson(runSizingStage(setup.source, setup.options), input);
 }
 
 // A CAD file or a NekMesh .mcf case (pipeline/case_setup.hpp).

@@ -58,30 +58,31 @@ double smallestSize(const std::vector<BoundarySample>& samples, const SizingPara
 }
 
 // Physical length of a parameter line of a face (alongU: v fixed), from 16 chords.
-double isoLength(const CadModel& cad, int face, const SurfaceBounds& b, bool alongU, double fixed) {
+// Length of the polyline through point(s) at s = 0, 1/16, ..., 1.
+template <class F>
+double chordLength(F&& point) {
   double length = 0.0;
-  Eigen::Vector3d prev;
-  for (int i = 0; i <= 16; ++i) {
-    const double s = i / 16.0;
-    const double u = alongU ? b.uMin + s * (b.uMax - b.uMin) : fixed;
-    const double v = alongU ? fixed : b.vMin + s * (b.vMax - b.vMin);
-    const Eigen::Vector3d p = cad.evaluateSurface(face, u, v).point;
-    if (i > 0) length += (p - prev).norm();
+  Eigen::Vector3d prev = point(0.0);
+  for (int i = 1; i <= 16; ++i) {
+    const Eigen::Vector3d p = point(i / 16.0);
+    length += (p - prev).norm();
     prev = p;
   }
   return length;
 }
 
+// Physical length of a parameter line of a face (alongU: v fixed).
+double isoLength(const CadModel& cad, int face, const SurfaceBounds& b, bool alongU, double fixed) {
+  return chordLength([&](double s) {
+    const double u = alongU ? b.uMin + s * (b.uMax - b.uMin) : fixed;
+    const double v = alongU ? fixed : b.vMin + s * (b.vMax - b.vMin);
+    return cad.evaluateSurface(face, u, v).point;
+  });
+}
+
 double curveLength(const CadModel& cad, int edge, const ParameterRange& r) {
-  double length = 0.0;
-  Eigen::Vector3d prev;
-  for (int i = 0; i <= 16; ++i) {
-    const Eigen::Vector3d p =
-        cad.evaluateCurve(edge, r.first + i / 16.0 * (r.last - r.first)).point;
-    if (i > 0) length += (p - prev).norm();
-    prev = p;
-  }
-  return length;
+  return chordLength(
+      [&](double s) { return cad.evaluateCurve(edge, r.first + s * (r.last - r.first)).point; });
 }
 
 // Which points of a (u, v) grid lie inside a trimmed face: the face's boundary in parameter
