@@ -10,7 +10,7 @@ PACKAGES="
   libeigen3-dev libgmsh-dev gmsh zlib1g-dev
   libboost-python-dev libboost-numpy-dev python3-dev python3-numpy
   libgtest-dev python3-pytest python3-meshio python3-vtk9
-  xvfb xauth
+  xvfb xauth ccache
 "
 
 missing=""
