@@ -124,7 +124,8 @@ class HighOrderMesh:
         stay fixed.
 
         The mesh kept is never worse than before in worst scaled Jacobian or invalid count.
-        Returns a dict: functional, iterations, converged, kept_iteration, worst_before,
+        Returns a dict: functional, iterations, converged, stopped (the rule that ended the
+        run: displacement, energy, stalled, iterations, cancelled), kept_iteration, worst_before,
         worst_after, invalid_before, invalid_after, nodal_worst_before/after (min J / max J at
         the nodes, NekMesh's measure), seconds, history (per sweep) and more.
         """

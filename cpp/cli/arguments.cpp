@@ -414,7 +414,7 @@ mesh returned is never worse than the input in either.
 options:
   -f, --functional F  hyperelastic (default), linearelastic, winslow, distortion
   -n, --maxiter N     at most N sweeps (default 100)
-      --tolerance T   stop when no node moves more than T x the mean element size (1e-6)
+      --tolerance T   stop when no node moves more than T x its smallest element's size (1e-6)
   -p, --order P       first re-interpolate the mesh at order P (1..10); "never worse" then
                       compares with the re-interpolated mesh
       --region Q      move only nodes near elements with scaled Jacobian below Q

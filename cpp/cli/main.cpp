@@ -207,8 +207,9 @@ class SweepLog : public homesh::OptimiserObserver {
   void iterationFinished(const homesh::IterationRecord& r) override {
     std::fprintf(stderr,
                  "homesh: iteration %3d  worst scaled Jacobian %8.5f  invalid %zu  undecided %zu  "
-                 "max move %.3g  %.3f s\n",
-                 r.iteration, r.worst, r.invalid, r.undecided, r.maxDisplacement, r.seconds);
+                 "max move %.3g (%.3g of its element)  energy %.6g  %.3f s\n",
+                 r.iteration, r.worst, r.invalid, r.undecided, r.maxDisplacement, r.maxRelativeMove,
+                 r.energy, r.seconds);
   }
 };
 
@@ -230,12 +231,12 @@ int runOptimise(const homesh::OptimiseCommand& cmd) {
   const homesh::OptimiserResult r = homesh::optimiseMesh(mesh, options, c.quiet ? nullptr : &log);
   const homesh::QualitySummary q = homesh::evaluateQuality(mesh, c.threads);
   if (!c.quiet) {
-    std::fprintf(stderr,
-                 "homesh: %s, %d iterations (%s), %zu free nodes in %zu colours, %.3f s (sweeps "
-                 "%.3f s)\n",
-                 homesh::functionalName(r.functional).c_str(), r.iterations,
-                 r.converged ? "converged" : (r.cancelled ? "cancelled" : "iteration limit"),
-                 r.freeNodes, r.colours, r.seconds, r.sweepSeconds);
+    std::fprintf(
+        stderr,
+        "homesh: %s, %d iterations (stopped: %s), %zu free nodes in %zu colours, %.3f s (sweeps "
+        "%.3f s)\n",
+        homesh::functionalName(r.functional).c_str(), r.iterations, r.stopReason.c_str(),
+        r.freeNodes, r.colours, r.seconds, r.sweepSeconds);
     std::fprintf(stderr,
                  "homesh: worst scaled Jacobian %.5f -> %.5f (at nodes %.5f -> %.5f), invalid %zu "
                  "-> %zu\n",

@@ -40,30 +40,43 @@ constexpr double kPoisson = 0.4;
 constexpr double kMu = 1.0 / (2.0 * (1.0 + kPoisson));
 constexpr double kBulk = 1.0 / (3.0 * (1.0 - 2.0 * kPoisson));
 
+// The scalar type T is double in the optimiser; the derivative tests instantiate the same code
+// with Eigen's forward-mode AutoDiffScalar, so every function below is written once for both.
+inline double cubeRoot(double x) {
+  return std::cbrt(x);
+}
+template <class T>
+T cubeRoot(const T& x) {
+  using std::pow;
+  return pow(x, 1.0 / 3.0);  // AutoDiffScalar has no cbrt
+}
+
 // psi and its partial derivatives in S and r = J_r.
+template <class T>
 struct Psi {
-  double v = 0, s = 0, r = 0, ss = 0, sr = 0, rr = 0;
+  T v = T(0), s = T(0), r = T(0), ss = T(0), sr = T(0), rr = T(0);
 };
 
 // Compile-time functional: the optimiser's inner loops are instantiated per functional, so
 // this inlines without a branch per point.
-template <int D, Functional F>
-Psi psi(double S, double r) {
-  Psi p;
+template <int D, Functional F, class T>
+Psi<T> psi(const T& S, const T& r) {
+  using std::log;
+  Psi<T> p;
   if (!(r > 0.0)) {
-    p.v = std::numeric_limits<double>::infinity();  // inverted, unregularised: a barrier
+    p.v = T(std::numeric_limits<double>::infinity());  // inverted, unregularised: a barrier
     return p;
   }
   if constexpr (F == Functional::Hyperelastic) {
-    const double l = std::log(r);
-    p.v = 0.5 * kMu * (S - D) - kMu * l + 0.5 * kBulk * l * l;
-    p.s = 0.5 * kMu;
+    const T l = log(r);
+    p.v = 0.5 * kMu * (S - double(D)) - kMu * l + 0.5 * kBulk * l * l;
+    p.s = T(0.5 * kMu);
     p.r = (-kMu + kBulk * l) / r;
     p.rr = (kMu + kBulk * (1.0 - l)) / (r * r);
   } else if constexpr (F == Functional::LinearElastic) {
-    const double l = std::log(r);
+    const T l = log(r);
     p.v = 0.5 * kBulk * l * l + kMu * S;
-    p.s = kMu;
+    p.s = T(kMu);
     p.r = kBulk * l / r;
     p.rr = kBulk * (1.0 - l) / (r * r);
   } else if constexpr (F == Functional::Winslow) {
@@ -74,18 +87,18 @@ Psi psi(double S, double r) {
     p.rr = 2.0 * S / (r * r * r);
   } else {
     constexpr double e = 2.0 / D;
-    const double rp = D == 2 ? r : std::cbrt(r * r);  // r^(2/d)
-    p.v = S / (D * rp);
-    p.s = 1.0 / (D * rp);
-    p.sr = -e / (D * rp * r);
-    p.r = -e * S / (D * rp * r);
-    p.rr = e * (e + 1.0) * S / (D * rp * r * r);
+    const T rp = D == 2 ? r : cubeRoot(T(r * r));  // r^(2/d)
+    p.v = S / (double(D) * rp);
+    p.s = 1.0 / (double(D) * rp);
+    p.sr = -e / (double(D) * rp * r);
+    p.r = -e * S / (double(D) * rp * r);
+    p.rr = e * (e + 1.0) * S / (double(D) * rp * r * r);
   }
   return p;
 }
 
-template <int D>
-double determinant(const Eigen::Matrix<double, D, D>& F) {
+template <int D, class T>
+T determinant(const Eigen::Matrix<T, D, D>& F) {
   if constexpr (D == 2) {
     return F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0);
   } else {
@@ -96,9 +109,9 @@ double determinant(const Eigen::Matrix<double, D, D>& F) {
 }
 
 // The cofactor matrix dJ/dF.
-template <int D>
-Eigen::Matrix<double, D, D> cofactor(const Eigen::Matrix<double, D, D>& F) {
-  Eigen::Matrix<double, D, D> c;
+template <int D, class T>
+Eigen::Matrix<T, D, D> cofactor(const Eigen::Matrix<T, D, D>& F) {
+  Eigen::Matrix<T, D, D> c;
   if constexpr (D == 2) {
     c << F(1, 1), -F(1, 0), -F(0, 1), F(0, 0);
   } else {
@@ -109,6 +122,14 @@ Eigen::Matrix<double, D, D> cofactor(const Eigen::Matrix<double, D, D>& F) {
       }
   }
   return c;
+}
+
+// Green's strain E = (F^T F - I) / 2.
+template <int D, class T>
+Eigen::Matrix<T, D, D> greenStrain(const Eigen::Matrix<T, D, D>& F) {
+  Eigen::Matrix<T, D, D> E = 0.5 * (F.transpose() * F);
+  for (int i = 0; i < D; ++i) E(i, i) -= 0.5;
+  return E;
 }
 
 // Calls fn(std::integral_constant<Functional, f>()) for the runtime value f.
@@ -130,85 +151,84 @@ decltype(auto) dispatch(Functional f, Fn&& fn) {
 }  // namespace functional_detail
 
 // J_r and its first two derivatives in J.
+template <class T>
 struct Regularised {
-  double r = 0, dr = 0, ddr = 0;
+  T r = T(0), dr = T(0), ddr = T(0);
 };
-inline Regularised regularise(double J, double eps) {
-  const double root = std::sqrt(J * J + 4.0 * eps * eps);
-  Regularised out;
+template <class T>
+Regularised<T> regularise(const T& J, double eps) {
+  using std::sqrt;
+  const T root = sqrt(J * J + 4.0 * eps * eps);
+  Regularised<T> out;
   // (J + root) / 2 cancels badly for J << 0: use the equivalent 2 eps^2 / (root - J).
-  out.r = J >= 0.0 ? 0.5 * (J + root) : 2.0 * eps * eps / (root - J);
-  out.dr = root > 0.0 ? out.r / root : (J > 0.0 ? 1.0 : 0.0);
-  out.ddr = root > 0.0 ? 2.0 * eps * eps / (root * root * root) : 0.0;
+  out.r = J >= 0.0 ? T(0.5 * (J + root)) : T(2.0 * eps * eps / (root - J));
+  out.dr = root > 0.0 ? T(out.r / root) : T(J > 0.0 ? 1.0 : 0.0);
+  out.ddr = root > 0.0 ? T(2.0 * eps * eps / (root * root * root)) : T(0.0);
   return out;
 }
 
 // W(F).
-template <int D, Functional Fn>
-double energyDensity(const Eigen::Matrix<double, D, D>& F, double eps) {
+template <int D, Functional Fn, class T>
+T energyDensity(const Eigen::Matrix<T, D, D>& F, double eps) {
   using namespace functional_detail;
-  const double J = determinant<D>(F);
-  double S = 0;
+  const T J = determinant<D>(F);
+  T S;
   if constexpr (Fn == Functional::LinearElastic) {
-    Eigen::Matrix<double, D, D> E = 0.5 * (F.transpose() * F);
-    E.diagonal().array() -= 0.5;
-    S = E.squaredNorm();
+    S = greenStrain<D>(F).squaredNorm();
   } else {
     S = F.squaredNorm();
   }
   return psi<D, Fn>(S, regularise(J, eps).r).v;
 }
 
-template <int D>
-double energyDensity(Functional f, const Eigen::Matrix<double, D, D>& F, double eps) {
+template <int D, class T>
+T energyDensity(Functional f, const Eigen::Matrix<T, D, D>& F, double eps) {
   return functional_detail::dispatch(
       f, [&](auto fn) { return energyDensity<D, decltype(fn)::value>(F, eps); });
 }
 
 // W(F) and its gradient and Hessian with respect to delta, where F(delta) = F + delta a^T.
-template <int D, Functional Fn>
-double energyDensityDerivatives(const Eigen::Matrix<double, D, D>& F,
-                                const Eigen::Matrix<double, D, 1>& a, double eps,
-                                Eigen::Matrix<double, D, 1>& gradient,
-                                Eigen::Matrix<double, D, D>& hessian) {
+template <int D, Functional Fn, class T>
+T energyDensityDerivatives(const Eigen::Matrix<T, D, D>& F, const Eigen::Matrix<T, D, 1>& a,
+                           double eps, Eigen::Matrix<T, D, 1>& gradient,
+                           Eigen::Matrix<T, D, D>& hessian) {
   using namespace functional_detail;
-  using Vec = Eigen::Matrix<double, D, 1>;
-  using Mat = Eigen::Matrix<double, D, D>;
-  const double J = determinant<D>(F);
+  using Vec = Eigen::Matrix<T, D, 1>;
+  using Mat = Eigen::Matrix<T, D, D>;
+  const T J = determinant<D>(F);
   const Vec g = cofactor<D>(F) * a;  // dJ/ddelta
   const Vec fa = F * a;
-  const double aa = a.squaredNorm();
-  double S = 0;
+  const T aa = a.squaredNorm();
+  T S;
   Vec dS;
   Mat ddS;
   if constexpr (Fn == Functional::LinearElastic) {
-    Mat E = 0.5 * (F.transpose() * F);
-    E.diagonal().array() -= 0.5;
+    const Mat E = greenStrain<D>(F);
     S = E.squaredNorm();
     dS = 2.0 * F * (E * a);
     ddS = aa * (F * F.transpose()) + fa * fa.transpose();
-    ddS.diagonal().array() += 2.0 * a.dot(E * a);
+    const T aEa = a.dot(E * a);
+    for (int i = 0; i < D; ++i) ddS(i, i) += 2.0 * aEa;
   } else {
     S = F.squaredNorm();
     dS = 2.0 * fa;
     ddS = Mat::Identity() * (2.0 * aa);
   }
-  const Regularised reg = regularise(J, eps);
-  const Psi p = psi<D, Fn>(S, reg.r);
-  const double pj = p.r * reg.dr;
-  const double pjj = p.rr * reg.dr * reg.dr + p.r * reg.ddr;
-  const double psj = p.sr * reg.dr;
+  const Regularised<T> reg = regularise(J, eps);
+  const Psi<T> p = psi<D, Fn>(S, reg.r);
+  const T pj = p.r * reg.dr;
+  const T pjj = p.rr * reg.dr * reg.dr + p.r * reg.ddr;
+  const T psj = p.sr * reg.dr;
   gradient = p.s * dS + pj * g;
   hessian = p.ss * (dS * dS.transpose()) + psj * (dS * g.transpose() + g * dS.transpose()) +
             pjj * (g * g.transpose()) + p.s * ddS;
   return p.v;
 }
 
-template <int D>
-double energyDensityDerivatives(Functional f, const Eigen::Matrix<double, D, D>& F,
-                                const Eigen::Matrix<double, D, 1>& a, double eps,
-                                Eigen::Matrix<double, D, 1>& gradient,
-                                Eigen::Matrix<double, D, D>& hessian) {
+template <int D, class T>
+T energyDensityDerivatives(Functional f, const Eigen::Matrix<T, D, D>& F,
+                           const Eigen::Matrix<T, D, 1>& a, double eps,
+                           Eigen::Matrix<T, D, 1>& gradient, Eigen::Matrix<T, D, D>& hessian) {
   return functional_detail::dispatch(f, [&](auto fn) {
     return energyDensityDerivatives<D, decltype(fn)::value>(F, a, eps, gradient, hessian);
   });

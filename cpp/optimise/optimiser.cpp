@@ -27,8 +27,12 @@ void OptimiserOptions::validate() const {
     throw ParameterError("maxiter must be >= 0, got " + std::to_string(maxIterations));
   if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
     throw ParameterError("tolerance must be a finite number >= 0");
+  if (!(energyTolerance >= 0.0) || !std::isfinite(energyTolerance))
+    throw ParameterError("energy tolerance must be a finite number >= 0");
   if (!(stall >= 0.0) || !std::isfinite(stall))
     throw ParameterError("stall must be a finite number >= 0");
+  if (!(stallEnergy >= 0.0) || !std::isfinite(stallEnergy))
+    throw ParameterError("stall energy must be a finite number >= 0");
   if (threads < 1 || threads > 1024)
     throw ParameterError("threads must be between 1 and 1024, got " + std::to_string(threads));
   if (regionThreshold && !(*regionThreshold > 0.0 && *regionThreshold <= 1.0))
@@ -134,18 +138,24 @@ class Optimiser {
     result_.setupSeconds = since(t0);
 
     IterationRecord best = before;
+    best.energy = result_.energyBefore = totalEnergy();
     std::vector<double> bestXyz, bestParam;  // empty: the input
     const std::vector<double> input = mesh_.xyz, inputParam = mesh_.nodeCadParam;
+    result_.stopReason = free_.empty() ? "no free nodes" : "iterations";
     try {
+      IterationRecord previous = best;
       for (int it = 1; it <= options_.maxIterations && !free_.empty(); ++it) {
         if (observer_ != nullptr && observer_->cancelRequested()) {
           result_.cancelled = true;
+          result_.stopReason = "cancelled";
           break;
         }
         const auto s0 = Clock::now();
-        const double moved = sweep();
+        const Moves moved = sweep();
         result_.sweepSeconds += since(s0);
-        const IterationRecord record = summarise(it, moved, t0);
+        IterationRecord record = summarise(it, moved.absolute, t0);
+        record.maxRelativeMove = moved.relative;
+        record.energy = totalEnergy();
         result_.history.push_back(record);
         result_.iterations = it;
         if (observer_ != nullptr) observer_->iterationFinished(record);
@@ -154,16 +164,11 @@ class Optimiser {
           bestXyz = mesh_.xyz;
           bestParam = mesh_.nodeCadParam;
         }
-        if (moved <= options_.tolerance * meanSize_) {
+        const std::string reason = stopRule(record, previous);
+        previous = record;
+        if (!reason.empty()) {
           result_.converged = true;
-          break;
-        }
-        const double previous = result_.history.size() > 1
-                                    ? result_.history[result_.history.size() - 2].worst
-                                    : before.worst;
-        if (options_.stall > 0.0 && record.invalid + record.undecided == 0 &&
-            record.worst - previous < options_.stall) {
-          result_.converged = true;
+          result_.stopReason = reason;
           break;
         }
       }
@@ -172,6 +177,7 @@ class Optimiser {
       mesh_.nodeCadParam = inputParam;
       throw;
     }
+    result_.energyAfter = best.energy;
     mesh_.xyz = bestXyz.empty() ? input : bestXyz;
     mesh_.nodeCadParam = bestXyz.empty() ? inputParam : bestParam;
     result_.keptIteration = best.iteration;
@@ -181,6 +187,63 @@ class Optimiser {
     result_.nodalWorstAfter = nodalScaledJacobian(mesh_, options_.threads);
     result_.seconds = since(t0);
     return result_;
+  }
+
+  // The setup of run() without quality, with F at every element, for NodeEnergyProbe.
+  void prepareProbe() {
+    setFrame();
+    buildBlocks();
+    convertToWorkingSet();
+    buildIncidence();
+    chooseFreeNodes();
+    changed_.resize(totalElements_);
+    for (std::size_t i = 0; i < totalElements_; ++i) changed_[i] = i;
+    computeGradients();
+  }
+
+  bool isFree(std::int64_t node) const {
+    return std::binary_search(free_.begin(), free_.end(), node);  // free_ sorted before colour()
+  }
+
+  Eigen::VectorXd probeCoordinates(std::int64_t node) const {
+    if (slide_[node] == 0) return position_[node];
+    return Eigen::Map<const Eigen::VectorXd>(&mesh_.nodeCadParam[2 * node], slide_[node]);
+  }
+
+  double probeRegularisation(std::int64_t node) {
+    std::vector<PointRef> pts;
+    return gather(node, pts);
+  }
+
+  // The energy of the node's patch with the node at `coordinates`, as visitWith assembles it.
+  NodeEnergy probe(std::int64_t node, const Eigen::VectorXd& coordinates, double eps) {
+    return functional_detail::dispatch(options_.functional, [&](auto fn) {
+      std::vector<PointRef> pts;
+      gather(node, pts);
+      Vec shift;
+      if (slide_[node] == 0) {
+        shift = coordinates - position_[node];
+      } else {
+        const double param[2] = {coordinates[0], slide_[node] == 2 ? coordinates[1] : 0.0};
+        shift = pointOn(threadCad(), node, param) - position_[node];
+      }
+      Vec grad;
+      Mat hess;
+      NodeEnergy out;
+      out.value = assemble<decltype(fn)::value>(pts, eps, grad, hess, &shift);
+      for (const PointRef& p : pts) {
+        const Mat F = *p.F + shift * p.a.transpose();
+        out.magnitude +=
+            p.w * (std::abs(energyDensity<D, decltype(fn)::value>(F, eps)) + F.squaredNorm());
+      }
+      if (slide_[node] == 0) {
+        out.gradient = grad;
+        out.hessian = hess;
+      } else {
+        chainRule(threadCad(), node, coordinates.data(), grad, hess, out.gradient, out.hessian);
+      }
+      return out;
+    });
   }
 
  private:
@@ -205,10 +268,10 @@ class Optimiser {
   std::vector<Block<D>> blocks_;
   std::vector<std::size_t> blockOffset_;  // first global element index of each block
   std::size_t totalElements_ = 0;
-  double meanSize_ = 1.0;
 
   std::vector<std::size_t> incidenceStart_;
   std::vector<Incidence> incidence_;
+  std::vector<double> nodeSize_;  // size of each node's smallest element (volume^(1/D))
 
   std::vector<double> scaled_;
   std::vector<Validity> validity_;
@@ -238,7 +301,6 @@ class Optimiser {
   }
 
   void buildBlocks() {
-    double volume = 0.0;
     for (const ElementBlock& cells : mesh_.blocks) {
       if (cellDimension(cells.type) != D || cells.count() == 0) continue;
       if (cells.type == CellType::Pyramid)
@@ -287,7 +349,6 @@ class Optimiser {
             b.idealInvT[e * idealPoints + q] = ideal.inverse().transpose();
           }
           b.weights[e * b.points + q] = rule.weights[q] * std::abs(det);
-          volume += rule.weights[q] * std::abs(det);
         }
       }
       blockOffset_.push_back(totalElements_);
@@ -297,7 +358,6 @@ class Optimiser {
     if (blocks_.empty())
       throw ParameterError("the mesh has no elements of dimension " + std::to_string(D) +
                            " to optimise");
-    meanSize_ = std::pow(volume / static_cast<double>(totalElements_), 1.0 / D);
   }
 
   // The same polynomial maps through the working node set's nodes (shared nodes get the same
@@ -332,6 +392,15 @@ class Optimiser {
         for (int k = 0; k < b.nodes; ++k) incidence_[fill[v[k]]++] = {static_cast<int>(bi), k, e};
       }
     }
+    nodeSize_.assign(nn, std::numeric_limits<double>::infinity());
+    for (const Block<D>& b : blocks_)
+      for (std::size_t e = 0; e < b.cells->count(); ++e) {
+        double volume = 0.0;
+        for (int q = 0; q < b.points; ++q) volume += b.weights[e * b.points + q];
+        const double size = std::pow(volume, 1.0 / D);
+        const std::int64_t* v = b.cells->element(e);
+        for (int k = 0; k < b.nodes; ++k) nodeSize_[v[k]] = std::min(nodeSize_[v[k]], size);
+      }
   }
 
   std::size_t globalIndex(const Incidence& inc) const {
@@ -506,7 +575,7 @@ class Optimiser {
   static double energyAfter(const std::vector<PointRef>& pts, const Vec& d, double eps, double e0) {
     double e1 = 0.0;
     for (const PointRef& p : pts) {
-      e1 += p.w * energyDensity<D, Fn>(*p.F + d * p.a.transpose(), eps);
+      e1 += p.w * energyDensity<D, Fn>(Mat(*p.F + d * p.a.transpose()), eps);
       if (!(e1 <= e0 + 1e300)) break;
     }
     return e1;
@@ -516,14 +585,9 @@ class Optimiser {
     for (const PointRef& p : pts) *p.F += d * p.a.transpose();
   }
 
-  // One Newton step on one node; returns the distance it moved.
-  double visit(std::int64_t node, std::vector<PointRef>& pts) {
-    return functional_detail::dispatch(
-        options_.functional, [&](auto fn) { return visitWith<decltype(fn)::value>(node, pts); });
-  }
-
-  template <Functional Fn>
-  double visitWith(std::int64_t node, std::vector<PointRef>& pts) {
+  // The patch of a node: F, a and the weight at every quadrature point of its elements. Returns
+  // the regularisation the patch needs (DESIGN.md section 6: sizeable only where it is inverted).
+  double gather(std::int64_t node, std::vector<PointRef>& pts) {
     pts.clear();
     double jmin = std::numeric_limits<double>::infinity();
     for (std::size_t k = incidenceStart_[node]; k < incidenceStart_[node + 1]; ++k) {
@@ -538,17 +602,42 @@ class Optimiser {
         jmin = std::min(jmin, functional_detail::determinant<D>(*F));
       }
     }
-    const double eps = jmin < 0.0 ? std::sqrt(1e-8 + 0.04 * jmin * jmin) : 1e-10;
+    return jmin < 0.0 ? std::sqrt(1e-8 + 0.04 * jmin * jmin) : 1e-10;
+  }
+
+  // The patch energy and its gradient and Hessian in the node's coordinates, with the node moved
+  // by `shift` from where the cached F has it (the sweeps pass none).
+  template <Functional Fn>
+  static double assemble(const std::vector<PointRef>& pts, double eps, Vec& grad, Mat& hess,
+                         const Vec* shift = nullptr) {
     double e0 = 0.0;
-    Vec grad = Vec::Zero();
-    Mat hess = Mat::Zero();
+    grad.setZero();
+    hess.setZero();
     Vec g;
     Mat h;
     for (const PointRef& p : pts) {
-      e0 += p.w * energyDensityDerivatives<D, Fn>(*p.F, p.a, eps, g, h);
+      const double w = shift == nullptr ? energyDensityDerivatives<D, Fn>(*p.F, p.a, eps, g, h)
+                                        : energyDensityDerivatives<D, Fn>(
+                                              Mat(*p.F + *shift * p.a.transpose()), p.a, eps, g, h);
+      e0 += p.w * w;
       grad += p.w * g;
       hess += p.w * h;
     }
+    return e0;
+  }
+
+  // One Newton step on one node; returns the distance it moved.
+  double visit(std::int64_t node, std::vector<PointRef>& pts) {
+    return functional_detail::dispatch(
+        options_.functional, [&](auto fn) { return visitWith<decltype(fn)::value>(node, pts); });
+  }
+
+  template <Functional Fn>
+  double visitWith(std::int64_t node, std::vector<PointRef>& pts) {
+    const double eps = gather(node, pts);
+    Vec grad;
+    Mat hess;
+    const double e0 = assemble<Fn>(pts, eps, grad, hess);
     if (!std::isfinite(e0) || !grad.allFinite() || !hess.allFinite()) return 0.0;
     if (slide_[node] != 0) return slide<Fn>(node, pts, eps, e0, grad, hess);
     Vec step;
@@ -566,29 +655,26 @@ class Optimiser {
     return 0.0;
   }
 
-  // A Newton step of a node on a CAD curve (face) in its parameter t ((u, v)): the chain rule
-  // through the curve's (surface's) first and second derivatives, then a backtracking line
-  // search whose trial points are evaluated on the CAD, so the node never leaves it.
-  template <Functional Fn>
-  double slide(std::int64_t node, const std::vector<PointRef>& pts, double eps, double e0,
-               const Vec& grad, const Mat& hess) {
-    const int n = slide_[node];  // parameters
-    const int entity = mesh_.nodeCadIndex[node];
-    const CadModel& cad = cadPerThread_[static_cast<std::size_t>(omp_get_thread_num())];
-    try {
-      return slideOn<Fn>(cad, node, n, entity, pts, eps, e0, grad, hess);
-    } catch (const CadError&) {
-      return 0.0;  // the CAD cannot be evaluated there (a degenerate point): the node stays
-    }
+  // The CAD model of the calling thread (OCCT's evaluators cache state).
+  const CadModel& threadCad() const {
+    return cadPerThread_[static_cast<std::size_t>(omp_get_thread_num())];
   }
 
-  template <Functional Fn>
-  double slideOn(const CadModel& cad, std::int64_t node, int n, int entity,
-                 const std::vector<PointRef>& pts, double eps, double e0, const Vec& grad,
-                 const Mat& hess) {
-    double* param = &mesh_.nodeCadParam[2 * node];
+  // The point (in the frame) of a sliding node at parameters `param` (t, or (u, v)).
+  Vec pointOn(const CadModel& cad, std::int64_t node, const double* param) const {
+    const int entity = mesh_.nodeCadIndex[node];
+    if (slide_[node] == 1) return frame_ * cad.evaluateCurve(entity, param[0]).point;
+    return frame_ * cad.evaluateSurface(entity, param[0], param[1]).point;
+  }
+
+  // The chain rule from the node's coordinates to its parameters at `param`: g = X^T grad and
+  // h = X^T hess X + grad . X'' with X = dx/dparam (exact: the second term is the curvature's).
+  void chainRule(const CadModel& cad, std::int64_t node, const double* param, const Vec& grad,
+                 const Mat& hess, Eigen::VectorXd& g, Eigen::MatrixXd& h) const {
+    const int n = slide_[node];
+    const int entity = mesh_.nodeCadIndex[node];
     Eigen::Matrix<double, D, Eigen::Dynamic> jac(D, n);
-    Eigen::MatrixXd h(n, n);
+    h.resize(n, n);
     if (n == 1) {
       const CurveDerivatives c = cad.evaluateCurve(entity, param[0]);
       jac.col(0) = frame_ * c.d1;
@@ -603,7 +689,30 @@ class Optimiser {
       h(0, 1) += grad.dot(frame_ * s.duv);
       h(1, 0) = h(0, 1);
     }
-    const Eigen::VectorXd g = jac.transpose() * grad;
+    g = jac.transpose() * grad;
+  }
+
+  // A Newton step of a node on a CAD curve (face) in its parameter t ((u, v)), then a
+  // backtracking line search whose trial points are evaluated on the CAD, so the node never
+  // leaves it.
+  template <Functional Fn>
+  double slide(std::int64_t node, const std::vector<PointRef>& pts, double eps, double e0,
+               const Vec& grad, const Mat& hess) {
+    try {
+      return slideOn<Fn>(threadCad(), node, pts, eps, e0, grad, hess);
+    } catch (const CadError&) {
+      return 0.0;  // the CAD cannot be evaluated there (a degenerate point): the node stays
+    }
+  }
+
+  template <Functional Fn>
+  double slideOn(const CadModel& cad, std::int64_t node, const std::vector<PointRef>& pts,
+                 double eps, double e0, const Vec& grad, const Mat& hess) {
+    double* param = &mesh_.nodeCadParam[2 * node];
+    const int entity = mesh_.nodeCadIndex[node];
+    Eigen::VectorXd g;
+    Eigen::MatrixXd h;
+    chainRule(cad, node, param, grad, hess, g, h);
     if (!g.allFinite() || !h.allFinite()) return 0.0;
     Eigen::VectorXd step;
     double slope = 0.0;
@@ -611,22 +720,20 @@ class Optimiser {
     double alpha = 1.0;
     for (int ls = 0; ls < kLineSearchSteps; ++ls, alpha *= 0.5) {
       double trial[2] = {param[0], param[1]};
-      Vec x;
-      if (n == 1) {
+      if (slide_[node] == 1) {
         const ParameterRange& r = curveRange_.at(entity);
         trial[0] = std::clamp(param[0] + alpha * step[0], r.first, r.last);
-        x = frame_ * cad.evaluateCurve(entity, trial[0]).point;
       } else {
         const SurfaceBounds& b = faceRange_.at(entity);
         trial[0] = std::clamp(param[0] + alpha * step[0], b.uMin, b.uMax);
         trial[1] = std::clamp(param[1] + alpha * step[1], b.vMin, b.vMax);
-        x = frame_ * cad.evaluateSurface(entity, trial[0], trial[1]).point;
       }
+      const Vec x = pointOn(cad, node, trial);
       const Vec d = x - position_[node];
       if (energyAfter<Fn>(pts, d, eps, e0) <= e0 + kArmijo * alpha * slope) {
         position_[node] = x;
         param[0] = trial[0];
-        if (n == 2) param[1] = trial[1];
+        param[1] = trial[1];
         applyMove(pts, d);
         return d.norm();
       }
@@ -634,12 +741,17 @@ class Optimiser {
     return 0.0;
   }
 
+  // The largest node move of a pass, absolute and relative to the node's element size.
+  struct Moves {
+    double absolute = 0.0, relative = 0.0;
+  };
+
   // One Newton step on each of `nodes` (grouped by colour: starts[c]..starts[c+1]).
-  double relax(const std::vector<std::int64_t>& nodes, const std::vector<std::size_t>& starts) {
-    double moved = 0.0;
+  Moves relax(const std::vector<std::int64_t>& nodes, const std::vector<std::size_t>& starts) {
+    double moved = 0.0, relative = 0.0;
     FirstFailure failure;
     const std::int64_t colours = static_cast<std::int64_t>(starts.size()) - 1;
-#pragma omp parallel num_threads(options_.threads) reduction(max : moved)
+#pragma omp parallel num_threads(options_.threads) reduction(max : moved, relative)
     {
       std::vector<PointRef> pts;
       for (std::int64_t c = 0; c < colours; ++c) {
@@ -648,7 +760,9 @@ class Optimiser {
 #pragma omp for schedule(dynamic, 8)
         for (std::int64_t i = lo; i < hi; ++i) {
           try {
-            moved = std::max(moved, visit(nodes[i], pts));
+            const double d = visit(nodes[i], pts);
+            moved = std::max(moved, d);
+            relative = std::max(relative, d / nodeSize_[nodes[i]]);
           } catch (...) {
             failure.capture();
           }
@@ -656,7 +770,7 @@ class Optimiser {
       }
     }
     failure.rethrow();
-    return moved;
+    return {moved, relative};
   }
 
   // One iteration: a Newton step on every free node, then `focusPasses` more on the nodes of
@@ -665,8 +779,8 @@ class Optimiser {
   // focused passes cost a fraction of a sweep (on NekMesh's cube-sphere at order 4, two passes
   // take the worst value after five iterations from 0.714 to 0.757 for 25 % more time).
   // Leaves mesh_.xyz and the certified quality up to date.
-  double sweep() {
-    const double moved = relax(free_, colourStart_);
+  Moves sweep() {
+    const Moves moved = relax(free_, colourStart_);
     writeBack();
     evaluate(changed_);
     if (options_.focusPasses > 0) {
@@ -763,6 +877,42 @@ class Optimiser {
     return r;
   }
 
+  // The first stop rule that holds after a sweep (OptimiserOptions), or "".
+  std::string stopRule(const IterationRecord& r, const IterationRecord& previous) const {
+    if (r.maxRelativeMove <= options_.tolerance) return "displacement";
+    const bool valid = r.invalid + r.undecided == 0;
+    const double fall = (previous.energy - r.energy) / std::max(std::abs(r.energy), 1e-300);
+    if (valid && fall < options_.energyTolerance) return "energy";
+    if (options_.stall > 0.0 && valid && r.worst - previous.worst < options_.stall &&
+        fall < options_.stallEnergy)
+      return "stalled";
+    return "";
+  }
+
+  // The energy of the elements that contain a free node (the others' is constant), from the
+  // current F, with the regularisation of a valid patch.
+  double totalEnergy() const {
+    std::vector<double> energy(changed_.size());  // summed in order: the same for any thread count
+    functional_detail::dispatch(options_.functional, [&](auto fn) {
+      const std::size_t* list = changed_.data();
+      double* out = energy.data();
+#pragma omp parallel for num_threads(options_.threads) schedule(static)
+      for (std::int64_t i = 0; i < static_cast<std::int64_t>(changed_.size()); ++i) {
+        const auto [bi, e] = locate(list[i]);
+        const Block<D>& b = blocks_[bi];
+        double sum = 0.0;
+        for (int q = 0; q < b.points; ++q) {
+          const std::size_t p = e * b.points + q;
+          sum += b.weights[p] * energyDensity<D, decltype(fn)::value>(b.F[p], 1e-10);
+        }
+        out[i] = sum;
+      }
+    });
+    double total = 0.0;
+    for (const double x : energy) total += x;
+    return total;
+  }
+
   // No worse than the input in worst value and in invalid count.
   static bool acceptable(const IterationRecord& r, const IterationRecord& input) {
     return r.invalid <= input.invalid && r.worst >= input.worst;
@@ -786,47 +936,87 @@ OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
                        std::to_string(mesh.dim));
 }
 
+class NodeEnergyProbe::Impl {
+ public:
+  virtual ~Impl() = default;
+  virtual bool isFree(std::int64_t node) const = 0;
+  virtual Eigen::VectorXd coordinates(std::int64_t node) const = 0;
+  virtual double regularisation(std::int64_t node) = 0;
+  virtual NodeEnergy evaluate(std::int64_t node, const Eigen::VectorXd& coordinates,
+                              double eps) = 0;
+};
+
 namespace {
 
 template <int D>
-NodeEnergy nodeEnergy(CellType type, int order, Functional functional, const Eigen::MatrixXd& ideal,
-                      const Eigen::MatrixXd& x, int local, double eps) {
-  using Mat = Eigen::Matrix<double, D, D>;
-  using Vec = Eigen::Matrix<double, D, 1>;
-  const ReferenceElement& ref = ReferenceElement::get(type, order, kWorkingSet);
-  const ReferenceElement& lin = ReferenceElement::get(type, 1);
-  const Eigen::MatrixXd working = x.leftCols(D);
-  const QuadratureRule rule = energyRule(type, order);
-  NodeEnergy out;
-  out.gradient = Eigen::VectorXd::Zero(D);
-  out.hessian = Eigen::MatrixXd::Zero(D, D);
-  Eigen::VectorXd values;
-  Eigen::MatrixXd grad, linGrad;
-  for (int q = 0; q < rule.size(); ++q) {
-    const double* xi = &rule.points[static_cast<std::size_t>(q) * D];
-    ref.evaluate(xi, values, grad);
-    lin.evaluate(xi, values, linGrad);
-    const Mat idealJacobian = ideal.leftCols(D).transpose() * linGrad;
-    const Mat invT = idealJacobian.inverse().transpose();
-    const Mat F = working.transpose() * grad * invT.transpose();
-    const Vec a = invT * grad.row(local).transpose();
-    const double w = rule.weights[q] * std::abs(idealJacobian.determinant());
-    Vec g;
-    Mat h;
-    out.value += w * energyDensityDerivatives<D>(functional, F, a, eps, g, h);
-    out.gradient += w * g;
-    out.hessian += w * h;
+class ProbeImpl : public NodeEnergyProbe::Impl {
+ public:
+  ProbeImpl(const Mesh& mesh, const OptimiserOptions& options, const CadModel* cad)
+      : mesh_(mesh), options_(options), optimiser_(mesh_, options_, nullptr, cad) {
+    optimiser_.prepareProbe();
   }
-  return out;
-}
+  bool isFree(std::int64_t node) const override { return optimiser_.isFree(node); }
+  Eigen::VectorXd coordinates(std::int64_t node) const override {
+    return optimiser_.probeCoordinates(node);
+  }
+  double regularisation(std::int64_t node) override { return optimiser_.probeRegularisation(node); }
+  NodeEnergy evaluate(std::int64_t node, const Eigen::VectorXd& coordinates, double eps) override {
+    return optimiser_.probe(node, coordinates, eps);
+  }
+
+ private:
+  Mesh mesh_;
+  OptimiserOptions options_;
+  Optimiser<D> optimiser_;
+};
 
 }  // namespace
 
-NodeEnergy elementNodeEnergy(CellType type, int order, Functional functional,
-                             const Eigen::MatrixXd& ideal, const Eigen::MatrixXd& x, int local,
-                             double eps) {
-  if (cellDimension(type) == 3) return nodeEnergy<3>(type, order, functional, ideal, x, local, eps);
-  return nodeEnergy<2>(type, order, functional, ideal, x, local, eps);
+NodeEnergyProbe::NodeEnergyProbe(const Mesh& mesh, const OptimiserOptions& options,
+                                 const CadModel* cad) {
+  options.validate();
+  mesh.checkConsistency();
+  if (mesh.dim == 3) {
+    impl_ = std::make_unique<ProbeImpl<3>>(mesh, options, cad);
+  } else if (mesh.dim == 2) {
+    impl_ = std::make_unique<ProbeImpl<2>>(mesh, options, cad);
+  } else {
+    throw ParameterError("the optimiser needs a 2D or 3D mesh, got dimension " +
+                         std::to_string(mesh.dim));
+  }
+  numNodes_ = mesh.numNodes();
+}
+
+NodeEnergyProbe::~NodeEnergyProbe() = default;
+
+void NodeEnergyProbe::check(std::int64_t node) const {
+  if (node < 0 || static_cast<std::size_t>(node) >= numNodes_)
+    throw ParameterError("node " + std::to_string(node) + " is not in the mesh");
+}
+
+bool NodeEnergyProbe::isFree(std::int64_t node) const {
+  check(node);
+  return impl_->isFree(node);
+}
+
+Eigen::VectorXd NodeEnergyProbe::coordinates(std::int64_t node) const {
+  check(node);
+  return impl_->coordinates(node);
+}
+
+double NodeEnergyProbe::regularisation(std::int64_t node) const {
+  check(node);
+  return impl_->regularisation(node);
+}
+
+NodeEnergy NodeEnergyProbe::evaluate(std::int64_t node, const Eigen::VectorXd& coordinates,
+                                     double eps) const {
+  check(node);
+  if (coordinates.size() != impl_->coordinates(node).size())
+    throw ParameterError("node " + std::to_string(node) + " has " +
+                         std::to_string(impl_->coordinates(node).size()) + " coordinates, got " +
+                         std::to_string(coordinates.size()));
+  return impl_->evaluate(node, coordinates, eps);
 }
 
 double nodalScaledJacobian(const Mesh& mesh, int threads) {

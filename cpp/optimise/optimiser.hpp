@@ -23,6 +23,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,11 +41,21 @@ class CadModel;
 struct OptimiserOptions {
   Functional functional = Functional::Hyperelastic;
   int maxIterations = 100;  // sweeps, >= 0
-  // Stop when a sweep moves no node by more than tolerance x the mean element size.
+  // Stop rules, checked after every sweep in this order (the result names the one that ended
+  // the run):
+  //  "displacement": no node moved by more than `tolerance` times the size of its smallest
+  //    element (its straight-sided volume to the power 1/d);
+  //  "energy": every element is proven valid and the sweep lowered the total energy by less
+  //    than `energyTolerance` of it (an invalid mesh keeps going: untangling can follow a
+  //    plateau of the energy);
+  //  "stalled" (only with `stall` > 0): every element is proven valid, the sweep raised the
+  //    worst scaled Jacobian by less than `stall` and lowered the energy by less than
+  //    `stallEnergy` of it: the worst element no longer improves and the rest little;
+  //  "iterations": maxIterations sweeps done.
   double tolerance = 1e-6;
-  // > 0: also stop once every element is proven valid and a sweep raised the worst scaled
-  // Jacobian by less than this (the mesh is valid and no longer improving much).
+  double energyTolerance = 1e-5;
   double stall = 0.0;
+  double stallEnergy = 1e-3;
   int threads = 1;
   // Work only around elements whose certified scaled Jacobian is below this (in (0, 1]).
   std::optional<double> regionThreshold;
@@ -69,13 +81,19 @@ struct IterationRecord {
   std::size_t invalid = 0;
   std::size_t undecided = 0;
   double maxDisplacement = 0.0;  // largest node move of the sweep
+  double maxRelativeMove = 0.0;  // largest node move / the size of the node's smallest element
+  double energy = 0.0;           // total energy of the elements with a free node, after
   double seconds = 0.0;          // since the optimiser started
 };
 
 struct OptimiserResult {
   Functional functional = Functional::Hyperelastic;
-  int iterations = 0;  // sweeps done
-  bool converged = false;
+  int iterations = 0;      // sweeps done
+  bool converged = false;  // stopped by "displacement", "energy" or "stalled"
+  // Which rule ended the run: "displacement", "energy", "stalled", "iterations", "cancelled",
+  // or "no free nodes" (see OptimiserOptions).
+  std::string stopReason;
+  double energyBefore = 0.0, energyAfter = 0.0;  // of the input and of the state kept
   bool cancelled = false;
   int keptIteration = 0;                       // the sweep whose state was returned (0: the input)
   double worstBefore = 0.0, worstAfter = 0.0;  // certified scaled Jacobian
@@ -106,19 +124,46 @@ class OptimiserObserver {
 OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
                              OptimiserObserver* observer = nullptr, const CadModel* cad = nullptr);
 
-// The energy of one element and its gradient and Hessian with respect to the coordinates of
-// node `local`, assembled as the optimiser assembles them (same quadrature). `x`: the node
-// coordinates at the optimiser's working nodes (ReferenceElement::get(type, order,
-// NodeSet::Optimal), Gmsh order); `ideal`: the vertices of the straight-sided ideal element.
-// 2D cells use the x and y columns. Exposed for the tests.
+// The optimiser's energy around one node as a function of that node's own coordinates, for the
+// derivative tests: the same setup, patch assembly, regularisation and chain rule through the
+// CAD as the sweeps (nothing is written for the tests alone). The coordinates are (x, y[, z]) in
+// the optimiser's frame for a node that moves freely (positions of the working node set when
+// the optimiser converts to it: without CAD and without a region), t for a node sliding on a
+// CAD curve and (u, v) for one sliding on a CAD face. The patch is every element around the
+// node; the other nodes stay where the mesh has them.
 struct NodeEnergy {
   double value = 0.0;
   Eigen::VectorXd gradient;
   Eigen::MatrixXd hessian;
+  // Sum over the patch's points of weight x (|W| + |F|^2): the size of the terms the energy
+  // adds up, so that c u magnitude bounds its rounding (u the unit roundoff).
+  double magnitude = 0.0;
 };
-NodeEnergy elementNodeEnergy(CellType type, int order, Functional functional,
-                             const Eigen::MatrixXd& ideal, const Eigen::MatrixXd& x, int local,
-                             double eps);
+
+class NodeEnergyProbe {
+ public:
+  // Throws as optimiseMesh for bad options or cells.
+  NodeEnergyProbe(const Mesh& mesh, const OptimiserOptions& options, const CadModel* cad = nullptr);
+  ~NodeEnergyProbe();
+  NodeEnergyProbe(const NodeEnergyProbe&) = delete;
+  NodeEnergyProbe& operator=(const NodeEnergyProbe&) = delete;
+
+  // Whether the sweeps move the node (any node can be probed).
+  bool isFree(std::int64_t node) const;
+  Eigen::VectorXd coordinates(std::int64_t node) const;
+  // The regularisation eps the sweeps use for the node's patch as it is.
+  double regularisation(std::int64_t node) const;
+  // Energy, gradient and Hessian with the node at `coordinates`. Throws ParameterError for a
+  // node outside the mesh or a coordinate count that does not match.
+  NodeEnergy evaluate(std::int64_t node, const Eigen::VectorXd& coordinates, double eps) const;
+
+  class Impl;
+
+ private:
+  void check(std::int64_t node) const;
+  std::unique_ptr<Impl> impl_;
+  std::size_t numNodes_ = 0;
+};
 
 // min over the mesh of (min J / max J over each element's nodes).
 double nodalScaledJacobian(const Mesh& mesh, int threads = 1);

@@ -38,7 +38,8 @@ struct MeshingOptions {
   int verbosity = 0;                       // 0 silent; 1 Gmsh's warnings; 2 Gmsh's information
   // > 0: after elevation, at most this many sweeps of the variational optimiser (hyperelastic,
   // boundary nodes sliding on the CAD; optimise/optimiser.hpp), stopping earlier once the mesh
-  // is proven valid and a sweep raises its worst scaled Jacobian by less than 0.001.
+  // is proven valid and no longer improving (OptimiserOptions: "energy", or "stalled" with
+  // stall 0.001).
   int optimiseIterations = 0;
 
   // Throws ParameterError naming the offending parameter.

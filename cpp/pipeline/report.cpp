@@ -197,6 +197,7 @@ void appendOptimiser(JsonWriter& json, const OptimiserResult& r) {
   json.value("functional", functionalName(r.functional));
   json.value("iterations", r.iterations);
   json.value("converged", r.converged);
+  json.value("stopped", r.stopReason);
   json.value("cancelled", r.cancelled);
   json.value("kept_iteration", r.keptIteration);
   json.value("worst_before", r.worstBefore);
@@ -207,6 +208,8 @@ void appendOptimiser(JsonWriter& json, const OptimiserResult& r) {
   json.value("undecided_after", r.undecidedAfter);
   json.value("nodal_worst_before", r.nodalWorstBefore);
   json.value("nodal_worst_after", r.nodalWorstAfter);
+  json.value("energy_before", r.energyBefore);
+  json.value("energy_after", r.energyAfter);
   json.value("free_nodes", r.freeNodes);
   json.value("colours", r.colours);
   json.value("region_elements", r.regionElements);
@@ -221,6 +224,8 @@ void appendOptimiser(JsonWriter& json, const OptimiserResult& r) {
     json.value("invalid", h.invalid);
     json.value("undecided", h.undecided);
     json.value("max_displacement", h.maxDisplacement);
+    json.value("max_relative_move", h.maxRelativeMove);
+    json.value("energy", h.energy);
     json.value("seconds", h.seconds);
     json.endObject();
   }
