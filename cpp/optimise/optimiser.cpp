@@ -33,6 +33,8 @@ void OptimiserOptions::validate() const {
     throw ParameterError("stall must be a finite number >= 0");
   if (!(stallEnergy >= 0.0) || !std::isfinite(stallEnergy))
     throw ParameterError("stall energy must be a finite number >= 0");
+  if (stallWindow < 1)
+    throw ParameterError("stall window must be >= 1, got " + std::to_string(stallWindow));
   if (threads < 1 || threads > 1024)
     throw ParameterError("threads must be between 1 and 1024, got " + std::to_string(threads));
   if (regionThreshold && !(*regionThreshold > 0.0 && *regionThreshold <= 1.0))
@@ -164,7 +166,7 @@ class Optimiser {
           bestXyz = mesh_.xyz;
           bestParam = mesh_.nodeCadParam;
         }
-        const std::string reason = stopRule(record, previous);
+        const std::string reason = stopRule(record, previous, before);
         previous = record;
         if (!reason.empty()) {
           result_.converged = true;
@@ -878,14 +880,19 @@ class Optimiser {
   }
 
   // The first stop rule that holds after a sweep (OptimiserOptions), or "".
-  std::string stopRule(const IterationRecord& r, const IterationRecord& previous) const {
+  std::string stopRule(const IterationRecord& r, const IterationRecord& previous,
+                       const IterationRecord& input) const {
     if (r.maxRelativeMove <= options_.tolerance) return "displacement";
     const bool valid = r.invalid + r.undecided == 0;
     const double fall = (previous.energy - r.energy) / std::max(std::abs(r.energy), 1e-300);
     if (valid && fall < options_.energyTolerance) return "energy";
-    if (options_.stall > 0.0 && valid && r.worst - previous.worst < options_.stall &&
-        fall < options_.stallEnergy)
-      return "stalled";
+    if (options_.stall > 0.0 && valid && fall < options_.stallEnergy) {
+      const auto n = static_cast<int>(result_.history.size());  // r is the last entry
+      const double then = n > options_.stallWindow
+                              ? result_.history[n - 1 - options_.stallWindow].worst
+                              : input.worst;
+      if (n >= options_.stallWindow && r.worst - then < options_.stall) return "stalled";
+    }
     return "";
   }
 

@@ -48,14 +48,17 @@ struct OptimiserOptions {
   //  "energy": every element is proven valid and the sweep lowered the total energy by less
   //    than `energyTolerance` of it (an invalid mesh keeps going: untangling can follow a
   //    plateau of the energy);
-  //  "stalled" (only with `stall` > 0): every element is proven valid, the sweep raised the
-  //    worst scaled Jacobian by less than `stall` and lowered the energy by less than
-  //    `stallEnergy` of it: the worst element no longer improves and the rest little;
+  //  "stalled" (only with `stall` > 0): every element is proven valid, the last `stallWindow`
+  //    sweeps together raised the worst scaled Jacobian by less than `stall`, and the last
+  //    sweep lowered the energy by less than `stallEnergy` of it: the worst element no longer
+  //    improves and the rest only slowly (a single sweep can lower the worst value while it
+  //    untangles the rest, hence the window);
   //  "iterations": maxIterations sweeps done.
   double tolerance = 1e-6;
   double energyTolerance = 1e-5;
   double stall = 0.0;
-  double stallEnergy = 1e-3;
+  double stallEnergy = 0.05;
+  int stallWindow = 3;
   int threads = 1;
   // Work only around elements whose certified scaled Jacobian is below this (in (0, 1]).
   std::optional<double> regionThreshold;
