@@ -4,6 +4,7 @@
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepBndLib.hxx>
 #include <BRepBuilderAPI_Transform.hxx>
+#include <BRepClass_FaceClassifier.hxx>
 #include <BRepLProp_SLProps.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
@@ -400,6 +401,36 @@ std::array<double, 2> CadModel::edgeParameterOnFace(int edge, int face, double t
     const gp_Pnt2d uv = pcurve->Value(t);
     return std::array<double, 2>{uv.X(), uv.Y()};
   });
+}
+
+std::array<double, 2> CadModel::facePeriods(int face) const {
+  const auto& s = impl_->surface(face);
+  return withOcctErrors(cadEntityName(2, face), [&] {
+    return std::array<double, 2>{s.IsUPeriodic() ? s.UPeriod() : 0.0,
+                                 s.IsVPeriodic() ? s.VPeriod() : 0.0};
+  });
+}
+
+bool CadModel::faceContains(int face, double u, double v) const {
+  const TopoDS_Face f = occtFace(*this, face);
+  return withOcctErrors(cadEntityName(2, face), [&] {
+    BRepClass_FaceClassifier classifier(f, gp_Pnt2d(u, v), BRep_Tool::Tolerance(f));
+    const TopAbs_State state = classifier.State();
+    return state == TopAbs_IN || state == TopAbs_ON;
+  });
+}
+
+double CadModel::tolerance(int dim, int index) const {
+  switch (dim) {
+    case 0:
+      return BRep_Tool::Tolerance(occtVertex(*this, index));
+    case 1:
+      return BRep_Tool::Tolerance(occtEdge(*this, index));
+    case 2:
+      return BRep_Tool::Tolerance(occtFace(*this, index));
+    default:
+      throw Error("tolerance: dimension " + std::to_string(dim) + " has no CAD tolerance");
+  }
 }
 
 std::string cadEntityName(int dim, int index) {
