@@ -217,6 +217,12 @@ TEST(FaceNodePlacement, SphereAcrossItsSeamAndPoles) {
     EXPECT_EQ(stats.faceInteriorsProjected, 0u);
     EXPECT_GT(stats.faceInteriors, 0u);
     EXPECT_EQ(evaluateQuality(mesh).invalid, 0u) << "order " << order;
+    const QualitySummary q = evaluateQuality(mesh);
+    for (std::size_t e = 0; e < q.scaledJacobian.size(); ++e)
+      std::printf("elem %zu sj %g\n", e, q.scaledJacobian[e]);
+    for (std::size_t i = 0; i < mesh.numNodes(); ++i)
+      std::printf("node %zu %g %g dim %d t %g\n", i, mesh.xyz[3 * i], mesh.xyz[3 * i + 1],
+                  mesh.nodeCadDim[i], mesh.nodeCadParam[2 * i]);
   }
 }
 
@@ -267,8 +273,82 @@ TEST(FaceNodePlacement, CoarseTorusAcrossBothSeams) {
   }
 }
 
+// A coarse planar mesh of the thin ellipse: a fan of triangles from the centre to seven nodes on
+// the curve (the first is the curve's vertex, t = 0), one edge spanning the blunt nose at t = pi
+// from pi - 0.5 to pi + 0.4 (like a thin aerofoil's leading edge between two coarse nodes).
+Mesh ellipseFanMesh(const CadModel& cad) {
+  Mesh mesh;
+  mesh.dim = 2;
+  const double centre[3] = {0.0, 0.0, 0.0};
+  const SurfaceProjection c = cad.projectOnSurface(1, Eigen::Vector3d::Zero());
+  mesh.addNode(centre, 2, 1, c.u, c.v);
+  const double ts[] = {0.0, 1.0, 1.9, M_PI - 0.5, M_PI + 0.4, 4.4, 5.3};
+  const int n = 7;
+  for (int k = 0; k < n; ++k) {
+    const double t = ts[k];
+    const Eigen::Vector3d x = cad.evaluateCurve(1, t).point;
+    if (k == 0) {
+      mesh.addNode(x.data(), 0, 1, std::nan(""), std::nan(""));
+    } else {
+      mesh.addNode(x.data(), 1, 1, t, std::nan(""));
+    }
+  }
+  ElementBlock tris, lines;
+  tris.type = CellType::Triangle;
+  lines.type = CellType::Line;
+  for (int k = 0; k < n; ++k) {
+    const std::int64_t a = 1 + k, b = 1 + (k + 1) % n;
+    for (const std::int64_t id : {std::int64_t{0}, a, b}) tris.nodes.push_back(id);
+    tris.entity.push_back(1);
+    lines.nodes.push_back(a);
+    lines.nodes.push_back(b);
+    lines.entity.push_back(1);
+  }
+  mesh.blocks.push_back(std::move(tris));
+  mesh.blocks.push_back(std::move(lines));
+  return mesh;
+}
+
+TEST(CurveNodePlacement, CoarseThinNoseWherePlainProjectionFolds) {
+  const CadModel cad = ellipseModel();
+  ASSERT_EQ(cad.numVertices(), 1);
+  const Mesh linear = ellipseFanMesh(cad);
+  for (const int order : {4, 6}) {
+    CurvingStats stats;
+    const Mesh mesh = elevateOrder(linear, order, &cad, &stats);
+    EXPECT_EQ(stats.curveEdges, 7u);
+    EXPECT_EQ(stats.curveEdgesAtStart, 0u);
+    // The previous placement, closest-point projection of the straight edge's nodes, folds
+    // the nose edge's parameters; `projected` is the mesh it gives.
+    Mesh projected = mesh;
+    std::size_t folds = 0;
+    for (const auto& [key, nodes] : meshEdges(mesh)) {
+      if (mesh.nodeCadDim[nodes[1]] != 1) continue;
+      const Eigen::Vector3d xa = nodePoint(mesh, key[0]), xb = nodePoint(mesh, key[1]);
+      std::vector<double> t;
+      for (int i = 1; i < order; ++i) {
+        const CurveProjection p = cad.projectOnCurve(1, xa + (xb - xa) * (i / double(order)));
+        t.push_back(p.t);
+        for (int k = 0; k < 3; ++k) projected.xyz[3 * nodes[i] + k] = p.point[k];
+      }
+      const auto endT = [&](std::int64_t node, double near) {
+        if (mesh.nodeCadDim[node] == 1) return mesh.nodeCadParam[2 * node];
+        return cad.vertexParameter(mesh.nodeCadIndex[node], 1, near);
+      };
+      t.insert(t.begin(), endT(key[0], t.front()));
+      t.push_back(endT(key[1], t.back()));
+      if (!strictlyMonotone(t)) ++folds;
+    }
+    EXPECT_GT(folds, 0u) << "order " << order;
+    // The new placement: monotone along every edge and on the curve. The nose element, a
+    // sliver from the centre round a nose of radius 0.03, stays invalid at this coarseness, but
+    // less so than with the folded projection.
+    const EdgeCheck check = checkBoundary(mesh, cad);
+    EXPECT_EQ(check.curveEdges, 7u);
+    EXPECT_EQ(check.nonMonotone, 0u) << "order " << order;
+    EXPECT_GT(evaluateQuality(mesh).scaled.min, evaluateQuality(projected).scaled.min);
+  }
+}
+
 }  // namespace
-}  // namespace homesh
-namespace homesh {
-namespace {}  // namespace
 }  // namespace homesh
