@@ -4,10 +4,10 @@
 // Nodes carry k = 1 (a curve's t) or k = 2 (a surface's (u, v)) parameters. The energy is
 //   E(x) = sum over springs s = (a, b, w) of  w * |r(x_a) - r(x_b)|^2,
 // the discrete Dirichlet energy of the node graph on the CAD entity (DESIGN.md section 5: with
-// w = 1 / (z_b - z_a) along an edge its minimiser spaces the nodes in arc length; over a
-// triangle's lattice it spreads them evenly on the surface). Fixed nodes keep their parameters;
-// free ones move by damped Gauss-Newton (Levenberg-Marquardt) steps that never raise E, clamped
-// to optional per-parameter bounds. The minimiser promises a lower or equal energy, not a
+// w = 1 / (z_b - z_a) along a resolved edge its minimiser spaces the nodes nearly in arc length;
+// over a triangle's lattice it spreads them evenly on the surface). Fixed nodes keep their
+// parameters; free ones move by damped Gauss-Newton (Levenberg-Marquardt) steps that never raise E,
+// clamped to optional per-parameter bounds. The minimiser promises a lower or equal energy, not a
 // well-ordered result: callers check monotonicity and trimming themselves.
 #pragma once
 
