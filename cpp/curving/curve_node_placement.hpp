@@ -2,13 +2,10 @@
 //
 // DESIGN.md section 5: the P-1 interior nodes of an edge from parameter ta to tb sit at the
 // parameters t_1..t_{P-1} that minimise sum_i |c(t_{i+1}) - c(t_i)|^2 / (z_{i+1} - z_i), z being
-// the element's reference node positions along the edge. The search starts at equal arc length
-// (z_i times the edge's length) and keeps each t_i inside its own arc-length cell (half-way to
-// the neighbours' equal-arc parameters): on a coarse edge over a blunt nose the energy has
-// minimisers that cut across the nose with nodes bunched on one flank, which the cells exclude.
-// Unlike projecting the straight edge's points onto the curve, this cannot jump to another
-// branch of a strongly curved curve; the result is checked strictly monotone and replaced by the
-// (monotone) start where it is not.
+// the element's reference node positions along the edge, subject to t strictly between ta and
+// tb; the search starts from t linear in z. Unlike projecting the straight edge's points onto
+// the curve, this cannot jump to another branch of a strongly curved curve: the result is checked
+// strictly monotone and replaced by the (monotone) start where it is not.
 #pragma once
 
 #include <cstdint>
@@ -28,7 +25,7 @@ double nodeCurveParameter(const CadModel& cad, const Mesh& mesh, std::int64_t no
 
 struct CurvePlacement {
   std::vector<double> t;   // P+1 parameters, ends included
-  bool optimised = false;  // false: the optimum was not monotone, t is the start
+  bool optimised = false;  // false: the optimum was not monotone, t is the linear start
 };
 
 // Places the nodes between ta and tb (ta != tb) at reference positions z (z.front() = 0 <

@@ -62,6 +62,11 @@ TEST(CurveNodePlacement, SpacesNodesInArcLengthAroundAStronglyCurvedNose) {
     ASSERT_TRUE(strictlyMonotone(placement.t));
     EXPECT_EQ(placement.t.front(), ta);
     EXPECT_EQ(placement.t.back(), tb);
+    // The same edge run the other way gives the same nodes (equispaced z are symmetric); the
+    // solves stop within about sqrt(1e-14) of the span (see CircleNodesAreEquallySpaced).
+    const CurvePlacement reversed = placeOnCurve(cad, 1, tb, ta, z);
+    for (int i = 0; i <= order; ++i)
+      EXPECT_NEAR(reversed.t[order - i], placement.t[i], 1e-6 * (tb - ta)) << "order " << order;
     std::vector<double> arcs;
     double kMax = 0.0;
     for (int i = 0; i < order; ++i) {
