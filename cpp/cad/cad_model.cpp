@@ -6,6 +6,7 @@
 #include <BRepBuilderAPI_Transform.hxx>
 #include <BRepLProp_SLProps.hxx>
 #include <BRepTools.hxx>
+#include <BRepTopAdaptor_FClass2d.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
@@ -44,6 +45,7 @@ struct CadModel::Impl {
   mutable std::vector<std::unique_ptr<BRepAdaptor_Curve>> curves;
   mutable std::vector<std::unique_ptr<BRepAdaptor_Surface>> surfaces;
   mutable std::vector<Handle(ShapeAnalysis_Surface)> analysers;
+  mutable std::vector<std::unique_ptr<BRepTopAdaptor_FClass2d>> classifiers;
 
   void index() {
     TopExp::MapShapes(shape, TopAbs_VERTEX, vertices);
@@ -53,6 +55,7 @@ struct CadModel::Impl {
     curves.resize(edges.Extent() + 1);
     surfaces.resize(faces.Extent() + 1);
     analysers.resize(faces.Extent() + 1);
+    classifiers.resize(faces.Extent() + 1);
     Bnd_Box box;  // the geometric box, not enlarged by the shape's tolerances
     BRepBndLib::AddOptimal(shape, box, false, false);
     if (!box.IsVoid()) {
@@ -87,6 +90,18 @@ struct CadModel::Impl {
     if (!slot)
       slot = withOcctErrors(cadEntityName(2, f), [&] {
         return std::make_unique<BRepAdaptor_Surface>(TopoDS::Face(faces(f)));
+      });
+    return *slot;
+  }
+
+  // Point-in-face classification of (u, v) against the face's trimming loops, built once.
+  BRepTopAdaptor_FClass2d& classifier(int f) const {
+    checkIndex(2, f, faces.Extent());
+    auto& slot = classifiers[f];
+    if (!slot)
+      slot = withOcctErrors(cadEntityName(2, f), [&] {
+        const TopoDS_Face face = TopoDS::Face(faces(f));
+        return std::make_unique<BRepTopAdaptor_FClass2d>(face, BRep_Tool::Tolerance(face));
       });
     return *slot;
   }
@@ -400,6 +415,35 @@ std::array<double, 2> CadModel::edgeParameterOnFace(int edge, int face, double t
     const gp_Pnt2d uv = pcurve->Value(t);
     return std::array<double, 2>{uv.X(), uv.Y()};
   });
+}
+
+std::array<double, 2> CadModel::facePeriods(int face) const {
+  const auto& s = impl_->surface(face);
+  return withOcctErrors(cadEntityName(2, face), [&] {
+    return std::array<double, 2>{s.IsUPeriodic() ? s.UPeriod() : 0.0,
+                                 s.IsVPeriodic() ? s.VPeriod() : 0.0};
+  });
+}
+
+bool CadModel::faceContains(int face, double u, double v) const {
+  BRepTopAdaptor_FClass2d& classifier = impl_->classifier(face);
+  return withOcctErrors(cadEntityName(2, face), [&] {
+    const TopAbs_State state = classifier.Perform(gp_Pnt2d(u, v));
+    return state == TopAbs_IN || state == TopAbs_ON;
+  });
+}
+
+double CadModel::tolerance(int dim, int index) const {
+  switch (dim) {
+    case 0:
+      return BRep_Tool::Tolerance(occtVertex(*this, index));
+    case 1:
+      return BRep_Tool::Tolerance(occtEdge(*this, index));
+    case 2:
+      return BRep_Tool::Tolerance(occtFace(*this, index));
+    default:
+      throw Error("tolerance: dimension " + std::to_string(dim) + " has no CAD tolerance");
+  }
 }
 
 std::string cadEntityName(int dim, int index) {

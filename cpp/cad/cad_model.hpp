@@ -114,6 +114,15 @@ class CadModel {
   // Parameters (u,v) of the point of an edge at parameter t on a face containing the edge
   // (via the edge's p-curve on that face).
   std::array<double, 2> edgeParameterOnFace(int edge, int face, double t) const;
+  // Periods of the face's surface in u and v; 0 where that direction is not periodic (a
+  // sphere or cylinder is periodic in u, a torus in both).
+  std::array<double, 2> facePeriods(int face) const;
+  // Whether (u, v) lies on the face: inside its trimming loops or on them within the face's
+  // tolerance (classified in the face's own parameter range; wrap periodic values first).
+  bool faceContains(int face, double u, double v) const;
+  // The CAD tolerance of a sub-shape (BRep_Tool::Tolerance): how far its points may lie from
+  // the exact geometry of its neighbours. dim 0, 1 or 2.
+  double tolerance(int dim, int index) const;
 
   // Implementation detail shared with the components that hand the shape to OCCT-based tools
   // (see cad/occt_access.hpp).

@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "curving/curve_node_placement.hpp"
+#include "curving/face_node_placement.hpp"
 #include "element/reference_element.hpp"
 
 namespace homesh {
@@ -172,13 +174,15 @@ struct Elevator {
   }
 };
 
-// Moves the nodes created by elevation (ids >= firstNew) that lie on a CAD curve or face onto it.
-void projectNewNodes(Mesh& mesh, std::size_t firstNew, const CadModel& cad) {
+// Moves the nodes created by elevation (ids >= firstNew) that lie on a CAD curve or face and
+// that `placed` does not mark onto it by closest-point projection (the last resort).
+void projectNewNodes(Mesh& mesh, std::size_t firstNew, const CadModel& cad,
+                     const std::vector<char>& placed) {
   for (auto id = static_cast<std::int64_t>(firstNew);
        id < static_cast<std::int64_t>(mesh.numNodes()); ++id) {
     const int dim = static_cast<int>(mesh.nodeCadDim[id]);
     const int entity = mesh.nodeCadIndex[id];
-    if (dim != 1 && dim != 2) continue;
+    if ((dim != 1 && dim != 2) || placed[id] != 0) continue;
     double* x = &mesh.xyz[3 * id];
     const Eigen::Vector3d straight(x[0], x[1], x[2]);
     if (dim == 1) {
@@ -193,6 +197,181 @@ void projectNewNodes(Mesh& mesh, std::size_t firstNew, const CadModel& cad) {
     }
   }
 }
+
+// Places the new nodes on the CAD: edges on curves by arc-length spacing in t, edges inside
+// faces by the same spacing in (u, v), triangle interiors by a relaxed lattice in (u, v)
+// (curve_node_placement.hpp, face_node_placement.hpp); whatever fails its checks is projected.
+class BoundaryPlacer {
+ public:
+  BoundaryPlacer(Elevator& elevator, std::size_t firstNew, const CadModel& cad, CurvingStats& stats)
+      : mesh_(elevator.out),
+        order_(elevator.order),
+        cad_(cad),
+        stats_(stats),
+        placed_(elevator.out.numNodes(), 0),
+        firstNew_(firstNew) {
+    const auto p = static_cast<std::size_t>(order_);
+    for (const auto& [key, id] : elevator.ids) {
+      if (static_cast<std::size_t>(id) < firstNew_) continue;
+      if (key.size == 2) {
+        auto& nodes = edges_[{key.vertex[0], key.vertex[1]}];
+        if (nodes.empty()) {
+          nodes.assign(p + 1, -1);
+          nodes.front() = key.vertex[0];
+          nodes.back() = key.vertex[1];
+        }
+        nodes[static_cast<std::size_t>(key.index[1])] = id;  // index[1] steps from vertex[0]
+      } else if (key.size == 3 && mesh_.nodeCadDim[id] == 2) {
+        auto& nodes = triangles_[{key.vertex[0], key.vertex[1], key.vertex[2]}];
+        if (nodes.empty()) nodes.assign((p + 1) * (p + 2) / 2, -1);
+        nodes[static_cast<std::size_t>(latticeIndex(order_, key.index[1], key.index[2]))] = id;
+      }
+    }
+  }
+
+  void run() {
+    const std::vector<double> z = equispacedPositions(order_);
+    for (const auto& [edge, nodes] : edges_)
+      if (mesh_.nodeCadDim[nodes[1]] == 1) placeCurveEdge(nodes, z);
+    for (const auto& [edge, nodes] : edges_)
+      if (mesh_.nodeCadDim[nodes[1]] == 2) placeFaceEdge(nodes, z);
+    for (const auto& [tri, nodes] : triangles_) placeTriangle(tri, nodes);
+    projectNewNodes(mesh_, firstNew_, cad_, placed_);
+  }
+
+ private:
+  Mesh& mesh_;
+  const int order_;
+  const CadModel& cad_;
+  CurvingStats& stats_;
+  std::vector<char> placed_;
+  const std::size_t firstNew_;
+  std::map<EdgeKey, std::vector<std::int64_t>> edges_;
+  std::map<FaceKey, std::vector<std::int64_t>> triangles_;
+  std::map<int, FaceChart> charts_;
+
+  const FaceChart& chart(int face) {
+    auto it = charts_.find(face);
+    if (it == charts_.end()) it = charts_.try_emplace(face, cad_, face).first;
+    return it->second;
+  }
+
+  Eigen::Vector3d point(std::int64_t node) const {
+    return {mesh_.xyz[3 * node], mesh_.xyz[3 * node + 1], mesh_.xyz[3 * node + 2]};
+  }
+
+  void setCurveNode(std::int64_t node, int curve, double t) {
+    const Eigen::Vector3d x = cad_.evaluateCurve(curve, t).point;
+    for (int c = 0; c < 3; ++c) mesh_.xyz[3 * node + c] = x[c];
+    mesh_.nodeCadParam[2 * node] = t;
+    mesh_.nodeCadParam[2 * node + 1] = kNaN;
+    placed_[node] = 1;
+  }
+
+  void setFaceNode(std::int64_t node, const FaceChart& chart, const FaceParameter& uv) {
+    const Eigen::Vector3d x = chart.point(uv);
+    const FaceParameter stored = chart.wrap(uv);
+    for (int c = 0; c < 3; ++c) mesh_.xyz[3 * node + c] = x[c];
+    mesh_.nodeCadParam[2 * node] = stored[0];
+    mesh_.nodeCadParam[2 * node + 1] = stored[1];
+    placed_[node] = 1;
+  }
+
+  void placeCurveEdge(const std::vector<std::int64_t>& nodes, const std::vector<double>& z) {
+    const int curve = mesh_.nodeCadIndex[nodes[1]];
+    if (cad_.isDegenerated(curve)) return;
+    const std::int64_t a = nodes.front(), b = nodes.back();
+    // The other end's own parameter (or a point a third along the edge) tells which end of a
+    // closed curve a vertex is.
+    const auto hint = [&](std::int64_t from, std::int64_t to) -> double {
+      if (mesh_.nodeCadDim[to] == 1 && mesh_.nodeCadIndex[to] == curve &&
+          std::isfinite(mesh_.nodeCadParam[2 * to]))
+        return mesh_.nodeCadParam[2 * to];
+      return cad_.projectOnCurve(curve, (2.0 * point(from) + point(to)) / 3.0).t;
+    };
+    const double ta = nodeCurveParameter(cad_, mesh_, a, curve, hint(a, b));
+    const double tb = nodeCurveParameter(cad_, mesh_, b, curve, hint(b, a));
+    if (!(ta != tb)) return;  // a degenerate span: projection decides
+    const CurvePlacement placement = placeOnCurve(cad_, curve, ta, tb, z);
+    ++stats_.curveEdges;
+    if (!placement.optimised) ++stats_.curveEdgesAtStart;
+    for (std::size_t i = 1; i + 1 < nodes.size(); ++i)
+      setCurveNode(nodes[i], curve, placement.t[i]);
+  }
+
+  void placeFaceEdge(const std::vector<std::int64_t>& nodes, const std::vector<double>& z) {
+    const FaceChart& ch = chart(mesh_.nodeCadIndex[nodes[1]]);
+    const std::int64_t a = nodes.front(), b = nodes.back();
+    const FaceParameter ua = nodeFaceParameter(ch, mesh_, a, std::nullopt);
+    const FaceParameter ub = nodeFaceParameter(ch, mesh_, b, ua);
+    const auto ends = edgeEnds(ch, ua, ub);
+    const FaceEdgePlacement placement =
+        placeOnFaceEdge(ch, ends[0], ends[1], point(a), point(b), z);
+    ++stats_.faceEdges;
+    if (!placement.valid) {
+      ++stats_.faceEdgesProjected;
+      return;
+    }
+    if (!placement.optimised) ++stats_.faceEdgesAtStart;
+    for (std::size_t i = 1; i + 1 < nodes.size(); ++i) setFaceNode(nodes[i], ch, placement.uv[i]);
+  }
+
+  void placeTriangle(const FaceKey& tri, std::vector<std::int64_t> nodes) {
+    const int p = order_;
+    const FaceChart& ch = chart(mesh_.nodeCadIndex[nodes[latticeIndex(p, 1, 1)]]);
+    // Corners and edge nodes into the lattice: corner 0, 1, 2 = tri[0], tri[1], tri[2].
+    nodes[latticeIndex(p, 0, 0)] = tri[0];
+    nodes[latticeIndex(p, p, 0)] = tri[1];
+    nodes[latticeIndex(p, 0, p)] = tri[2];
+    const auto edgeNodes = [&](std::int64_t v, std::int64_t w) -> const std::vector<std::int64_t>* {
+      const auto it = edges_.find({v, w});  // v < w: the list runs from v to w
+      return it == edges_.end() ? nullptr : &it->second;
+    };
+    const auto* e01 = edgeNodes(tri[0], tri[1]);
+    const auto* e02 = edgeNodes(tri[0], tri[2]);
+    const auto* e12 = edgeNodes(tri[1], tri[2]);
+    if (e01 == nullptr || e02 == nullptr || e12 == nullptr) return;
+    for (int k = 1; k < p; ++k) {
+      nodes[latticeIndex(p, k, 0)] = (*e01)[k];
+      nodes[latticeIndex(p, 0, k)] = (*e02)[k];
+      nodes[latticeIndex(p, p - k, k)] = (*e12)[k];
+    }
+    ++stats_.faceInteriors;
+    // One chart for the whole lattice, next to a corner that is not a pole.
+    std::array<FaceParameter, 3> corner;
+    std::array<bool, 3> pole{};
+    const int cornerIndex[3] = {latticeIndex(p, 0, 0), latticeIndex(p, p, 0),
+                                latticeIndex(p, 0, p)};
+    for (int c = 0; c < 3; ++c) {
+      corner[c] = nodeFaceParameter(ch, mesh_, nodes[cornerIndex[c]], std::nullopt);
+      const auto s = ch.singular(corner[c]);
+      pole[c] = s[0] || s[1];
+    }
+    int ref = 0;
+    while (ref < 2 && pole[ref]) ++ref;
+    std::vector<FaceParameter> uv(nodes.size());
+    std::vector<Eigen::Vector3d> x(nodes.size());
+    for (int j = 0; j <= p; ++j)
+      for (int i = 0; i + j <= p; ++i) {
+        const int k = latticeIndex(p, i, j);
+        x[k] = point(nodes[k]);
+        const bool interior = i >= 1 && j >= 1 && i + j < p;
+        if (!interior)
+          uv[k] = ch.unwrapNear(nodeFaceParameter(ch, mesh_, nodes[k], corner[ref]), corner[ref]);
+      }
+    const TrianglePlacement placement = placeTriangleInterior(ch, p, uv, x);
+    if (!placement.valid) {
+      ++stats_.faceInteriorsProjected;
+      return;
+    }
+    if (!placement.relaxed) ++stats_.faceInteriorsAtStart;
+    for (int j = 1; j < p; ++j)
+      for (int i = 1; i + j < p; ++i) {
+        const int k = latticeIndex(p, i, j);
+        setFaceNode(nodes[k], ch, placement.uv[k]);
+      }
+  }
+};
 
 // Drops the nodes no cell uses (the source's high-order nodes after an order change) and
 // renumbers the rest in their original order.
@@ -222,18 +401,19 @@ void compactNodes(Mesh& mesh) {
 
 }  // namespace
 
-Mesh changeOrder(const Mesh& mesh, int order, const CadModel* cad) {
+Mesh changeOrder(const Mesh& mesh, int order, const CadModel* cad, CurvingStats* stats) {
   if (order < 1 || order > 10)
     throw ParameterError("order must be between 1 and 10, got " + std::to_string(order));
   Elevator elevator(mesh, order);
   for (const ElementBlock& block : mesh.blocks) elevator.elevateBlock(block);
-  if (cad != nullptr) projectNewNodes(elevator.out, mesh.numNodes(), *cad);
+  CurvingStats local;
+  if (cad != nullptr) BoundaryPlacer(elevator, mesh.numNodes(), *cad, stats ? *stats : local).run();
   compactNodes(elevator.out);
   elevator.out.checkConsistency();
   return std::move(elevator.out);
 }
 
-Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad) {
+Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad, CurvingStats* stats) {
   if (linear.order != 1)
     throw ParameterError("order elevation needs a linear mesh, got order " +
                          std::to_string(linear.order));
@@ -241,7 +421,9 @@ Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad) {
     throw ParameterError("order must be between 1 and 10, got " + std::to_string(order));
   Elevator elevator(linear, order);
   for (const ElementBlock& block : linear.blocks) elevator.elevateBlock(block);
-  if (cad != nullptr) projectNewNodes(elevator.out, linear.numNodes(), *cad);
+  CurvingStats local;
+  if (cad != nullptr)
+    BoundaryPlacer(elevator, linear.numNodes(), *cad, stats ? *stats : local).run();
   elevator.out.checkConsistency();
   return std::move(elevator.out);
 }

@@ -3,25 +3,41 @@
 // New nodes are shared between the elements that contain them: a node is identified by the
 // global vertices of the edge, face or cell it belongs to and its integer barycentric index
 // there, which every neighbour computes identically whatever its local orientation. Nodes on a
-// CAD curve or face (known from the linear mesh's boundary lines and triangles) are projected
-// onto it and record their parameters; interior nodes stay at their straight-sided positions
-// (the optimiser curves the interior later).
+// CAD curve or face (known from the linear mesh's boundary lines and triangles) are placed on it
+// and record their parameters: along curves spaced in arc length from the end vertices'
+// parameters, along edges inside faces spaced in (u, v) towards the geodesic, inside boundary
+// triangles as a relaxed lattice in (u, v) (curve_node_placement.hpp, face_node_placement.hpp);
+// where such a placement fails its checks (order along the edge, no flipped lattice triangle,
+// inside the face's trimming) the nodes are projected onto the entity. Interior nodes stay at
+// their straight-sided positions (the optimiser curves the interior later).
 #pragma once
+
+#include <cstddef>
 
 #include "cad/cad_model.hpp"
 #include "core/mesh.hpp"
 
 namespace homesh {
 
+// How the new boundary nodes were placed (counts of mesh edges and triangles). "AtStart": the
+// spacing optimum failed its checks and the monotone start was kept; "Projected": the start
+// failed too and the nodes were projected onto the CAD one by one.
+struct CurvingStats {
+  std::size_t curveEdges = 0, curveEdgesAtStart = 0;
+  std::size_t faceEdges = 0, faceEdgesAtStart = 0, faceEdgesProjected = 0;
+  std::size_t faceInteriors = 0, faceInteriorsAtStart = 0, faceInteriorsProjected = 0;
+};
+
 // `linear` must have order 1. `cad` may be null (no projection: a straight-sided order-P mesh).
 // Throws ParameterError for an order outside 1..10.
-Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad);
+Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad,
+                  CurvingStats* stats = nullptr);
 
 // The same for a mesh of any order: each new node is the source element's own (curved) map
 // evaluated at the node's reference position, so raising the order keeps the geometry exactly
 // and lowering it interpolates it (what NekMesh does before optimising at a lower order). Nodes
 // the new mesh no longer uses are dropped and the rest renumbered in order. With `cad`, new
-// nodes on CAD curves and faces are projected onto them as above.
-Mesh changeOrder(const Mesh& mesh, int order, const CadModel* cad);
+// nodes on CAD curves and faces are placed on them as above.
+Mesh changeOrder(const Mesh& mesh, int order, const CadModel* cad, CurvingStats* stats = nullptr);
 
 }  // namespace homesh

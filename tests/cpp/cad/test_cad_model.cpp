@@ -187,6 +187,34 @@ TEST(CadModel, TorusPrincipalCurvatures) {
   }
 }
 
+TEST(CadModel, PeriodsTrimmingAndTolerances) {
+  const CadModel sphere = test::toModel(test::sphere(1.0));
+  const auto ps = sphere.facePeriods(1);
+  EXPECT_DOUBLE_EQ(ps[0], 2.0 * M_PI);
+  EXPECT_EQ(ps[1], 0.0);
+  const CadModel torus = test::toModel(test::torus(1.0, 0.3));
+  EXPECT_DOUBLE_EQ(torus.facePeriods(1)[0], 2.0 * M_PI);
+  EXPECT_DOUBLE_EQ(torus.facePeriods(1)[1], 2.0 * M_PI);
+  // The box with a hole: the face whose plane is z = 2 is trimmed by the hole's circle around
+  // (2, 2); its (u, v) are found by projection.
+  const CadModel holed = test::toModel(test::boxWithHole());
+  int top = 0;
+  for (int f = 1; f <= holed.numFaces(); ++f)
+    if (holed.isPlanar(f) && std::abs(holed.plane(f).first.z() - 2.0) < 1e-12) top = f;
+  ASSERT_GT(top, 0);
+  EXPECT_EQ(holed.facePeriods(top)[0], 0.0);
+  const auto uvOf = [&](double x, double y) {
+    const SurfaceProjection p = holed.projectOnSurface(top, Eigen::Vector3d(x, y, 2.0));
+    return std::array<double, 2>{p.u, p.v};
+  };
+  const auto material = uvOf(0.5, 0.5), hole = uvOf(2.2, 2.1), outside = uvOf(5.0, 1.0);
+  EXPECT_TRUE(holed.faceContains(top, material[0], material[1]));
+  EXPECT_FALSE(holed.faceContains(top, hole[0], hole[1]));
+  EXPECT_FALSE(holed.faceContains(top, outside[0], outside[1]));
+  for (int d = 0; d <= 2; ++d) EXPECT_GT(holed.tolerance(d, 1), 0.0);
+  EXPECT_THROW(holed.tolerance(3, 1), Error);
+}
+
 TEST(CadModel, ClearErrorsNameTheProblem) {
   const auto dir = test::tempDir();
   try {
