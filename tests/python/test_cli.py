@@ -39,7 +39,7 @@ def test_boundary_nodes_lie_on_the_sphere(sphere_run):
     mesh = meshio.read(sphere_run["msh"])
     boundary = np.unique(np.concatenate(
         [c.data.ravel() for c in mesh.cells if c.type.startswith("triangle")]))
-    assert len(boundary) > 1000
+    assert len(boundary) > 1000  # 2850 measured; Gmsh's count moves by a few % with last bits
     # Points of OCCT's sphere, written with 17 digits: 1 to rounding (~1e-15); 1e-7 is slack.
     radius = np.linalg.norm(mesh.points[boundary], axis=1)
     assert np.max(np.abs(radius - 1.0)) < 1e-7

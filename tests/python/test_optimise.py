@@ -163,7 +163,7 @@ def test_python_optimise_slides_on_the_cad(data):
     record = m.optimise(maxiter=5, threads=2)
     assert record["worst_after"] > before
     on_cad = m.node_cad_dim < 3
-    assert on_cad.sum() > 500
+    assert on_cad.sum() > 500  # 1029 .. 1061 over 1e-12 perturbations of the CAD
     radii = np.linalg.norm(m.nodes[on_cad], axis=1)
     assert np.abs(radii - 1.0).max() < 1e-7  # points of OCCT's sphere: 1 to rounding
     assert not np.array_equal(m.nodes[on_cad], make_mesh(str(data / "sphere.brep"), order=4,
