@@ -99,12 +99,14 @@ class CadModel {
   // Parameter of a vertex on an edge it bounds. For a closed edge both ends qualify; the one
   // nearer `near` is returned when given, else the first.
   double vertexParameter(int vertex, int edge, std::optional<double> near = std::nullopt) const;
-  // Closest point on the edge's curve within its parameter range.
+  // Closest point on the edge's curve within its parameter range, found to 1e-9 of the
+  // bounding diagonal (the precision handed to OCCT's search).
   CurveProjection projectOnCurve(int edge, const Eigen::Vector3d& p) const;
 
   SurfaceBounds faceBounds(int face) const;
   SurfaceDerivatives evaluateSurface(int face, double u, double v) const;
-  // Closest point on the face's underlying surface; `guess` speeds up and disambiguates.
+  // Closest point on the face's underlying surface, found to 1e-9 of the bounding diagonal;
+  // `guess` speeds up and disambiguates. The point returned is S(u, v) itself.
   SurfaceProjection projectOnSurface(int face, const Eigen::Vector3d& p,
                                      std::optional<std::array<double, 2>> guess = {}) const;
   PrincipalCurvatures curvature(int face, double u, double v) const;

@@ -17,7 +17,7 @@ class MeshingPartShapes(unittest.TestCase):
         m = homesh.mesh(Part.makeSphere(1.0), order=4, size=0.3)
         self.assertEqual(m.order, 4)
         self.assertEqual(m.elements.shape[1], 35)
-        on_cad = m.node_cad_dim <= 2
+        on_cad = m.node_cad_dim <= 2  # points of OCCT's sphere: 1 to rounding, 1e-7 is slack
         self.assertTrue(np.all(np.abs(np.linalg.norm(m.nodes[on_cad], axis=1) - 1.0) < 1e-7))
         self.assertEqual(m.quality()["invalid_elements"], 0)
 
@@ -25,6 +25,7 @@ class MeshingPartShapes(unittest.TestCase):
         shape = Part.makeBox(1, 2, 3)
         shape.Placement = FreeCAD.Placement(FreeCAD.Vector(10, 0, 0), FreeCAD.Rotation())
         m = homesh.mesh(shape, order=2, size=0.5)
+        # A translation by an integer of integer coordinates: exact; 1e-9 is slack.
         self.assertAlmostEqual(float(m.nodes[:, 0].min()), 10.0, places=9)
         self.assertAlmostEqual(float(m.nodes[:, 0].max()), 11.0, places=9)
 
@@ -37,6 +38,7 @@ class MeshingPartShapes(unittest.TestCase):
         for face_index in set(tris.cad_entity.tolist()):
             face = shape.Faces[face_index - 1]
             nodes = np.unique(tris.elements[tris.cad_entity == face_index])
+            # Nodes are S(u, v) of the face (~1e-15 off); a node on the wrong face is >= 0.1 off.
             for p in m.nodes[nodes[:: max(1, len(nodes) // 20)]]:
                 self.assertLess(face.distToShape(Part.Vertex(FreeCAD.Vector(*p)))[0], 1e-7)
 
@@ -51,7 +53,7 @@ class MeshingPartShapes(unittest.TestCase):
             Part.Wire(Part.makeCircle(1.0))), order=4, size=0.25)
         self.assertEqual(m.dim, 2)
         self.assertEqual(m.element_type, "tri")
-        on_circle = m.node_cad_dim == 1
+        on_circle = m.node_cad_dim == 1  # points of the circle: 1 to rounding
         self.assertTrue(np.all(np.abs(np.linalg.norm(m.nodes[on_circle], axis=1) - 1) < 1e-7))
 
 

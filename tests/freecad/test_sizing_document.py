@@ -45,8 +45,10 @@ class SizingObject(unittest.TestCase):
         self.assertGreater(sizing.OctreeLeaves, 0)
         self.assertGreater(sizing.SmallestSize.Value, 0.0)
         self.assertLessEqual(sizing.SmallestSize.Value, 0.5 + 1e-9)
-        self.assertAlmostEqual(sizing.Gradation, 0.2)
+        self.assertAlmostEqual(sizing.Gradation, 0.2)  # a constant, stored as is
         self.assertIn("%d elements predicted" % sizing.PredictedElements, sizing.Status)
+        # The prediction's promised 10 %. Gmsh's count moves with the CAD's last bits: 0.966 ..
+        # 0.985 of the prediction over 1e-12 perturbations (bench/tolerance_sensitivity).
         self.assertLess(abs(mesh.NumElements / sizing.PredictedElements - 1.0), 0.10,
                         "predicted %d, meshed %d" % (sizing.PredictedElements, mesh.NumElements))
         # The same figure as the Python API with the same parameters.

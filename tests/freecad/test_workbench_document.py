@@ -86,7 +86,7 @@ class HighOrderMeshObject(unittest.TestCase):
         obj.OptimiserIterations = 20
         self.doc.recompute()
         self.assertTrue(obj.isValid())
-        self.assertGreater(obj.MinScaledJacobian, plain)
+        self.assertGreater(obj.MinScaledJacobian, plain)  # -0.38 -> 0.69 measured
         self.assertEqual(obj.InvalidElements, 0)
         mesh = homesh.freecad.get_mesh(obj)
         # Nodes on the hole's cylinder (radius from the fixture) stay on it.
@@ -95,6 +95,7 @@ class HighOrderMeshObject(unittest.TestCase):
         on_face = mesh.node_cad_dim == 2
         self.assertTrue(np.any(moved & on_face), "face nodes slide")
         radius = lambda x: np.hypot(x[:, 0] - 2.0, x[:, 1] - 2.0)
+        # Points of the cylinder are 1 from its axis to rounding (~1e-15): 1e-7 is slack.
         on_hole = np.abs(radius(plain_nodes) - 1.0) < 1e-7
         self.assertGreater(int((on_hole & moved).sum()), 10)
         np.testing.assert_allclose(radius(mesh.nodes[on_hole]), 1.0, atol=1e-7)

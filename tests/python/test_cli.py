@@ -39,7 +39,8 @@ def test_boundary_nodes_lie_on_the_sphere(sphere_run):
     mesh = meshio.read(sphere_run["msh"])
     boundary = np.unique(np.concatenate(
         [c.data.ravel() for c in mesh.cells if c.type.startswith("triangle")]))
-    assert len(boundary) > 1000
+    assert len(boundary) > 1000  # 2850 measured; Gmsh's count moves by a few % with last bits
+    # Points of OCCT's sphere, written with 17 digits: 1 to rounding (~1e-15); 1e-7 is slack.
     radius = np.linalg.norm(mesh.points[boundary], axis=1)
     assert np.max(np.abs(radius - 1.0)) < 1e-7
     # Interior nodes are inside.
@@ -61,9 +62,10 @@ def test_report_counts_match_the_file(sphere_run):
     assert 0.0 < quality["scaled_jacobian"]["min"] <= quality["scaled_jacobian"]["mean"] <= 1.0
     assert set(report["timings_s"]) >= {"cad", "linear", "high_order", "output"}
     # The per-element field in the file is the one the report summarises.
+    # The same double, in the MSH file with 17 digits and in the JSON with 15 (5e-16 relative).
     field = np.asarray(mesh.cell_data["scaled_jacobian"][
         [c.type for c in mesh.cells].index("tetra35")])
-    assert np.isclose(field.min(), quality["scaled_jacobian"]["min"])
+    assert abs(field.min() - quality["scaled_jacobian"]["min"]) <= 1e-14 * abs(field.min())
 
 
 def test_meshio_reads_the_vtu(sphere_run):

@@ -2,6 +2,7 @@
 record, Gmsh's independent verdict on the result, untangling the sphere in a box that Gmsh
 leaves invalid at order 4, fixed boundaries, and clear errors."""
 
+import gzip
 import json
 import re
 import subprocess
@@ -20,6 +21,10 @@ NACA = PEERS / "varopti_naca.msh"
 CUBE_SPHERE = PEERS / "varopti_cube_sphere.msh"
 GMSH_VERDICT = SHARED / "tools" / "gmsh-worst-quality"
 
+# How tests/data/sphere_in_box_p4.msh.gz was made (gmsh t.geo -3, Gmsh 4.8.4). The file is
+# stored because Gmsh's mesh of this .geo changes with the last bits of its input: with the
+# sphere's radius 1 - 1e-12 it is an untangled mesh of 1211 elements, not this tangled one of
+# 1194 (bench/tolerance_sensitivity.cpp, docs/testing.md).
 SPHERE_IN_BOX = """SetFactory("OpenCASCADE");
 Box(1) = {-2, -2, -2, 4, 4, 4};
 Sphere(2) = {0, 0, 0, 1};
@@ -38,13 +43,12 @@ def gmsh_worst(path, dim=3):
 
 
 @pytest.fixture(scope="module")
-def tangled(tmp_path_factory):
-    """Gmsh's order-4 sphere in a box: boundary nodes on the sphere, negative Jacobians inside."""
-    d = tmp_path_factory.mktemp("tangled")
-    (d / "t.geo").write_text(SPHERE_IN_BOX)
-    subprocess.run(["gmsh", str(d / "t.geo"), "-3", "-o", str(d / "t.msh")], check=True,
-                   capture_output=True)
-    return d / "t.msh"
+def tangled(tmp_path_factory, data):
+    """Gmsh's order-4 sphere in a box (SPHERE_IN_BOX): boundary nodes on the sphere, negative
+    Jacobians inside."""
+    path = tmp_path_factory.mktemp("tangled") / "t.msh"
+    path.write_bytes(gzip.decompress((data / "sphere_in_box_p4.msh.gz").read_bytes()))
+    return path
 
 
 def test_optimise_command_logs_each_sweep_and_reports(homesh_bin, tmp_path):
@@ -61,18 +65,22 @@ def test_optimise_command_logs_each_sweep_and_reports(homesh_bin, tmp_path):
         assert key in o
     assert o["functional"] == "linearelastic" and o["iterations"] == 5
     assert o["invalid_after"] == 0 and len(o["history"]) == 5
-    # NekMesh's regression value (at the nodes) and the certified one beside it.
+    # NekMesh's regression value (at the nodes; its .tst: 0.872585, tolerance 5e-3); ours is
+    # 0.8840 and moves by 6e-12 with the input's last bits or the thread count.
     assert o["nodal_worst_after"] >= 0.8726
-    assert o["worst_after"] > o["worst_before"] + 0.4
+    assert o["worst_after"] > o["worst_before"] + 0.4  # measured 0.527, spread 1e-12
+    # The same double printed twice with %.15g: equal (the slack is the format's 5e-16).
     assert rep["quality"]["scaled_jacobian"]["min"] == pytest.approx(o["worst_after"], abs=1e-12)
-    # Gmsh's own Bezier-bounded verdict on the written file agrees.
+    # Gmsh's own Bezier-bounded verdict on the written file agrees: both are lower bounds
+    # within 1e-3 (relative to max J) of the same minimum, refined independently.
     assert gmsh_worst(out, 2) == pytest.approx(o["worst_after"], abs=1e-3)
     mesh = meshio.read(out)
     assert sum(len(c.data) for c in mesh.cells if c.type.startswith("triangle")) == 524
 
 
 def test_cube_sphere_order_3_like_nekmesh(homesh_bin, tmp_path):
-    """NekMesh's test varopti:hyperelastic:maxiter=5:nq=4 (order 3) expects 0.6664."""
+    """NekMesh's test varopti:hyperelastic:maxiter=5:nq=4 expects 0.6664 (tolerance 2e-2); ours
+    is 0.6897 at the nodes, 0.6864 certified, each moving by 2e-11 with the last bits."""
     report = tmp_path / "r.json"
     r = run([homesh_bin, "optimise", str(CUBE_SPHERE), "--order", "3", "-n", "5", "-j", "2",
              "--report", str(report), "-q"])
@@ -90,11 +98,13 @@ def test_tangled_sphere_in_box_becomes_valid_with_free_interfaces(homesh_bin, tm
              "-o", str(out), "--report", str(report)])
     assert r.returncode == 0, r.stderr
     o = json.loads(report.read_text())["optimiser"]
-    assert o["invalid_before"] >= 1 and o["worst_before"] < 0
+    assert o["invalid_before"] >= 1 and o["worst_before"] < 0  # 4 elements, -3.77
+    # Measured 0.798 after 10 sweeps, valid from sweep 3; a 1e-12 change of the input moves the
+    # former by 1e-5 and leaves the latter.
     assert o["invalid_after"] == 0 and o["worst_after"] > 0.3
     first_valid = next(h["iteration"] for h in o["history"] if h["invalid"] == 0)
     assert first_valid <= 4  # NekMesh needs 4 iterations on this mesh
-    assert gmsh_worst(out) == pytest.approx(o["worst_after"], abs=1e-3)
+    assert gmsh_worst(out) == pytest.approx(o["worst_after"], abs=1e-3)  # both within 1e-3
     # The box's faces stayed where they were.
     before, after = meshio.read(tangled).points, meshio.read(out).points
     on_box = (np.abs(np.abs(before) - 2.0) < 1e-12).any(axis=1)
@@ -153,9 +163,9 @@ def test_python_optimise_slides_on_the_cad(data):
     record = m.optimise(maxiter=5, threads=2)
     assert record["worst_after"] > before
     on_cad = m.node_cad_dim < 3
-    assert on_cad.sum() > 500
+    assert on_cad.sum() > 500  # 1029 .. 1061 over 1e-12 perturbations of the CAD
     radii = np.linalg.norm(m.nodes[on_cad], axis=1)
-    assert np.abs(radii - 1.0).max() < 1e-7
+    assert np.abs(radii - 1.0).max() < 1e-7  # points of OCCT's sphere: 1 to rounding
     assert not np.array_equal(m.nodes[on_cad], make_mesh(str(data / "sphere.brep"), order=4,
                                                          size=0.5).nodes[on_cad])
 
@@ -166,8 +176,13 @@ def test_mesh_command_with_optimise(homesh_bin, data, tmp_path):
              "--optimise", "-n", "5", "--report", str(report), "-q"])
     assert r.returncode == 0, r.stderr
     rep = json.loads(report.read_text())
-    assert rep["optimiser"]["iterations"] == 5
+    # `mesh --optimise` stops early once the mesh is valid and a sweep gains < 1e-3, and the
+    # gains depend on Gmsh's mesh, which moves with the CAD's last bits (smallest gain 0.008 to
+    # 0.025 over 1e-12 perturbations): any count up to the limit is right.
+    assert 1 <= rep["optimiser"]["iterations"] <= 5
+    assert len(rep["optimiser"]["history"]) == rep["optimiser"]["iterations"]
     assert "optimise" in rep["timings_s"]
-    assert rep["quality"]["scaled_jacobian"]["min"] == pytest.approx(rep["optimiser"]["worst_after"])
+    # The same double, printed twice with %.15g.
+    assert rep["quality"]["scaled_jacobian"]["min"] == rep["optimiser"]["worst_after"]
     r = run([homesh_bin, "mesh", str(data / "sphere.brep"), "-n", "5"])
     assert r.returncode == 2 and "--optimise" in r.stderr

@@ -27,6 +27,8 @@ def test_mcf_case_meshes_with_its_prediction(homesh_bin, tmp_path, case):
     report = _report(result)
     cells = report["elements"]["tet"] + report["elements"]["tri"]
     assert report["predicted_elements"] == report["sizing"]["predicted_elements"]
+    # The prediction's promised 10 %; measured 0.99 .. 1.055, moving by <= 2 % (3D) when the
+    # CAD's last bits change (docs/testing.md).
     assert abs(report["predicted_elements"] / cells - 1.0) <= 0.10
     assert report["sizing"]["octree"]["leaves"] > 0
     # The boundary layer is not made yet: said, not silently dropped.
@@ -49,12 +51,12 @@ def test_predict_prints_the_count_and_writes_the_octree(homesh_bin, tmp_path):
     sizing = report["sizing"]
     assert (sizing["min_delta"], sizing["max_delta"], sizing["eps"]) == (0.04, 0.2, 0.02)
     # The sphere's curvature size: 2 R sqrt(eps (2 - eps)) with R = 0.25 m (the CAD in metres).
-    assert sizing["octree"]["smallest_delta"] < 0.25 * 2 * np.sqrt(0.02 * 1.98) * 1.01
+    assert sizing["octree"]["smallest_delta"] < 0.25 * 2 * np.sqrt(0.02 * 1.98) * 1.01  # 0.076
     leaves = meshio.read(octree)
     delta = leaves.cell_data["delta"][0]
     assert sizing["octree"]["inside_leaves"] <= len(delta)
     assert len(delta) <= sizing["octree"]["inside_leaves"] + sizing["octree"]["boundary_leaves"]
-    assert delta.min() >= 0.04 - 1e-12 and delta.max() <= 0.2 + 1e-12
+    assert delta.min() >= 0.04 and delta.max() <= 0.2  # clamped to MinDelta and MaxDelta: exact
     fraction = leaves.cell_data["inside_fraction"][0]
     assert np.all((fraction > 0) & (fraction <= 1))
 
@@ -66,7 +68,8 @@ def test_flags_override_the_mcf(homesh_bin):
                          "--report", "-", "-q"]))
     assert finer["sizing"]["max_delta"] == 0.1
     assert finer["sizing"]["min_delta"] == 0.03  # still the .mcf's
-    # Halving MaxDelta far from curved walls: about 8 times the elements.
+    # Halving MaxDelta far from curved walls: about 8 times the elements (fewer where curvature
+    # already set the size). The prediction moves by < 1e-8 relative with the last bits.
     assert 5 < finer["predicted_elements"] / base["predicted_elements"] < 9
     refined = _report(run([homesh_bin, "predict", MESHGEN / "3d_bl_cyl.mcf", "--refine-line",
                            "0.1,0,0.25,1.5,0,0.25,0.15,0.03", "--report", "-", "-q"]))
@@ -79,6 +82,7 @@ def test_plain_cad_gets_automatic_sizing(homesh_bin, data):
     report = _report(run([homesh_bin, "mesh", data / "box_hole.step", "--order", "1",
                           "--report", "-", "-q"]))
     assert report["sizing"]["max_delta"] == pytest.approx(report["sizing"]["min_delta"] * 20)
+    # Measured 0.984 .. 1.000 over 1e-12 perturbations of the CAD: 15 % is slack.
     assert abs(report["predicted_elements"] / report["elements"]["tet"] - 1) < 0.15
 
 
@@ -106,6 +110,7 @@ def test_python_predict_matches_the_mesh(data):
     mesh = homesh.mesh(data / "sphere.brep", order=1, min_delta=0.05, max_delta=0.2, eps=0.05)
     meshed = mesh.report()
     assert meshed["predicted_elements"] == report["predicted_elements"]
+    # Promised 10 %; measured 1.004 .. 1.018 over 1e-12 perturbations of the CAD.
     assert abs(report["predicted_elements"] / meshed["elements"]["tet"] - 1) < 0.10
     with pytest.raises(homesh.ParameterError, match="eps"):
         homesh.predict(data / "sphere.brep", eps=-1)

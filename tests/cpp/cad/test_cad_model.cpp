@@ -9,6 +9,7 @@
 #include <TopoDS.hxx>
 #include <cmath>
 #include <fstream>
+#include <limits>
 
 #include "cad/cad_model.hpp"
 #include "core/error.hpp"
@@ -49,7 +50,8 @@ TEST(CadModel, NumberingIsTopExpMapShapes) {
   const TopoDS_Shape shape = test::boxWithHole();
   const CadModel cad = toModel(shape);
   // BRep text keeps sub-shape order, so the model's FaceN is the N-th MapShapes entry of the
-  // original shape: compare by geometry.
+  // original shape: compare by geometry (the vertices' coordinates are small integers, which
+  // the BRep text keeps exactly; 1e-12 is slack).
   TopTools_IndexedMapOfShape vertices;
   TopExp::MapShapes(shape, TopAbs_VERTEX, vertices);
   ASSERT_EQ(vertices.Extent(), cad.numVertices());
@@ -71,31 +73,48 @@ TEST(CadModel, SphereEvaluationProjectionAndCurvature) {
   // OCCT's sphere: P(u, v) = r (cos v cos u, cos v sin u, sin v).
   const double u = 0.7, v = 0.3;
   const SurfaceDerivatives d = cad.evaluateSurface(1, u, v);
+  // OCCT evaluates the same closed form: a few roundings of |P| = r apart.
   EXPECT_NEAR((d.point - r * Eigen::Vector3d(std::cos(v) * std::cos(u), std::cos(v) * std::sin(u),
                                              std::sin(v)))
                   .norm(),
               0.0, 1e-12);
-  // First and second derivatives against central differences.
-  const double h = 1e-5;
+  // First and second derivatives against central differences. Every derivative of P has norm
+  // <= r, and each evaluation of P is off by a few ulps of r (at most 4 eps r, say), so per
+  // component: first differences err by <= h^2 r / 6 (truncation) + 4 eps r / h (rounding),
+  // second differences by <= h^2 r / 12 + 16 eps r / h^2, the mixed one by <= h^2 r / 3 +
+  // 4 eps r / h^2. The tolerance is 10x that bound (sqrt 3 for the norm, and margin); h is
+  // chosen near the minimum of each bound.
+  const double eps = std::numeric_limits<double>::epsilon();
   const auto p = [&](double uu, double vv) { return cad.evaluateSurface(1, uu, vv).point; };
-  EXPECT_NEAR((d.du - (p(u + h, v) - p(u - h, v)) / (2 * h)).norm(), 0.0, 1e-8);
-  EXPECT_NEAR((d.dv - (p(u, v + h) - p(u, v - h)) / (2 * h)).norm(), 0.0, 1e-8);
-  EXPECT_NEAR((d.duu - (p(u + h, v) - 2 * d.point + p(u - h, v)) / (h * h)).norm(), 0.0, 1e-4);
-  EXPECT_NEAR((d.dvv - (p(u, v + h) - 2 * d.point + p(u, v - h)) / (h * h)).norm(), 0.0, 1e-4);
-  EXPECT_NEAR((d.duv - (p(u + h, v + h) - p(u + h, v - h) - p(u - h, v + h) + p(u - h, v - h)) /
-                           (4 * h * h))
-                  .norm(),
-              0.0, 1e-4);
+  const double h1 = 1e-5, h2 = 1e-4;
+  const double tol1 = 10 * (h1 * h1 * r / 6 + 4 * eps * r / h1);             // 2.1e-9
+  const double tol2 = 10 * (h2 * h2 * r / 12 + 16 * eps * r / (h2 * h2));    // 7e-6
+  const double tolMixed = 10 * (h2 * h2 * r / 3 + 4 * eps * r / (h2 * h2));  // 1.9e-6
+  EXPECT_NEAR((d.du - (p(u + h1, v) - p(u - h1, v)) / (2 * h1)).norm(), 0.0, tol1);
+  EXPECT_NEAR((d.dv - (p(u, v + h1) - p(u, v - h1)) / (2 * h1)).norm(), 0.0, tol1);
+  EXPECT_NEAR((d.duu - (p(u + h2, v) - 2 * d.point + p(u - h2, v)) / (h2 * h2)).norm(), 0.0, tol2);
+  EXPECT_NEAR((d.dvv - (p(u, v + h2) - 2 * d.point + p(u, v - h2)) / (h2 * h2)).norm(), 0.0, tol2);
+  EXPECT_NEAR(
+      (d.duv - (p(u + h2, v + h2) - p(u + h2, v - h2) - p(u - h2, v + h2) + p(u - h2, v - h2)) /
+                   (4 * h2 * h2))
+          .norm(),
+      0.0, tolMixed);
 
+  // Projection is OCCT's iterative search to 1e-9 of the bounding diagonal (CadModel's
+  // promise); the projected point is then evaluated on the surface, so it lies on it to rounding.
+  const double projection = 1e-9 * cad.boundingDiagonal();
   for (const Eigen::Vector3d& q :
        {Eigen::Vector3d(3, 1, -2), Eigen::Vector3d(0.1, -0.2, 0.3), Eigen::Vector3d(-1, 4, 0.5)}) {
     const SurfaceProjection proj = cad.projectOnSurface(1, q);
-    EXPECT_NEAR(proj.distance, std::abs(q.norm() - r), 1e-9);
-    EXPECT_NEAR((proj.point - r * q.normalized()).norm(), 0.0, 1e-9);
+    EXPECT_NEAR(proj.distance, std::abs(q.norm() - r), projection);
+    EXPECT_NEAR((proj.point - r * q.normalized()).norm(), 0.0, projection);
     EXPECT_NEAR((cad.evaluateSurface(1, proj.u, proj.v).point - proj.point).norm(), 0.0, 1e-12);
   }
 
-  // Convex: both principal curvatures are -1/r against the outward normal.
+  // Convex: both principal curvatures are -1/r against the outward normal. Curvatures come from
+  // the exact derivatives through a few products and one 2 x 2 eigenproblem: rounding ~1e-15/r,
+  // so 1e-9 is slack (the same holds for every curvature below; zero curvatures come from
+  // second derivatives that are exactly zero).
   const PrincipalCurvatures k = cad.curvature(1, u, v);
   ASSERT_TRUE(k.defined);
   EXPECT_NEAR(k.kMin, -1.0 / r, 1e-9);
@@ -156,9 +175,11 @@ TEST(CadModel, CylinderCurvesAndCurvature) {
     const CurveProjection proj = cad.projectOnCurve(e, q);
     const Eigen::Vector3d expected = Eigen::Vector3d(
         r * q.x() / std::hypot(q.x(), q.y()), r * q.y() / std::hypot(q.x(), q.y()), c.point.z());
-    EXPECT_NEAR((proj.point - expected).norm(), 0.0, 1e-9);
+    // OCCT's projection precision: 1e-9 of the bounding diagonal.
+    EXPECT_NEAR((proj.point - expected).norm(), 0.0, 1e-9 * cad.boundingDiagonal());
     EXPECT_NEAR((cad.evaluateCurve(e, proj.t).point - proj.point).norm(), 0.0, 1e-12);
-    // Each circle is closed at one vertex: both parameters are valid, `near` picks one.
+    // Each circle is closed at one vertex: both parameters are valid, `near` picks one (OCCT
+    // stores them exactly: 0 and 2 pi as the edge's range).
     const std::vector<int> ends = cad.subShapeIndices(1, e, 0);
     ASSERT_EQ(ends.size(), 1u);
     EXPECT_NEAR(cad.vertexParameter(ends[0], e, range.last - 0.1), range.last, 1e-12);

@@ -73,6 +73,8 @@ TEST_P(SphereOrders, NodesAreSharedAndBoundaryNodesLieOnTheSphere) {
     const double r = nodePoint(mesh, i).norm();
     if (mesh.nodeCadDim[i] <= 2) {
       ++onSphere;
+      // Boundary nodes are S(u, v) of OCCT's sphere (the projection only chooses (u, v)):
+      // |x| = 1 to rounding, ~1e-15.
       EXPECT_NEAR(r, radius, 1e-9) << "node " << i;
       // Parameters reproduce the node.
       if (mesh.nodeCadDim[i] == 2) {
@@ -82,7 +84,8 @@ TEST_P(SphereOrders, NodesAreSharedAndBoundaryNodesLieOnTheSphere) {
       }
     }
   }
-  // Nodes inside the solid stay where the straight-sided element puts them.
+  // Nodes inside the solid stay where the straight-sided element puts them (the same affine
+  // combination of the vertices, computed twice: ~1e-15).
   const ElementBlock& tets = mesh.blocks[0];
   const ReferenceElement& ref = ReferenceElement::get(CellType::Tetrahedron, order);
   std::size_t interior = 0;
@@ -125,7 +128,8 @@ TEST(OrderElevation, WithoutCadTheElementsStayStraight) {
       EXPECT_NEAR((nodePoint(mesh, t[n]) - straightPosition(mesh, t, ref, n)).norm(), 0.0, 1e-12);
   }
   const QualitySummary q = evaluateQuality(mesh);
-  // The certified bound sits below 1 by the proven rounding margin only.
+  // The certified bound sits below 1 by the proven rounding margin only: 2e-9 for these
+  // order-5 tetrahedra (test_jacobian_quality.cpp lists the margins by shape and order).
   EXPECT_NEAR(q.scaled.min, 1.0, 1e-7);
   EXPECT_EQ(q.invalid, 0u);
 }
@@ -138,7 +142,8 @@ TEST(OrderElevation, CurvedCylinderKeepsValidElements) {
     if (mesh.nodeCadDim[i] != 1) continue;
     const Eigen::Vector3d x = nodePoint(mesh, i);
     const double radial = std::hypot(x.x(), x.y());
-    // Nodes on curves: the two circles (radius r) or the seam (radius r too).
+    // Nodes on curves: the two circles (radius r) or the seam (radius r too); points of the
+    // curves themselves, so exact to rounding.
     EXPECT_NEAR(radial, r, 1e-9);
     const auto c = cad.evaluateCurve(mesh.nodeCadIndex[i], mesh.nodeCadParam[2 * i]);
     EXPECT_NEAR((c.point - x).norm(), 0.0, 1e-9);

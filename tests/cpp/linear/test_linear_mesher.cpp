@@ -25,7 +25,9 @@ namespace {
 
 using test::nodePoint;
 
-// Every node on a CAD curve or face sits where its recorded parameters say.
+// Every node on a CAD curve or face sits where its recorded parameters say. Gmsh computes each
+// such node as C(t) or S(u, v) through OCCT itself: equal up to a few roundings of |x| <= 5
+// (~1e-15), so `tol` = 1e-9 is slack; a wrong entity or parameter is off by 1e-2 or more.
 void expectParametersReproduceNodes(const Mesh& mesh, const CadModel& cad, double tol) {
   std::size_t onCurves = 0, onFaces = 0;
   for (std::size_t i = 0; i < mesh.numNodes(); ++i) {
@@ -65,6 +67,8 @@ void expectSolidsFilled(const TopoDS_Shape& shape, double size) {
   for (int s = 1; s <= solids.Extent(); ++s) {
     GProp_GProps props;
     BRepGProp::VolumeProperties(solids(s), props);
+    // Straight tetrahedra fill a box exactly; the sum of n < 1e5 volumes <= 3.4 errs by
+    // <= n eps 3.4 = 7e-11 (OCCT integrates planar faces exactly).
     EXPECT_NEAR(volumeBySolid[s], props.Mass(), 1e-9) << "Solid" << s;
   }
   expectParametersReproduceNodes(mesh, cad, 1e-9);
@@ -84,7 +88,8 @@ TEST(LinearMesher, BoxWithHoleGivesPositiveTetsFillingTheVolume) {
     volume += v;
   }
   // The straight-sided mesh of the hole is a polygonal prism, inscribed in the cylinder and
-  // (with at least 6 sides) larger than the hexagonal one.
+  // (with at least 6 sides) larger than the hexagonal one: geometric bounds 1.1 apart, far
+  // beyond rounding.
   EXPECT_GT(volume, 32.0 - 2.0 * M_PI);
   EXPECT_LT(volume, 32.0 - 2.0 * (1.5 * std::sqrt(3.0)));
   expectParametersReproduceNodes(mesh, cad, 1e-9);
@@ -149,7 +154,7 @@ TEST(LinearMesher, PlanarFaceGivesOrientedTriangles) {
   const Mesh mesh = generateLinearMesh(cad, LinearMeshOptions::uniform(0.25));
   ASSERT_EQ(mesh.dim, 2);
   const Eigen::Vector3d n(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
-  EXPECT_NEAR(std::abs(n.dot(Eigen::Vector3d(1, 1, 1).normalized())), 1.0, 1e-12);
+  EXPECT_NEAR(std::abs(n.dot(Eigen::Vector3d(1, 1, 1).normalized())), 1.0, 1e-12);  // rounding
   const ElementBlock& tris = mesh.blocks[0];
   ASSERT_EQ(tris.type, CellType::Triangle);
   double area = 0.0;
@@ -161,7 +166,7 @@ TEST(LinearMesher, PlanarFaceGivesOrientedTriangles) {
     EXPECT_GT(signedArea, 0.0);
     area += signedArea;
   }
-  EXPECT_NEAR(area, 8.0, 1e-9);
+  EXPECT_NEAR(area, 8.0, 1e-9);  // exact tiling; the sum's rounding is ~n eps 8 = 1e-12
   EXPECT_EQ(mesh.blocks[1].type, CellType::Line);
   expectParametersReproduceNodes(mesh, cad, 1e-9);
 }

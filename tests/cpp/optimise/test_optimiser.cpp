@@ -13,6 +13,7 @@
 #include "io/mesh_readers.hpp"
 #include "optimise/mesh_topology.hpp"
 #include "optimise/optimiser.hpp"
+#include "quality/bezier_jacobian.hpp"
 #include "quality/mesh_quality.hpp"
 
 namespace homesh {
@@ -84,7 +85,10 @@ TEST(ChangeOrder, RaisingKeepsTheGeometryAndLoweringInterpolatesIt) {
   // Raising P3 to P6 represents the same polynomial map: the volumes agree.
   const Mesh p6 = changeOrder(p3, 6, nullptr);
   const QualitySummary q3 = evaluateQuality(p3), q6 = evaluateQuality(p6);
-  EXPECT_NEAR(q3.scaled.min, q6.scaled.min, 2e-3);
+  // Both are certified lower bounds of the same min J / max J, each refined until its min and
+  // max bounds are within kJacobianBoundTolerance (1e-3) of values found: they differ by at
+  // most twice that (the P3 -> P6 map itself is exact up to rounding, ~1e-15).
+  EXPECT_NEAR(q3.scaled.min, q6.scaled.min, 2 * kJacobianBoundTolerance);
   EXPECT_EQ(q6.invalid, 0U);
 }
 
@@ -93,7 +97,11 @@ std::string peer(const char* name) {
 }
 
 // NekMesh's regression test: varopti:hyperelastic:maxiter=5:nq=4 expects 0.6664 (+-2e-2) at
-// the nodes; we require at least 0.666 and report the certified value beside it.
+// the nodes; we require at least 0.666 (the peer's figure) and report the certified value beside
+// it. The thresholds below are peers' figures, not ours: we measure 0.6897 at the nodes and
+// 0.6864 certified, and bench/tolerance_sensitivity shows them moving by 2e-11 when the input
+// coordinates change by 1e-12 relative or the run uses 1 thread instead of 2 (the optimiser's
+// sweeps are deterministic given the input), 1e9 times less than the margin.
 TEST(OptimiserPeer, CubeSphereOrder3FiveIterations) {
   Mesh mesh = changeOrder(readMesh(peer("varopti_cube_sphere.msh")), 3, nullptr);
   OptimiserOptions options;
@@ -105,7 +113,7 @@ TEST(OptimiserPeer, CubeSphereOrder3FiveIterations) {
   EXPECT_GE(r.worstAfter, 0.666);
   EXPECT_EQ(r.invalidAfter, 0U);
   const QualitySummary q = evaluateQuality(mesh);
-  EXPECT_NEAR(q.scaled.min, r.worstAfter, 1e-12);
+  EXPECT_NEAR(q.scaled.min, r.worstAfter, 1e-12);  // the same bounds of the same mesh
   std::printf(
       "cube-sphere P3, 5 iterations: worst at nodes %.4f, certified %.4f (NekMesh 0.6664)\n",
       r.nodalWorstAfter, r.worstAfter);
@@ -119,6 +127,7 @@ TEST(OptimiserPeer, NacaLinearElasticFiveIterations) {
   options.functional = Functional::LinearElastic;
   options.maxIterations = 5;
   const OptimiserResult r = optimiseMesh(mesh, options);
+  // NekMesh's .tst: 0.872585 (+-5e-3). Ours: 0.8840, moving by 6e-12 with the last bits.
   EXPECT_GE(r.nodalWorstAfter, 0.8726);
   EXPECT_GT(r.worstAfter, r.worstBefore);
   // The mesh stays in its plane.
@@ -135,6 +144,8 @@ TEST(OptimiserPeer, CubeSphereOrder4ConvergesAbove0757AndKeepsTheBoundary) {
   options.maxIterations = 60;
   options.threads = 2;
   const OptimiserResult r = optimiseMesh(mesh, options);
+  // NekMesh's converged figure on this mesh, 0.7571 (bench/README.md). Ours: 0.7618 certified,
+  // 0.7619 at the nodes, moving by 6e-12 with the input's last bits or the thread count.
   EXPECT_GE(r.worstAfter, 0.757);
   EXPECT_GE(r.nodalWorstAfter, 0.757);
   // Nodes on the boundary (the cube's faces and the sphere) did not move.
@@ -160,6 +171,8 @@ TEST(Optimiser, ResultDoesNotDependOnTheNumberOfThreads) {
   optimiseMesh(a, options);
   options.threads = 2;
   optimiseMesh(b, options);
+  // Exact by design: nodes of one colour share no element, so each node's Newton step reads the
+  // same data whichever thread computes it (the only reduction is a max).
   EXPECT_EQ(a.xyz, b.xyz);
 }
 

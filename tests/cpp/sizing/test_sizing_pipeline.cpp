@@ -60,8 +60,11 @@ TEST_P(PeerCase, PredictionWithinTenPercentAndSizesFollowTheSpecification) {
   const auto actual = static_cast<double>(r.mesh.numElements());
   RecordProperty("predicted", std::to_string(predicted));
   RecordProperty("actual", std::to_string(actual));
+  // The prediction's promised accuracy (10 %). Measured 0.986 .. 1.055; Gmsh's 3D element count
+  // moves by up to 2 % when the CAD's scale and the sizes change by 1e-12 relative (2D: not at
+  // all), so the margin is at least twice the largest move (bench/tolerance_sensitivity).
   EXPECT_NEAR(predicted / actual, 1.0, 0.10) << predicted << " predicted, " << actual << " made";
-  EXPECT_GE(fractionOfEdgesWithinSpec(r.mesh, *r.sizing->octree), 0.90);
+  EXPECT_GE(fractionOfEdgesWithinSpec(r.mesh, *r.sizing->octree), 0.90);  // measured 1.00
   // Every boundary node keeps its CAD entity.
   const ElementBlock& b = boundaryBlock(r.mesh);
   for (const std::int64_t n : b.nodes) {
@@ -91,6 +94,8 @@ TEST(SizingPipeline, HalvingEpsRefinesTheSphereAsTheChordFormulaPredicts) {
   const double coarse = sphereTriangles(0.02), fine = sphereTriangles(0.01);
   const double expected = std::pow(chordSize(0.25, 0.02) / chordSize(0.25, 0.01), 2.0);  // 1.99
   EXPECT_GT(chordSize(0.25, 0.01), 0.04);  // above MinDelta: the formula, not the clamp, decides
+  // The 1 / delta^2 law holds up to the mesh's discretisation (15 %). Measured 0.881 of it;
+  // the surface mesh did not change under 1e-12 perturbations of the CAD's scale.
   EXPECT_NEAR(fine / coarse, expected, 0.15 * expected) << coarse << " -> " << fine;
 }
 
@@ -109,6 +114,8 @@ TEST(SizingPipeline, SeveralSolidsWithAnInternalFace) {
   p.minDelta = 0.1;
   p.maxDelta = 0.2;
   const SizingResult s = runSizing(cad, p);
+  // The octree's classification of sub-cells (1 %): measured 2.006, unchanged when the boxes
+  // are scaled by 1 +- 1e-12.
   EXPECT_NEAR(s.prediction.domainMeasure, 2.0, 0.02);
   MeshingOptions options;
   options.order = 1;
@@ -116,6 +123,7 @@ TEST(SizingPipeline, SeveralSolidsWithAnInternalFace) {
   const MeshResult r =
       runMeshPipeline(CadSource::brepText(test::brepText(builder.Shape())), options);
   const auto actual = static_cast<double>(r.mesh.numElements());
+  // Promised 10 %; measured 0.964 .. 0.972 over 1e-12 perturbations of the boxes' size.
   EXPECT_NEAR(r.sizing->prediction.elements / actual, 1.0, 0.10);
   // Tetrahedra in both solids.
   std::vector<int> perSolid(3, 0);
@@ -129,11 +137,13 @@ TEST(SizingPipeline, McfSetupReadsTheCaseInMetres) {
   EXPECT_TRUE(s.fromMcf);
   EXPECT_EQ(s.options.order, 4);
   ASSERT_TRUE(s.options.sizing.has_value());
+  // Parsed decimals are the correctly rounded literals: equal (DOUBLE_EQ's 4 ulps are slack).
   EXPECT_DOUBLE_EQ(s.options.sizing->minDelta, 0.04);
   EXPECT_DOUBLE_EQ(s.options.sizing->maxDelta, 0.2);
   EXPECT_DOUBLE_EQ(s.options.sizing->eps, 0.02);
   EXPECT_DOUBLE_EQ(s.source.scale, 0.001);
   const CadModel cad = s.source.load();
+  // OCCT's optimal box finds the sphere's extremes to its precision (1e-7 mm, 1e-10 m here).
   EXPECT_NEAR(cad.boundingDiagonal(), std::sqrt(16.0 + 4.0 + 0.75 * 0.75), 1e-6);
   // SurfaceOptimiser is NekMesh's and not ours: reported, not silently ignored.
   ASSERT_FALSE(s.notices.empty());
@@ -151,6 +161,7 @@ TEST(SizingPipeline, AutomaticSizingWithoutParameters) {
       runMeshPipeline(CadSource::brepText(test::brepText(test::sphere(1.0))), options);
   ASSERT_TRUE(r.sizing.has_value());
   EXPECT_NEAR(r.sizing->octree->parameters().maxDelta, r.cad->boundingDiagonal() / 20.0, 1e-12);
+  // Measured 0.9998 (0.997 .. 1.001 over 1e-12 perturbations of the CAD): 15 % is slack.
   EXPECT_NEAR(r.sizing->prediction.elements / double(r.mesh.numElements()), 1.0, 0.15);
   MeshingOptions both = options;
   both.size = 0.3;
