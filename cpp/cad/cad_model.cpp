@@ -301,12 +301,22 @@ double CadModel::vertexParameter(int vertex, int edge, std::optional<double> nea
   });
 }
 
-CurveProjection CadModel::projectOnCurve(int edge, const Eigen::Vector3d& p) const {
+CurveProjection CadModel::projectOnCurve(int edge, const Eigen::Vector3d& p,
+                                         std::optional<double> guess) const {
   const auto& c = impl_->curve(edge);
   return withOcctErrors("projecting onto " + cadEntityName(1, edge), [&] {
     gp_Pnt proj;
     double t = 0.0;
-    const double d = ShapeAnalysis_Curve().Project(c, toGp(p), 1e-9 * impl_->diagonal, proj, t);
+    const double precision = 1e-9 * impl_->diagonal;
+    const ShapeAnalysis_Curve analysis;
+    if (guess) {
+      // NextProject can end farther than its start (at the end of a closed curve's range it
+      // returned the opposite point): then the global search decides.
+      const double d = analysis.NextProject(*guess, c, toGp(p), precision, proj, t);
+      if (d <= c.Value(*guess).Distance(toGp(p)) + precision)
+        return CurveProjection{t, toEigen(proj), d};
+    }
+    const double d = analysis.Project(c, toGp(p), precision, proj, t);
     return CurveProjection{t, toEigen(proj), d};
   });
 }
@@ -335,9 +345,15 @@ SurfaceProjection CadModel::projectOnSurface(int face, const Eigen::Vector3d& p,
   ShapeAnalysis_Surface& analyser = impl_->analyser(face);
   return withOcctErrors("projecting onto " + cadEntityName(2, face), [&] {
     const double precision = 1e-9 * impl_->diagonal;
-    const gp_Pnt2d uv =
-        guess ? analyser.NextValueOfUV(gp_Pnt2d((*guess)[0], (*guess)[1]), toGp(p), precision)
-              : analyser.ValueOfUV(toGp(p), precision);
+    if (guess) {
+      // A local search that ends farther than its start failed: the global one decides.
+      const gp_Pnt2d start((*guess)[0], (*guess)[1]);
+      const gp_Pnt2d uv = analyser.NextValueOfUV(start, toGp(p), precision);
+      const gp_Pnt q = analyser.Value(uv);
+      if (q.Distance(toGp(p)) <= analyser.Value(start).Distance(toGp(p)) + precision)
+        return SurfaceProjection{uv.X(), uv.Y(), toEigen(q), q.Distance(toGp(p))};
+    }
+    const gp_Pnt2d uv = analyser.ValueOfUV(toGp(p), precision);
     const gp_Pnt q = analyser.Value(uv);
     return SurfaceProjection{uv.X(), uv.Y(), toEigen(q), q.Distance(toGp(p))};
   });

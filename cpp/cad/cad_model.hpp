@@ -99,8 +99,10 @@ class CadModel {
   // Parameter of a vertex on an edge it bounds. For a closed edge both ends qualify; the one
   // nearer `near` is returned when given, else the first.
   double vertexParameter(int vertex, int edge, std::optional<double> near = std::nullopt) const;
-  // Closest point on the edge's curve within its parameter range.
-  CurveProjection projectOnCurve(int edge, const Eigen::Vector3d& p) const;
+  // Closest point on the edge's curve within its parameter range; `guess` (a nearby parameter)
+  // starts a local search there, which picks the right side of a closed curve's seam.
+  CurveProjection projectOnCurve(int edge, const Eigen::Vector3d& p,
+                                 std::optional<double> guess = std::nullopt) const;
 
   SurfaceBounds faceBounds(int face) const;
   SurfaceDerivatives evaluateSurface(int face, double u, double v) const;
