@@ -111,13 +111,13 @@ void appendGeometry(JsonWriter& json, const GeometryAccuracy& g) {
   json.value("diagonal", g.diagonal);
   json.value("worst_entity", g.worstEntity);
   if (!g.worstEntity.empty())
-    json.numbers("worst_point", std::vector<double>{g.worstPoint.x(), g.worstPoint.y(),
-                                                    g.worstPoint.z()});
+    json.numbers("worst_point",
+                 std::vector<double>{g.worstPoint.x(), g.worstPoint.y(), g.worstPoint.z()});
   json.value("worst_angle_entity", g.worstAngleEntity);
   if (!g.worstAngleEntity.empty())
-    json.numbers("worst_angle_point", std::vector<double>{g.worstAnglePoint.x(),
-                                                          g.worstAnglePoint.y(),
-                                                          g.worstAnglePoint.z()});
+    json.numbers(
+        "worst_angle_point",
+        std::vector<double>{g.worstAnglePoint.x(), g.worstAnglePoint.y(), g.worstAnglePoint.z()});
   json.value("method",
              "boundary cells sampled at quadrature points of degree 2P+2 and at their nodes, "
              "projected on their CAD face or curve; angle between mesh and CAD normals (2D: "
