@@ -203,6 +203,7 @@ GeometryAccuracy measureGeometryAccuracy(const Mesh& mesh, const CadModel& cad, 
   GeometryAccuracy result;
   result.diagonal = cad.boundingDiagonal();
   std::vector<CadModel> perThread;  // CadModel's caches are not thread-safe
+  perThread.reserve(static_cast<std::size_t>(threads));
   for (int t = 0; t < threads; ++t) perThread.push_back(cad.clone());
 
   double sumDistance = 0.0, sumAngle = 0.0, maxAngle = -1.0;

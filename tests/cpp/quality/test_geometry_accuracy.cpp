@@ -133,11 +133,11 @@ TEST(GeometryAccuracy, NekMeshSphereCaseIsReported) {
   const MeshResult linear = runMeshPipeline(setup.source, setup.options);
   ASSERT_TRUE(linear.geometry.has_value());
   const std::string json = meshReportJson(linear, "3d_sphere.mcf");
-  for (const char* key : {"\"geometry\": {", "\"max_distance\": ", "\"max_distance_relative\": ",
-                          "\"max_normal_angle_deg\": ", "\"mean_normal_angle_deg\": ",
-                          "\"samples\": ", "\"worst_entity\": \"Face"})
+  for (const char* key : {R"("geometry": {)", R"("max_distance": )", R"("max_distance_relative": )",
+                          R"("max_normal_angle_deg": )", R"("mean_normal_angle_deg": )",
+                          R"("samples": )", R"("worst_entity": "Face)"})
     EXPECT_NE(json.find(key), std::string::npos) << key;
-  EXPECT_NE(json.find("\"geometry\": ", json.find("\"timings_s\"")), std::string::npos);
+  EXPECT_NE(json.find(R"("geometry": )", json.find(R"("timings_s")")), std::string::npos);
   double previous = 180.0;
   for (const int order : {2, 4, 6}) {
     const Mesh mesh = elevateOrder(linear.mesh, order, linear.cad.get());
