@@ -309,15 +309,17 @@ CurveProjection CadModel::projectOnCurve(int edge, const Eigen::Vector3d& p,
     double t = 0.0;
     const double precision = 1e-9 * impl_->diagonal;
     const ShapeAnalysis_Curve analysis;
-    if (guess) {
-      // NextProject can end farther than its start (at the end of a closed curve's range it
-      // returned the opposite point): then the global search decides.
-      const double d = analysis.NextProject(*guess, c, toGp(p), precision, proj, t);
-      if (d <= c.Value(*guess).Distance(toGp(p)) + precision)
-        return CurveProjection{t, toEigen(proj), d};
-    }
     const double d = analysis.Project(c, toGp(p), precision, proj, t);
-    return CurveProjection{t, toEigen(proj), d};
+    CurveProjection best{t, toEigen(proj), d};
+    // The local search from the guess settles ties (a point as near to both ends of a closed
+    // curve) on the guess's side. Alone it is not enough: it stops at once where the curve's
+    // speed vanishes (a cosine-spaced aerofoil's trailing edge) and can end at the opposite
+    // point of a closed curve, so the global result stands unless the local one is as near.
+    if (guess) {
+      const double dLocal = analysis.NextProject(*guess, c, toGp(p), precision, proj, t);
+      if (dLocal <= d + precision) best = CurveProjection{t, toEigen(proj), dLocal};
+    }
+    return best;
   });
 }
 
@@ -343,19 +345,36 @@ SurfaceDerivatives CadModel::evaluateSurface(int face, double u, double v) const
 SurfaceProjection CadModel::projectOnSurface(int face, const Eigen::Vector3d& p,
                                              std::optional<std::array<double, 2>> guess) const {
   ShapeAnalysis_Surface& analyser = impl_->analyser(face);
+  const auto& surface = impl_->surface(face);
   return withOcctErrors("projecting onto " + cadEntityName(2, face), [&] {
     const double precision = 1e-9 * impl_->diagonal;
-    if (guess) {
-      // A local search that ends farther than its start failed: the global one decides.
-      const gp_Pnt2d start((*guess)[0], (*guess)[1]);
-      const gp_Pnt2d uv = analyser.NextValueOfUV(start, toGp(p), precision);
+    const gp_Pnt target = toGp(p);
+    const auto result = [&](const gp_Pnt2d& uv) {
       const gp_Pnt q = analyser.Value(uv);
-      if (q.Distance(toGp(p)) <= analyser.Value(start).Distance(toGp(p)) + precision)
-        return SurfaceProjection{uv.X(), uv.Y(), toEigen(q), q.Distance(toGp(p))};
+      return SurfaceProjection{uv.X(), uv.Y(), toEigen(q), q.Distance(target)};
+    };
+    std::optional<SurfaceProjection> local;
+    if (guess) {
+      const gp_Pnt2d start((*guess)[0], (*guess)[1]);
+      local = result(analyser.NextValueOfUV(start, target, precision));
+      // Kept when it lies on the surface, or is a foot point (the residual normal to a regular
+      // surface there) no farther than its start; a local search can stop where the
+      // parametrisation degenerates or end farther than it began.
+      if (local->distance <= 1e3 * precision) return *local;
+      gp_Pnt q;
+      gp_Vec du, dv;
+      surface.D1(local->u, local->v, q, du, dv);
+      const gp_Vec r(q, target);
+      const double rn = r.Magnitude();
+      const bool regular =
+          du.Crossed(dv).Magnitude() > 1e-8 * std::max(du.SquareMagnitude(), dv.SquareMagnitude());
+      const bool foot = regular && std::abs(r.Dot(du)) <= 1e-3 * rn * du.Magnitude() &&
+                        std::abs(r.Dot(dv)) <= 1e-3 * rn * dv.Magnitude();
+      if (foot && local->distance <= analyser.Value(start).Distance(target) + precision)
+        return *local;
     }
-    const gp_Pnt2d uv = analyser.ValueOfUV(toGp(p), precision);
-    const gp_Pnt q = analyser.Value(uv);
-    return SurfaceProjection{uv.X(), uv.Y(), toEigen(q), q.Distance(toGp(p))};
+    const SurfaceProjection global = result(analyser.ValueOfUV(target, precision));
+    return local && local->distance <= global.distance ? *local : global;
   });
 }
 
