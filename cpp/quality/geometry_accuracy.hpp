@@ -7,12 +7,14 @@
 //   - 2D: lines on CAD curves (distance, and the angle between the mesh edge's tangent and the
 //     curve's tangent, which is the angle between their normals in the mesh plane).
 // Each sample point x(xi) is projected onto its entity, starting from the parameters of the
-// cell's node nearest to xi in reference coordinates (local search: it stays on the right side
-// of a periodic seam); the distance is |x - projection|. The angle compares the mesh normal
-// x_xi1 x x_xi2 with the CAD normal S_u x S_v at the projected parameters, unsigned
-// (atan2(|n x m|, |n . m|), accurate for tiny angles too). Points where the CAD normal or
-// tangent is undefined (a sphere's pole: S_u = 0) are skipped for the angle and counted; a
-// point where the mesh map itself degenerates (zero tangent) counts as 90 degrees.
+// cell's node nearest to xi in reference coordinates (CadModel checks the local result against
+// its global search, see cad_model.hpp); the distance is |x - projection|. The angle compares
+// the mesh normal x_xi1 x x_xi2 with the CAD normal S_u x S_v at the projected parameters,
+// unsigned (atan2(|n x m|, |n . m|), accurate for tiny angles too). Points where the CAD normal
+// is undefined (S_u x S_v below 1e-8 of max |S_u|^2, |S_v|^2: a sphere's pole) or the curve's
+// tangent is (|C'| below 1e-3 of the curve's typical speed: an aerofoil's cosine-spaced
+// trailing edge) are skipped for the angle and counted; a point where the mesh map itself
+// degenerates (zero tangent) counts as 90 degrees.
 //
 // The result does not depend on the number of threads.
 #pragma once
