@@ -137,6 +137,14 @@ class HighOrderMesh:
         self.__init__(core)
         return json.loads(record)["optimiser"]
 
+    def geometry(self):
+        """How closely the boundary follows the CAD, for a mesh made from CAD (None for a mesh
+        read from a file): the report's "geometry" record as a dict, with ``max_distance`` (and
+        ``max_distance_relative`` to the model's diagonal) of boundary sample points to their
+        CAD face or curve, ``max_normal_angle_deg`` and ``mean_normal_angle_deg`` between mesh
+        and CAD normals, ``samples`` and the worst entity and point."""
+        return self.report().get("geometry")
+
     def report(self, input_name=""):
         """The JSON report of ``homesh mesh --report`` as a dict."""
         return json.loads(self._core.report_json(str(input_name)))

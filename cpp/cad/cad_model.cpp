@@ -316,13 +316,25 @@ double CadModel::vertexParameter(int vertex, int edge, std::optional<double> nea
   });
 }
 
-CurveProjection CadModel::projectOnCurve(int edge, const Eigen::Vector3d& p) const {
+CurveProjection CadModel::projectOnCurve(int edge, const Eigen::Vector3d& p,
+                                         std::optional<double> guess) const {
   const auto& c = impl_->curve(edge);
   return withOcctErrors("projecting onto " + cadEntityName(1, edge), [&] {
     gp_Pnt proj;
     double t = 0.0;
-    const double d = ShapeAnalysis_Curve().Project(c, toGp(p), 1e-9 * impl_->diagonal, proj, t);
-    return CurveProjection{t, toEigen(proj), d};
+    const double precision = 1e-9 * impl_->diagonal;
+    const ShapeAnalysis_Curve analysis;
+    const double d = analysis.Project(c, toGp(p), precision, proj, t);
+    CurveProjection best{t, toEigen(proj), d};
+    // The local search from the guess settles ties (a point as near to both ends of a closed
+    // curve) on the guess's side. Alone it is not enough: it stops at once where the curve's
+    // speed vanishes (a cosine-spaced aerofoil's trailing edge) and can end at the opposite
+    // point of a closed curve, so the global result stands unless the local one is as near.
+    if (guess) {
+      const double dLocal = analysis.NextProject(*guess, c, toGp(p), precision, proj, t);
+      if (dLocal <= d + precision) best = CurveProjection{t, toEigen(proj), dLocal};
+    }
+    return best;
   });
 }
 
@@ -348,13 +360,36 @@ SurfaceDerivatives CadModel::evaluateSurface(int face, double u, double v) const
 SurfaceProjection CadModel::projectOnSurface(int face, const Eigen::Vector3d& p,
                                              std::optional<std::array<double, 2>> guess) const {
   ShapeAnalysis_Surface& analyser = impl_->analyser(face);
+  const auto& surface = impl_->surface(face);
   return withOcctErrors("projecting onto " + cadEntityName(2, face), [&] {
     const double precision = 1e-9 * impl_->diagonal;
-    const gp_Pnt2d uv =
-        guess ? analyser.NextValueOfUV(gp_Pnt2d((*guess)[0], (*guess)[1]), toGp(p), precision)
-              : analyser.ValueOfUV(toGp(p), precision);
-    const gp_Pnt q = analyser.Value(uv);
-    return SurfaceProjection{uv.X(), uv.Y(), toEigen(q), q.Distance(toGp(p))};
+    const gp_Pnt target = toGp(p);
+    const auto result = [&](const gp_Pnt2d& uv) {
+      const gp_Pnt q = analyser.Value(uv);
+      return SurfaceProjection{uv.X(), uv.Y(), toEigen(q), q.Distance(target)};
+    };
+    std::optional<SurfaceProjection> local;
+    if (guess) {
+      const gp_Pnt2d start((*guess)[0], (*guess)[1]);
+      local = result(analyser.NextValueOfUV(start, target, precision));
+      // Kept when it lies on the surface, or is a foot point (the residual normal to a regular
+      // surface there) no farther than its start; a local search can stop where the
+      // parametrisation degenerates or end farther than it began.
+      if (local->distance <= 1e3 * precision) return *local;
+      gp_Pnt q;
+      gp_Vec du, dv;
+      surface.D1(local->u, local->v, q, du, dv);
+      const gp_Vec r(q, target);
+      const double rn = r.Magnitude();
+      const bool regular =
+          du.Crossed(dv).Magnitude() > 1e-8 * std::max(du.SquareMagnitude(), dv.SquareMagnitude());
+      const bool foot = regular && std::abs(r.Dot(du)) <= 1e-3 * rn * du.Magnitude() &&
+                        std::abs(r.Dot(dv)) <= 1e-3 * rn * dv.Magnitude();
+      if (foot && local->distance <= analyser.Value(start).Distance(target) + precision)
+        return *local;
+    }
+    const SurfaceProjection global = result(analyser.ValueOfUV(target, precision));
+    return local && local->distance <= global.distance ? *local : global;
   });
 }
 

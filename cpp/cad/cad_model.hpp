@@ -100,13 +100,18 @@ class CadModel {
   // nearer `near` is returned when given, else the first.
   double vertexParameter(int vertex, int edge, std::optional<double> near = std::nullopt) const;
   // Closest point on the edge's curve within its parameter range, found to 1e-9 of the
-  // bounding diagonal (the precision handed to OCCT's search).
-  CurveProjection projectOnCurve(int edge, const Eigen::Vector3d& p) const;
+  // bounding diagonal (the precision handed to OCCT's search); `guess` (a nearby parameter)
+  // starts a local search there, whose result is kept when it is as near as the global one
+  // (it decides between equally near points, e.g. either side of a closed curve's seam).
+  CurveProjection projectOnCurve(int edge, const Eigen::Vector3d& p,
+                                 std::optional<double> guess = std::nullopt) const;
 
   SurfaceBounds faceBounds(int face) const;
   SurfaceDerivatives evaluateSurface(int face, double u, double v) const;
   // Closest point on the face's underlying surface, found to 1e-9 of the bounding diagonal;
-  // `guess` speeds up and disambiguates. The point returned is S(u, v) itself.
+  // `guess` speeds up and disambiguates (its local search is kept when it ends on the surface or
+  // at a regular foot point no farther than the guess, otherwise the nearer of it and the global
+  // search). The point returned is S(u, v) itself.
   SurfaceProjection projectOnSurface(int face, const Eigen::Vector3d& p,
                                      std::optional<std::array<double, 2>> guess = {}) const;
   PrincipalCurvatures curvature(int face, double u, double v) const;

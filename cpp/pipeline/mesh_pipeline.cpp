@@ -239,6 +239,10 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   StageClock quality("quality", result.timings, observer);
   result.quality = evaluateQuality(result.mesh, options.threads);
   quality.done();
+
+  StageClock geometry("geometry", result.timings, observer);
+  result.geometry = measureGeometryAccuracy(result.mesh, *result.cad, options.threads);
+  geometry.done();
   return result;
 }
 

@@ -1,7 +1,8 @@
 // CAD in, curved mesh out: the stages in order, with timings and progress.
 //
 //   CAD model -> linear mesh (Gmsh, uniform size) -> order elevation with boundary nodes on the
-//   CAD -> [variational optimiser, nodes sliding on the CAD] -> quality.
+//   CAD -> [variational optimiser, nodes sliding on the CAD] -> quality -> geometry (distance and
+//   normal angle of the boundary to the CAD, quality/geometry_accuracy.hpp).
 //
 // The command line, the Python module and the tests all drive meshing through this one entry
 // point, so they validate parameters and report identically.
@@ -18,6 +19,7 @@
 #include "core/mesh.hpp"
 #include "io/mesh_writers.hpp"
 #include "optimise/optimiser.hpp"
+#include "quality/geometry_accuracy.hpp"
 #include "quality/mesh_quality.hpp"
 #include "sizing/element_count.hpp"
 #include "sizing/sizing_octree.hpp"
@@ -133,6 +135,7 @@ struct MeshResult {
   QualitySummary quality;
   std::optional<OptimiserResult> optimiser;  // when the optimiser ran
   std::optional<SizingResult> sizing;        // when the sizes came from the octree
+  std::optional<GeometryAccuracy> geometry;  // boundary against the CAD (a mesh made from CAD)
   StageTimings timings;
   MeshingOptions options;
 };

@@ -98,6 +98,33 @@ void appendQuality(JsonWriter& json, const Mesh& mesh, const QualitySummary& q) 
   json.endObject();
 }
 
+void appendGeometry(JsonWriter& json, const GeometryAccuracy& g) {
+  json.beginObject("geometry");
+  json.value("max_distance", g.maxDistance);
+  json.value("max_distance_relative", g.maxDistanceRelative());
+  json.value("mean_distance_relative", g.meanDistanceRelative());
+  json.value("max_normal_angle_deg", g.maxAngleDeg);
+  json.value("mean_normal_angle_deg", g.meanAngleDeg);
+  json.value("samples", g.samples);
+  json.value("angle_samples", g.angleSamples);
+  json.value("undefined_normals", g.undefinedNormals);
+  json.value("diagonal", g.diagonal);
+  json.value("worst_entity", g.worstEntity);
+  if (!g.worstEntity.empty())
+    json.numbers("worst_point",
+                 std::vector<double>{g.worstPoint.x(), g.worstPoint.y(), g.worstPoint.z()});
+  json.value("worst_angle_entity", g.worstAngleEntity);
+  if (!g.worstAngleEntity.empty())
+    json.numbers(
+        "worst_angle_point",
+        std::vector<double>{g.worstAnglePoint.x(), g.worstAnglePoint.y(), g.worstAnglePoint.z()});
+  json.value("method",
+             "boundary cells sampled at quadrature points of degree 2P+2 and at their nodes, "
+             "projected on their CAD face or curve; angle between mesh and CAD normals (2D: "
+             "tangents), unsigned");
+  json.endObject();
+}
+
 void appendSizing(JsonWriter& json, const SizingResult& sizing) {
   const SizingOctree& octree = *sizing.octree;
   const SizingParameters& p = octree.parameters();
@@ -158,6 +185,7 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
     appendSizing(json, *result.sizing);
   }
   appendQuality(json, result.mesh, result.quality);
+  if (result.geometry) appendGeometry(json, *result.geometry);
   if (result.optimiser) appendOptimiser(json, *result.optimiser);
   json.beginObject("timings_s");
   for (const auto& [stage, s] : result.timings.seconds) json.value(stage, s);

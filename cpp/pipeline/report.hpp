@@ -24,6 +24,11 @@ const char* validityName(Validity v);
 // Appends "elements" (cells of the mesh dimension by type) and "boundary" (lower cells).
 void appendCounts(JsonWriter& json, const Mesh& mesh);
 
+// Appends "geometry": the largest and mean distance of boundary sample points to their CAD entity
+// (absolute and relative to the model's diagonal), the largest and mean angle between mesh and
+// CAD normals, the sample counts and where the worst distance and angle were found.
+void appendGeometry(JsonWriter& json, const GeometryAccuracy& geometry);
+
 // Appends "sizing": the parameters, the prediction and the octree's statistics.
 void appendSizing(JsonWriter& json, const SizingResult& sizing);
 
@@ -31,7 +36,7 @@ void appendSizing(JsonWriter& json, const SizingResult& sizing);
 std::string predictReportJson(const SizingResult& sizing, const std::string& input);
 
 // The report of `homesh mesh`: input, order, size, counts, "predicted_elements" and "sizing"
-// (octree sizing), quality, timings.
+// (octree sizing), quality, geometry, timings.
 std::string meshReportJson(const MeshResult& result, const std::string& input);
 
 // The report of `homesh quality`: input, order, counts, quality.

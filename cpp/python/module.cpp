@@ -266,6 +266,7 @@ class PyMesh {
       // A mesh made from CAD keeps it: boundary nodes slide on their curves and faces.
       record = optimiseMesh(copy.mesh, options, nullptr, copy.cad.get());
       copy.quality = evaluateQuality(copy.mesh, threads);
+      if (copy.cad) copy.geometry = measureGeometryAccuracy(copy.mesh, *copy.cad, threads);
     }
     JsonWriter json;
     json.beginObject();

@@ -60,7 +60,14 @@ def test_report_counts_match_the_file(sphere_run):
     quality = report["quality"]
     assert quality["invalid_elements"] == 0
     assert 0.0 < quality["scaled_jacobian"]["min"] <= quality["scaled_jacobian"]["mean"] <= 1.0
-    assert set(report["timings_s"]) >= {"cad", "linear", "high_order", "output"}
+    assert set(report["timings_s"]) >= {"cad", "linear", "high_order", "geometry", "output"}
+    # The worst boundary point lies max_distance off the unit sphere (closed form), to the CAD
+    # projection's precision (1e-9 of the diagonal).
+    geometry = report["geometry"]
+    worst = np.linalg.norm(geometry["worst_point"])
+    assert abs(worst - 1.0) == pytest.approx(geometry["max_distance"],
+                                             abs=1e-9 * geometry["diagonal"])
+    assert geometry["worst_entity"] == "Face1" or geometry["worst_entity"].startswith("Edge")
     # The per-element field in the file is the one the report summarises.
     # The same double, in the MSH file with 17 digits and in the JSON with 15 (5e-16 relative).
     field = np.asarray(mesh.cell_data["scaled_jacobian"][

@@ -41,6 +41,30 @@ def test_quality_and_report(sphere):
     json.dumps(report)
 
 
+def test_geometry_record_of_a_mesh_made_from_cad(sphere, tmp_path):
+    g = sphere.geometry()
+    assert g == sphere.report()["geometry"]
+    assert g["diagonal"] == pytest.approx(2 * 3 ** 0.5)  # the unit sphere's bounding box
+    assert g["max_distance_relative"] == pytest.approx(g["max_distance"] / g["diagonal"])
+    assert g["samples"] > g["angle_samples"] > 0  # lines on the seam: distance only
+    assert 0 < g["mean_normal_angle_deg"] <= g["max_normal_angle_deg"]
+    assert g["worst_angle_entity"] == "Face1" and len(g["worst_point"]) == 3
+    sphere.write(tmp_path / "s.npz")
+    assert homesh.load(tmp_path / "s.npz").geometry() is None  # no CAD, no record
+
+
+
+def test_optimising_a_mesh_made_from_cad_remeasures_its_geometry(data):
+    m = homesh.mesh(str(data / "sphere.brep"), order=2, size=0.6)
+    before = m.geometry()
+    m.optimise(maxiter=2)
+    after = m.geometry()  # the boundary slid on the CAD: measured again, same sampling
+    assert after is not None and after["samples"] == before["samples"]
+    # Nodes on the sphere: the quadratic boundary stays nearer than the chord of an edge 1.5
+    # times the size (Gmsh's edges stay within that) sags from the unit sphere.
+    assert after["max_distance"] < 1 - (1 - (1.5 * 0.6 / 2) ** 2) ** 0.5
+
+
 def test_npz_round_trip_keeps_everything(sphere, tmp_path):
     path = tmp_path / "m.npz"
     sphere.write(path)
@@ -147,7 +171,8 @@ def test_progress_reports_stages_and_can_cancel(data):
     seen = []
     homesh.mesh(str(data / "sphere.brep"), order=2, size=0.5,
                 progress=lambda stage, seconds: seen.append((stage, seconds)))
-    assert [s for s, t in seen if t is None] == ["cad", "linear", "high_order", "quality"]
+    assert [s for s, t in seen if t is None] == [
+        "cad", "linear", "high_order", "quality", "geometry"]
     assert all(t >= 0 for s, t in seen if t is not None)
 
     def stop(stage, seconds):
