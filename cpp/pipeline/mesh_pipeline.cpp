@@ -289,15 +289,20 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     Mesh next;
     if (!plan.splits.empty()) {
       // Local: only the cells around the split edges change; the rest wait for the next round.
-      record.action = "split";
-      record.elements = plan.splitCells;
       next = from.linear;
       record.edgesSplit = applySplits(next, plan.splits, *result.cad);
+    }
+    if (record.edgesSplit > 0) {
+      record.action = "split";
+      record.elements = plan.splitCells;
     } else {
+      // Nothing to split (or no split kept its cells positive): refine around every offender.
+      const std::vector<RefinementSource>& added =
+          plan.splits.empty() ? plan.sources : plan.allSources;
       record.action = "refine";
-      record.elements = plan.refineCells;
-      record.sources = plan.sources.size();
-      sources.insert(sources.end(), plan.sources.begin(), plan.sources.end());
+      record.elements = added.size();
+      record.sources = added.size();
+      sources.insert(sources.end(), added.begin(), added.end());
       LinearMeshOptions refined = linearOptions;
       if (!refined.sizeField) {  // a uniform size: the constant field, capped
         const double size = linearOptions.size;

@@ -17,6 +17,10 @@ Eigen::Vector3d nodePoint(const Mesh& mesh, std::int64_t i) {
   return {mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]};
 }
 
+MeshEdge sortedEdge(std::int64_t a, std::int64_t b) {
+  return a < b ? MeshEdge{a, b} : MeshEdge{b, a};
+}
+
 // The linear cells of dimension mesh.dim, in element order.
 std::vector<const std::int64_t*> cellsOf(const Mesh& mesh) {
   std::vector<const std::int64_t*> cells;
@@ -98,6 +102,11 @@ CurvedFaceEdges::CurvedFaceEdges(const Mesh& linear, const CadModel& cad)
       boundary_(boundaryEdges(linear)),
       cells_(cellsOf(linear)) {
   std::map<int, bool> curved;
+  std::set<MeshEdge> curveEdges;  // 3D: edges on CAD curves (their nodes would go on the curve)
+  for (const ElementBlock& block : linear.blocks)
+    if (linear.dim == 3 && block.type == CellType::Line && block.order == 1)
+      for (std::size_t e = 0; e < block.count(); ++e)
+        curveEdges.insert(sortedEdge(block.element(e)[0], block.element(e)[1]));
   for (const ElementBlock& block : linear.blocks) {
     if (cellDimension(block.type) != linear.dim - 1 || block.order != 1) continue;
     const int nv = cellNumVertices(block.type);
@@ -108,28 +117,51 @@ CurvedFaceEdges::CurvedFaceEdges(const Mesh& linear, const CadModel& cad)
       if (it == curved.end())
         it = curved.emplace(entity, linear.dim == 2 || !cad.isPlanar(entity)).first;
       if (!it->second) continue;
+      const std::int64_t* v = block.element(e);
       for (int k = 0; k < nv; ++k) {
-        std::vector<int>& faces = nodeFaces_[static_cast<std::size_t>(block.element(e)[k])];
+        std::vector<int>& faces = nodeFaces_[static_cast<std::size_t>(v[k])];
         if (std::find(faces.begin(), faces.end(), entity) == faces.end()) faces.push_back(entity);
+        if (nv == 2 && k == 1) break;  // a line has one edge
+        const MeshEdge edge = sortedEdge(v[k], v[(k + 1) % nv]);
+        if (curveEdges.count(edge) == 0) faceEdges_.emplace(edge, entity);
       }
     }
   }
   for (std::vector<int>& faces : nodeFaces_) std::sort(faces.begin(), faces.end());
 }
 
-std::vector<CurvedFaceEdge> CurvedFaceEdges::of(std::size_t cell) const {
+std::vector<CurvedFaceEdge> CurvedFaceEdges::interior(std::size_t cell) const {
   std::vector<CurvedFaceEdge> found;
   const std::int64_t* v = cells_.at(cell);
   const int nv = mesh_.dim + 1;
   for (int i = 0; i < nv; ++i)
     for (int j = i + 1; j < nv; ++j) {
-      const MeshEdge edge = v[i] < v[j] ? MeshEdge{v[i], v[j]} : MeshEdge{v[j], v[i]};
+      const MeshEdge edge = sortedEdge(v[i], v[j]);
       if (boundary_.count(edge) > 0) continue;
       const std::vector<int>& fa = nodeFaces_[static_cast<std::size_t>(edge[0])];
       const std::vector<int>& fb = nodeFaces_[static_cast<std::size_t>(edge[1])];
       std::vector<int> common;
       std::set_intersection(fa.begin(), fa.end(), fb.begin(), fb.end(), std::back_inserter(common));
-      if (!common.empty()) found.push_back({edge, common.front()});
+      if (!common.empty()) found.push_back({edge, common.front(), false});
+    }
+  return found;
+}
+
+std::optional<CurvedFaceEdge> CurvedFaceEdges::longestOnFace(std::size_t cell) const {
+  std::optional<CurvedFaceEdge> found;
+  double longest = 0.0;
+  const std::int64_t* v = cells_.at(cell);
+  const int nv = mesh_.dim + 1;
+  for (int i = 0; i < nv; ++i)
+    for (int j = i + 1; j < nv; ++j) {
+      const MeshEdge edge = sortedEdge(v[i], v[j]);
+      const auto it = faceEdges_.find(edge);
+      if (it == faceEdges_.end()) continue;
+      const double length = (nodePoint(mesh_, v[i]) - nodePoint(mesh_, v[j])).norm();
+      if (length > longest) {
+        longest = length;
+        found = CurvedFaceEdge{edge, it->second, true};
+      }
     }
   return found;
 }
@@ -147,14 +179,6 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
   const int nv = linear.dim + 1;
   for (std::size_t c = 0; c < cells.size(); ++c) {
     if (validity[c] == Validity::Valid) continue;
-    const std::vector<CurvedFaceEdge> edges = finder.of(c);
-    if (!edges.empty()) {
-      ++plan.splitCells;
-      for (const CurvedFaceEdge& e : edges)
-        if (planned.insert(e.edge).second) plan.splits.push_back(e);
-      continue;
-    }
-    ++plan.refineCells;
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     double longest = 0.0, total = 0.0;
     int edgeCount = 0;
@@ -167,7 +191,20 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
         ++edgeCount;
       }
     }
-    plan.sources.push_back(RefinementSource::sphere(centroid, longest, 0.5 * total / edgeCount));
+    const RefinementSource sphere =
+        RefinementSource::sphere(centroid, longest, 0.5 * total / edgeCount);
+    plan.allSources.push_back(sphere);
+    std::vector<CurvedFaceEdge> edges = finder.interior(c);
+    if (edges.empty())
+      if (const auto onFace = finder.longestOnFace(c)) edges.push_back(*onFace);
+    if (!edges.empty()) {
+      ++plan.splitCells;
+      for (const CurvedFaceEdge& e : edges)
+        if (planned.insert(e.edge).second) plan.splits.push_back(e);
+      continue;
+    }
+    ++plan.refineCells;
+    plan.sources.push_back(sphere);
   }
   return plan;
 }
@@ -178,6 +215,24 @@ std::size_t applySplits(Mesh& linear, const std::vector<CurvedFaceEdge>& splits,
   for (const CurvedFaceEdge& split : splits) {
     const Eigen::Vector3d mid =
         0.5 * (nodePoint(linear, split.edge[0]) + nodePoint(linear, split.edge[1]));
+    if (split.boundary) {
+      SplitNode node;
+      if (linear.dim == 3) {
+        const SurfaceProjection proj = cad.projectOnSurface(split.entity, mid);
+        node.point = proj.point;
+        node.cadDim = 2;
+        node.param0 = proj.u;
+        node.param1 = proj.v;
+      } else {
+        const CurveProjection proj = cad.projectOnCurve(split.entity, mid);
+        node.point = proj.point;
+        node.cadDim = 1;
+        node.param0 = proj.t;
+      }
+      node.cadIndex = split.entity;
+      if (splitEdge(linear, split.edge, node)) ++done;
+      continue;
+    }
     const Eigen::Vector3d point = splitPoint(linear, cad, split);
     // The midpoint always halves positive cells into positive cells.
     if (!splitInteriorEdge(linear, split.edge, point) &&
