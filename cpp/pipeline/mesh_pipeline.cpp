@@ -276,8 +276,9 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   // Repair rounds: each works from the previous round's mesh; the best state is kept.
   std::vector<RefinementSource> sources;  // accumulated over the refine rounds
   std::optional<CurvedState> last;        // the last round's state when it was not kept
+  bool splitFailed = false;  // the last round split and made things worse: refine instead
   for (int round = 1; round <= options.repairRounds; ++round) {
-    const CurvedState& from = last ? *last : best;
+    const CurvedState& from = last && !splitFailed ? *last : best;
     if (from.notValid() == 0) break;
     StageClock clock("repair " + std::to_string(round), result.timings, observer);
     const auto start = std::chrono::steady_clock::now();
@@ -287,7 +288,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     // Every flagged cell gets edges to split or a refinement sphere: the plan is never empty.
     const RepairPlan plan = planRepair(from.linear, from.quality.validity, *result.cad);
     Mesh next;
-    if (!plan.splits.empty()) {
+    if (!plan.splits.empty() && !splitFailed) {
       // Local: only the cells around the split edges change; the rest wait for the next round.
       next = from.linear;
       record.edgesSplit = applySplits(next, plan.splits, *result.cad);
@@ -298,7 +299,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     } else {
       // Nothing to split (or no split kept its cells positive): refine around every offender.
       const std::vector<RefinementSource>& added =
-          plan.splits.empty() ? plan.sources : plan.allSources;
+          plan.splits.empty() ? plan.sources : plan.allSources;  // (splitFailed: every offender)
       record.action = "refine";
       record.elements = added.size();
       record.sources = added.size();
@@ -321,6 +322,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     record.undecidedAfter = state.quality.undecided;
     record.meshElements = state.mesh.numElements();
     record.kept = state.betterThan(best);
+    splitFailed = !record.kept && record.action == "split";
     if (record.kept) {
       best = std::move(state);
       last.reset();
