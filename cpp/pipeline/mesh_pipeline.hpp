@@ -148,9 +148,9 @@ struct MeshResult {
 // "repair 1", ...): each locates those elements in the linear mesh, splits or refines there
 // (planRepair), and elevates, optimises and evaluates the new linear mesh; the next round works
 // from that mesh, except after a split that made the mesh worse than the best: then it refines
-// around the best mesh's offenders instead. The result is the best mesh seen: fewest elements not proven valid, then the
-// best worst scaled Jacobian (a round never makes the result worse). Throws ParameterError,
-// IoError, CadError, MeshingError or CancelledError.
+// around the best mesh's offenders instead. The result is the best mesh seen: fewest elements not
+// proven valid, then the best worst scaled Jacobian (a round never makes the result worse). Throws
+// ParameterError, IoError, CadError, MeshingError or CancelledError.
 MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
                            PipelineObserver* observer = nullptr);
 

@@ -532,11 +532,10 @@ BOOST_PYTHON_MODULE(_core) {
       .def("report_json", &PyMesh::reportJson)
       .def("optimise", &PyMesh::optimise);
 
-  bp::def(
-      "mesh_file", &meshFile,
-      (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"), bp::arg("verbosity"),
-       bp::arg("progress"), bp::arg("optimise") = 0, bp::arg("sizing") = bp::object(),
-       bp::arg("repair_rounds") = 3));
+  bp::def("mesh_file", &meshFile,
+          (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
+           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
+           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = 3));
   bp::def("mesh_brep", &meshBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
            bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
