@@ -316,7 +316,7 @@ def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_o
 
 
 def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
-         optimise=0, min_delta=None, max_delta=None, eps=None, sources=()):
+         optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=3):
     """Meshes a CAD shape with curved elements of the given order.
 
     shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
@@ -334,6 +334,11 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
               the FreeCAD object's label); default "the shape".
     optimise  > 0: after curving, at most this many sweeps of the variational optimiser
               (hyperelastic; boundary nodes slide on the CAD), stage "optimise".
+    repair_rounds
+              at most this many repair rounds (0..20) while elements are not proven valid:
+              each splits the offending linear elements' edges on curved CAD faces (or refines
+              around them), then curves, optimises and checks again (stages "repair 1", ...;
+              ``report()["rounds"]``). 0: none.
 
     Raises ParameterError, FileError, CadError, MeshingError or CancelledError.
     """
@@ -341,6 +346,7 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     threads = _check_int("threads", threads)
     verbosity = _check_int("verbosity", verbosity)
     optimise = _check_int("optimise", optimise)
+    repair_rounds = _check_int("repair_rounds", repair_rounds)
     if size is not None:
         if isinstance(size, bool) or not isinstance(size, numbers.Real):
             raise ParameterError("size must be a positive number, got %r" % (size,))
@@ -356,10 +362,10 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
         core = _core.mesh_brep(value, label, order, size, threads, verbosity, progress, optimise,
-                               sizing)
+                               sizing, repair_rounds)
     else:
         core = _core.mesh_file(value, order, size, threads, verbosity, progress, optimise,
-                               sizing)
+                               sizing, repair_rounds)
     return HighOrderMesh(core)
 
 

@@ -192,6 +192,12 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
     maxiter = parseInteger(o, v);
     if (*maxiter < 1) throw UsageError{"--maxiter must be >= 1, got " + v};
   });
+  table.value({"--repair-rounds"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.repairRounds = parseInteger(o, v);
+    if (cmd.repairRounds < 0 || cmd.repairRounds > kMaxRepairRounds)
+      throw UsageError{"--repair-rounds must be from 0 to " + std::to_string(kMaxRepairRounds) +
+                       ", got " + v};
+  });
   table.flag({"--verbose", "-v"}, [&cmd] { ++cmd.verbosity; });
   table.flag({"-vv"}, [&cmd] { cmd.verbosity += 2; });
   cmd.input = onlyInput(table.parse(args, 1, "mesh"), "mesh", "an INPUT CAD or .mcf file");
@@ -351,6 +357,9 @@ options:
       --optimise      curve the interior with the variational optimiser (hyperelastic),
                       boundary nodes sliding on the CAD curves and faces
   -n, --maxiter N     at most N optimiser sweeps (default 100)
+      --repair-rounds N  at most N repair rounds while elements are not proven valid
+                      (split their edges on curved faces, or refine around them; then curve,
+                      optimise and check again); default 3, 0 for none
   -o, --output FILE   write the mesh: .msh (Gmsh 4.1), .vtu (VTK), .xml (Nektar++); repeatable
       --binary        binary MSH, raw appended VTU data
       --compressed    compressed Nektar++ XML (B64Z-LittleEndian)
@@ -359,7 +368,9 @@ options:
   -v, --verbose       show Gmsh's warnings (-vv: and its information)
   -q, --quiet         print nothing but errors
 
-exit status: 0 success, 1 failure (file, CAD or meshing), 2 bad command line or parameter
+exit status: 0 success, 1 failure (file, CAD or meshing), 2 bad command line or parameter,
+4 the mesh was made (and written) but elements are still not proven valid (the report's
+flagged_elements lists them)
 )";
   if (topic == "predict")
     return R"(usage: homesh predict INPUT [options]

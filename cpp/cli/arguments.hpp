@@ -39,6 +39,7 @@ struct MeshCommand {
   SizingFlags sizing;
   int verbosity = 0;           // -v: 1, -vv: 2
   int optimiseIterations = 0;  // --optimise: 100, --maxiter N
+  int repairRounds = 3;        // --repair-rounds N, 0..kMaxRepairRounds
   CommonOptions common;
 };
 

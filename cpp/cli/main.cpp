@@ -23,6 +23,9 @@
 
 namespace {
 
+// `homesh mesh`: the mesh was made and written, but elements are still not proven valid.
+constexpr int kNotProvenValid = 4;
+
 // Prints each stage as it ends, on stderr (stdout may carry the JSON report).
 class StderrProgress : public homesh::PipelineObserver {
  public:
@@ -107,6 +110,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
   options.threads = c.threads;
   options.verbosity = cmd.verbosity;
   options.optimiseIterations = cmd.optimiseIterations;
+  options.repairRounds = cmd.repairRounds;
   StderrProgress progress;
   homesh::PipelineObserver* observer = c.quiet ? nullptr : &progress;
   homesh::MeshResult result = homesh::runMeshPipeline(setup.source, options, observer);
@@ -118,12 +122,27 @@ int runMesh(const homesh::MeshCommand& cmd) {
                  "%.4f; %zu invalid\n",
                  result.mesh.numNodes(), result.mesh.numElements(), result.mesh.order,
                  result.quality.scaled.min, result.quality.scaled.mean, result.quality.invalid);
+    for (std::size_t k = 0; k < result.rounds.size(); ++k) {
+      const homesh::RepairRound& r = result.rounds[k];
+      std::fprintf(stderr,
+                   "homesh: repair %zu: %zu invalid, %zu undecided -> %s %zu elements -> %zu "
+                   "invalid, %zu undecided (%zu elements)%s\n",
+                   k + 1, r.invalid, r.undecided, r.action.c_str(), r.elements, r.invalidAfter,
+                   r.undecidedAfter, r.meshElements, r.kept ? "" : ", not kept");
+    }
     if (cmd.sizing.writeOctree)
       std::fprintf(stderr, "homesh: wrote %s\n", cmd.sizing.writeOctree->c_str());
     for (const std::string& path : c.outputs)
       std::fprintf(stderr, "homesh: wrote %s\n", path.c_str());
   }
   if (c.report) writeReport(*c.report, homesh::meshReportJson(result, cmd.input));
+  // The mesh is written either way; status 4 tells scripts it is not proven valid.
+  if (result.quality.invalid + result.quality.undecided > 0) {
+    if (!c.quiet)
+      std::fprintf(stderr, "homesh: %zu elements invalid, %zu undecided (exit status 4)\n",
+                   result.quality.invalid, result.quality.undecided);
+    return kNotProvenValid;
+  }
   return 0;
 }
 

@@ -14,6 +14,7 @@
 #include "core/format.hpp"
 #include "curving/order_elevation.hpp"
 #include "linear/linear_mesher.hpp"
+#include "pipeline/repair.hpp"
 #include "sizing/octree_export.hpp"
 
 namespace homesh {
@@ -29,6 +30,9 @@ void MeshingOptions::validate() const {
   if (optimiseIterations < 0)
     throw ParameterError("optimiser iterations must be >= 0, got " +
                          std::to_string(optimiseIterations));
+  if (repairRounds < 0 || repairRounds > kMaxRepairRounds)
+    throw ParameterError("repair rounds must be from 0 to " + std::to_string(kMaxRepairRounds) +
+                         ", got " + std::to_string(repairRounds));
   if (size && !octreeOutput.empty())
     throw ParameterError("writing the sizing octree needs octree sizing, not a uniform size");
   if (size && sizing)
@@ -186,6 +190,54 @@ class OptimiserCancel : public OptimiserObserver {
 
 }  // namespace
 
+namespace {
+
+// A curved mesh and what the stages after the linear mesh found.
+struct CurvedState {
+  Mesh linear;
+  Mesh mesh;
+  QualitySummary quality;
+  std::optional<OptimiserResult> optimiser;
+
+  std::size_t notValid() const { return quality.invalid + quality.undecided; }
+  bool betterThan(const CurvedState& other) const {
+    if (notValid() != other.notValid()) return notValid() < other.notValid();
+    return quality.scaled.min > other.quality.scaled.min;
+  }
+};
+
+// Elevation, optimiser and quality of a linear mesh. With `clocked`, each stage is timed
+// under its own name; a repair round times them all as one stage instead.
+CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& cad,
+                  StageTimings& timings, PipelineObserver* observer, bool clocked) {
+  CurvedState state;
+  state.linear = std::move(linear);
+  checkHighOrderMemory(state.linear, options.order);
+  std::optional<StageClock> clock;
+  if (clocked) clock.emplace("high_order", timings, observer);
+  state.mesh = elevateOrder(state.linear, options.order, &cad);
+  if (clocked) clock->done();
+
+  if (options.optimiseIterations > 0) {
+    if (clocked) clock.emplace("optimise", timings, observer);
+    OptimiserOptions o;
+    o.maxIterations = options.optimiseIterations;
+    o.stall = 1e-3;  // valid and no longer improving: stop early
+    o.threads = options.threads;
+    OptimiserCancel cancel(observer);
+    state.optimiser = optimiseMesh(state.mesh, o, &cancel, &cad);
+    if (state.optimiser->cancelled) throw CancelledError("cancelled during optimise");
+    if (clocked) clock->done();
+  }
+
+  if (clocked) clock.emplace("quality", timings, observer);
+  state.quality = evaluateQuality(state.mesh, options.threads);
+  if (clocked) clock->done();
+  return state;
+}
+
+}  // namespace
+
 MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
                            PipelineObserver* observer) {
   options.validate();  // before the (possibly slow) CAD import
@@ -216,29 +268,76 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     linearOptions.size = *options.size;
   }
   StageClock linear("linear", result.timings, observer);
-  const Mesh linearMesh = generateLinearMesh(*result.cad, linearOptions);
+  Mesh linearMesh = generateLinearMesh(*result.cad, linearOptions);
   linear.done();
 
-  checkHighOrderMemory(linearMesh, options.order);
-  StageClock highOrder("high_order", result.timings, observer);
-  result.mesh = elevateOrder(linearMesh, options.order, result.cad.get());
-  highOrder.done();
-
-  if (options.optimiseIterations > 0) {
-    StageClock optimise("optimise", result.timings, observer);
-    OptimiserOptions o;
-    o.maxIterations = options.optimiseIterations;
-    o.stall = 1e-3;  // valid and no longer improving: stop early
-    o.threads = options.threads;
-    OptimiserCancel cancel(observer);
-    result.optimiser = optimiseMesh(result.mesh, o, &cancel, result.cad.get());
-    if (result.optimiser->cancelled) throw CancelledError("cancelled during optimise");
-    optimise.done();
+  CurvedState best =
+      curve(std::move(linearMesh), options, *result.cad, result.timings, observer, true);
+  // Repair rounds: each works from the previous round's mesh; the best state is kept.
+  std::vector<RefinementSource> sources;  // accumulated over the refine rounds
+  std::optional<CurvedState> last;        // the last round's state when it was not kept
+  bool splitFailed = false;  // the last round split and made things worse: refine instead
+  for (int round = 1; round <= options.repairRounds; ++round) {
+    const CurvedState& from = last && !splitFailed ? *last : best;
+    if (from.notValid() == 0) break;
+    StageClock clock("repair " + std::to_string(round), result.timings, observer);
+    const auto start = std::chrono::steady_clock::now();
+    RepairRound record;
+    record.invalid = from.quality.invalid;
+    record.undecided = from.quality.undecided;
+    // Every flagged cell gets edges to split or a refinement sphere: the plan is never empty.
+    const RepairPlan plan = planRepair(from.linear, from.quality.validity, *result.cad);
+    Mesh next;
+    if (!plan.splits.empty() && !splitFailed) {
+      // Local: only the cells around the split edges change; the rest wait for the next round.
+      next = from.linear;
+      record.edgesSplit = applySplits(next, plan.splits, *result.cad);
+    }
+    if (record.edgesSplit > 0) {
+      record.action = "split";
+      record.elements = plan.splitCells;
+    } else {
+      // Nothing to split (or no split kept its cells positive): refine around every offender.
+      const std::vector<RefinementSource>& added =
+          plan.splits.empty() ? plan.sources : plan.allSources;  // (splitFailed: every offender)
+      record.action = "refine";
+      record.elements = added.size();
+      record.sources = added.size();
+      sources.insert(sources.end(), added.begin(), added.end());
+      LinearMeshOptions refined = linearOptions;
+      if (!refined.sizeField) {  // a uniform size: the constant field, capped
+        const double size = linearOptions.size;
+        refined.sizeField = [size](const Eigen::Vector3d&) { return size; };
+        refined.maxSize = size;
+        refined.minSize = size;
+      }
+      refined.sizeField = cappedSizeField(refined.sizeField, sources);
+      for (const RefinementSource& src : sources)
+        refined.minSize = std::min(refined.minSize, src.delta);
+      next = generateLinearMesh(*result.cad, refined);
+    }
+    CurvedState state =
+        curve(std::move(next), options, *result.cad, result.timings, observer, false);
+    record.invalidAfter = state.quality.invalid;
+    record.undecidedAfter = state.quality.undecided;
+    record.meshElements = state.mesh.numElements();
+    record.kept = state.betterThan(best);
+    splitFailed = !record.kept && record.action == "split";
+    if (record.kept) {
+      best = std::move(state);
+      last.reset();
+    } else {
+      last = std::move(state);
+    }
+    record.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.rounds.push_back(record);
+    clock.done();
   }
 
-  StageClock quality("quality", result.timings, observer);
-  result.quality = evaluateQuality(result.mesh, options.threads);
-  quality.done();
+  result.mesh = std::move(best.mesh);
+  result.quality = std::move(best.quality);
+  result.optimiser = std::move(best.optimiser);
 
   StageClock geometry("geometry", result.timings, observer);
   result.geometry = measureGeometryAccuracy(result.mesh, *result.cad, options.threads);

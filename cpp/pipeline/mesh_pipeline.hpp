@@ -20,6 +20,7 @@
 #include "io/mesh_writers.hpp"
 #include "optimise/optimiser.hpp"
 #include "quality/geometry_accuracy.hpp"
+#include "pipeline/repair.hpp"
 #include "quality/mesh_quality.hpp"
 #include "sizing/element_count.hpp"
 #include "sizing/sizing_octree.hpp"
@@ -27,6 +28,7 @@
 namespace homesh {
 
 inline constexpr int kMaxThreads = 1024;
+inline constexpr int kMaxRepairRounds = 20;
 
 struct MeshingOptions {
   int order = 4;  // polynomial order, 1..10
@@ -43,6 +45,10 @@ struct MeshingOptions {
   // is proven valid and no longer improving (OptimiserOptions: "energy", or "stalled" with
   // stall 0.001).
   int optimiseIterations = 0;
+  // Repair rounds (pipeline/repair.hpp) while elements are not proven valid, 0..kMaxRepairRounds:
+  // each splits the offending linear cells' edges on curved faces (or refines around them),
+  // then curves, optimises and checks again. 0: none.
+  int repairRounds = 3;
 
   // Throws ParameterError naming the offending parameter.
   void validate() const;
@@ -136,11 +142,19 @@ struct MeshResult {
   std::optional<OptimiserResult> optimiser;  // when the optimiser ran
   std::optional<SizingResult> sizing;        // when the sizes came from the octree
   std::optional<GeometryAccuracy> geometry;  // boundary against the CAD (a mesh made from CAD)
+  std::vector<RepairRound> rounds;           // the repair rounds run, in order
   StageTimings timings;
   MeshingOptions options;
 };
 
-// Runs every stage. Throws ParameterError, IoError, CadError, MeshingError or CancelledError.
+// Runs every stage: CAD, sizing, linear mesh, elevation, optimiser (optional), quality, then
+// up to options.repairRounds repair rounds while an element is not proven valid (stages
+// "repair 1", ...): each locates those elements in the linear mesh, splits or refines there
+// (planRepair), and elevates, optimises and evaluates the new linear mesh; the next round works
+// from that mesh, except after a split that made the mesh worse than the best: then it refines
+// around the best mesh's offenders instead. The result is the best mesh seen: fewest elements not
+// proven valid, then the best worst scaled Jacobian (a round never makes the result worse). Throws
+// ParameterError, IoError, CadError, MeshingError or CancelledError.
 MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
                            PipelineObserver* observer = nullptr);
 

@@ -187,6 +187,7 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
   appendQuality(json, result.mesh, result.quality);
   if (result.geometry) appendGeometry(json, *result.geometry);
   if (result.optimiser) appendOptimiser(json, *result.optimiser);
+  appendRepairRounds(json, result.rounds);
   json.beginObject("timings_s");
   for (const auto& [stage, s] : result.timings.seconds) json.value(stage, s);
   json.endObject();
@@ -264,6 +265,26 @@ void appendOptimiser(JsonWriter& json, const OptimiserResult& r) {
 std::string optimiseReportJson(const Mesh& mesh, const QualitySummary& quality,
                                const OptimiserResult& result, const std::string& input) {
   return fileReportJson(mesh, quality, &result, input);
+}
+
+void appendRepairRounds(JsonWriter& json, const std::vector<RepairRound>& rounds) {
+  json.beginArray("rounds");
+  for (const RepairRound& r : rounds) {
+    json.beginObject();
+    json.value("invalid", r.invalid);
+    json.value("undecided", r.undecided);
+    json.value("action", r.action);
+    json.value("elements", r.elements);
+    json.value("edges_split", r.edgesSplit);
+    json.value("refinement_spheres", r.sources);
+    json.value("invalid_after", r.invalidAfter);
+    json.value("undecided_after", r.undecidedAfter);
+    json.value("mesh_elements", r.meshElements);
+    json.value("kept", r.kept);
+    json.value("seconds", r.seconds);
+    json.endObject();
+  }
+  json.endArray();
 }
 
 }  // namespace homesh

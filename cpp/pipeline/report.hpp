@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "core/mesh.hpp"
 #include "io/json_writer.hpp"
@@ -36,8 +37,11 @@ void appendSizing(JsonWriter& json, const SizingResult& sizing);
 std::string predictReportJson(const SizingResult& sizing, const std::string& input);
 
 // The report of `homesh mesh`: input, order, size, counts, "predicted_elements" and "sizing"
-// (octree sizing), quality, geometry, timings.
+// (octree sizing), quality, optimiser, repair rounds, geometry, timings.
 std::string meshReportJson(const MeshResult& result, const std::string& input);
+
+// Appends "rounds": one record per repair round (pipeline/repair.hpp), in order; [] when none ran.
+void appendRepairRounds(JsonWriter& json, const std::vector<RepairRound>& rounds);
 
 // The report of `homesh quality`: input, order, counts, quality.
 std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,

@@ -328,9 +328,10 @@ SizingParameters sizingFrom(const bp::dict& d) {
 }
 
 MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity,
-                           int optimise, const bp::object& sizing = bp::object()) {
+                           int optimise, const bp::object& sizing, int repairRounds) {
   MeshingOptions options;
   options.optimiseIterations = optimise;
+  options.repairRounds = repairRounds;
   options.order = order;
   if (!size.is_none()) options.size = bp::extract<double>(size);
   if (!sizing.is_none()) options.sizing = sizingFrom(bp::extract<bp::dict>(sizing));
@@ -378,9 +379,11 @@ PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::o
 
 // A CAD file or a NekMesh .mcf case: a case's CAD and sizes (unless given here) are used.
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
-                int verbosity, bp::object progress, int optimise, const bp::object& sizing) {
+                int verbosity, bp::object progress, int optimise, const bp::object& sizing,
+                int repairRounds) {
   const CaseSetup setup = setupCase(path);
-  MeshingOptions options = makeOptions(order, size, threads, verbosity, optimise, sizing);
+  MeshingOptions options =
+      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds);
   if (!options.size && !options.sizing) options.sizing = setup.options.sizing;
   options.expectedDimension = setup.options.expectedDimension;
   return runPipeline(setup.source, options, std::move(progress));
@@ -388,9 +391,9 @@ PyMesh meshFile(const std::string& path, int order, const bp::object& size, int 
 
 PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
                 int threads, int verbosity, bp::object progress, int optimise,
-                const bp::object& sizing) {
+                const bp::object& sizing, int repairRounds) {
   return runPipeline(CadSource::brepText(text, name),
-                     makeOptions(order, size, threads, verbosity, optimise, sizing),
+                     makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds),
                      std::move(progress));
 }
 
@@ -530,14 +533,14 @@ BOOST_PYTHON_MODULE(_core) {
       .def("report_json", &PyMesh::reportJson)
       .def("optimise", &PyMesh::optimise);
 
-  bp::def(
-      "mesh_file", &meshFile,
-      (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"), bp::arg("verbosity"),
-       bp::arg("progress"), bp::arg("optimise") = 0, bp::arg("sizing") = bp::object()));
+  bp::def("mesh_file", &meshFile,
+          (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
+           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
+           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = 3));
   bp::def("mesh_brep", &meshBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
            bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
-           bp::arg("sizing") = bp::object()));
+           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = 3));
   bp::def("predict_file", &predictFile,
           (bp::arg("path"), bp::arg("sizing") = bp::object(), bp::arg("octree_path") = "",
            bp::arg("threads") = 1));

@@ -109,6 +109,12 @@ class HighOrderMeshProxy(_Proxy):
                             "it stops earlier once the mesh is valid and no longer improving); "
                             "boundary nodes slide on the CAD")
             obj.OptimiserIterations = (20, 0, 1000, 1)
+        if "RepairRounds" not in have:
+            obj.addProperty("App::PropertyIntegerConstraint", "RepairRounds", "Mesh",
+                            "Most repair rounds while elements are not proven valid (split "
+                            "their edges on curved faces or refine around them, then curve, "
+                            "optimise and check again); 0: none")
+            obj.RepairRounds = (3, 0, 20, 1)
         if "MeshData" not in have:
             obj.addProperty("App::PropertyFileIncluded", "MeshData", "Result",
                             "The curved mesh, stored in the document")
@@ -145,7 +151,8 @@ class HighOrderMeshProxy(_Proxy):
         progress = _Progress(obj.Label)
         try:
             mesh = homesh.mesh(shape, order=obj.Order, size=size, progress=progress,
-                               name=obj.Part.Label, optimise=obj.OptimiserIterations, **sizing)
+                               name=obj.Part.Label, optimise=obj.OptimiserIterations,
+                               repair_rounds=obj.RepairRounds, **sizing)
         except homesh.HOMeshError as e:
             FreeCAD.Console.PrintError("HOMesh: %s: %s\n" % (obj.Label, e))
             raise

@@ -79,6 +79,8 @@ class HighOrderMeshObject(unittest.TestCase):
         part = box_with_hole(self.doc)
         obj = homesh.freecad.make_high_order_mesh(self.doc, part, order=4, size=1.0)
         self.assertEqual(obj.OptimiserIterations, 20)
+        self.assertEqual(obj.RepairRounds, 3)
+        obj.RepairRounds = 0  # the optimiser alone, on the same linear mesh
         obj.OptimiserIterations = 0
         self.doc.recompute()
         plain = obj.MinScaledJacobian

@@ -41,6 +41,16 @@ TEST(Arguments, Defaults) {
   EXPECT_TRUE(p.mesh.common.outputs.empty());
 }
 
+TEST(Arguments, RepairRounds) {
+  EXPECT_EQ(parse({"mesh", "part.brep"}).mesh.repairRounds, 3);
+  EXPECT_EQ(parse({"mesh", "part.brep", "--repair-rounds", "0"}).mesh.repairRounds, 0);
+  EXPECT_EQ(parse({"mesh", "part.brep", "--repair-rounds", "20"}).mesh.repairRounds, 20);
+  for (const char* bad : {"-1", "21", "2.5", "x"})
+    EXPECT_NE(usageError({"mesh", "part.brep", "--repair-rounds", bad}).find("--repair-rounds"),
+              std::string::npos)
+        << bad;
+}
+
 TEST(Arguments, SizingAndPredict) {
   const ParsedCommand p =
       parse({"predict", "case.mcf", "--max-delta", "0.5", "--eps", "0.1", "--refine-sphere",

@@ -1,0 +1,255 @@
+#include "pipeline/repair.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <limits>
+#include <map>
+#include <utility>
+
+#include "core/error.hpp"
+
+namespace homesh {
+namespace {
+
+Eigen::Vector3d nodePoint(const Mesh& mesh, std::int64_t i) {
+  return {mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]};
+}
+
+MeshEdge sortedEdge(std::int64_t a, std::int64_t b) {
+  return a < b ? MeshEdge{a, b} : MeshEdge{b, a};
+}
+
+// The linear cells of dimension mesh.dim, in element order.
+std::vector<const std::int64_t*> cellsOf(const Mesh& mesh) {
+  std::vector<const std::int64_t*> cells;
+  for (const ElementBlock& block : mesh.blocks) {
+    if (cellDimension(block.type) != mesh.dim) continue;
+    if (block.order != 1 || cellNumVertices(block.type) != mesh.dim + 1)
+      throw ParameterError("repair needs a linear simplex mesh, got " + cellShortName(block.type) +
+                           "s of order " + std::to_string(block.order));
+    for (std::size_t e = 0; e < block.count(); ++e) cells.push_back(block.element(e));
+  }
+  return cells;
+}
+
+// The point of CAD face (3D) or curve (2D) `entity` nearest to x, and the unit normal there (the
+// face's du x dv; for a curve, the plane normal x tangent).
+std::pair<Eigen::Vector3d, Eigen::Vector3d> footAndNormal(const Mesh& mesh, const CadModel& cad,
+                                                          int entity, const Eigen::Vector3d& x) {
+  if (mesh.dim == 3) {
+    const SurfaceProjection proj = cad.projectOnSurface(entity, x);
+    const SurfaceDerivatives d = cad.evaluateSurface(entity, proj.u, proj.v);
+    const Eigen::Vector3d n = d.du.cross(d.dv);
+    const double norm = n.norm();
+    return {proj.point, norm > 0.0 ? Eigen::Vector3d(n / norm) : Eigen::Vector3d::Zero()};
+  }
+  const CurveProjection proj = cad.projectOnCurve(entity, x);
+  const CurveDerivatives d = cad.evaluateCurve(entity, proj.t);
+  const Eigen::Vector3d plane(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
+  const Eigen::Vector3d n = plane.cross(d.d1);
+  const double norm = n.norm();
+  return {proj.point, norm > 0.0 ? Eigen::Vector3d(n / norm) : Eigen::Vector3d::Zero()};
+}
+
+// Signed distance of x to the face along its normal at x's foot point.
+double signedDistance(const Mesh& mesh, const CadModel& cad, int entity, const Eigen::Vector3d& x) {
+  const auto [foot, normal] = footAndNormal(mesh, cad, entity, x);
+  return (x - foot).dot(normal);
+}
+
+// Where the new node of a split goes (see applySplits in repair.hpp): the midpoint, or its
+// mirror image in the face when the cells around the edge lie on the other side.
+Eigen::Vector3d splitPoint(const Mesh& mesh, const CadModel& cad, const CurvedFaceEdge& split) {
+  const Eigen::Vector3d a = nodePoint(mesh, split.edge[0]), b = nodePoint(mesh, split.edge[1]);
+  const Eigen::Vector3d mid = 0.5 * (a + b);
+  const auto [foot, normal] = footAndNormal(mesh, cad, split.entity, mid);
+  const double depth = (mid - foot).dot(normal);
+  if (normal.isZero() || depth == 0.0) return mid;
+  // Which side the cells around the edge are on: the vote of their other vertices that are
+  // clearly off the face (a fraction of the edge length; vertices on the face say nothing).
+  const double clear = 1e-6 * (b - a).norm();
+  int side = 0;
+  std::vector<std::int64_t> seen;
+  for (const ElementBlock& block : mesh.blocks) {
+    if (cellDimension(block.type) != mesh.dim) continue;
+    const int nv = cellNumVertices(block.type);
+    for (std::size_t e = 0; e < block.count(); ++e) {
+      const std::int64_t* v = block.element(e);
+      if (std::find(v, v + nv, split.edge[0]) == v + nv ||
+          std::find(v, v + nv, split.edge[1]) == v + nv)
+        continue;
+      for (int k = 0; k < nv; ++k) {
+        if (v[k] == split.edge[0] || v[k] == split.edge[1]) continue;
+        if (std::find(seen.begin(), seen.end(), v[k]) != seen.end()) continue;
+        seen.push_back(v[k]);
+        const double s = signedDistance(mesh, cad, split.entity, nodePoint(mesh, v[k]));
+        if (s > clear) ++side;
+        if (s < -clear) --side;
+      }
+    }
+  }
+  if (side == 0 || (side > 0) == (depth > 0.0)) return mid;
+  return foot - depth * normal;  // the mirror image: as far from the face, on the cells' side
+}
+
+}  // namespace
+
+CurvedFaceEdges::CurvedFaceEdges(const Mesh& linear, const CadModel& cad)
+    : mesh_(linear),
+      nodeFaces_(linear.numNodes()),
+      boundary_(boundaryEdges(linear)),
+      cells_(cellsOf(linear)) {
+  std::map<int, bool> curved;
+  std::set<MeshEdge> curveEdges;  // 3D: edges on CAD curves (their nodes would go on the curve)
+  for (const ElementBlock& block : linear.blocks)
+    if (linear.dim == 3 && block.type == CellType::Line && block.order == 1)
+      for (std::size_t e = 0; e < block.count(); ++e)
+        curveEdges.insert(sortedEdge(block.element(e)[0], block.element(e)[1]));
+  for (const ElementBlock& block : linear.blocks) {
+    if (cellDimension(block.type) != linear.dim - 1 || block.order != 1) continue;
+    const int nv = cellNumVertices(block.type);
+    for (std::size_t e = 0; e < block.count(); ++e) {
+      const int entity = block.entity[e];
+      if (entity <= 0) continue;
+      auto it = curved.find(entity);
+      if (it == curved.end())
+        it = curved.emplace(entity, linear.dim == 2 || !cad.isPlanar(entity)).first;
+      if (!it->second) continue;
+      const std::int64_t* v = block.element(e);
+      for (int k = 0; k < nv; ++k) {
+        std::vector<int>& faces = nodeFaces_[static_cast<std::size_t>(v[k])];
+        if (std::find(faces.begin(), faces.end(), entity) == faces.end()) faces.push_back(entity);
+        if (nv == 2 && k == 1) break;  // a line has one edge
+        const MeshEdge edge = sortedEdge(v[k], v[(k + 1) % nv]);
+        if (curveEdges.count(edge) == 0) faceEdges_.emplace(edge, entity);
+      }
+    }
+  }
+  for (std::vector<int>& faces : nodeFaces_) std::sort(faces.begin(), faces.end());
+}
+
+std::vector<CurvedFaceEdge> CurvedFaceEdges::interior(std::size_t cell) const {
+  std::vector<CurvedFaceEdge> found;
+  const std::int64_t* v = cells_.at(cell);
+  const int nv = mesh_.dim + 1;
+  for (int i = 0; i < nv; ++i)
+    for (int j = i + 1; j < nv; ++j) {
+      const MeshEdge edge = sortedEdge(v[i], v[j]);
+      if (boundary_.count(edge) > 0) continue;
+      const std::vector<int>& fa = nodeFaces_[static_cast<std::size_t>(edge[0])];
+      const std::vector<int>& fb = nodeFaces_[static_cast<std::size_t>(edge[1])];
+      std::vector<int> common;
+      std::set_intersection(fa.begin(), fa.end(), fb.begin(), fb.end(), std::back_inserter(common));
+      if (!common.empty()) found.push_back({edge, common.front(), false});
+    }
+  return found;
+}
+
+std::optional<CurvedFaceEdge> CurvedFaceEdges::longestOnFace(std::size_t cell) const {
+  std::optional<CurvedFaceEdge> found;
+  double longest = 0.0;
+  const std::int64_t* v = cells_.at(cell);
+  const int nv = mesh_.dim + 1;
+  for (int i = 0; i < nv; ++i)
+    for (int j = i + 1; j < nv; ++j) {
+      const MeshEdge edge = sortedEdge(v[i], v[j]);
+      const auto it = faceEdges_.find(edge);
+      if (it == faceEdges_.end()) continue;
+      const double length = (nodePoint(mesh_, v[i]) - nodePoint(mesh_, v[j])).norm();
+      if (length > longest) {
+        longest = length;
+        found = CurvedFaceEdge{edge, it->second, true};
+      }
+    }
+  return found;
+}
+
+RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
+                      const CadModel& cad) {
+  const CurvedFaceEdges finder(linear, cad);
+  const std::vector<const std::int64_t*> cells = cellsOf(linear);
+  if (validity.size() != cells.size())
+    throw ParameterError("repair: " + std::to_string(validity.size()) +
+                         " verdicts for a linear mesh of " + std::to_string(cells.size()) +
+                         " cells");
+  RepairPlan plan;
+  std::set<MeshEdge> planned;
+  const int nv = linear.dim + 1;
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    if (validity[c] == Validity::Valid) continue;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    double longest = 0.0, total = 0.0;
+    int edgeCount = 0;
+    for (int i = 0; i < nv; ++i) {
+      centroid += nodePoint(linear, cells[c][i]) / nv;
+      for (int j = i + 1; j < nv; ++j) {
+        const double l = (nodePoint(linear, cells[c][i]) - nodePoint(linear, cells[c][j])).norm();
+        longest = std::max(longest, l);
+        total += l;
+        ++edgeCount;
+      }
+    }
+    const RefinementSource sphere =
+        RefinementSource::sphere(centroid, longest, 0.5 * total / edgeCount);
+    plan.allSources.push_back(sphere);
+    std::vector<CurvedFaceEdge> edges = finder.interior(c);
+    if (edges.empty())
+      if (const auto onFace = finder.longestOnFace(c)) edges.push_back(*onFace);
+    if (!edges.empty()) {
+      ++plan.splitCells;
+      for (const CurvedFaceEdge& e : edges)
+        if (planned.insert(e.edge).second) plan.splits.push_back(e);
+      continue;
+    }
+    ++plan.refineCells;
+    plan.sources.push_back(sphere);
+  }
+  return plan;
+}
+
+std::size_t applySplits(Mesh& linear, const std::vector<CurvedFaceEdge>& splits,
+                        const CadModel& cad) {
+  std::size_t done = 0;
+  for (const CurvedFaceEdge& split : splits) {
+    const Eigen::Vector3d mid =
+        0.5 * (nodePoint(linear, split.edge[0]) + nodePoint(linear, split.edge[1]));
+    if (split.boundary) {
+      SplitNode node;
+      if (linear.dim == 3) {
+        const SurfaceProjection proj = cad.projectOnSurface(split.entity, mid);
+        node.point = proj.point;
+        node.cadDim = 2;
+        node.param0 = proj.u;
+        node.param1 = proj.v;
+      } else {
+        const CurveProjection proj = cad.projectOnCurve(split.entity, mid);
+        node.point = proj.point;
+        node.cadDim = 1;
+        node.param0 = proj.t;
+      }
+      node.cadIndex = split.entity;
+      if (splitEdge(linear, split.edge, node)) ++done;
+      continue;
+    }
+    const Eigen::Vector3d point = splitPoint(linear, cad, split);
+    // The midpoint always halves positive cells into positive cells.
+    if (!splitInteriorEdge(linear, split.edge, point) &&
+        !splitInteriorEdge(linear, split.edge, mid))
+      throw MeshingError("repair: splitting an edge at its midpoint made a flat cell");
+    ++done;
+  }
+  return done;
+}
+
+SizeField cappedSizeField(SizeField base, std::vector<RefinementSource> sources, double growth) {
+  return [base = std::move(base), sources = std::move(sources), growth](const Eigen::Vector3d& x) {
+    double size = base(x);
+    for (const RefinementSource& s : sources)
+      size = std::min(size, s.delta + growth * s.distance(x));
+    return size;
+  };
+}
+
+}  // namespace homesh

@@ -1,0 +1,106 @@
+// Repair of the elements that curving left not proven valid: where they come from in the linear
+// mesh, and what to change there.
+//
+// The classic offender is a linear cell with an interior edge whose two ends lie on one curved
+// CAD face (in 2D: curve), for example a tetrahedron with two faces on a sphere: curving moves
+// the boundary around the edge but not the edge, and no placement of interior nodes can make
+// the element valid. Splitting that edge (a new interior node, every cell around the edge
+// halved) removes the configuration. A cell without such an edge is refined instead: a
+// refinement sphere around it asks the linear mesher for smaller elements there.
+//
+// The curved mesh's elements come from the linear cells with the same index (elevation keeps
+// the cell order), so a verdict per curved element points at its linear cell.
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "cad/cad_model.hpp"
+#include "core/mesh.hpp"
+#include "linear/edge_split.hpp"
+#include "linear/linear_mesher.hpp"
+#include "quality/bezier_jacobian.hpp"
+#include "sizing/refinement_source.hpp"
+
+namespace homesh {
+
+// One repair round, as the report records it.
+struct RepairRound {
+  std::size_t invalid = 0, undecided = 0;  // elements not proven valid that the round found
+  std::string action;                      // "split", "refine" or "none" (nothing to act on)
+  std::size_t elements = 0;                // linear cells it acted on
+  std::size_t edgesSplit = 0;              // edges bisected ("split")
+  std::size_t sources = 0;                 // refinement spheres added ("refine")
+  std::size_t invalidAfter = 0, undecidedAfter = 0;  // of the mesh the round made
+  std::size_t meshElements = 0;                      // elements of the mesh the round made
+  bool kept = false;  // the round's mesh is no worse than the best before it and was kept
+  double seconds = 0.0;
+};
+
+struct CurvedFaceEdge {
+  MeshEdge edge;
+  int entity = 0;         // the curved CAD face (curve in 2D) both ends lie on
+  bool boundary = false;  // the edge lies on that face (else it is an interior chord)
+};
+
+// The edges of linear cells whose two ends lie on one curved CAD face (3D: a face that is not
+// planar; 2D: any curve), found from the boundary cells: a node lies on a CAD face when a
+// boundary triangle of that face (line, in 2D) has it.
+class CurvedFaceEdges {
+ public:
+  CurvedFaceEdges(const Mesh& linear, const CadModel& cad);
+  // The interior edges (on no boundary cell) of cell `cell` (index among the cells of dimension
+  // mesh.dim) with both ends on one curved face: chords that curving cannot follow.
+  std::vector<CurvedFaceEdge> interior(std::size_t cell) const;
+  // The longest edge of cell `cell` that lies on a curved face (3D: an edge of that face's
+  // boundary triangles and of no CAD curve; 2D: a boundary line), if any: where curving moves
+  // the cell's boundary most.
+  std::optional<CurvedFaceEdge> longestOnFace(std::size_t cell) const;
+
+ private:
+  const Mesh& mesh_;
+  std::vector<std::vector<int>> nodeFaces_;  // curved CAD faces per node, sorted
+  std::set<MeshEdge> boundary_;
+  std::map<MeshEdge, int> faceEdges_;  // edges on a curved face (not on a CAD curve in 3D)
+  std::vector<const std::int64_t*> cells_;
+};
+
+// What a round does on the linear mesh.
+struct RepairPlan {
+  std::vector<CurvedFaceEdge> splits;        // distinct edges to bisect
+  std::vector<RefinementSource> sources;     // spheres around the flagged cells without such edges
+  std::vector<RefinementSource> allSources;  // spheres around every flagged cell
+  std::size_t splitCells = 0, refineCells = 0;
+};
+
+// Locates the elements whose verdict is not Valid (`validity` per element of the curved mesh,
+// in element order) in `linear`. A flagged cell with interior edges on one curved face gets
+// those split; else one with an edge on a curved face gets its longest such edge split (the
+// face's triangles there are halved, which halves the sagitta curving has to follow); else it
+// gets a sphere of radius its longest edge, centred at its centroid, of size half its mean edge
+// length. Throws ParameterError when `validity` does not match the linear mesh's cell count.
+RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
+                      const CadModel& cad);
+
+// Splits the plan's edges in turn (linear/edge_split.hpp) and returns how many it split. An
+// interior edge's new node goes at its midpoint when that lies on the solid's side of the curved
+// face (the side of the cells around the edge, from the signed distances of their other
+// vertices to the face); where the chord crosses to the other side (a tetrahedron outside a
+// convex face), it goes to the mirror image of the midpoint in the face, and back to the
+// midpoint if that would make a cell of non-positive volume. A boundary edge's new node is the
+// midpoint projected onto its face (curve), with its parameters; such an edge is skipped when
+// that would make a cell of non-positive volume.
+std::size_t applySplits(Mesh& linear, const std::vector<CurvedFaceEdge>& splits,
+                        const CadModel& cad);
+
+// `base` capped by the refinement spheres, each growing by `growth` per unit distance outside
+// its sphere (size(x) = min(base(x), min over sources (delta + growth * distance))).
+inline constexpr double kRepairSizeGrowth = 1.0;
+SizeField cappedSizeField(SizeField base, std::vector<RefinementSource> sources,
+                          double growth = kRepairSizeGrowth);
+
+}  // namespace homesh

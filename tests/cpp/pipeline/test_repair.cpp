@@ -1,0 +1,188 @@
+// Repair rounds: the edge split alone (volumes, orientation, no chord left on a curved face) and
+// the pipeline on the sphere in a box, which curving alone leaves invalid.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "core/error.hpp"
+#include "linear/edge_split.hpp"
+#include "linear/linear_mesher.hpp"
+#include "pipeline/mesh_pipeline.hpp"
+#include "pipeline/repair.hpp"
+#include "pipeline/report.hpp"
+#include "test_support.hpp"
+
+namespace homesh {
+namespace {
+
+const std::string kSphereBox = std::string(HOMESH_SOURCE_DIR) + "/examples/sphere_box.step";
+
+std::vector<double> cellVolumes(const Mesh& mesh) {
+  std::vector<double> v;
+  for (const ElementBlock& b : mesh.blocks)
+    if (b.type == CellType::Tetrahedron)
+      for (std::size_t e = 0; e < b.count(); ++e) v.push_back(simplexVolume(mesh, b.element(e)));
+  return v;
+}
+
+std::size_t countTriangles(const Mesh& mesh) {
+  std::size_t n = 0;
+  for (const ElementBlock& b : mesh.blocks)
+    if (b.type == CellType::Triangle) n += b.count();
+  return n;
+}
+
+// Every cell's interior chords on a curved face.
+std::vector<CurvedFaceEdge> allChords(const Mesh& mesh, const CadModel& cad) {
+  const CurvedFaceEdges finder(mesh, cad);
+  std::vector<CurvedFaceEdge> chords;
+  std::set<MeshEdge> seen;
+  for (std::size_t c = 0; c < mesh.numElements(); ++c)
+    for (const CurvedFaceEdge& e : finder.interior(c))
+      if (seen.insert(e.edge).second) chords.push_back(e);
+  return chords;
+}
+
+// The octahedron inscribed in the unit sphere, cut into four tetrahedra around its axis: the axis
+// is an interior edge whose ends both lie on the sphere (each tetrahedron has two faces on it).
+Mesh octahedronAroundItsAxis() {
+  Mesh mesh;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double p[6][3] = {{0, 0, -1}, {0, 0, 1}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
+  for (const auto& x : p) mesh.addNode(x, 2, 1, nan, nan);
+  ElementBlock tets, tris;
+  tris.type = CellType::Triangle;
+  for (std::int64_t k = 0; k < 4; ++k) {
+    const std::int64_t a = 2 + k, b = 2 + (k + 1) % 4;
+    std::vector<std::int64_t> t{0, 1, a, b};
+    if (simplexVolume(mesh, t.data()) < 0.0) std::swap(t[2], t[3]);
+    tets.nodes.insert(tets.nodes.end(), t.begin(), t.end());
+    tets.entity.push_back(1);
+    for (const std::int64_t pole : {0, 1}) {
+      tris.nodes.insert(tris.nodes.end(), {pole, a, b});
+      tris.entity.push_back(1);
+    }
+  }
+  mesh.blocks = {tets, tris};
+  mesh.checkConsistency();
+  return mesh;
+}
+
+TEST(EdgeSplit, SplittingTheChordsOfABallKeepsVolumesAndLeavesNoChord) {
+  const CadModel cad = test::toModel(test::sphere(1.0));
+  ASSERT_EQ(cad.numFaces(), 1);
+  Mesh mesh = octahedronAroundItsAxis();
+  const std::vector<CurvedFaceEdge> chords = allChords(mesh, cad);
+  ASSERT_EQ(chords.size(), 1u);  // the axis
+  const std::vector<double> before = cellVolumes(mesh);
+  const double total = std::accumulate(before.begin(), before.end(), 0.0);
+  const std::size_t triangles = countTriangles(mesh);
+
+  EXPECT_EQ(applySplits(mesh, chords, cad), chords.size());
+  const std::vector<double> after = cellVolumes(mesh);
+  EXPECT_GT(after.size(), before.size());
+  for (const double v : after) EXPECT_GT(v, 0.0);
+  // Inside a convex ball every chord's midpoint is on the ball's side, so the new nodes are the
+  // midpoints and each cell is halved exactly: the total changes only by rounding, a few
+  // ulps of each cell's determinant (|v| <= 1, a handful of cells): 1e-14 relative.
+  EXPECT_NEAR(std::accumulate(after.begin(), after.end(), 0.0), total, 1e-14 * total);
+  EXPECT_EQ(after.size(), 8u);
+  EXPECT_EQ(countTriangles(mesh), triangles);  // interior splits leave the boundary alone
+  EXPECT_TRUE(allChords(mesh, cad).empty());
+  mesh.checkConsistency();
+}
+
+TEST(EdgeSplit, MidpointHalvesEveryCellAroundTheEdge) {
+  const CadModel cad = test::toModel(test::box(1, 1, 1));
+  Mesh mesh = generateLinearMesh(cad, LinearMeshOptions::uniform(0.4));
+  const std::set<MeshEdge> boundary = boundaryEdges(mesh);
+  // The first interior edge of the cells.
+  MeshEdge edge{-1, -1};
+  const ElementBlock& tets = mesh.blocks.front();
+  for (std::size_t e = 0; e < tets.count() && edge[0] < 0; ++e)
+    for (int i = 0; i < 4 && edge[0] < 0; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        const std::int64_t a = tets.element(e)[i], b = tets.element(e)[j];
+        const MeshEdge candidate = a < b ? MeshEdge{a, b} : MeshEdge{b, a};
+        if (boundary.count(candidate) == 0) {
+          edge = candidate;
+          break;
+        }
+      }
+  ASSERT_GE(edge[0], 0);
+  const std::vector<double> before = cellVolumes(mesh);
+  const std::size_t nodes = mesh.numNodes();
+  const Eigen::Vector3d a(&mesh.xyz[3 * edge[0]]), b(&mesh.xyz[3 * edge[1]]);
+  ASSERT_TRUE(splitInteriorEdge(mesh, edge, 0.5 * (a + b)));
+  EXPECT_EQ(mesh.numNodes(), nodes + 1);
+  EXPECT_EQ(mesh.nodeCadDim.back(), 3);
+  const std::vector<double> after = cellVolumes(mesh);
+  // Each cell around the edge kept its slot with half its volume; its other half was appended.
+  // Halving is exact up to the determinant's rounding (a few ulps of |v|, v <= 1): 1e-15.
+  std::size_t halved = 0;
+  for (std::size_t k = 0; k < before.size(); ++k)
+    if (std::abs(after[k] - before[k]) > 1e-15) {
+      EXPECT_NEAR(after[k], 0.5 * before[k], 1e-15);
+      ++halved;
+    }
+  EXPECT_EQ(after.size(), before.size() + halved);
+  EXPECT_GE(halved, 3u);  // an interior edge has at least three cells around it
+  // Splitting a boundary edge as if it were interior is refused; so is a point that would turn
+  // a cell inside out (far beyond the edge), leaving the mesh unchanged.
+  const MeshEdge onBoundary = *boundary.begin();
+  EXPECT_THROW(splitInteriorEdge(mesh, onBoundary, Eigen::Vector3d::Zero()), ParameterError);
+  // Beyond a on the line through the new edge (a, m): the half that keeps a turns over.
+  const auto m = static_cast<std::int64_t>(mesh.numNodes() - 1);
+  const Eigen::Vector3d mid(&mesh.xyz[3 * m]);
+  EXPECT_FALSE(splitInteriorEdge(mesh, {edge[0], m}, a + 5.0 * (a - mid)));
+  EXPECT_EQ(cellVolumes(mesh).size(), after.size());
+  EXPECT_EQ(mesh.numNodes(), nodes + 1);
+}
+
+// The sphere in a box at size 1.2, order 4: curving and 20 optimiser sweeps leave invalid
+// elements (tetrahedra outside the sphere with an edge or a face on it); repair rounds must end
+// with every element proven valid, by local changes (a few more elements, not a finer mesh).
+TEST(RepairRounds, SphereInBoxEndsProvenValid) {
+  MeshingOptions options;
+  options.order = 4;
+  options.size = 1.2;
+  options.optimiseIterations = 20;
+  options.repairRounds = 0;
+  const MeshResult without = runMeshPipeline(CadSource::file(kSphereBox), options);
+  ASSERT_GT(without.quality.invalid + without.quality.undecided, 0u)
+      << "the case no longer needs repair: choose a coarser one";
+  EXPECT_TRUE(without.rounds.empty());
+
+  options.repairRounds = 3;
+  const MeshResult result = runMeshPipeline(CadSource::file(kSphereBox), options);
+  ASSERT_GE(result.rounds.size(), 1u);
+  EXPECT_EQ(result.quality.invalid, 0u);
+  EXPECT_EQ(result.quality.undecided, 0u);
+  EXPECT_GT(result.quality.scaled.min, 0.0);
+  EXPECT_EQ(result.rounds.front().invalid, without.quality.invalid);
+  EXPECT_LT(result.mesh.numElements(), without.mesh.numElements() * 3 / 2);
+  bool timed = false;
+  for (const auto& [stage, s] : result.timings.seconds) timed = timed || stage == "repair 1";
+  EXPECT_TRUE(timed);
+  const std::string json = meshReportJson(result, "sphere_box");
+  const std::size_t rounds = json.find("\"rounds\": [");
+  ASSERT_NE(rounds, std::string::npos);
+  EXPECT_EQ(json.find("\"invalid\": " + std::to_string(without.quality.invalid), rounds),
+            json.find("\"invalid\"", rounds));
+  EXPECT_NE(json.find("\"action\": \"", rounds), std::string::npos);
+}
+
+TEST(RepairRounds, RoundsAreValidated) {
+  MeshingOptions options;
+  options.repairRounds = -1;
+  EXPECT_THROW(options.validate(), ParameterError);
+  options.repairRounds = kMaxRepairRounds + 1;
+  EXPECT_THROW(options.validate(), ParameterError);
+  options.repairRounds = 0;
+  EXPECT_NO_THROW(options.validate());
+}
+
+}  // namespace
+}  // namespace homesh

@@ -1,0 +1,80 @@
+"""Repair rounds from the command line and Python: `--repair-rounds 0` leaves the invalid
+elements of the sphere in a box and exits with status 4 (mesh written), rounds are recorded in
+the report, and bad round counts are refused. Without the optimiser, so each run takes seconds."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+import homesh
+from conftest import run
+
+SPHERE_BOX = Path(__file__).resolve().parents[2] / "examples" / "sphere_box.step"
+# Order 4 at size 1.2: curving alone leaves tetrahedra outside the sphere invalid.
+CASE = ["--size", "1.2", "--order", "4"]
+ROUND_KEYS = {"invalid", "undecided", "action", "elements", "edges_split", "refinement_spheres",
+              "invalid_after", "undecided_after", "mesh_elements", "kept", "seconds"}
+
+
+def _mesh(homesh_bin, tmp_path, rounds):
+    msh, report = tmp_path / ("r%d.msh" % rounds), tmp_path / ("r%d.json" % rounds)
+    result = run([homesh_bin, "mesh", SPHERE_BOX, *CASE, "--repair-rounds", rounds, "-o", msh,
+                  "--report", report])
+    return result, msh, json.loads(report.read_text())
+
+
+def test_no_rounds_exits_4_with_the_mesh_written(homesh_bin, tmp_path):
+    result, msh, report = _mesh(homesh_bin, tmp_path, 0)
+    quality = report["quality"]
+    assert quality["invalid_elements"] > 0, "the case no longer needs repair"
+    assert result.returncode == 4, result.stderr
+    assert "exit status 4" in result.stderr
+    assert msh.is_file()
+    assert report["rounds"] == []
+    assert not any(stage.startswith("repair") for stage in report["timings_s"])
+    assert len(quality["flagged_elements"]) == quality["invalid_elements"] + \
+        quality["undecided_elements"]
+
+
+def test_rounds_are_recorded(homesh_bin, tmp_path):
+    _, _, before = _mesh(homesh_bin, tmp_path, 0)
+    result, _, report = _mesh(homesh_bin, tmp_path, 3)
+    rounds = report["rounds"]
+    assert 1 <= len(rounds) <= 3
+    for r in rounds:
+        assert set(r) == ROUND_KEYS
+        assert r["action"] in ("split", "refine")
+        assert r["elements"] > 0 and r["seconds"] >= 0
+    first = rounds[0]
+    assert (first["invalid"], first["undecided"]) == \
+        (before["quality"]["invalid_elements"], before["quality"]["undecided_elements"])
+    # Each round starts from the previous one's mesh.
+    for a, b in zip(rounds, rounds[1:]):
+        assert (b["invalid"], b["undecided"]) == (a["invalid_after"], a["undecided_after"])
+    quality = report["quality"]
+    not_valid = quality["invalid_elements"] + quality["undecided_elements"]
+    assert not_valid < first["invalid"] + first["undecided"]
+    assert result.returncode == (4 if not_valid else 0), result.stderr
+    assert [s for s in report["timings_s"] if s.startswith("repair")] == \
+        ["repair %d" % (k + 1) for k in range(len(rounds))]
+
+
+@pytest.mark.parametrize("rounds", ["-1", "21", "two"])
+def test_bad_round_counts_are_refused(homesh_bin, rounds):
+    result = run([homesh_bin, "mesh", SPHERE_BOX, *CASE, "--repair-rounds", rounds])
+    assert result.returncode == 2, result.stderr
+    assert "--repair-rounds" in result.stderr
+
+
+def test_python_repair_rounds():
+    without = homesh.mesh(str(SPHERE_BOX), order=4, size=1.2, repair_rounds=0).report()
+    assert without["rounds"] == [] and without["quality"]["invalid_elements"] > 0
+    one = homesh.mesh(str(SPHERE_BOX), order=4, size=1.2, repair_rounds=1).report()
+    assert len(one["rounds"]) == 1
+    assert one["rounds"][0]["invalid"] == without["quality"]["invalid_elements"]
+    for bad in (-1, 21):
+        with pytest.raises(homesh.ParameterError, match="repair rounds"):
+            homesh.mesh(str(SPHERE_BOX), order=4, size=1.2, repair_rounds=bad)
+    with pytest.raises(homesh.ParameterError, match="repair_rounds"):
+        homesh.mesh(str(SPHERE_BOX), order=4, size=1.2, repair_rounds=1.5)
