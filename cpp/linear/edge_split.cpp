@@ -11,14 +11,6 @@
 namespace homesh {
 namespace {
 
-Eigen::Vector3d nodePoint(const Mesh& mesh, std::int64_t i) {
-  return {mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]};
-}
-
-MeshEdge ordered(std::int64_t a, std::int64_t b) {
-  return a < b ? MeshEdge{a, b} : MeshEdge{b, a};
-}
-
 double simplexVolumeAt(const Mesh& mesh, const std::array<Eigen::Vector3d, 4>& p) {
   if (mesh.dim == 3) return (p[1] - p[0]).cross(p[2] - p[0]).dot(p[3] - p[0]) / 6.0;
   const Eigen::Vector3d normal(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
@@ -36,9 +28,9 @@ std::set<MeshEdge> boundaryEdges(const Mesh& mesh) {
     for (std::size_t e = 0; e < block.count(); ++e) {
       const std::int64_t* v = block.element(e);
       if (nv == 2) {
-        edges.insert(ordered(v[0], v[1]));
+        edges.insert(meshEdge(v[0], v[1]));
       } else {
-        for (int k = 0; k < nv; ++k) edges.insert(ordered(v[k], v[(k + 1) % nv]));
+        for (int k = 0; k < nv; ++k) edges.insert(meshEdge(v[k], v[(k + 1) % nv]));
       }
     }
   }
@@ -120,7 +112,7 @@ bool splitEdge(Mesh& mesh, const MeshEdge& edge, const SplitNode& node) {
 }
 
 bool splitInteriorEdge(Mesh& mesh, const MeshEdge& edge, const Eigen::Vector3d& point) {
-  if (boundaryEdges(mesh).count(ordered(edge[0], edge[1])) > 0)
+  if (boundaryEdges(mesh).count(meshEdge(edge[0], edge[1])) > 0)
     throw ParameterError("edge (" + std::to_string(edge[0]) + ", " + std::to_string(edge[1]) +
                          ") lies on a boundary cell: only interior edges are split");
   SplitNode node;

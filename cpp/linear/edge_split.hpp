@@ -24,6 +24,16 @@ namespace homesh {
 
 using MeshEdge = std::array<std::int64_t, 2>;  // node ids, smaller first
 
+// The edge between nodes a and b (smaller id first).
+inline MeshEdge meshEdge(std::int64_t a, std::int64_t b) {
+  return a < b ? MeshEdge{a, b} : MeshEdge{b, a};
+}
+
+// Coordinates of node i.
+inline Eigen::Vector3d nodePoint(const Mesh& mesh, std::int64_t i) {
+  return {mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]};
+}
+
 // The edges of the mesh's lower-dimensional cells (boundary triangles' edges in 3D, boundary
 // lines in 2D), smaller id first.
 std::set<MeshEdge> boundaryEdges(const Mesh& mesh);

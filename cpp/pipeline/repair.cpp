@@ -13,14 +13,6 @@
 namespace homesh {
 namespace {
 
-Eigen::Vector3d nodePoint(const Mesh& mesh, std::int64_t i) {
-  return {mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]};
-}
-
-MeshEdge sortedEdge(std::int64_t a, std::int64_t b) {
-  return a < b ? MeshEdge{a, b} : MeshEdge{b, a};
-}
-
 // The linear cells of dimension mesh.dim, in element order.
 std::vector<const std::int64_t*> cellsOf(const Mesh& mesh) {
   std::vector<const std::int64_t*> cells;
@@ -106,7 +98,7 @@ CurvedFaceEdges::CurvedFaceEdges(const Mesh& linear, const CadModel& cad)
   for (const ElementBlock& block : linear.blocks)
     if (linear.dim == 3 && block.type == CellType::Line && block.order == 1)
       for (std::size_t e = 0; e < block.count(); ++e)
-        curveEdges.insert(sortedEdge(block.element(e)[0], block.element(e)[1]));
+        curveEdges.insert(meshEdge(block.element(e)[0], block.element(e)[1]));
   for (const ElementBlock& block : linear.blocks) {
     if (cellDimension(block.type) != linear.dim - 1 || block.order != 1) continue;
     const int nv = cellNumVertices(block.type);
@@ -122,7 +114,7 @@ CurvedFaceEdges::CurvedFaceEdges(const Mesh& linear, const CadModel& cad)
         std::vector<int>& faces = nodeFaces_[static_cast<std::size_t>(v[k])];
         if (std::find(faces.begin(), faces.end(), entity) == faces.end()) faces.push_back(entity);
         if (nv == 2 && k == 1) break;  // a line has one edge
-        const MeshEdge edge = sortedEdge(v[k], v[(k + 1) % nv]);
+        const MeshEdge edge = meshEdge(v[k], v[(k + 1) % nv]);
         if (curveEdges.count(edge) == 0) faceEdges_.emplace(edge, entity);
       }
     }
@@ -136,7 +128,7 @@ std::vector<CurvedFaceEdge> CurvedFaceEdges::interior(std::size_t cell) const {
   const int nv = mesh_.dim + 1;
   for (int i = 0; i < nv; ++i)
     for (int j = i + 1; j < nv; ++j) {
-      const MeshEdge edge = sortedEdge(v[i], v[j]);
+      const MeshEdge edge = meshEdge(v[i], v[j]);
       if (boundary_.count(edge) > 0) continue;
       const std::vector<int>& fa = nodeFaces_[static_cast<std::size_t>(edge[0])];
       const std::vector<int>& fb = nodeFaces_[static_cast<std::size_t>(edge[1])];
@@ -154,7 +146,7 @@ std::optional<CurvedFaceEdge> CurvedFaceEdges::longestOnFace(std::size_t cell) c
   const int nv = mesh_.dim + 1;
   for (int i = 0; i < nv; ++i)
     for (int j = i + 1; j < nv; ++j) {
-      const MeshEdge edge = sortedEdge(v[i], v[j]);
+      const MeshEdge edge = meshEdge(v[i], v[j]);
       const auto it = faceEdges_.find(edge);
       if (it == faceEdges_.end()) continue;
       const double length = (nodePoint(mesh_, v[i]) - nodePoint(mesh_, v[j])).norm();

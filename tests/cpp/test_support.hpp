@@ -64,10 +64,10 @@ inline Eigen::Vector3d nodePoint(const Mesh& mesh, std::int64_t i) {
 
 // Signed volume of a linear tetrahedron given by its first four nodes.
 inline double tetVolume(const Mesh& mesh, const std::int64_t* t) {
-  const Eigen::Vector3d a = nodePoint(mesh, t[0]);
-  return (nodePoint(mesh, t[1]) - a)
-             .cross(nodePoint(mesh, t[2]) - a)
-             .dot(nodePoint(mesh, t[3]) - a) /
+  const Eigen::Vector3d a = test::nodePoint(mesh, t[0]);
+  return (test::nodePoint(mesh, t[1]) - a)
+             .cross(test::nodePoint(mesh, t[2]) - a)
+             .dot(test::nodePoint(mesh, t[3]) - a) /
          6.0;
 }
 
