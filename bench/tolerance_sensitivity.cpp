@@ -246,7 +246,7 @@ void sizingGroup() {
       setup.options.order = 1;
       setup.options.threads = v.threads;
       const homesh::MeshResult r = homesh::runMeshPipeline(setup.source, setup.options);
-      const double actual = double(r.mesh.numElements());
+      const auto actual = double(r.mesh.numElements());
       runs.push_back({{"predicted", r.sizing->prediction.elements},
                       {"actual", actual},
                       {"predicted / actual", r.sizing->prediction.elements / actual},
@@ -317,7 +317,7 @@ void sizingGroup() {
         options.sizing = p;
       }
       const homesh::MeshResult r = homesh::runMeshPipeline(source, options);
-      const double actual = double(r.mesh.numElements());
+      const auto actual = double(r.mesh.numElements());
       runs.push_back(
           {{"predicted / actual", r.sizing->prediction.elements / actual}, {"actual", actual}});
     }

@@ -162,7 +162,10 @@ FaceEdgePlacement placeOnFaceEdge(const FaceChart& chart, const FaceParameter& a
   for (int i = 0; i + 1 < n; ++i) system.springs.push_back({i, i + 1, 1.0 / (z[i + 1] - z[i])});
   minimiseSprings(system, [&](const double* uv) { return chart.map(uv); });
   std::vector<FaceParameter> optimum(z.size());
-  for (int i = 0; i < n; ++i) optimum[i] = {system.params[2 * i], system.params[2 * i + 1]};
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(2) * static_cast<std::size_t>(i);
+    optimum[i] = {system.params[k], system.params[k + 1]};
+  }
   if (acceptable(optimum)) {
     result.uv = std::move(optimum);
     result.optimised = result.valid = true;
@@ -274,7 +277,8 @@ TrianglePlacement placeTriangleInterior(const FaceChart& chart, int order,
   std::vector<FaceParameter> relaxed = start;
   for (const auto& f : free) {
     const int k = at(f[0], f[1]);
-    relaxed[k] = {system.params[2 * k], system.params[2 * k + 1]};
+    relaxed[k] = {system.params[2 * static_cast<std::size_t>(k)],
+                  system.params[2 * static_cast<std::size_t>(k) + 1]};
   }
   if (acceptable(relaxed)) {
     result.uv = std::move(relaxed);

@@ -407,7 +407,8 @@ Mesh changeOrder(const Mesh& mesh, int order, const CadModel* cad, CurvingStats*
   Elevator elevator(mesh, order);
   for (const ElementBlock& block : mesh.blocks) elevator.elevateBlock(block);
   CurvingStats local;
-  if (cad != nullptr) BoundaryPlacer(elevator, mesh.numNodes(), *cad, stats ? *stats : local).run();
+  if (cad != nullptr)
+    BoundaryPlacer(elevator, mesh.numNodes(), *cad, stats != nullptr ? *stats : local).run();
   compactNodes(elevator.out);
   elevator.out.checkConsistency();
   return std::move(elevator.out);
@@ -423,7 +424,7 @@ Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad, CurvingSta
   for (const ElementBlock& block : linear.blocks) elevator.elevateBlock(block);
   CurvingStats local;
   if (cad != nullptr)
-    BoundaryPlacer(elevator, linear.numNodes(), *cad, stats ? *stats : local).run();
+    BoundaryPlacer(elevator, linear.numNodes(), *cad, stats != nullptr ? *stats : local).run();
   elevator.out.checkConsistency();
   return std::move(elevator.out);
 }

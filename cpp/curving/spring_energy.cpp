@@ -24,7 +24,8 @@ Evaluation evaluate(const SpringSystem& s, const std::vector<double>& params,
       e.points[i].point = s.pinned[i];
       e.points[i].jacobian.setZero();
     } else {
-      e.points[i] = map(&params[static_cast<std::size_t>(s.paramDim * i)]);
+      e.points[i] =
+          map(&params[static_cast<std::size_t>(s.paramDim) * static_cast<std::size_t>(i)]);
     }
   }
   for (const Spring& sp : s.springs)
@@ -98,7 +99,8 @@ SpringResult minimiseSprings(SpringSystem& s, const ParameterMap& map, int maxIt
       }
       std::vector<double> trial = s.params;
       for (int j = 0; j < m; ++j) {
-        const auto p = static_cast<std::size_t>(k * free[j / k] + j % k);
+        const auto p = static_cast<std::size_t>(k) * static_cast<std::size_t>(free[j / k]) +
+                       static_cast<std::size_t>(j % k);
         trial[p] += step[j];
         if (!s.lower.empty()) trial[p] = std::clamp(trial[p], s.lower[p], s.upper[p]);
       }

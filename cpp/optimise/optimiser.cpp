@@ -10,6 +10,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <utility>
 
 #include "cad/cad_model.hpp"
 #include "core/error.hpp"
@@ -35,6 +36,8 @@ void OptimiserOptions::validate() const {
     throw ParameterError("stall energy must be a finite number >= 0");
   if (stallWindow < 1)
     throw ParameterError("stall window must be >= 1, got " + std::to_string(stallWindow));
+  if (stuckWindow < 1)
+    throw ParameterError("stuck window must be >= 1, got " + std::to_string(stuckWindow));
   if (threads < 1 || threads > 1024)
     throw ParameterError("threads must be between 1 and 1024, got " + std::to_string(threads));
   if (regionThreshold && !(*regionThreshold > 0.0 && *regionThreshold <= 1.0))
@@ -169,7 +172,7 @@ class Optimiser {
         const std::string reason = stopRule(record, previous, before);
         previous = record;
         if (!reason.empty()) {
-          result_.converged = true;
+          result_.converged = reason != "stuck";
           result_.stopReason = reason;
           break;
         }
@@ -893,6 +896,17 @@ class Optimiser {
                               : input.worst;
       if (n >= options_.stallWindow && r.worst - then < options_.stall) return "stalled";
     }
+    // Invalid and stuck: over the last stuckWindow sweeps no element became proven valid and the
+    // worst value did not rise by `stall`; what is left is for a repair round, not more sweeps.
+    if (options_.stall > 0.0 && !valid && fall < options_.stallEnergy) {
+      const auto n = static_cast<int>(result_.history.size());
+      if (n > options_.stuckWindow) {
+        const IterationRecord& then = result_.history[n - 1 - options_.stuckWindow];
+        if (r.invalid + r.undecided >= then.invalid + then.undecided &&
+            r.worst - then.worst < options_.stall)
+          return "stuck";
+      }
+    }
     return "";
   }
 
@@ -958,8 +972,8 @@ namespace {
 template <int D>
 class ProbeImpl : public NodeEnergyProbe::Impl {
  public:
-  ProbeImpl(const Mesh& mesh, const OptimiserOptions& options, const CadModel* cad)
-      : mesh_(mesh), options_(options), optimiser_(mesh_, options_, nullptr, cad) {
+  ProbeImpl(Mesh mesh, const OptimiserOptions& options, const CadModel* cad)
+      : mesh_(std::move(mesh)), options_(options), optimiser_(mesh_, options_, nullptr, cad) {
     optimiser_.prepareProbe();
   }
   bool isFree(std::int64_t node) const override { return optimiser_.isFree(node); }

@@ -53,12 +53,17 @@ struct OptimiserOptions {
   //    sweep lowered the energy by less than `stallEnergy` of it: the worst element no longer
   //    improves and the rest only slowly (a single sweep can lower the worst value while it
   //    untangles the rest, hence the window);
+  //  "stuck" (only with `stall` > 0): elements are not proven valid, and over the last
+  //    `stuckWindow` sweeps their count did not fall, the worst scaled Jacobian rose by less
+  //    than `stall` and the last sweep lowered the energy by less than `stallEnergy`: more
+  //    sweeps will not make the mesh valid (the pipeline's repair rounds take over);
   //  "iterations": maxIterations sweeps done.
   double tolerance = 1e-6;
   double energyTolerance = 1e-5;
   double stall = 0.0;
   double stallEnergy = 0.05;
   int stallWindow = 3;
+  int stuckWindow = 10;
   int threads = 1;
   // Work only around elements whose certified scaled Jacobian is below this (in (0, 1]).
   std::optional<double> regionThreshold;
@@ -93,7 +98,8 @@ struct OptimiserResult {
   Functional functional = Functional::Hyperelastic;
   int iterations = 0;      // sweeps done
   bool converged = false;  // stopped by "displacement", "energy" or "stalled"
-  // Which rule ended the run: "displacement", "energy", "stalled", "iterations", "cancelled",
+  // Which rule ended the run: "displacement", "energy", "stalled", "stuck", "iterations",
+  // "cancelled",
   // or "no free nodes" (see OptimiserOptions).
   std::string stopReason;
   double energyBefore = 0.0, energyAfter = 0.0;  // of the input and of the state kept

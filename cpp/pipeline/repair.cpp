@@ -55,7 +55,7 @@ double signedDistance(const Mesh& mesh, const CadModel& cad, int entity, const E
 // mirror image in the face when the cells around the edge lie on the other side.
 Eigen::Vector3d splitPoint(const Mesh& mesh, const CadModel& cad, const CurvedFaceEdge& split) {
   const Eigen::Vector3d a = nodePoint(mesh, split.edge[0]), b = nodePoint(mesh, split.edge[1]);
-  const Eigen::Vector3d mid = 0.5 * (a + b);
+  Eigen::Vector3d mid = 0.5 * (a + b);  // not const: returned by move
   const auto [foot, normal] = footAndNormal(mesh, cad, split.entity, mid);
   const double depth = (mid - foot).dot(normal);
   if (normal.isZero() || depth == 0.0) return mid;

@@ -247,7 +247,7 @@ Mesh torusSurfaceMesh(const CadModel& cad, int nu, int nv) {
     }
   ElementBlock tris;
   tris.type = CellType::Triangle;
-  const auto id = [&](int i, int j) { return static_cast<std::int64_t>((j % nv) * nu + i % nu); };
+  const auto id = [&](int i, int j) { return static_cast<std::int64_t>(j % nv) * nu + i % nu; };
   for (int j = 0; j < nv; ++j)
     for (int i = 0; i < nu; ++i) {
       const std::int64_t a = id(i, j), c = id(i + 1, j + 1);

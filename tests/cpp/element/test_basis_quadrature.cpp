@@ -141,7 +141,7 @@ TEST_P(Shapes, BasisReproducesItsPolynomialsAndTheirDerivatives) {
         // times |monomial| <= 1 at the nodes: error ~ N eps sum_n |phi_n(x)| (the Lebesgue
         // function), likewise with |d phi_n / d x_k| for derivatives. Measured: at most 0.45 of
         // that on every shape and order; the tolerance is 8 times it.
-        const double n = static_cast<double>(ref.numNodes());
+        const auto n = static_cast<double>(ref.numNodes());
         const double tolValue = 8.0 * n * kEps * values.cwiseAbs().sum();
         for (std::size_t m = 0; m < space.size(); ++m) {
           ASSERT_NEAR(f(m), evaluate(space[m], xi.data(), dim), tolValue)
