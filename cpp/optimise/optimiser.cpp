@@ -1033,10 +1033,10 @@ double NodeEnergyProbe::regularisation(std::int64_t node) const {
 NodeEnergy NodeEnergyProbe::evaluate(std::int64_t node, const Eigen::VectorXd& coordinates,
                                      double eps) const {
   check(node);
-  if (coordinates.size() != impl_->coordinates(node).size())
-    throw ParameterError("node " + std::to_string(node) + " has " +
-                         std::to_string(impl_->coordinates(node).size()) + " coordinates, got " +
-                         std::to_string(coordinates.size()));
+  const Eigen::Index expected = impl_->coordinates(node).size();
+  if (coordinates.size() != expected)
+    throw ParameterError("node " + std::to_string(node) + " has " + std::to_string(expected) +
+                         " coordinates, got " + std::to_string(coordinates.size()));
   return impl_->evaluate(node, coordinates, eps);
 }
 
