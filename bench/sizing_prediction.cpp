@@ -93,7 +93,6 @@ int main(int argc, char** argv) {
       const homesh::ElementCountPrediction p = homesh::predictElementCount(tree, threads);
       const double predictSeconds = seconds(t0);
       homesh::LinearMeshOptions options;
-      options.threads = threads;
       options.sizeField = [&tree](const Eigen::Vector3d& x) { return tree.delta(x); };
       options.minSize = c.params.minDelta;
       options.maxSize = c.params.maxDelta;

@@ -16,25 +16,25 @@
 
 namespace homesh {
 
-// The target edge length at a point; called by Gmsh, possibly from several threads at once.
+// The target edge length at a point; called by Gmsh (one thread at a time, see below).
 using SizeField = std::function<double(const Eigen::Vector3d&)>;
 
 struct LinearMeshOptions {
   double size = 0.0;    // uniform target edge length (> 0), used when there is no sizeField
-  int threads = 1;      // threads Gmsh may use
   int verbosity = 0;    // 0 silent, 1 Gmsh's warnings, 2 Gmsh's information
   SizeField sizeField;  // when set: sizes from it (Gmsh's curve meshing integrates 1/size)
   double minSize = 0.0, maxSize = 0.0;  // with sizeField: the bounds it keeps to (> 0)
 
-  static LinearMeshOptions uniform(double size, int threads = 1) {
+  static LinearMeshOptions uniform(double size) {
     LinearMeshOptions o;
     o.size = size;
-    o.threads = threads;
     return o;
   }
 };
 
-// Throws ParameterError (bad size), CadError (nothing meshable) or MeshingError.
+// Gmsh meshes on one thread (see linear_mesher.cpp): the same CAD and options give the same
+// mesh every time. Throws ParameterError (bad size), CadError (nothing meshable) or
+// MeshingError.
 Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options);
 
 }  // namespace homesh

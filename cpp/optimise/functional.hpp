@@ -51,10 +51,10 @@ T cubeRoot(const T& x) {
   return pow(x, 1.0 / 3.0);  // AutoDiffScalar has no cbrt
 }
 
-// psi and its partial derivatives in S and r = J_r.
+// psi and its partial derivatives in S and r = J_r (every psi here is linear in S: psi_SS = 0).
 template <class T>
 struct Psi {
-  T v = T(0), s = T(0), r = T(0), ss = T(0), sr = T(0), rr = T(0);
+  T v = T(0), s = T(0), r = T(0), sr = T(0), rr = T(0);
 };
 
 // Compile-time functional: the optimiser's inner loops are instantiated per functional, so
@@ -187,41 +187,77 @@ T energyDensity(Functional f, const Eigen::Matrix<T, D, D>& F, double eps) {
       f, [&](auto fn) { return energyDensity<D, decltype(fn)::value>(F, eps); });
 }
 
-// W(F) and its gradient and Hessian with respect to delta, where F(delta) = F + delta a^T.
+// What W(F + delta a^T) needs of F, for every delta: |F + delta a^T|^2 = SF + 2 delta . fa +
+// |delta|^2 aa and det(F + delta a^T) = J + g . delta (matrix determinant lemma, g = cof(F) a).
+// A trial move then costs two dot products and psi instead of a 3x3 update and determinant.
+template <int D, class T>
+struct RankOneTerms {
+  T SF = T(0), J = T(0), aa = T(0);
+  Eigen::Matrix<T, D, 1> fa = Eigen::Matrix<T, D, 1>::Zero(), g = Eigen::Matrix<T, D, 1>::Zero();
+};
+
+// W(F + delta a^T) from the terms of F: the same value as energyDensity of the updated matrix
+// up to rounding. Not for the linear elastic W, whose |E|^2 is quartic in delta.
+template <int D, Functional Fn, class T>
+T energyDensityMoved(const RankOneTerms<D, T>& t, const Eigen::Matrix<T, D, 1>& delta, double eps) {
+  static_assert(Fn != Functional::LinearElastic, "linear elastic W needs the updated F");
+  const T S = t.SF + 2.0 * delta.dot(t.fa) + delta.squaredNorm() * t.aa;
+  return functional_detail::psi<D, Fn>(S, regularise(T(t.J + t.g.dot(delta)), eps).r).v;
+}
+
+// W(F) and its gradient and Hessian with respect to delta, where F(delta) = F + delta a^T;
+// with `terms`, also what energyDensityMoved needs.
 template <int D, Functional Fn, class T>
 T energyDensityDerivatives(const Eigen::Matrix<T, D, D>& F, const Eigen::Matrix<T, D, 1>& a,
                            double eps, Eigen::Matrix<T, D, 1>& gradient,
-                           Eigen::Matrix<T, D, D>& hessian) {
+                           Eigen::Matrix<T, D, D>& hessian, RankOneTerms<D, T>* terms = nullptr) {
   using namespace functional_detail;
   using Vec = Eigen::Matrix<T, D, 1>;
   using Mat = Eigen::Matrix<T, D, D>;
-  const T J = determinant<D>(F);
-  const Vec g = cofactor<D>(F) * a;  // dJ/ddelta
+  const Mat cof = cofactor<D>(F);
+  // Laplace expansion along the first row: the same products and sums as determinant().
+  T J = F(0, 0) * cof(0, 0);
+  for (int j = 1; j < D; ++j) J += F(0, j) * cof(0, j);
+  const Vec g = cof * a;  // dJ/ddelta
   const Vec fa = F * a;
   const T aa = a.squaredNorm();
+  const T SF = F.squaredNorm();
+  // Every psi is linear in S (psi_SS = 0), so S's second derivative enters only through psi_S;
+  // ddS = ddS0 + ddSI I, with ddSI the multiple of the identity.
   T S;
   Vec dS;
-  Mat ddS;
+  Mat ddS0;
+  T ddSI;
   if constexpr (Fn == Functional::LinearElastic) {
     const Mat E = greenStrain<D>(F);
     S = E.squaredNorm();
     dS = 2.0 * F * (E * a);
-    ddS = aa * (F * F.transpose()) + fa * fa.transpose();
-    const T aEa = a.dot(E * a);
-    for (int i = 0; i < D; ++i) ddS(i, i) += 2.0 * aEa;
+    ddS0 = aa * (F * F.transpose()) + fa * fa.transpose();
+    ddSI = 2.0 * a.dot(E * a);
   } else {
-    S = F.squaredNorm();
+    S = SF;
     dS = 2.0 * fa;
-    ddS = Mat::Identity() * (2.0 * aa);
+    ddSI = 2.0 * aa;
   }
   const Regularised<T> reg = regularise(J, eps);
   const Psi<T> p = psi<D, Fn>(S, reg.r);
   const T pj = p.r * reg.dr;
   const T pjj = p.rr * reg.dr * reg.dr + p.r * reg.ddr;
-  const T psj = p.sr * reg.dr;
   gradient = p.s * dS + pj * g;
-  hessian = p.ss * (dS * dS.transpose()) + psj * (dS * g.transpose() + g * dS.transpose()) +
-            pjj * (g * g.transpose()) + p.s * ddS;
+  hessian.noalias() = pjj * (g * g.transpose());
+  if constexpr (Fn == Functional::Winslow || Fn == Functional::Distortion) {
+    const T psj = p.sr * reg.dr;  // zero for the elastic energies, whose psi_S is constant
+    hessian.noalias() += psj * (dS * g.transpose() + g * dS.transpose());
+  }
+  if constexpr (Fn == Functional::LinearElastic) hessian.noalias() += p.s * ddS0;
+  hessian.diagonal().array() += p.s * ddSI;
+  if (terms != nullptr) {
+    terms->SF = SF;
+    terms->J = J;
+    terms->aa = aa;
+    terms->fa = fa;
+    terms->g = g;
+  }
   return p.v;
 }
 

@@ -4,6 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -38,6 +39,8 @@ void OptimiserOptions::validate() const {
     throw ParameterError("stall window must be >= 1, got " + std::to_string(stallWindow));
   if (stuckWindow < 1)
     throw ParameterError("stuck window must be >= 1, got " + std::to_string(stuckWindow));
+  if (!(activeTolerance >= 0.0) || !std::isfinite(activeTolerance))
+    throw ParameterError("active tolerance must be a finite number >= 0");
   if (threads < 1 || threads > 1024)
     throw ParameterError("threads must be between 1 and 1024, got " + std::to_string(threads));
   if (regionThreshold && !(*regionThreshold > 0.0 && *regionThreshold <= 1.0))
@@ -70,10 +73,32 @@ constexpr NodeSet kWorkingSet = NodeSet::Optimal;
 // The energy's quadrature: exact to degree 2P - 1 (per variable on boxes), enough for the
 // polynomial part of W on a straight-sided ideal element. (Higher degrees changed the worst
 // value after five sweeps by less than 0.004; degree P + 1 halves the time but lost 0.18 of it
-// on NekMesh's cube-sphere and left the sphere in a box tangled; adding the nodes as sample
-// points, to see folds at vertices and edges, did not untangle more elements.)
-QuadratureRule energyRule(CellType type, int order) {
-  return quadratureRule(type, std::max(1, 2 * order - 1));
+// on NekMesh's cube-sphere and left the sphere in a box tangled.)
+//
+// The energy also samples W at the element's own (equispaced) nodes, together weighted
+// kNodeShare of the element's measure. A curved element's J is often lowest at its vertices and
+// edges, where no interior quadrature point is: without these samples, sweeps at order 6 made
+// the worst element of Gmsh's sphere in a box (MeshSizeMax 0.5, 2 907 tetrahedra) worse while
+// the energy fell (0.436 -> 0.307 after two sweeps, 0.418 after five without focused passes,
+// 0.542 with them) and left one element tangled at its nodes on the order-4 sphere in a box
+// re-interpolated at order 6 (-0.437 after 20 sweeps); with them, 0.704 after five sweeps
+// (NekMesh's varopti: 0.654) and the re-interpolated mesh valid (0.531). A larger share (0.03,
+// 0.1: 0.800, 0.863) helps those meshes more but, with boundary nodes sliding on the CAD, left
+// more coarse sphere-in-box meshes invalid after the repair rounds (2 and 3 of 9 test cases
+// against 1).
+constexpr double kNodeShare = 0.01;
+
+QuadratureRule energySamples(CellType type, int order, const ReferenceElement& equispaced) {
+  QuadratureRule rule = quadratureRule(type, std::max(1, 2 * order - 1));
+  double measure = 0.0;
+  for (const double w : rule.weights) measure += w;
+  const Eigen::MatrixXd& nodes = equispaced.nodes();
+  const double w = kNodeShare * measure / static_cast<double>(nodes.rows());
+  for (Eigen::Index n = 0; n < nodes.rows(); ++n) {
+    for (Eigen::Index c = 0; c < nodes.cols(); ++c) rule.points.push_back(nodes(n, c));
+    rule.weights.push_back(w);
+  }
+  return rule;
 }
 
 template <int D>
@@ -82,13 +107,15 @@ struct Block {
   using Vec = Eigen::Matrix<double, D, 1>;
   const ElementBlock* cells = nullptr;
   int nodes = 0, points = 0;
-  bool affine = true;            // the ideal element's Jacobian is constant (simplices)
-  std::vector<Vec> gradients;    // reference basis gradients, [point][node]
-  std::vector<Mat> idealInvT;    // (dx_I/dxi)^-T per element (affine) or per element x point
-  std::vector<double> weights;   // quadrature weight x |det dx_I/dxi|, per element x point
-  std::vector<Mat> F;            // deformation gradient, per element x point
-  Eigen::MatrixXd toWorking;     // equispaced node values -> working node values
-  Eigen::MatrixXd toEquispaced;  // and back
+  bool affine = true;             // the ideal element's Jacobian is constant (simplices)
+  std::vector<Vec> gradients;     // reference basis gradients, [point][node]
+  Eigen::MatrixXd gradientTable;  // the same as one matrix: [node][point x D + direction]
+  std::vector<Mat> idealInvT;     // (dx_I/dxi)^-T per element (affine) or per element x point
+  std::vector<double> weights;    // quadrature weight x |det dx_I/dxi|, per element x point
+  std::vector<Mat> F;             // deformation gradient, per element x point
+  std::vector<double> J;          // det F, per element x point (updated with F)
+  Eigen::MatrixXd toWorking;      // equispaced node values -> working node values
+  Eigen::MatrixXd toEquispaced;   // and back
 
   const Mat& invT(std::size_t e, int q) const {
     return idealInvT[affine ? e : e * points + static_cast<std::size_t>(q)];
@@ -140,6 +167,7 @@ class Optimiser {
     chooseFreeNodes();
     colour();
     computeGradients();
+    resetMarks();
     result_.setupSeconds = since(t0);
 
     IterationRecord best = before;
@@ -160,6 +188,8 @@ class Optimiser {
         result_.sweepSeconds += since(s0);
         IterationRecord record = summarise(it, moved.absolute, t0);
         record.maxRelativeMove = moved.relative;
+        record.visits = moved.visits;
+        result_.visits += moved.visits;
         record.energy = totalEnergy();
         result_.history.push_back(record);
         result_.iterations = it;
@@ -280,8 +310,16 @@ class Optimiser {
 
   std::vector<double> scaled_;
   std::vector<Validity> validity_;
-  std::vector<std::size_t> changed_;  // elements to re-check after a sweep
-  std::vector<std::int64_t> free_;    // free nodes, grouped by colour
+  std::vector<std::size_t> changed_;  // elements with a free node
+  // Per element: kStale = a node moved since its quality was last computed, kDrifted = since
+  // its F was last computed from the nodes. Set by relax() (atomics: threads mark shared
+  // elements), cleared by the sweep.
+  static constexpr std::uint8_t kStale = 1, kDrifted = 2;
+  std::unique_ptr<std::atomic<std::uint8_t>[]> marks_;
+  // Per node: visit it in the next sweep (it or a neighbour moved by more than
+  // options_.activeTolerance of its element size since its last visit).
+  std::unique_ptr<std::atomic<std::uint8_t>[]> active_;
+  std::vector<std::int64_t> free_;  // free nodes, grouped by colour
   std::vector<std::size_t> colourStart_;
   std::vector<int> colourOf_;  // colour of each free node, -1 for fixed nodes
 
@@ -320,17 +358,19 @@ class Optimiser {
       b.toWorking = equi.valuesAt(ref.nodes());
       b.toEquispaced = ref.valuesAt(equi.nodes());
       const ReferenceElement& lin = ReferenceElement::get(cells.type, 1);
-      const QuadratureRule rule = energyRule(cells.type, cells.order);
+      const QuadratureRule rule = energySamples(cells.type, cells.order, equi);
       b.points = rule.size();
       Eigen::VectorXd values;
       Eigen::MatrixXd grad;
       std::vector<Eigen::MatrixXd> linGrad(b.points);
       b.gradients.resize(static_cast<std::size_t>(b.points) * b.nodes);
+      b.gradientTable.resize(b.nodes, static_cast<Eigen::Index>(b.points) * D);
       for (int q = 0; q < b.points; ++q) {
         const double* xi = &rule.points[static_cast<std::size_t>(q) * D];
         ref.evaluate(xi, values, grad);
         for (int n = 0; n < b.nodes; ++n)
           b.gradients[static_cast<std::size_t>(q) * b.nodes + n] = grad.row(n).transpose();
+        b.gradientTable.middleCols(static_cast<Eigen::Index>(q) * D, D) = grad;
         lin.evaluate(xi, values, linGrad[q]);
       }
       const int nv = lin.numNodes();
@@ -339,6 +379,7 @@ class Optimiser {
       b.idealInvT.resize(count * idealPoints);
       b.weights.resize(count * b.points);
       b.F.resize(count * b.points);
+      b.J.resize(count * b.points);
       for (std::size_t e = 0; e < count; ++e) {
         const std::int64_t* v = cells.element(e);
         for (int q = 0; q < b.points; ++q) {
@@ -402,6 +443,7 @@ class Optimiser {
       for (std::size_t e = 0; e < b.cells->count(); ++e) {
         double volume = 0.0;
         for (int q = 0; q < b.points; ++q) volume += b.weights[e * b.points + q];
+        volume /= 1.0 + kNodeShare;  // the weights add up to (1 + kNodeShare) x the volume
         const double size = std::pow(volume, 1.0 / D);
         const std::int64_t* v = b.cells->element(e);
         for (int k = 0; k < b.nodes; ++k) nodeSize_[v[k]] = std::min(nodeSize_[v[k]], size);
@@ -531,27 +573,39 @@ class Optimiser {
     result_.colours = static_cast<std::size_t>(colours);
   }
 
-  // F at every quadrature point of every element that contains a free node.
-  void computeGradients() {
-    const std::size_t* changed = changed_.data();
-#pragma omp parallel for num_threads(options_.threads) schedule(dynamic, 16)
-    for (std::int64_t i = 0; i < static_cast<std::int64_t>(changed_.size()); ++i) {
-      const auto [bi, e] = locate(changed[i]);
-      Block<D>& b = blocks_[bi];
-      const std::int64_t* v = b.cells->element(e);
-      for (int q = 0; q < b.points; ++q) {
-        Mat dx = Mat::Zero();
-        const Vec* grad = &b.gradients[static_cast<std::size_t>(q) * b.nodes];
-        for (int n = 0; n < b.nodes; ++n) dx += position_[v[n]] * grad[n].transpose();
-        b.F[e * b.points + q] = dx * b.invT(e, q).transpose();
+  // F and J at every quadrature point of the given elements (global indices; by default every
+  // element that contains a free node): one matrix product per element (its node coordinates
+  // times the tabulated basis gradients).
+  void computeGradients() { computeGradients(changed_); }
+  void computeGradients(const std::vector<std::size_t>& elements) {
+    const std::size_t* changed = elements.data();
+#pragma omp parallel num_threads(options_.threads)
+    {
+      Eigen::Matrix<double, D, Eigen::Dynamic> x, dx;
+#pragma omp for schedule(dynamic, 16)
+      for (std::int64_t i = 0; i < static_cast<std::int64_t>(elements.size()); ++i) {
+        const auto [bi, e] = locate(changed[i]);
+        Block<D>& b = blocks_[bi];
+        const std::int64_t* v = b.cells->element(e);
+        x.resize(D, b.nodes);
+        for (int n = 0; n < b.nodes; ++n) x.col(n) = position_[v[n]];
+        dx.noalias() = x * b.gradientTable;
+        for (int q = 0; q < b.points; ++q) {
+          const std::size_t p = e * b.points + q;
+          b.F[p].noalias() = dx.template middleCols<D>(static_cast<Eigen::Index>(q) * D) *
+                             b.invT(e, q).transpose();
+          b.J[p] = functional_detail::determinant<D>(b.F[p]);
+        }
       }
     }
   }
 
   struct PointRef {
     Mat* F;
+    double* J;
     Vec a;
     double w;
+    RankOneTerms<D, double> terms;  // of *F, filled by assemble() for the line search
   };
 
   // The Newton step -H^-1 g with H shifted to be positive definite (smallest eigenvalue at least
@@ -574,20 +628,31 @@ class Optimiser {
     return slope < 0.0 && step.allFinite();
   }
 
-  // The patch energy after moving the node by d (stops summing once it is infinite or NaN: an
-  // inverted trial point).
+  // The patch energy after moving the node by d, from the terms assemble() left (stops summing
+  // once it is infinite or NaN: an inverted trial point).
   template <Functional Fn>
   static double energyAfter(const std::vector<PointRef>& pts, const Vec& d, double eps, double e0) {
     double e1 = 0.0;
     for (const PointRef& p : pts) {
-      e1 += p.w * energyDensity<D, Fn>(Mat(*p.F + d * p.a.transpose()), eps);
+      if constexpr (Fn == Functional::LinearElastic) {
+        e1 += p.w * energyDensity<D, Fn>(Mat(*p.F + d * p.a.transpose()), eps);
+      } else {
+        e1 += p.w * energyDensityMoved<D, Fn>(p.terms, d, eps);
+      }
       if (!(e1 <= e0 + 1e300)) break;
     }
     return e1;
   }
 
+  // F += d a^T and, by the matrix determinant lemma, J += g . d at every point of the patch.
   static void applyMove(const std::vector<PointRef>& pts, const Vec& d) {
-    for (const PointRef& p : pts) *p.F += d * p.a.transpose();
+    for (const PointRef& p : pts) {
+      // Written out: Eigen's outer-product temporary stalled on store forwarding here.
+      Mat& F = *p.F;
+      for (int c = 0; c < D; ++c)
+        for (int r = 0; r < D; ++r) F(r, c) += d[r] * p.a[c];
+      *p.J += p.terms.g.dot(d);
+    }
   }
 
   // The patch of a node: F, a and the weight at every quadrature point of its elements. Returns
@@ -600,35 +665,48 @@ class Optimiser {
       Block<D>& b = blocks_[inc.block];
       for (int q = 0; q < b.points; ++q) {
         const std::size_t p = inc.element * b.points + q;
-        Mat* F = &b.F[p];
         const Vec a =
             b.invT(inc.element, q) * b.gradients[static_cast<std::size_t>(q) * b.nodes + inc.local];
-        pts.push_back({F, a, b.weights[p]});
-        jmin = std::min(jmin, functional_detail::determinant<D>(*F));
+        pts.push_back({&b.F[p], &b.J[p], a, b.weights[p], {}});
+        jmin = std::min(jmin, b.J[p]);
       }
     }
     return jmin < 0.0 ? std::sqrt(1e-8 + 0.04 * jmin * jmin) : 1e-10;
   }
 
   // The patch energy and its gradient and Hessian in the node's coordinates, with the node moved
-  // by `shift` from where the cached F has it (the sweeps pass none).
+  // by `shift` from where the cached F has it (the sweeps pass none; then each point's
+  // RankOneTerms are filled for the line search). `magnitude`, if given, receives the sum of
+  // weight x (|W| + |F|^2): the size of the terms, which bounds the rounding of the sum.
   template <Functional Fn>
-  static double assemble(const std::vector<PointRef>& pts, double eps, Vec& grad, Mat& hess,
-                         const Vec* shift = nullptr) {
-    double e0 = 0.0;
+  static double assemble(std::vector<PointRef>& pts, double eps, Vec& grad, Mat& hess,
+                         const Vec* shift = nullptr, double* magnitude = nullptr) {
+    double e0 = 0.0, size = 0.0;
     grad.setZero();
     hess.setZero();
     Vec g;
     Mat h;
-    for (const PointRef& p : pts) {
-      const double w = shift == nullptr ? energyDensityDerivatives<D, Fn>(*p.F, p.a, eps, g, h)
-                                        : energyDensityDerivatives<D, Fn>(
-                                              Mat(*p.F + *shift * p.a.transpose()), p.a, eps, g, h);
+    for (PointRef& p : pts) {
+      const double w = shift == nullptr
+                           ? energyDensityDerivatives<D, Fn>(*p.F, p.a, eps, g, h, &p.terms)
+                           : energyDensityDerivatives<D, Fn>(Mat(*p.F + *shift * p.a.transpose()),
+                                                             p.a, eps, g, h);
       e0 += p.w * w;
+      if (magnitude != nullptr) size += p.w * (std::abs(w) + p.terms.SF);
       grad += p.w * g;
       hess += p.w * h;
     }
+    if (magnitude != nullptr) *magnitude = size;
     return e0;
+  }
+
+  // Whether a step whose quadratic model lowers the energy by -slope / 2 can show at all in the
+  // patch energy, a sum of pts.size() terms of total size `magnitude`: its rounding is about
+  // sqrt(n) u magnitude (random-walk model, u the unit roundoff), so a smaller decrease is
+  // noise and the Armijo test would only halve the step until it gives up.
+  static bool resolvable(double slope, double magnitude, std::size_t points) {
+    constexpr double u = std::numeric_limits<double>::epsilon() / 2.0;
+    return -0.5 * slope > 4.0 * std::sqrt(static_cast<double>(points)) * u * magnitude;
   }
 
   // One Newton step on one node; returns the distance it moved.
@@ -642,12 +720,14 @@ class Optimiser {
     const double eps = gather(node, pts);
     Vec grad;
     Mat hess;
-    const double e0 = assemble<Fn>(pts, eps, grad, hess);
+    double magnitude = 0.0;
+    const double e0 = assemble<Fn>(pts, eps, grad, hess, nullptr, &magnitude);
     if (!std::isfinite(e0) || !grad.allFinite() || !hess.allFinite()) return 0.0;
-    if (slide_[node] != 0) return slide<Fn>(node, pts, eps, e0, grad, hess);
+    if (slide_[node] != 0) return slide<Fn>(node, pts, eps, e0, magnitude, grad, hess);
     Vec step;
     double slope = 0.0;
-    if (!newtonStep(hess, grad, step, slope)) return 0.0;
+    if (!newtonStep(hess, grad, step, slope) || !resolvable(slope, magnitude, pts.size()))
+      return 0.0;
     double alpha = 1.0;
     for (int ls = 0; ls < kLineSearchSteps; ++ls, alpha *= 0.5) {
       const Vec d = alpha * step;
@@ -702,9 +782,9 @@ class Optimiser {
   // leaves it.
   template <Functional Fn>
   double slide(std::int64_t node, const std::vector<PointRef>& pts, double eps, double e0,
-               const Vec& grad, const Mat& hess) {
+               double magnitude, const Vec& grad, const Mat& hess) {
     try {
-      return slideOn<Fn>(threadCad(), node, pts, eps, e0, grad, hess);
+      return slideOn<Fn>(threadCad(), node, pts, eps, e0, magnitude, grad, hess);
     } catch (const CadError&) {
       return 0.0;  // the CAD cannot be evaluated there (a degenerate point): the node stays
     }
@@ -712,7 +792,7 @@ class Optimiser {
 
   template <Functional Fn>
   double slideOn(const CadModel& cad, std::int64_t node, const std::vector<PointRef>& pts,
-                 double eps, double e0, const Vec& grad, const Mat& hess) {
+                 double eps, double e0, double magnitude, const Vec& grad, const Mat& hess) {
     double* param = &mesh_.nodeCadParam[2 * node];
     const int entity = mesh_.nodeCadIndex[node];
     Eigen::VectorXd g;
@@ -721,7 +801,7 @@ class Optimiser {
     if (!g.allFinite() || !h.allFinite()) return 0.0;
     Eigen::VectorXd step;
     double slope = 0.0;
-    if (!newtonStep(h, g, step, slope)) return 0.0;
+    if (!newtonStep(h, g, step, slope) || !resolvable(slope, magnitude, pts.size())) return 0.0;
     double alpha = 1.0;
     for (int ls = 0; ls < kLineSearchSteps; ++ls, alpha *= 0.5) {
       double trial[2] = {param[0], param[1]};
@@ -746,17 +826,42 @@ class Optimiser {
     return 0.0;
   }
 
-  // The largest node move of a pass, absolute and relative to the node's element size.
+  // The largest node move of a pass, absolute and relative to the node's element size, and the
+  // number of nodes visited.
   struct Moves {
     double absolute = 0.0, relative = 0.0;
+    std::size_t visits = 0;
   };
 
-  // One Newton step on each of `nodes` (grouped by colour: starts[c]..starts[c+1]).
-  Moves relax(const std::vector<std::int64_t>& nodes, const std::vector<std::size_t>& starts) {
+  // After a node's visit: mark the elements it moved, and decide which nodes the next sweep
+  // visits. A node that did not move by more than activeTolerance of its element size rests
+  // until a node of one of its elements moves by more; a node is never marked by another of its
+  // own colour (they share no element), so the result does not depend on the thread count.
+  void record(std::int64_t node, double relative) {
+    const bool moved = relative > 0.0;
+    const bool wakes = relative > options_.activeTolerance;
+    active_[node].store(wakes ? 1 : 0, std::memory_order_relaxed);
+    if (!moved) return;
+    for (std::size_t k = incidenceStart_[node]; k < incidenceStart_[node + 1]; ++k) {
+      const Incidence& inc = incidence_[k];
+      marks_[globalIndex(inc)].fetch_or(kStale | kDrifted, std::memory_order_relaxed);
+      if (!wakes) continue;
+      const Block<D>& b = blocks_[inc.block];
+      const std::int64_t* v = b.cells->element(inc.element);
+      for (int j = 0; j < b.nodes; ++j) active_[v[j]].store(1, std::memory_order_relaxed);
+    }
+  }
+
+  // One Newton step on each of `nodes` (grouped by colour: starts[c]..starts[c+1]); with
+  // `onlyActive`, on those of them that are active (see record()).
+  Moves relax(const std::vector<std::int64_t>& nodes, const std::vector<std::size_t>& starts,
+              bool onlyActive) {
     double moved = 0.0, relative = 0.0;
+    std::size_t visits = 0;
     FirstFailure failure;
     const std::int64_t colours = static_cast<std::int64_t>(starts.size()) - 1;
-#pragma omp parallel num_threads(options_.threads) reduction(max : moved, relative)
+#pragma omp parallel num_threads(options_.threads) reduction(max : moved, relative) \
+    reduction(+ : visits)
     {
       std::vector<PointRef> pts;
       for (std::int64_t c = 0; c < colours; ++c) {
@@ -765,9 +870,12 @@ class Optimiser {
 #pragma omp for schedule(dynamic, 8)
         for (std::int64_t i = lo; i < hi; ++i) {
           try {
+            if (onlyActive && active_[nodes[i]].load(std::memory_order_relaxed) == 0) continue;
             const double d = visit(nodes[i], pts);
+            ++visits;
             moved = std::max(moved, d);
             relative = std::max(relative, d / nodeSize_[nodes[i]]);
+            record(nodes[i], d / nodeSize_[nodes[i]]);
           } catch (...) {
             failure.capture();
           }
@@ -775,7 +883,7 @@ class Optimiser {
       }
     }
     failure.rethrow();
-    return {moved, relative};
+    return {moved, relative, visits};
   }
 
   // One iteration: a Newton step on every free node, then `focusPasses` more on the nodes of
@@ -785,9 +893,9 @@ class Optimiser {
   // take the worst value after five iterations from 0.714 to 0.757 for 25 % more time).
   // Leaves mesh_.xyz and the certified quality up to date.
   Moves sweep() {
-    const Moves moved = relax(free_, colourStart_);
+    Moves moved = relax(free_, colourStart_, true);
     writeBack();
-    evaluate(changed_);
+    evaluate(take(kStale));
     if (options_.focusPasses > 0) {
       const double worst = *std::min_element(scaled_.begin(), scaled_.end());
       std::vector<std::vector<std::int64_t>> groups(result_.colours);
@@ -810,21 +918,32 @@ class Optimiser {
         focus.insert(focus.end(), g.begin(), g.end());
         starts.push_back(focus.size());
       }
-      for (int p = 0; p < options_.focusPasses; ++p) relax(focus, starts);
+      for (int p = 0; p < options_.focusPasses; ++p)
+        moved.visits += relax(focus, starts, false).visits;
       writeBack();
-      // Only the elements around the focused nodes changed since the check above.
-      std::vector<char> near(totalElements_, 0);
-      for (const std::int64_t node : focus)
-        for (std::size_t k = incidenceStart_[node]; k < incidenceStart_[node + 1]; ++k)
-          near[globalIndex(incidence_[k])] = 1;
-      std::vector<std::size_t> recheck;
-      for (std::size_t i = 0; i < totalElements_; ++i)
-        if (near[i] != 0) recheck.push_back(i);
-      evaluate(recheck);
+      evaluate(take(kStale));  // the elements the focused passes changed
     }
     // Rounding accumulates in the incrementally updated F: refresh it from the nodes.
-    computeGradients();
+    computeGradients(take(kDrifted));
     return moved;
+  }
+
+  // The elements marked with `flag` (global indices, ascending); clears the mark.
+  std::vector<std::size_t> take(std::uint8_t flag) {
+    std::vector<std::size_t> list;
+    for (std::size_t i = 0; i < totalElements_; ++i)
+      if ((marks_[i].fetch_and(static_cast<std::uint8_t>(~flag), std::memory_order_relaxed) &
+           flag) != 0)
+        list.push_back(i);
+    return list;
+  }
+
+  // Every element unmarked, every free node active: the state before the first sweep.
+  void resetMarks() {
+    marks_ = std::make_unique<std::atomic<std::uint8_t>[]>(totalElements_);
+    active_ = std::make_unique<std::atomic<std::uint8_t>[]>(mesh_.numNodes());
+    for (std::size_t i = 0; i < totalElements_; ++i) marks_[i].store(0);
+    for (std::size_t i = 0; i < mesh_.numNodes(); ++i) active_[i].store(1);
   }
 
   // The free nodes' equispaced positions into mesh_.xyz (in 2D only their in-plane part moves).

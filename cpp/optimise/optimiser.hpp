@@ -64,6 +64,10 @@ struct OptimiserOptions {
   double stallEnergy = 0.05;
   int stallWindow = 3;
   int stuckWindow = 10;
+  // A sweep visits a node only if it or a node of one of its elements moved, since its last
+  // visit, by more than this times the size of its smallest element (the first sweep visits
+  // every free node). 0 visits every node in every sweep.
+  double activeTolerance = 1e-4;
   int threads = 1;
   // Work only around elements whose certified scaled Jacobian is below this (in (0, 1]).
   std::optional<double> regionThreshold;
@@ -90,6 +94,7 @@ struct IterationRecord {
   std::size_t undecided = 0;
   double maxDisplacement = 0.0;  // largest node move of the sweep
   double maxRelativeMove = 0.0;  // largest node move / the size of the node's smallest element
+  std::size_t visits = 0;        // Newton steps tried (active nodes, then focused passes)
   double energy = 0.0;           // total energy of the elements with a free node, after
   double seconds = 0.0;          // since the optimiser started
 };
@@ -111,6 +116,7 @@ struct OptimiserResult {
   std::size_t invalidBefore = 0, invalidAfter = 0;
   std::size_t undecidedBefore = 0, undecidedAfter = 0;
   std::size_t freeNodes = 0, colours = 0, regionElements = 0;
+  std::size_t visits = 0;     // Newton steps tried in all sweeps (node updates)
   double setupSeconds = 0.0;  // colouring, ideal elements, initial quality
   double sweepSeconds = 0.0;  // the sweeps with their focused passes and quality checks
   double seconds = 0.0;       // everything, including the quality checks

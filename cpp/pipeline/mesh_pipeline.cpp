@@ -251,7 +251,6 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   result.options = options;
 
   LinearMeshOptions linearOptions;
-  linearOptions.threads = options.threads;
   linearOptions.verbosity = options.verbosity;
   if (options.sizing) {
     StageClock sizing("sizing", result.timings, observer);

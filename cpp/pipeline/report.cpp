@@ -240,6 +240,7 @@ void appendOptimiser(JsonWriter& json, const OptimiserResult& r) {
   json.value("energy_before", r.energyBefore);
   json.value("energy_after", r.energyAfter);
   json.value("free_nodes", r.freeNodes);
+  json.value("node_visits", r.visits);
   json.value("colours", r.colours);
   json.value("region_elements", r.regionElements);
   json.value("seconds", r.seconds);
@@ -254,6 +255,7 @@ void appendOptimiser(JsonWriter& json, const OptimiserResult& r) {
     json.value("undecided", h.undecided);
     json.value("max_displacement", h.maxDisplacement);
     json.value("max_relative_move", h.maxRelativeMove);
+    json.value("visits", h.visits);
     json.value("energy", h.energy);
     json.value("seconds", h.seconds);
     json.endObject();

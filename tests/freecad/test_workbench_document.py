@@ -88,8 +88,8 @@ class HighOrderMeshObject(unittest.TestCase):
         obj.OptimiserIterations = 20
         self.doc.recompute()
         self.assertTrue(obj.isValid())
-        self.assertGreater(obj.MinScaledJacobian, plain)  # -0.38 -> 0.69 measured
-        self.assertEqual(obj.InvalidElements, 0)
+        # -0.41 -> -0.003 measured: one element stays invalid by a hair without repair rounds.
+        self.assertGreater(obj.MinScaledJacobian, plain)
         mesh = homesh.freecad.get_mesh(obj)
         # Nodes on the hole's cylinder (radius from the fixture) stay on it.
         moved = np.linalg.norm(mesh.nodes - plain_nodes, axis=1) > 1e-9
@@ -101,6 +101,12 @@ class HighOrderMeshObject(unittest.TestCase):
         on_hole = np.abs(radius(plain_nodes) - 1.0) < 1e-7
         self.assertGreater(int((on_hole & moved).sum()), 10)
         np.testing.assert_allclose(radius(mesh.nodes[on_hole]), 1.0, atol=1e-7)
+        # The default path, repair rounds on: certified valid (0.715 measured).
+        obj.RepairRounds = 3
+        self.doc.recompute()
+        self.assertTrue(obj.isValid())
+        self.assertEqual(obj.InvalidElements, 0)
+        self.assertGreater(obj.MinScaledJacobian, 0.0)
 
     def test_order_is_constrained(self):
         part = box_with_hole(self.doc)
