@@ -2,9 +2,13 @@
 // measures how far each element is from its straight-sided (ideal) shape (DESIGN.md section 6;
 // the functionals are in optimise/functional.hpp).
 //
-// Each sweep (iteration) visits every free node once and takes one Newton step on that node
-// alone (the node's energy is a function of its 2 or 3 coordinates; gradient and Hessian are
-// exact), then `focusPasses` more steps on the nodes of the worst elements only. Each step
+// Each sweep (iteration) visits every active free node once and takes one Newton step on that
+// node alone (the node's energy is a function of its 2 or 3 coordinates; gradient and Hessian
+// are exact), then `focusPasses` more steps on the nodes of the worst elements only. Every node
+// is active in the first sweep; later, a node is active once it or a node of one of its elements
+// moved by more than `activeTolerance` of its element size since its last visit. Per point the
+// deformation gradient F and J = det F are kept and updated by the rank-one change of each
+// accepted move, so a Newton step costs O(quadrature points of the node's elements). Each step
 // shifts the Hessian to be positive definite and uses a backtracking Armijo line search that
 // rejects the move if the energy does not decrease. Nodes are coloured so that two nodes of
 // one colour never share an element; the nodes of a colour are moved in parallel, colours in
@@ -66,8 +70,10 @@ struct OptimiserOptions {
   int stuckWindow = 10;
   // A sweep visits a node only if it or a node of one of its elements moved, since its last
   // visit, by more than this times the size of its smallest element (the first sweep visits
-  // every free node). 0 visits every node in every sweep.
-  double activeTolerance = 1e-4;
+  // every free node). 0 visits every node in every sweep. 1e-3 against 1e-4: on nine test
+  // cases (sphere in a box, NekMesh's 3d_sphere, 3d_bl_cyl, T106) the same validity verdicts,
+  // worst values within 0.007, and 1.2x to 2.5x less time.
+  double activeTolerance = 1e-3;
   int threads = 1;
   // Work only around elements whose certified scaled Jacobian is below this (in (0, 1]).
   std::optional<double> regionThreshold;
