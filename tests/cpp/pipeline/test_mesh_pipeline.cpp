@@ -34,7 +34,8 @@ TEST(MeshPipeline, RunsEveryStageAndReports) {
   CountingObserver observer;
   const MeshResult result =
       runMeshPipeline(CadSource::brepText(test::brepText(test::sphere(1.0))), options, &observer);
-  EXPECT_EQ(observer.started, (std::vector<std::string>{"cad", "linear", "high_order", "quality", "geometry"}));
+  EXPECT_EQ(observer.started,
+            (std::vector<std::string>{"cad", "linear", "high_order", "quality", "geometry"}));
   EXPECT_EQ(result.mesh.order, 3);
   EXPECT_EQ(result.quality.scaledJacobian.size(), result.mesh.numElements());
   const std::string json = meshReportJson(result, "sphere");
