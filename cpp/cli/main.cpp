@@ -126,9 +126,9 @@ int runMesh(const homesh::MeshCommand& cmd) {
       const homesh::RepairRound& r = result.rounds[k];
       std::fprintf(stderr,
                    "homesh: repair %zu: %zu invalid, %zu undecided -> %s %zu elements -> %zu "
-                   "invalid, %zu undecided (%zu elements)%s\n",
+                   "invalid, %zu undecided (%zu elements, %zu reused)%s\n",
                    k + 1, r.invalid, r.undecided, r.action.c_str(), r.elements, r.invalidAfter,
-                   r.undecidedAfter, r.meshElements, r.kept ? "" : ", not kept");
+                   r.undecidedAfter, r.meshElements, r.reused, r.kept ? "" : ", not kept");
     }
     if (cmd.sizing.writeOctree)
       std::fprintf(stderr, "homesh: wrote %s\n", cmd.sizing.writeOctree->c_str());

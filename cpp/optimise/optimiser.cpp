@@ -140,7 +140,7 @@ class Optimiser {
         options_(options),
         observer_(observer),
         cad_(cad),
-        converting_(cad == nullptr && !options.regionThreshold) {}
+        converting_(cad == nullptr && !options.regionThreshold && options.regionSeed.empty()) {}
 
   OptimiserResult run() {
     const auto t0 = Clock::now();
@@ -461,12 +461,21 @@ class Optimiser {
     return {bi, g - blockOffset_[bi]};
   }
 
-  // Elements whose nodes may move: all, or the poor ones and `regionLayers` layers around them.
+  // Elements whose nodes may move: all, or the poor (or seeded) ones and `regionLayers` layers
+  // around them.
   std::vector<char> region() {
     std::vector<char> in(totalElements_, 1);
-    if (!options_.regionThreshold) return in;
+    const std::vector<char>& seed = options_.regionSeed;
+    if (!options_.regionThreshold && seed.empty()) return in;
+    if (!seed.empty() && seed.size() != totalElements_)
+      throw ParameterError("the optimiser's region seed has " + std::to_string(seed.size()) +
+                           " entries for " + std::to_string(totalElements_) + " elements");
     for (std::size_t i = 0; i < totalElements_; ++i)
-      in[i] = scaled_[i] < *options_.regionThreshold || validity_[i] != Validity::Valid ? 1 : 0;
+      in[i] = (!seed.empty() && seed[i] != 0) ||
+                      (options_.regionThreshold && scaled_[i] < *options_.regionThreshold) ||
+                      validity_[i] != Validity::Valid
+                  ? 1
+                  : 0;
     for (int layer = 0; layer < options_.regionLayers; ++layer) {
       std::vector<char> grown = in;
       for (std::size_t node = 0; node + 1 < incidenceStart_.size(); ++node) {

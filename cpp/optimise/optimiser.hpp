@@ -16,9 +16,9 @@
 //
 // Without CAD, free nodes are those not on the mesh's boundary (faces in 3D, edges in 2D, of
 // exactly one element), not on an interface between elements of different entities and not on a
-// lower-dimensional cell of the mesh; the others stay fixed. With a region threshold, only the
-// nodes of elements whose scaled Jacobian is below it, grown by `regionLayers` layers of
-// neighbours, move.
+// lower-dimensional cell of the mesh; the others stay fixed. With a region threshold (or seed),
+// only the nodes of elements whose scaled Jacobian is below it (or that the seed names), grown
+// by `regionLayers` layers of neighbours, move.
 //
 // Never worse: after every sweep the certified scaled Jacobian (quality/bezier_jacobian.hpp)
 // of every element that can have changed is recomputed; the state kept at the end is the best
@@ -77,6 +77,10 @@ struct OptimiserOptions {
   int threads = 1;
   // Work only around elements whose certified scaled Jacobian is below this (in (0, 1]).
   std::optional<double> regionThreshold;
+  // Work only around these elements (1 per element in block order, as Mesh::blocks lists the
+  // cells of dimension mesh.dim) and those not proven valid; empty: no such restriction. With
+  // regionThreshold too, the region is the union.
+  std::vector<char> regionSeed;
   int regionLayers = 2;  // layers of neighbours (sharing a node) added to the region
   // After each sweep, this many extra Newton steps on the nodes of the elements whose scaled
   // Jacobian is within focusMargin of the mesh's worst (see sweep() in optimiser.cpp).

@@ -14,6 +14,7 @@
 #include "core/format.hpp"
 #include "curving/order_elevation.hpp"
 #include "linear/linear_mesher.hpp"
+#include "pipeline/curved_reuse.hpp"
 #include "pipeline/repair.hpp"
 #include "sizing/octree_export.hpp"
 
@@ -198,6 +199,7 @@ struct CurvedState {
   Mesh mesh;
   QualitySummary quality;
   std::optional<OptimiserResult> optimiser;
+  std::size_t reused = 0;  // elements that took their curved nodes from the round before
 
   std::size_t notValid() const { return quality.invalid + quality.undecided; }
   bool betterThan(const CurvedState& other) const {
@@ -206,16 +208,32 @@ struct CurvedState {
   }
 };
 
+// Layers of neighbours around a repair round's new elements that the optimiser moves too.
+constexpr int kRepairRegionLayers = 4;
+// Poor elements below this certified scaled Jacobian join the region too.
+constexpr double kRepairRegionThreshold = 0.2;
+
 // Elevation, optimiser and quality of a linear mesh. With `clocked`, each stage is timed
-// under its own name; a repair round times them all as one stage instead.
+// under its own name; a repair round times them all as one stage instead. With `previous` (a
+// repair round's starting state), the elements whose linear cell is unchanged take their
+// curved nodes from it and the optimiser works only on the new elements, the ones not proven
+// valid and kRepairRegionLayers layers around them.
 CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& cad,
-                  StageTimings& timings, PipelineObserver* observer, bool clocked) {
+                  StageTimings& timings, PipelineObserver* observer, bool clocked,
+                  const CurvedState* previous = nullptr) {
   CurvedState state;
   state.linear = std::move(linear);
   checkHighOrderMemory(state.linear, options.order);
   std::optional<StageClock> clock;
   if (clocked) clock.emplace("high_order", timings, observer);
   state.mesh = elevateOrder(state.linear, options.order, &cad);
+  std::vector<char> fresh;  // the optimiser's region seed: empty for the whole mesh
+  if (previous != nullptr) {
+    CurvedReuse reuse =
+        reuseCurvedNodes(previous->linear, previous->mesh, state.linear, state.mesh);
+    state.reused = reuse.reused;
+    if (reuse.reused > 0) fresh = std::move(reuse.fresh);
+  }
   if (clocked) clock->done();
 
   if (options.optimiseIterations > 0) {
@@ -224,6 +242,11 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
     o.maxIterations = options.optimiseIterations;
     o.stall = 1e-3;  // valid and no longer improving: stop early
     o.threads = options.threads;
+    if (!fresh.empty()) {
+      o.regionSeed = std::move(fresh);
+      o.regionLayers = kRepairRegionLayers;
+      o.regionThreshold = kRepairRegionThreshold;
+    }
     OptimiserCancel cancel(observer);
     state.optimiser = optimiseMesh(state.mesh, o, &cancel, &cad);
     if (state.optimiser->cancelled) throw CancelledError("cancelled during optimise");
@@ -316,7 +339,8 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       next = generateLinearMesh(*result.cad, refined);
     }
     CurvedState state =
-        curve(std::move(next), options, *result.cad, result.timings, observer, false);
+        curve(std::move(next), options, *result.cad, result.timings, observer, false, &from);
+    record.reused = state.reused;
     record.invalidAfter = state.quality.invalid;
     record.undecidedAfter = state.quality.undecided;
     record.meshElements = state.mesh.numElements();

@@ -37,7 +37,8 @@ struct RepairRound {
   std::size_t sources = 0;                 // refinement spheres added ("refine")
   std::size_t invalidAfter = 0, undecidedAfter = 0;  // of the mesh the round made
   std::size_t meshElements = 0;                      // elements of the mesh the round made
-  bool kept = false;  // the round's mesh is no worse than the best before it and was kept
+  std::size_t reused = 0;  // of those, elements whose curved nodes came from the round before
+  bool kept = false;       // the round's mesh is no worse than the best before it and was kept
   double seconds = 0.0;
 };
 

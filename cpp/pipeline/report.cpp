@@ -282,6 +282,7 @@ void appendRepairRounds(JsonWriter& json, const std::vector<RepairRound>& rounds
     json.value("invalid_after", r.invalidAfter);
     json.value("undecided_after", r.undecidedAfter);
     json.value("mesh_elements", r.meshElements);
+    json.value("reused_elements", r.reused);
     json.value("kept", r.kept);
     json.value("seconds", r.seconds);
     json.endObject();

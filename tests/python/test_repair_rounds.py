@@ -14,7 +14,8 @@ SPHERE_BOX = Path(__file__).resolve().parents[2] / "examples" / "sphere_box.step
 # Order 4 at size 1.2: curving alone leaves tetrahedra outside the sphere invalid.
 CASE = ["--size", "1.2", "--order", "4"]
 ROUND_KEYS = {"invalid", "undecided", "action", "elements", "edges_split", "refinement_spheres",
-              "invalid_after", "undecided_after", "mesh_elements", "kept", "seconds"}
+              "invalid_after", "undecided_after", "mesh_elements", "reused_elements", "kept",
+              "seconds"}
 
 
 def _mesh(homesh_bin, tmp_path, rounds):

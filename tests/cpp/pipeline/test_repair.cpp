@@ -2,13 +2,18 @@
 // the pipeline on the sphere in a box, which curving alone leaves invalid.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <numeric>
+#include <set>
 
 #include "core/error.hpp"
+#include "curving/order_elevation.hpp"
 #include "linear/edge_split.hpp"
 #include "linear/linear_mesher.hpp"
+#include "pipeline/curved_reuse.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/repair.hpp"
 #include "pipeline/report.hpp"
@@ -139,6 +144,73 @@ TEST(EdgeSplit, MidpointHalvesEveryCellAroundTheEdge) {
   EXPECT_FALSE(splitInteriorEdge(mesh, {edge[0], m}, a + 5.0 * (a - mid)));
   EXPECT_EQ(cellVolumes(mesh).size(), after.size());
   EXPECT_EQ(mesh.numNodes(), nodes + 1);
+}
+
+// The first edge of the first tetrahedron that is on no boundary triangle.
+MeshEdge firstInteriorEdge(const Mesh& mesh) {
+  const std::set<MeshEdge> boundary = boundaryEdges(mesh);
+  const ElementBlock& tets = mesh.blocks.front();
+  for (std::size_t e = 0; e < tets.count(); ++e)
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        const MeshEdge edge = meshEdge(tets.element(e)[i], tets.element(e)[j]);
+        if (boundary.count(edge) == 0) return edge;
+      }
+  return {-1, -1};
+}
+
+// A repair round's split changes the cells around one edge; every other element must come back
+// with its old curved nodes (here marked by a shift the new elevation cannot reproduce), and
+// only the split cells are fresh.
+TEST(CurvedReuse, UnchangedCellsKeepTheirCurvedNodesAndOnlySplitCellsAreFresh) {
+  const CadModel cad = test::toModel(test::box(1, 1, 1));
+  const Mesh oldLinear = generateLinearMesh(cad, LinearMeshOptions::uniform(0.4));
+  Mesh oldCurved = elevateOrder(oldLinear, 3, &cad);
+  for (std::size_t i = 0; i < oldCurved.numNodes(); ++i)
+    if (oldCurved.nodeCadDim[i] == 3) oldCurved.xyz[3 * i] += 1e-3 * static_cast<double>(i % 7 + 1);
+
+  Mesh newLinear = oldLinear;
+  const MeshEdge edge = firstInteriorEdge(newLinear);
+  ASSERT_GE(edge[0], 0);
+  const Eigen::Vector3d a = nodePoint(newLinear, edge[0]), b = nodePoint(newLinear, edge[1]);
+  ASSERT_TRUE(splitInteriorEdge(newLinear, edge, 0.5 * (a + b)));
+  const std::size_t added = newLinear.numElements() - oldLinear.numElements();
+  ASSERT_GE(added, 3u);  // an interior edge has at least three cells around it
+  Mesh newCurved = elevateOrder(newLinear, 3, &cad);
+  const Mesh elevated = newCurved;
+
+  const CurvedReuse reuse = reuseCurvedNodes(oldLinear, oldCurved, newLinear, newCurved);
+  ASSERT_EQ(reuse.fresh.size(), newLinear.numElements());
+  // Each cell around the edge kept its slot (changed) and its other half was appended.
+  EXPECT_EQ(reuse.reused, oldLinear.numElements() - added);
+  EXPECT_EQ(std::count(reuse.fresh.begin(), reuse.fresh.end(), 1),
+            static_cast<std::ptrdiff_t>(2 * added));
+  const ElementBlock& before = oldCurved.blocks.front();
+  const ElementBlock& after = newCurved.blocks.front();
+  std::set<std::int64_t> reusedNodes;
+  for (std::size_t e = 0; e < after.count(); ++e) {
+    if (reuse.fresh[e] != 0) continue;
+    ASSERT_LT(e, before.count());  // unchanged cells keep their slots
+    for (int k = 0; k < after.nodesPerElement(); ++k) {
+      reusedNodes.insert(after.element(e)[k]);
+      for (int c = 0; c < 3; ++c)  // copied, so equal bit for bit
+        EXPECT_EQ(newCurved.xyz[3 * after.element(e)[k] + c],
+                  oldCurved.xyz[3 * before.element(e)[k] + c]);
+    }
+  }
+  // The nodes of fresh elements that no reused element shares keep the new elevation.
+  for (std::size_t e = 0; e < after.count(); ++e)
+    for (int k = 0; k < after.nodesPerElement() && reuse.fresh[e] != 0; ++k) {
+      const std::int64_t n = after.element(e)[k];
+      if (reusedNodes.count(n) == 0) {
+        EXPECT_EQ(newCurved.xyz[3 * n], elevated.xyz[3 * n]);
+      }
+    }
+
+  const Mesh otherOrder = elevateOrder(newLinear, 2, &cad);
+  Mesh target = otherOrder;
+  EXPECT_THROW(reuseCurvedNodes(oldLinear, oldCurved, newLinear, target), ParameterError);
+  EXPECT_THROW(reuseCurvedNodes(newLinear, oldCurved, newLinear, newCurved), ParameterError);
 }
 
 // The sphere in a box at size 1.2, order 4: curving and 20 optimiser sweeps leave invalid
