@@ -200,6 +200,10 @@ struct CurvedState {
   QualitySummary quality;
   std::optional<OptimiserResult> optimiser;
   std::size_t reused = 0;  // elements that took their curved nodes from the round before
+  // Above kContinuationOrder with the optimiser: the mesh of that order, optimised, that the
+  // final order started from (empty otherwise).
+  Mesh lowOrder;
+  std::optional<OptimiserResult> lowOrderOptimiser;
 
   std::size_t notValid() const { return quality.invalid + quality.undecided; }
   bool betterThan(const CurvedState& other) const {
@@ -209,49 +213,77 @@ struct CurvedState {
 };
 
 // Layers of neighbours around a repair round's new elements that the optimiser moves too.
+// Sweeps without fewer invalid elements after which the optimiser gives the mesh to the repair
+// rounds (the optimiser alone waits 10).
+constexpr int kPipelineStuckWindow = 5;
+
 constexpr int kRepairRegionLayers = 4;
 // Poor elements below this certified scaled Jacobian join the region too.
 constexpr double kRepairRegionThreshold = 0.2;
+
+OptimiserOptions pipelineOptimiserOptions(const MeshingOptions& options) {
+  OptimiserOptions o;
+  o.maxIterations = options.optimiseIterations;
+  o.stall = 1e-3;                        // valid and no longer improving: stop early
+  o.stuckWindow = kPipelineStuckWindow;  // not valid and not improving: repair rounds take over
+  o.threads = options.threads;
+  return o;
+}
 
 // Elevation, optimiser and quality of a linear mesh. With `clocked`, each stage is timed
 // under its own name; a repair round times them all as one stage instead. With `previous` (a
 // repair round's starting state), the elements whose linear cell is unchanged take their
 // curved nodes from it and the optimiser works only on the new elements, the ones not proven
-// valid and kRepairRegionLayers layers around them.
+// valid or poor, and kRepairRegionLayers layers around them.
 CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& cad,
                   StageTimings& timings, PipelineObserver* observer, bool clocked,
                   const CurvedState* previous = nullptr) {
   CurvedState state;
   state.linear = std::move(linear);
   checkHighOrderMemory(state.linear, options.order);
-  std::optional<StageClock> clock;
-  if (clocked) clock.emplace("high_order", timings, observer);
-  state.mesh = elevateOrder(state.linear, options.order, &cad);
-  std::vector<char> fresh;  // the optimiser's region seed: empty for the whole mesh
-  if (previous != nullptr) {
-    CurvedReuse reuse =
-        reuseCurvedNodes(previous->linear, previous->mesh, state.linear, state.mesh);
-    state.reused = reuse.reused;
-    if (reuse.reused > 0) fresh = std::move(reuse.fresh);
-  }
-  if (clocked) clock->done();
-
-  if (options.optimiseIterations > 0) {
-    if (clocked) clock.emplace("optimise", timings, observer);
-    OptimiserOptions o;
-    o.maxIterations = options.optimiseIterations;
-    o.stall = 1e-3;  // valid and no longer improving: stop early
-    o.threads = options.threads;
+  OptimiserCancel cancel(observer);
+  // Elevates to `order`, takes what it can from `previous` (its mesh of that order) and
+  // optimises (the whole mesh, or around what changed).
+  const auto curveAt = [&](int order, Mesh& mesh, const Mesh* before, const char* stage) {
+    std::vector<char> fresh;  // the optimiser's region seed: empty for the whole mesh
+    if (before != nullptr) {
+      CurvedReuse reuse = reuseCurvedNodes(previous->linear, *before, state.linear, mesh);
+      if (order == options.order) state.reused = reuse.reused;
+      if (reuse.reused > 0) fresh = std::move(reuse.fresh);
+    }
+    if (options.optimiseIterations <= 0) return std::optional<OptimiserResult>();
+    std::optional<StageClock> clock;
+    if (clocked) clock.emplace(stage, timings, observer);
+    OptimiserOptions o = pipelineOptimiserOptions(options);
     if (!fresh.empty()) {
       o.regionSeed = std::move(fresh);
       o.regionLayers = kRepairRegionLayers;
       o.regionThreshold = kRepairRegionThreshold;
     }
-    OptimiserCancel cancel(observer);
-    state.optimiser = optimiseMesh(state.mesh, o, &cancel, &cad);
-    if (state.optimiser->cancelled) throw CancelledError("cancelled during optimise");
+    std::optional<OptimiserResult> r = optimiseMesh(mesh, o, &cancel, &cad);
+    if (r->cancelled) throw CancelledError("cancelled during optimise");
     if (clocked) clock->done();
+    return r;
+  };
+
+  std::optional<StageClock> clock;
+  if (options.optimiseIterations > 0 && options.order > kContinuationOrder) {
+    if (clocked) clock.emplace("high_order", timings, observer);
+    state.lowOrder = elevateOrder(state.linear, kContinuationOrder, &cad);
+    if (clocked) clock->done();
+    state.lowOrderOptimiser = curveAt(
+        kContinuationOrder, state.lowOrder,
+        previous != nullptr && previous->lowOrder.numNodes() > 0 ? &previous->lowOrder : nullptr,
+        "optimise_low_order");
+    if (clocked) clock.emplace("raise_order", timings, observer);
+    state.mesh = changeOrder(state.lowOrder, options.order, &cad);
+  } else {
+    if (clocked) clock.emplace("high_order", timings, observer);
+    state.mesh = elevateOrder(state.linear, options.order, &cad);
   }
+  if (clocked) clock->done();
+  state.optimiser = curveAt(options.order, state.mesh,
+                            previous != nullptr ? &previous->mesh : nullptr, "optimise");
 
   if (clocked) clock.emplace("quality", timings, observer);
   state.quality = evaluateQuality(state.mesh, options.threads);
@@ -361,6 +393,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   result.mesh = std::move(best.mesh);
   result.quality = std::move(best.quality);
   result.optimiser = std::move(best.optimiser);
+  result.lowOrderOptimiser = std::move(best.lowOrderOptimiser);
 
   StageClock geometry("geometry", result.timings, observer);
   result.geometry = measureGeometryAccuracy(result.mesh, *result.cad, options.threads);

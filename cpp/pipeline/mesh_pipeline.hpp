@@ -29,6 +29,11 @@ namespace homesh {
 
 inline constexpr int kMaxThreads = 1024;
 inline constexpr int kMaxRepairRounds = 20;
+// With the optimiser, orders above this are first curved and optimised at this order, then
+// raised (curving/order_elevation.hpp's changeOrder) and optimised again: the low order
+// untangles the interior with a fraction of the nodes and a far better conditioned problem
+// (equispaced nodes of order 8 couple strongly), and the high order only corrects it.
+inline constexpr int kContinuationOrder = 4;
 
 struct MeshingOptions {
   int order = 4;  // polynomial order, 1..10
@@ -140,6 +145,8 @@ struct MeshResult {
   Mesh mesh;
   QualitySummary quality;
   std::optional<OptimiserResult> optimiser;  // when the optimiser ran
+  // Above kContinuationOrder: the optimiser's run at that order that the mesh started from.
+  std::optional<OptimiserResult> lowOrderOptimiser;
   std::optional<SizingResult> sizing;        // when the sizes came from the octree
   std::optional<GeometryAccuracy> geometry;  // boundary against the CAD (a mesh made from CAD)
   std::vector<RepairRound> rounds;           // the repair rounds run, in order

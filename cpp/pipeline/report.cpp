@@ -187,6 +187,9 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
   appendQuality(json, result.mesh, result.quality);
   if (result.geometry) appendGeometry(json, *result.geometry);
   if (result.optimiser) appendOptimiser(json, *result.optimiser);
+  if (result.lowOrderOptimiser)
+    appendOptimiser(json, *result.lowOrderOptimiser,
+                    "optimiser_order_" + std::to_string(kContinuationOrder));
   appendRepairRounds(json, result.rounds);
   json.beginObject("timings_s");
   for (const auto& [stage, s] : result.timings.seconds) json.value(stage, s);
@@ -221,8 +224,8 @@ std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
   return fileReportJson(mesh, quality, nullptr, input);
 }
 
-void appendOptimiser(JsonWriter& json, const OptimiserResult& r) {
-  json.beginObject("optimiser");
+void appendOptimiser(JsonWriter& json, const OptimiserResult& r, const std::string& key) {
+  json.beginObject(key);
   json.value("functional", functionalName(r.functional));
   json.value("iterations", r.iterations);
   json.value("converged", r.converged);

@@ -49,7 +49,8 @@ std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
 
 // Appends "optimiser": {functional, iterations, worst_before, worst_after, invalid_before,
 // invalid_after, seconds, ...} with the per-sweep history.
-void appendOptimiser(JsonWriter& json, const OptimiserResult& result);
+void appendOptimiser(JsonWriter& json, const OptimiserResult& result,
+                     const std::string& key = "optimiser");
 
 // The report of `homesh optimise`: the quality report of the result plus "optimiser".
 std::string optimiseReportJson(const Mesh& mesh, const QualitySummary& quality,

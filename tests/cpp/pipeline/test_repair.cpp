@@ -8,6 +8,7 @@
 #include <limits>
 #include <numeric>
 #include <set>
+#include <string>
 
 #include "core/error.hpp"
 #include "curving/order_elevation.hpp"
@@ -246,6 +247,39 @@ TEST(RepairRounds, SphereInBoxEndsProvenValid) {
   EXPECT_EQ(json.find("\"invalid\": " + std::to_string(without.quality.invalid), rounds),
             json.find("\"invalid\"", rounds));
   EXPECT_NE(json.find("\"action\": \"", rounds), std::string::npos);
+}
+
+// Order 8 on the same coarse sphere in a box: curved and optimised at order 4 first, raised,
+// then optimised at order 8 (measured: 32 elements left invalid after 26 sweeps when order 8
+// was optimised from the straight interior). The result must be proven valid, and Gmsh's
+// own verdict on it is checked by the CLI tests' order sweep.
+TEST(RepairRounds, OrderEightStartsFromTheOptimisedOrderFourMeshAndEndsProvenValid) {
+  MeshingOptions options;
+  options.order = 8;
+  options.size = 1.2;
+  options.optimiseIterations = 30;
+  options.threads = 2;
+  const MeshResult result = runMeshPipeline(CadSource::file(kSphereBox), options);
+  ASSERT_TRUE(result.lowOrderOptimiser.has_value());
+  ASSERT_TRUE(result.optimiser.has_value());
+  EXPECT_EQ(result.mesh.order, 8);
+  // The order-8 optimiser starts from the raised order-4 mesh: far less tangled than the
+  // straight interior (83 invalid elements, worst -5.8 measured) and its energy far lower.
+  EXPECT_LT(result.optimiser->invalidBefore, 20u);
+  EXPECT_EQ(result.quality.invalid, 0u);
+  EXPECT_EQ(result.quality.undecided, 0u);
+  EXPECT_GT(result.quality.scaled.min, 0.0);
+  std::set<std::string> stages;
+  for (const auto& [stage, s] : result.timings.seconds) stages.insert(stage);
+  EXPECT_EQ(stages.count("optimise_low_order"), 1u);
+  EXPECT_EQ(stages.count("raise_order"), 1u);
+  EXPECT_NE(meshReportJson(result, "sphere_box").find("\"optimiser_order_4\": {"),
+            std::string::npos);
+
+  options.order = kContinuationOrder;  // no continuation at or below order 4
+  options.optimiseIterations = 2;
+  options.repairRounds = 0;
+  EXPECT_FALSE(runMeshPipeline(CadSource::file(kSphereBox), options).lowOrderOptimiser);
 }
 
 TEST(RepairRounds, RoundsAreValidated) {
