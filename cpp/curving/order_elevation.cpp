@@ -20,10 +20,17 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// A node by its support: the global vertices with a non-zero barycentric index, sorted by vertex.
+// A node by its support: the global vertices with a non-zero weight in the straight-sided
+// (multi)linear map, sorted by vertex, with those weights as integers over kScale(P) = P^3.
+// The weight a point gives each vertex of the edge, face or cell it lies in is intrinsic (the
+// same from every cell that has the point, whatever its local orientation or shape: a
+// triangle face weights its vertices alike from a tetrahedron and from a prism, a
+// quadrilateral face alike from the two hexahedra on it), so equal keys mean one node.
+constexpr int kMaxSupport = 8;
+
 struct NodeKey {
-  std::array<std::int64_t, 4> vertex{-1, -1, -1, -1};
-  std::array<int, 4> index{0, 0, 0, 0};
+  std::array<std::int64_t, kMaxSupport> vertex{};
+  std::array<int, kMaxSupport> index{};  // weight x P^3
   int size = 0;
   bool operator==(const NodeKey& o) const {
     return size == o.size && vertex == o.vertex && index == o.index;
@@ -41,8 +48,55 @@ struct NodeKeyHash {
   }
 };
 
+int cube(int p) {
+  return p * p * p;
+}
+
+// The vertex weights x P^3 of lattice point c of an order-P cell (node_ordering.hpp's lattice:
+// quadrilateral corners (0,0) (P,0) (P,P) (0,P); prism triangle at k = 0 then k = P;
+// hexahedron quadrilateral at k = 0 then k = P).
+std::array<int, kMaxSupport> vertexWeights(CellType type, const LatticePoint& c, int p) {
+  std::array<int, kMaxSupport> w{};
+  const int i = c[0], j = c[1], k = c[2];
+  switch (type) {
+    case CellType::Line:
+      w[0] = (p - i) * p * p;
+      w[1] = i * p * p;
+      break;
+    case CellType::Triangle:
+    case CellType::Tetrahedron: {
+      const std::array<int, 4> a = simplexBarycentric(c, cellDimension(type), p);
+      for (int v = 0; v < cellNumVertices(type); ++v) w[v] = a[v] * p * p;
+      break;
+    }
+    case CellType::Quadrilateral:
+      w = {(p - i) * (p - j) * p, i * (p - j) * p, i * j * p, (p - i) * j * p};
+      break;
+    case CellType::Prism: {
+      const int t[3] = {p - i - j, i, j};
+      for (int v = 0; v < 3; ++v) {
+        w[v] = t[v] * (p - k) * p;
+        w[v + 3] = t[v] * k * p;
+      }
+      break;
+    }
+    case CellType::Hexahedron: {
+      const int q[4] = {(p - i) * (p - j), i * (p - j), i * j, (p - i) * j};
+      for (int v = 0; v < 4; ++v) {
+        w[v] = q[v] * (p - k);
+        w[v + 4] = q[v] * k;
+      }
+      break;
+    }
+    default:
+      throw ParameterError("changing the order does not support " + cellShortName(type));
+  }
+  return w;
+}
+
 using EdgeKey = std::array<std::int64_t, 2>;
 using FaceKey = std::array<std::int64_t, 3>;
+using QuadKey = std::array<std::int64_t, 4>;
 
 template <std::size_t N>
 std::array<std::int64_t, N> sorted(std::array<std::int64_t, N> a) {
@@ -55,19 +109,25 @@ struct BoundaryClassification {
   std::map<EdgeKey, int> edgeCurve;  // edge on a CAD curve
   std::map<EdgeKey, int> edgeFace;   // edge inside a CAD face
   std::map<FaceKey, int> faceFace;   // triangle on a CAD face (3D)
+  std::map<QuadKey, int> quadFace;   // quadrilateral on a CAD face (3D)
 
   explicit BoundaryClassification(const Mesh& linear) {
     for (const ElementBlock& block : linear.blocks) {
-      const bool boundaryFaces = block.type == CellType::Triangle;
+      const bool triangles = block.type == CellType::Triangle;
+      const bool quads = block.type == CellType::Quadrilateral;
       for (std::size_t e = 0; e < block.count(); ++e) {
         const std::int64_t* v = block.element(e);
         if (block.type == CellType::Line) {
           edgeCurve[sorted<2>({v[0], v[1]})] = block.entity[e];
-        } else if (boundaryFaces) {
-          // In 2D the cells themselves are the face's triangles; in 3D the boundary triangles.
-          if (linear.dim == 3) faceFace[sorted<3>({v[0], v[1], v[2]})] = block.entity[e];
-          for (int k = 0; k < 3; ++k)
-            edgeFace.emplace(sorted<2>({v[k], v[(k + 1) % 3]}), block.entity[e]);
+        } else if (triangles || quads) {
+          // In 2D the cells themselves are the face's cells; in 3D the boundary cells.
+          if (linear.dim == 3 && triangles)
+            faceFace[sorted<3>({v[0], v[1], v[2]})] = block.entity[e];
+          if (linear.dim == 3 && quads)
+            quadFace[sorted<4>({v[0], v[1], v[2], v[3]})] = block.entity[e];
+          const int n = triangles ? 3 : 4;
+          for (int k = 0; k < n; ++k)
+            edgeFace.emplace(sorted<2>({v[k], v[(k + 1) % n]}), block.entity[e]);
         }
       }
     }
@@ -104,6 +164,10 @@ struct Elevator {
       const FaceKey face{key.vertex[0], key.vertex[1], key.vertex[2]};
       if (auto it = classes.faceFace.find(face); it != classes.faceFace.end())
         return {2, it->second};
+    } else if (key.size == 4 && linear.dim == 3) {  // a quadrilateral face (or a cell interior)
+      const QuadKey face{key.vertex[0], key.vertex[1], key.vertex[2], key.vertex[3]};
+      if (auto it = classes.quadFace.find(face); it != classes.quadFace.end())
+        return {2, it->second};
     }
     return {cellDim, cellEntity};
   }
@@ -119,7 +183,8 @@ struct Elevator {
     } else {
       for (int i = 0; i < key.size; ++i)
         for (int c = 0; c < 3; ++c)
-          p[c] += linear.xyz[3 * key.vertex[i] + c] * key.index[i] / static_cast<double>(order);
+          p[c] +=
+              linear.xyz[3 * key.vertex[i] + c] * key.index[i] / static_cast<double>(cube(order));
     }
     const auto [dim, entity] = classify(key, cell, cellEntity);
     it->second = out.addNode(p, dim, entity, kNaN, kNaN);
@@ -127,10 +192,8 @@ struct Elevator {
   }
 
   void elevateBlock(const ElementBlock& block) {
-    if (block.type != CellType::Line && block.type != CellType::Triangle &&
-        block.type != CellType::Tetrahedron)
-      throw ParameterError("changing the order supports lines, triangles and tetrahedra, not " +
-                           cellShortName(block.type));
+    if (block.type == CellType::Pyramid)
+      throw ParameterError("changing the order does not support pyramids");
     const ReferenceElement& ref = ReferenceElement::get(block.type, order);
     const int nv = cellNumVertices(block.type);
     ElementBlock high;
@@ -152,12 +215,12 @@ struct Elevator {
         if (curvedSource)
           for (int j = 0; j < sourceNodes; ++j)
             for (int c = 0; c < 3; ++c) curved[c] += interpolation(r, j) * linear.xyz[3 * v[j] + c];
-        const std::array<int, 4> a = simplexBarycentric(point, ref.dim(), order);
-        std::array<std::pair<std::int64_t, int>, 4> support{};
+        const std::array<int, kMaxSupport> a = vertexWeights(block.type, point, order);
+        std::array<std::pair<std::int64_t, int>, kMaxSupport> support{};
         int n = 0;
         for (int k = 0; k < nv; ++k)
           if (a[k] > 0) support[n++] = {v[k], a[k]};
-        for (int i = 1; i < n; ++i)  // insertion sort of at most 4 entries
+        for (int i = 1; i < n; ++i)  // insertion sort of at most 8 entries
           for (int j = i; j > 0 && support[j] < support[j - 1]; --j)
             std::swap(support[j], support[j - 1]);
         NodeKey key;
@@ -220,12 +283,16 @@ class BoundaryPlacer {
           nodes.front() = key.vertex[0];
           nodes.back() = key.vertex[1];
         }
-        nodes[static_cast<std::size_t>(key.index[1])] = id;  // index[1] steps from vertex[0]
+        // index[1] / P^2 steps from vertex[0]
+        nodes[static_cast<std::size_t>(key.index[1] / (order_ * order_))] = id;
       } else if (key.size == 3 && mesh_.nodeCadDim[id] == 2) {
         auto& nodes = triangles_[{key.vertex[0], key.vertex[1], key.vertex[2]}];
         if (nodes.empty()) nodes.assign((p + 1) * (p + 2) / 2, -1);
-        nodes[static_cast<std::size_t>(latticeIndex(order_, key.index[1], key.index[2]))] = id;
+        const int scale = order_ * order_;
+        nodes[static_cast<std::size_t>(
+            latticeIndex(order_, key.index[1] / scale, key.index[2] / scale))] = id;
       }
+      // Nodes inside quadrilaterals on a CAD face are projected onto it (projectNewNodes).
     }
   }
 

@@ -1,14 +1,17 @@
 // Raises a linear mesh to order P and puts the new boundary nodes on the CAD.
 //
-// New nodes are shared between the elements that contain them: a node is identified by the
-// global vertices of the edge, face or cell it belongs to and its integer barycentric index
-// there, which every neighbour computes identically whatever its local orientation. Nodes on a
+// Every shape but the pyramid: lines, triangles, quadrilaterals, tetrahedra, prisms and
+// hexahedra, mixed in one mesh. New nodes are shared between the elements that contain them: a
+// node is identified by the global vertices of the edge, face or cell it belongs to and the
+// integer weights (times P^3) its straight-sided position gives them, which every neighbour
+// computes identically whatever its local orientation or shape. Nodes on a
 // CAD curve or face (known from the linear mesh's boundary lines and triangles) are placed on it
 // and record their parameters: along curves spaced in arc length from the end vertices'
 // parameters, along edges inside faces spaced in (u, v) towards the geodesic, inside boundary
 // triangles as a relaxed lattice in (u, v) (curve_node_placement.hpp, face_node_placement.hpp);
 // where such a placement fails its checks (order along the edge, no flipped lattice triangle,
-// inside the face's trimming) the nodes are projected onto the entity. Interior nodes stay at
+// inside the face's trimming) the nodes are projected onto the entity, as are the nodes inside
+// boundary quadrilaterals (no (u, v) lattice placement for them yet). Interior nodes stay at
 // their straight-sided positions (the optimiser curves the interior later).
 #pragma once
 

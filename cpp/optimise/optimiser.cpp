@@ -851,13 +851,20 @@ class Optimiser {
     const bool wakes = relative > options_.activeTolerance;
     active_[node].store(wakes ? 1 : 0, std::memory_order_relaxed);
     if (!moved) return;
+    // Loads before stores: the flags are mostly set already, and a store (even of the same
+    // value) takes the cache line from the other threads working on neighbouring nodes.
+    constexpr std::uint8_t both = kStale | kDrifted;
     for (std::size_t k = incidenceStart_[node]; k < incidenceStart_[node + 1]; ++k) {
       const Incidence& inc = incidence_[k];
-      marks_[globalIndex(inc)].fetch_or(kStale | kDrifted, std::memory_order_relaxed);
+      std::atomic<std::uint8_t>& mark = marks_[globalIndex(inc)];
+      if ((mark.load(std::memory_order_relaxed) & both) != both)
+        mark.fetch_or(both, std::memory_order_relaxed);
       if (!wakes) continue;
       const Block<D>& b = blocks_[inc.block];
       const std::int64_t* v = b.cells->element(inc.element);
-      for (int j = 0; j < b.nodes; ++j) active_[v[j]].store(1, std::memory_order_relaxed);
+      for (int j = 0; j < b.nodes; ++j)
+        if (active_[v[j]].load(std::memory_order_relaxed) == 0)
+          active_[v[j]].store(1, std::memory_order_relaxed);
     }
   }
 

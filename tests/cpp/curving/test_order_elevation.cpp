@@ -151,6 +151,157 @@ TEST(OrderElevation, CurvedCylinderKeepsValidElements) {
   EXPECT_EQ(evaluateQuality(mesh).invalid, 0u);
 }
 
+// A unit hexahedron at [0,1]^3 and two prisms filling [1,2]x[0,1]x[0,1] (its base square cut
+// along a diagonal), sharing the quadrilateral face x = 1, with their boundary quadrilaterals
+// and triangles.
+Mesh hexAndPrisms() {
+  Mesh mesh;
+  const double pts[12][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1},
+                             {1, 1, 1}, {0, 1, 1}, {2, 0, 0}, {2, 1, 0}, {2, 0, 1}, {2, 1, 1}};
+  for (const auto& x : pts) mesh.addNode(x, 3, 1, std::nan(""), std::nan(""));
+  ElementBlock hex{CellType::Hexahedron, 1, {0, 1, 2, 3, 4, 5, 6, 7}, {1}};
+  // Bottom triangles counter-clockwise seen from +z, then their tops.
+  ElementBlock prisms{CellType::Prism, 1, {1, 8, 9, 5, 10, 11, 1, 9, 2, 5, 11, 6}, {1, 1}};
+  ElementBlock quads{CellType::Quadrilateral, 1, {0, 3, 2, 1, 8, 10, 11, 9}, {1, 1}};
+  ElementBlock tris{CellType::Triangle, 1, {1, 9, 8, 5, 10, 11}, {1, 1}};
+  mesh.blocks = {hex, prisms, quads, tris};
+  mesh.checkConsistency();
+  return mesh;
+}
+
+TEST(OrderElevation, HexahedraPrismsAndQuadrilateralsShareTheirNodes) {
+  const Mesh linear = hexAndPrisms();
+  const int p = 3;
+  const Mesh mesh = elevateOrder(linear, p, nullptr);
+  ASSERT_EQ(mesh.blocks.size(), 4u);
+  EXPECT_EQ(mesh.blocks[0].nodesPerElement(), 64);  // (P + 1)^3
+  EXPECT_EQ(mesh.blocks[1].nodesPerElement(), 40);  // (P + 1)(P + 1)(P + 2) / 2
+  // Every node of the straight-sided cells sits on the lattice of spacing 1/P of the box, and
+  // no two nodes coincide: shared edges and faces (the quadrilateral at x = 1, the prisms'
+  // diagonal face) gave one node per point. Coordinates are sums of at most 8 products of
+  // small integers / 27, so 1e-12 covers their rounding.
+  std::set<std::array<long, 3>> seen;
+  for (std::size_t i = 0; i < mesh.numNodes(); ++i) {
+    std::array<long, 3> cell{};
+    for (int c = 0; c < 3; ++c) {
+      const double scaled = mesh.xyz[3 * i + c] * p;
+      cell[c] = std::lround(scaled);
+      EXPECT_NEAR(scaled, static_cast<double>(cell[c]), 1e-12) << "node " << i;
+    }
+    EXPECT_TRUE(seen.insert(cell).second) << "node " << i << " is a duplicate";
+  }
+  // The hexahedron's lattice and the prisms' together: all (2P+1) x (P+1) x (P+1) points of
+  // the box's lattice (the prisms' lattice points are exactly those of their square).
+  EXPECT_EQ(mesh.numNodes(), static_cast<std::size_t>((2 * p + 1) * (p + 1) * (p + 1)));
+  std::size_t onSharedFace = 0;
+  for (std::size_t i = 0; i < mesh.numNodes(); ++i)
+    if (std::abs(mesh.xyz[3 * i] - 1.0) < 1e-12) ++onSharedFace;
+  EXPECT_EQ(onSharedFace, static_cast<std::size_t>((p + 1) * (p + 1)));
+  const QualitySummary q = evaluateQuality(mesh);
+  EXPECT_EQ(q.invalid + q.undecided, 0u);
+  // Straight-sided unit cells (rounding margin of the certified bound: see above).
+  EXPECT_NEAR(q.scaled.min, 1.0, 1e-7);
+}
+
+// Eight prisms around the axis of a cylinder (radius 1, height 1), their outer quadrilaterals on
+// its lateral face, their end triangles on its end faces, the arcs on its two circles: elevation
+// must put every new node of the lateral face on the cylinder and keep the prisms valid.
+TEST(OrderElevation, PrismsAroundACylinderAxisCurveOntoItsLateralFace) {
+  const CadModel cad = test::toModel(test::cylinder(1.0, 1.0));
+  const auto faceThrough = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    for (int f = 1; f <= cad.numFaces(); ++f)
+      if (cad.projectOnSurface(f, a).distance < 1e-9 && cad.projectOnSurface(f, b).distance < 1e-9)
+        return f;
+    return 0;
+  };
+  const auto curveThrough = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    for (int c = 1; c <= cad.numEdges(); ++c)
+      if (cad.projectOnCurve(c, a).distance < 1e-9 && cad.projectOnCurve(c, b).distance < 1e-9)
+        return c;
+    return 0;
+  };
+  const int lateral = faceThrough({1, 0, 0.5}, {0, 1, 0.5});
+  const int bottom = faceThrough({0, 0, 0}, {0.5, 0, 0});
+  const int top = faceThrough({0, 0, 1}, {0.5, 0, 1});
+  const int lower = curveThrough({0, 1, 0}, {-1, 0, 0});
+  const int upper = curveThrough({0, 1, 1}, {-1, 0, 1});
+  const int seam = curveThrough({1, 0, 0.25}, {1, 0, 0.75});
+  const auto vertexAt = [&](const Eigen::Vector3d& x) {
+    for (int v = 1; v <= cad.numVertices(); ++v)
+      if ((cad.vertexPoint(v) - x).norm() < 1e-9) return v;
+    return 0;
+  };
+  // OpenCASCADE's cylinder closes its circles and its lateral face at angle 0, where its two
+  // vertices are: a mesh has nodes there, and the seam line between them is a mesh edge.
+  const int seamVertex[2] = {vertexAt({1, 0, 0}), vertexAt({1, 0, 1})};
+  ASSERT_TRUE(lateral > 0 && bottom > 0 && top > 0 && lower > 0 && upper > 0 && seam > 0);
+  ASSERT_TRUE(seamVertex[0] > 0 && seamVertex[1] > 0);
+
+  const int n = 8;
+  const double nan = std::nan("");
+  Mesh linear;
+  for (int level = 0; level < 2; ++level) {
+    const double z = level;
+    const double centre[3] = {0.0, 0.0, z};
+    linear.addNode(centre, 2, level == 0 ? bottom : top, nan, nan);
+    for (int i = 0; i < n; ++i) {
+      const double a = i * 2.0 * M_PI / n;
+      const double x[3] = {std::cos(a), std::sin(a), z};
+      if (i == 0) {
+        linear.addNode(x, 0, seamVertex[level], nan, nan);
+      } else {
+        linear.addNode(x, 1, level == 0 ? lower : upper, nan, nan);
+      }
+    }
+  }
+  const auto ring = [&](int level, int i) -> std::int64_t { return level * (n + 1) + 1 + i % n; };
+  ElementBlock prisms{CellType::Prism, 1, {}, {}}, quads{CellType::Quadrilateral, 1, {}, {}};
+  ElementBlock tris{CellType::Triangle, 1, {}, {}}, lines{CellType::Line, 1, {}, {}};
+  for (int i = 0; i < n; ++i) {
+    prisms.nodes.insert(prisms.nodes.end(),
+                        {0, ring(0, i), ring(0, i + 1), n + 1, ring(1, i), ring(1, i + 1)});
+    prisms.entity.push_back(1);
+    quads.nodes.insert(quads.nodes.end(), {ring(0, i), ring(0, i + 1), ring(1, i + 1), ring(1, i)});
+    quads.entity.push_back(lateral);
+    tris.nodes.insert(tris.nodes.end(), {0, ring(0, i + 1), ring(0, i)});
+    tris.entity.push_back(bottom);
+    tris.nodes.insert(tris.nodes.end(), {n + 1, ring(1, i), ring(1, i + 1)});
+    tris.entity.push_back(top);
+    for (int level = 0; level < 2; ++level) {
+      lines.nodes.insert(lines.nodes.end(), {ring(level, i), ring(level, i + 1)});
+      lines.entity.push_back(level == 0 ? lower : upper);
+    }
+  }
+  lines.nodes.insert(lines.nodes.end(), {ring(0, 0), ring(1, 0)});
+  lines.entity.push_back(seam);
+  linear.blocks = {prisms, quads, tris, lines};
+  linear.checkConsistency();
+
+  const int p = 4;
+  const Mesh mesh = elevateOrder(linear, p, &cad);
+  std::size_t onLateral = 0;
+  for (std::size_t i = 0; i < mesh.numNodes(); ++i) {
+    const Eigen::Vector3d x = nodePoint(mesh, i);
+    if (mesh.nodeCadDim[i] == 2 && mesh.nodeCadIndex[i] == lateral) {
+      ++onLateral;
+      // Projected onto the cylinder, or placed on it from (u, v): a point of the surface, to
+      // the rounding of its evaluation (|x| <= 1.5).
+      EXPECT_NEAR(std::hypot(x.x(), x.y()), 1.0, 1e-9) << "node " << i;
+      EXPECT_GT(x.z(), 0.0);
+      EXPECT_LT(x.z(), 1.0);
+    }
+    if (mesh.nodeCadDim[i] == 1) {
+      EXPECT_NEAR(std::hypot(x.x(), x.y()), 1.0, 1e-9) << "node " << i;
+    }
+  }
+  // The lateral face's new nodes: inside each quadrilateral (P-1)^2, on its vertical edges
+  // P-1 each but the seam's (on the seam curve).
+  EXPECT_EQ(onLateral, static_cast<std::size_t>(n * (p - 1) * (p - 1) + (n - 1) * (p - 1)));
+  const QualitySummary q = evaluateQuality(mesh);
+  EXPECT_EQ(q.invalid + q.undecided, 0u);
+  EXPECT_GT(q.scaled.min, 0.0);
+}
+
 TEST(OrderElevation, RejectsBadOrders) {
   const CadModel cad = test::toModel(test::box(1, 1, 1));
   const Mesh linear = generateLinearMesh(cad, LinearMeshOptions::uniform(0.5));
