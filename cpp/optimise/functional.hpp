@@ -69,10 +69,11 @@ Psi<T> psi(const T& S, const T& r) {
   }
   if constexpr (F == Functional::Hyperelastic) {
     const T l = log(r);
+    const T ir = 1.0 / r;  // one division for both derivatives
     p.v = 0.5 * kMu * (S - double(D)) - kMu * l + 0.5 * kBulk * l * l;
     p.s = T(0.5 * kMu);
-    p.r = (-kMu + kBulk * l) / r;
-    p.rr = (kMu + kBulk * (1.0 - l)) / (r * r);
+    p.r = (-kMu + kBulk * l) * ir;
+    p.rr = (kMu + kBulk * (1.0 - l)) * (ir * ir);
   } else if constexpr (F == Functional::LinearElastic) {
     const T l = log(r);
     p.v = 0.5 * kBulk * l * l + kMu * S;
@@ -158,8 +159,16 @@ struct Regularised {
 template <class T>
 Regularised<T> regularise(const T& J, double eps) {
   using std::sqrt;
-  const T root = sqrt(J * J + 4.0 * eps * eps);
   Regularised<T> out;
+  // Far from inversion (eps^2 / J^2 below 1e-18, under the unit roundoff): J_r = J and
+  // dJ_r/dJ = 1 to rounding; the common case of a valid patch, without the square root.
+  if (J > 1e9 * eps) {
+    out.r = J;
+    out.dr = T(1.0);
+    out.ddr = 2.0 * eps * eps / (J * J * J);
+    return out;
+  }
+  const T root = sqrt(J * J + 4.0 * eps * eps);
   // (J + root) / 2 cancels badly for J << 0: use the equivalent 2 eps^2 / (root - J).
   out.r = J >= 0.0 ? T(0.5 * (J + root)) : T(2.0 * eps * eps / (root - J));
   out.dr = root > 0.0 ? T(out.r / root) : T(J > 0.0 ? 1.0 : 0.0);
