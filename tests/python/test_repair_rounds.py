@@ -9,6 +9,7 @@ import pytest
 
 import homesh
 from conftest import run
+from test_optimise import gmsh_worst
 
 SPHERE_BOX = Path(__file__).resolve().parents[2] / "examples" / "sphere_box.step"
 # Order 4 at size 1.2: curving alone leaves tetrahedra outside the sphere invalid.
@@ -79,3 +80,19 @@ def test_python_repair_rounds():
             homesh.mesh(str(SPHERE_BOX), order=4, size=1.2, repair_rounds=bad)
     with pytest.raises(homesh.ParameterError, match="repair_rounds"):
         homesh.mesh(str(SPHERE_BOX), order=4, size=1.2, repair_rounds=1.5)
+
+
+def test_order_eight_sphere_box_is_valid_for_gmsh_too(homesh_bin, tmp_path):
+    """Order 8 at size 1.2: optimised at order 4 first, raised, optimised again; certified
+    valid by us and positive by Gmsh's own Bezier-bounded verdict on the written file."""
+    msh, report = tmp_path / "p8.msh", tmp_path / "p8.json"
+    result = run([homesh_bin, "mesh", SPHERE_BOX, "--size", "1.2", "--order", "8", "--optimise",
+                  "-j", "2", "-o", msh, "--report", report])
+    assert result.returncode == 0, result.stderr
+    data = json.loads(report.read_text())
+    assert data["order"] == 8
+    assert data["quality"]["invalid_elements"] == 0
+    assert data["quality"]["undecided_elements"] == 0
+    assert "optimiser_order_4" in data
+    assert {"optimise_low_order", "raise_order"} <= set(data["timings_s"])
+    assert gmsh_worst(msh) > 0.0

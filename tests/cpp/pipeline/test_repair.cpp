@@ -251,8 +251,8 @@ TEST(RepairRounds, SphereInBoxEndsProvenValid) {
 
 // Order 8 on the same coarse sphere in a box: curved and optimised at order 4 first, raised,
 // then optimised at order 8 (measured: 32 elements left invalid after 26 sweeps when order 8
-// was optimised from the straight interior). The result must be proven valid, and Gmsh's
-// own verdict on it is checked by the CLI tests' order sweep.
+// was optimised from the straight interior). The result must be proven valid; Gmsh's own
+// verdict on the written file is checked by tests/python/test_repair_rounds.py.
 TEST(RepairRounds, OrderEightStartsFromTheOptimisedOrderFourMeshAndEndsProvenValid) {
   MeshingOptions options;
   options.order = 8;
