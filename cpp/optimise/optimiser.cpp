@@ -1107,8 +1107,10 @@ namespace {
 template <int D>
 class ProbeImpl : public NodeEnergyProbe::Impl {
  public:
-  ProbeImpl(Mesh mesh, const OptimiserOptions& options, const CadModel* cad)
-      : mesh_(std::move(mesh)), options_(options), optimiser_(mesh_, options_, nullptr, cad) {
+  ProbeImpl(Mesh mesh, OptimiserOptions options, const CadModel* cad)
+      : mesh_(std::move(mesh)),
+        options_(std::move(options)),
+        optimiser_(mesh_, options_, nullptr, cad) {
     optimiser_.prepareProbe();
   }
   bool isFree(std::int64_t node) const override { return optimiser_.isFree(node); }
