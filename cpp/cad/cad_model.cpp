@@ -33,6 +33,7 @@
 
 #include "cad/occt_access.hpp"
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 
 namespace homesh {
 
@@ -188,9 +189,7 @@ CadModel::~CadModel() = default;
 
 CadModel CadModel::fromFile(const std::string& path) {
   namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw IoError("input file '" + path + "' does not exist");
-  if (fs::is_directory(path, ec)) throw IoError("input '" + path + "' is a directory, not a file");
+  requireRegularFile(path, "input file");
   const std::string ext = lowerExtension(path);
   auto impl = std::make_unique<Impl>();
   impl->source = "'" + fs::path(path).filename().string() + "'";

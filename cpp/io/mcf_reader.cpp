@@ -16,6 +16,7 @@
 
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "core/input_file.hpp"
 #include "io/xml_document.hpp"
 
 namespace homesh {
@@ -385,10 +386,7 @@ void Reader::validate() {
 
 McfCase Reader::read() {
   const std::string& path = case_.path;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw IoError("mesh configuration file '" + path + "' does not exist");
-  if (!fs::is_regular_file(path, ec))
-    throw IoError("mesh configuration file '" + path + "' is not a regular file");
+  requireRegularFile(path, "mesh configuration file");
   std::ifstream in(path, std::ios::binary);
   std::stringstream buffer;
   if (in) buffer << in.rdbuf();

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 #include "io/msh_reader.hpp"
 #include "io/nektar_reader.hpp"
 
@@ -14,9 +15,7 @@ Mesh readMesh(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw IoError("mesh file '" + path + "' does not exist");
+  requireRegularFile(path, "mesh file");
   if (ext == ".msh") return readMsh(path);
   if (ext == ".xml") return readNektarXml(path);
   throw IoError("cannot read '" + path + "': unknown mesh format '" + ext + "' (use .msh or .xml)");

@@ -31,5 +31,5 @@ def data():
 
 def run(args, **kwargs):
     """Runs a command, returning the CompletedProcess (text mode, never raises on failure)."""
-    return subprocess.run([str(a) for a in args], capture_output=True, text=True, timeout=600,
-                          **kwargs)
+    kwargs.setdefault("timeout", 600)
+    return subprocess.run([str(a) for a in args], capture_output=True, text=True, **kwargs)

@@ -2,6 +2,7 @@
 that match the files, and clear errors with non-zero exit codes."""
 
 import json
+import os
 import shutil
 
 import meshio
@@ -118,6 +119,17 @@ def test_bad_inputs_give_one_line_errors(homesh_bin, data, tmp_path):
                     "too small")
     _expect_failure(run([homesh_bin, "frobnicate"]), 2, "frobnicate")
     assert not (tmp_path / "x.stl").exists()
+
+
+def test_fifos_and_folders_are_refused_not_waited_on(homesh_bin, tmp_path):
+    # Opening a FIFO blocks until another process writes to it: every reader must refuse it at
+    # once (the timeout turns a hang into a failure).
+    for name, command in [("in.step", "mesh"), ("in.msh", "quality"), ("in.mcf", "mesh")]:
+        fifo = tmp_path / name
+        os.mkfifo(fifo)
+        _expect_failure(run([homesh_bin, command, fifo], timeout=30), 1, name,
+                        "not a regular file")
+    _expect_failure(run([homesh_bin, "mesh", tmp_path]), 1, "is a directory")
 
 
 def test_verbose_gmsh_output_stays_off_stdout(homesh_bin, data):

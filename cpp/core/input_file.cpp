@@ -1,0 +1,20 @@
+#include "core/input_file.hpp"
+
+#include <filesystem>
+#include <system_error>
+
+#include "core/error.hpp"
+
+namespace homesh {
+
+void requireRegularFile(const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (!fs::exists(status)) throw IoError(what + " '" + path + "' does not exist");
+  if (fs::is_directory(status)) throw IoError(what + " '" + path + "' is a directory, not a file");
+  if (!fs::is_regular_file(status))
+    throw IoError(what + " '" + path + "' is not a regular file (a FIFO, socket or device)");
+}
+
+}  // namespace homesh

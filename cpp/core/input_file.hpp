@@ -1,0 +1,14 @@
+// The one check every reader makes before opening an input: the path names a regular file.
+// A FIFO would block the reader until some other process writes to it (a hang, not an error),
+// and a directory or device is never an input.
+#pragma once
+
+#include <string>
+
+namespace homesh {
+
+// Throws IoError naming `what` (e.g. "input file", "mesh file") and the path when it does not
+// exist, is a directory, or is not a regular file (FIFO, socket, device).
+void requireRegularFile(const std::string& path, const std::string& what);
+
+}  // namespace homesh
