@@ -106,10 +106,11 @@ std::array<std::int64_t, N> sorted(std::array<std::int64_t, N> a) {
 
 // Which CAD entity the edges and faces of the linear mesh lie on.
 struct BoundaryClassification {
-  std::map<EdgeKey, int> edgeCurve;  // edge on a CAD curve
-  std::map<EdgeKey, int> edgeFace;   // edge inside a CAD face
-  std::map<FaceKey, int> faceFace;   // triangle on a CAD face (3D)
-  std::map<QuadKey, int> quadFace;   // quadrilateral on a CAD face (3D)
+  std::map<EdgeKey, int> edgeCurve;      // edge on a CAD curve
+  std::map<EdgeKey, int> edgeFace;       // edge inside a CAD face
+  std::map<FaceKey, int> faceFace;       // triangle on a CAD face (3D)
+  std::map<QuadKey, int> quadFace;       // quadrilateral on a CAD face (3D)
+  std::map<QuadKey, QuadKey> quadCycle;  // its vertices in cyclic order, by the sorted key
 
   explicit BoundaryClassification(const Mesh& linear) {
     for (const ElementBlock& block : linear.blocks) {
@@ -123,8 +124,10 @@ struct BoundaryClassification {
           // In 2D the cells themselves are the face's cells; in 3D the boundary cells.
           if (linear.dim == 3 && triangles)
             faceFace[sorted<3>({v[0], v[1], v[2]})] = block.entity[e];
-          if (linear.dim == 3 && quads)
+          if (linear.dim == 3 && quads) {
             quadFace[sorted<4>({v[0], v[1], v[2], v[3]})] = block.entity[e];
+            quadCycle[sorted<4>({v[0], v[1], v[2], v[3]})] = {v[0], v[1], v[2], v[3]};
+          }
           const int n = triangles ? 3 : 4;
           for (int k = 0; k < n; ++k)
             edgeFace.emplace(sorted<2>({v[k], v[(k + 1) % n]}), block.entity[e]);
@@ -291,8 +294,24 @@ class BoundaryPlacer {
         const int scale = order_ * order_;
         nodes[static_cast<std::size_t>(
             latticeIndex(order_, key.index[1] / scale, key.index[2] / scale))] = id;
+      } else if (key.size == 4 && mesh_.nodeCadDim[id] == 2) {
+        const QuadKey sortedKey{key.vertex[0], key.vertex[1], key.vertex[2], key.vertex[3]};
+        const auto cycle = elevator.classes.quadCycle.find(sortedKey);
+        if (cycle == elevator.classes.quadCycle.end()) continue;
+        auto& nodes = quads_[cycle->second];
+        if (nodes.empty()) nodes.assign((p + 1) * (p + 1), -1);
+        // Weights (P-i)(P-j)P, i(P-j)P, ijP, (P-i)jP of the corners in cyclic order.
+        const auto weight = [&](std::int64_t vertex) {
+          for (int k = 0; k < 4; ++k)
+            if (key.vertex[k] == vertex) return key.index[k];
+          return 0;
+        };
+        const QuadKey& c = cycle->second;
+        const int scale = order_ * order_;
+        const int i = (weight(c[1]) + weight(c[2])) / scale;
+        const int j = (weight(c[2]) + weight(c[3])) / scale;
+        nodes[static_cast<std::size_t>(j * (order_ + 1) + i)] = id;
       }
-      // Nodes inside quadrilaterals on a CAD face are projected onto it (projectNewNodes).
     }
   }
 
@@ -303,6 +322,7 @@ class BoundaryPlacer {
     for (const auto& [edge, nodes] : edges_)
       if (mesh_.nodeCadDim[nodes[1]] == 2) placeFaceEdge(nodes, z);
     for (const auto& [tri, nodes] : triangles_) placeTriangle(tri, nodes);
+    for (const auto& [quad, nodes] : quads_) placeQuadrilateral(quad, nodes);
     projectNewNodes(mesh_, firstNew_, cad_, placed_);
   }
 
@@ -315,6 +335,7 @@ class BoundaryPlacer {
   const std::size_t firstNew_;
   std::map<EdgeKey, std::vector<std::int64_t>> edges_;
   std::map<FaceKey, std::vector<std::int64_t>> triangles_;
+  std::map<QuadKey, std::vector<std::int64_t>> quads_;  // by corners in cyclic order
   std::map<int, FaceChart> charts_;
 
   const FaceChart& chart(int face) {
@@ -437,6 +458,86 @@ class BoundaryPlacer {
         const int k = latticeIndex(p, i, j);
         setFaceNode(nodes[k], ch, placement.uv[k]);
       }
+  }
+
+  // A quadrilateral on a CAD face, corners c in cyclic order, node (i, j) at nodes[j (P+1) + i]:
+  // its interior nodes at the transfinite (Coons) interpolation in (u, v) of its four placed
+  // edges, kept when every lattice cell keeps one orientation in (u, v) and every node lies
+  // inside the face's trimming (else they are projected, as before).
+  void placeQuadrilateral(const QuadKey& c, std::vector<std::int64_t> nodes) {
+    const int p = order_;
+    const auto at = [p](int i, int j) { return static_cast<std::size_t>(j * (p + 1) + i); };
+    nodes[at(0, 0)] = c[0];
+    nodes[at(p, 0)] = c[1];
+    nodes[at(p, p)] = c[2];
+    nodes[at(0, p)] = c[3];
+    // The node k steps from corner a along edge (a, b) (the lists run from the smaller id).
+    const auto edgeNode = [&](std::int64_t a, std::int64_t b, int k) -> std::int64_t {
+      const auto it = edges_.find({std::min(a, b), std::max(a, b)});
+      if (it == edges_.end()) return -1;
+      return it->second[static_cast<std::size_t>(a < b ? k : p - k)];
+    };
+    for (int k = 1; k < p; ++k) {
+      nodes[at(k, 0)] = edgeNode(c[0], c[1], k);
+      nodes[at(p, k)] = edgeNode(c[1], c[2], k);
+      nodes[at(k, p)] = edgeNode(c[3], c[2], k);
+      nodes[at(0, k)] = edgeNode(c[0], c[3], k);
+    }
+    for (int k = 0; k <= p; ++k)
+      for (const std::size_t b : {at(k, 0), at(p, k), at(k, p), at(0, k)})
+        if (nodes[b] < 0) return;
+    ++stats_.quadInteriors;
+    const FaceChart& ch = chart(mesh_.nodeCadIndex[nodes[at(1, 1)]]);
+    std::array<FaceParameter, 4> corner;
+    int ref = -1;
+    for (int k = 0; k < 4; ++k) {
+      corner[k] = nodeFaceParameter(ch, mesh_, c[k], std::nullopt);
+      const auto s = ch.singular(corner[k]);
+      if (ref < 0 && !s[0] && !s[1]) ref = k;
+    }
+    if (ref < 0) ref = 0;
+    std::vector<FaceParameter> uv(nodes.size());
+    for (int k = 0; k <= p; ++k)
+      for (const std::size_t b : {at(k, 0), at(p, k), at(k, p), at(0, k)})
+        uv[b] = ch.unwrapNear(nodeFaceParameter(ch, mesh_, nodes[b], corner[ref]), corner[ref]);
+    for (int j = 1; j < p; ++j)
+      for (int i = 1; i < p; ++i) {
+        const double s = static_cast<double>(i) / p, t = static_cast<double>(j) / p;
+        for (int d = 0; d < 2; ++d)
+          uv[at(i, j)][d] = (1 - t) * uv[at(i, 0)][d] + t * uv[at(i, p)][d] +
+                            (1 - s) * uv[at(0, j)][d] + s * uv[at(p, j)][d] -
+                            ((1 - s) * (1 - t) * uv[at(0, 0)][d] + s * (1 - t) * uv[at(p, 0)][d] +
+                             s * t * uv[at(p, p)][d] + (1 - s) * t * uv[at(0, p)][d]);
+      }
+    if (!unflipped(uv, p)) {
+      ++stats_.quadInteriorsProjected;
+      return;
+    }
+    for (int j = 1; j < p; ++j)
+      for (int i = 1; i < p; ++i)
+        if (!ch.contains(uv[at(i, j)])) {
+          ++stats_.quadInteriorsProjected;
+          return;
+        }
+    for (int j = 1; j < p; ++j)
+      for (int i = 1; i < p; ++i) setFaceNode(nodes[at(i, j)], ch, uv[at(i, j)]);
+  }
+
+  // Whether every cell of a (P+1) x (P+1) lattice in (u, v) has the same, non-zero orientation.
+  static bool unflipped(const std::vector<FaceParameter>& uv, int p) {
+    int sign = 0;
+    for (int j = 0; j < p; ++j)
+      for (int i = 0; i < p; ++i) {
+        const FaceParameter& o = uv[static_cast<std::size_t>(j * (p + 1) + i)];
+        const FaceParameter& a = uv[static_cast<std::size_t>(j * (p + 1) + i + 1)];
+        const FaceParameter& b = uv[static_cast<std::size_t>((j + 1) * (p + 1) + i)];
+        const double cross = (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+        if (!std::isfinite(cross) || cross == 0.0) return false;
+        const int here = cross > 0.0 ? 1 : -1;
+        if (sign != 0 && here != sign) return false;
+        sign = here;
+      }
+    return true;
   }
 };
 

@@ -10,8 +10,9 @@
 // parameters, along edges inside faces spaced in (u, v) towards the geodesic, inside boundary
 // triangles as a relaxed lattice in (u, v) (curve_node_placement.hpp, face_node_placement.hpp);
 // where such a placement fails its checks (order along the edge, no flipped lattice triangle,
-// inside the face's trimming) the nodes are projected onto the entity, as are the nodes inside
-// boundary quadrilaterals (no (u, v) lattice placement for them yet). Interior nodes stay at
+// inside the face's trimming) the nodes are projected onto the entity. Inside boundary
+// quadrilaterals the nodes are the transfinite (Coons) interpolation in (u, v) of the placed
+// edges, checked unflipped and inside the trimming, else projected. Interior nodes stay at
 // their straight-sided positions (the optimiser curves the interior later).
 #pragma once
 
@@ -29,6 +30,7 @@ struct CurvingStats {
   std::size_t curveEdges = 0, curveEdgesAtStart = 0;
   std::size_t faceEdges = 0, faceEdgesAtStart = 0, faceEdgesProjected = 0;
   std::size_t faceInteriors = 0, faceInteriorsAtStart = 0, faceInteriorsProjected = 0;
+  std::size_t quadInteriors = 0, quadInteriorsProjected = 0;  // boundary quadrilaterals
 };
 
 // `linear` must have order 1. `cad` may be null (no projection: a straight-sided order-P mesh).

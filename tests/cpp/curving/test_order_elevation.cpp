@@ -205,7 +205,8 @@ TEST(OrderElevation, HexahedraPrismsAndQuadrilateralsShareTheirNodes) {
 
 // Eight prisms around the axis of a cylinder (radius 1, height 1), their outer quadrilaterals on
 // its lateral face, their end triangles on its end faces, the arcs on its two circles: elevation
-// must put every new node of the lateral face on the cylinder and keep the prisms valid.
+// must put every new node of the lateral face on the cylinder, evenly in its (angle, height)
+// parameters, and keep the prisms valid.
 TEST(OrderElevation, PrismsAroundACylinderAxisCurveOntoItsLateralFace) {
   const CadModel cad = test::toModel(test::cylinder(1.0, 1.0));
   const auto faceThrough = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -289,6 +290,13 @@ TEST(OrderElevation, PrismsAroundACylinderAxisCurveOntoItsLateralFace) {
       EXPECT_NEAR(std::hypot(x.x(), x.y()), 1.0, 1e-9) << "node " << i;
       EXPECT_GT(x.z(), 0.0);
       EXPECT_LT(x.z(), 1.0);
+      // Edges spaced in arc length and quadrilateral interiors interpolated in (u, v) =
+      // (angle, height): every node on the lattice of angle 2 pi / (n P) and height 1 / P
+      // (closest-point projection of the straight quadrilateral's nodes would bunch the
+      // angles towards the corners). Rounding of atan2 and the evaluation: 1e-9.
+      const double angle = std::atan2(x.y(), x.x()) * n * p / (2.0 * M_PI);
+      EXPECT_NEAR(angle, std::round(angle), 1e-9) << "node " << i;
+      EXPECT_NEAR(x.z() * p, std::round(x.z() * p), 1e-9) << "node " << i;
     }
     if (mesh.nodeCadDim[i] == 1) {
       EXPECT_NEAR(std::hypot(x.x(), x.y()), 1.0, 1e-9) << "node " << i;
