@@ -301,16 +301,17 @@ class BoundaryPlacer {
         auto& nodes = quads_[cycle->second];
         if (nodes.empty()) nodes.assign((p + 1) * (p + 1), -1);
         // Weights (P-i)(P-j)P, i(P-j)P, ijP, (P-i)jP of the corners in cyclic order.
-        const auto weight = [&](std::int64_t vertex) {
+        const NodeKey& support = key;  // (a structured binding cannot be captured in C++17)
+        const auto weight = [&support](std::int64_t vertex) {
           for (int k = 0; k < 4; ++k)
-            if (key.vertex[k] == vertex) return key.index[k];
+            if (support.vertex[k] == vertex) return support.index[k];
           return 0;
         };
         const QuadKey& c = cycle->second;
         const int scale = order_ * order_;
         const int i = (weight(c[1]) + weight(c[2])) / scale;
         const int j = (weight(c[2]) + weight(c[3])) / scale;
-        nodes[static_cast<std::size_t>(j * (order_ + 1) + i)] = id;
+        nodes[quadIndex(order_, i, j)] = id;
       }
     }
   }
@@ -460,13 +461,19 @@ class BoundaryPlacer {
       }
   }
 
+  // Node (i, j) of an order-P quadrilateral's lattice, row by row.
+  static std::size_t quadIndex(int p, int i, int j) {
+    return static_cast<std::size_t>(j) * static_cast<std::size_t>(p + 1) +
+           static_cast<std::size_t>(i);
+  }
+
   // A quadrilateral on a CAD face, corners c in cyclic order, node (i, j) at nodes[j (P+1) + i]:
   // its interior nodes at the transfinite (Coons) interpolation in (u, v) of its four placed
   // edges, kept when every lattice cell keeps one orientation in (u, v) and every node lies
   // inside the face's trimming (else they are projected, as before).
   void placeQuadrilateral(const QuadKey& c, std::vector<std::int64_t> nodes) {
     const int p = order_;
-    const auto at = [p](int i, int j) { return static_cast<std::size_t>(j * (p + 1) + i); };
+    const auto at = [p](int i, int j) { return quadIndex(p, i, j); };
     nodes[at(0, 0)] = c[0];
     nodes[at(p, 0)] = c[1];
     nodes[at(p, p)] = c[2];
@@ -528,9 +535,9 @@ class BoundaryPlacer {
     int sign = 0;
     for (int j = 0; j < p; ++j)
       for (int i = 0; i < p; ++i) {
-        const FaceParameter& o = uv[static_cast<std::size_t>(j * (p + 1) + i)];
-        const FaceParameter& a = uv[static_cast<std::size_t>(j * (p + 1) + i + 1)];
-        const FaceParameter& b = uv[static_cast<std::size_t>((j + 1) * (p + 1) + i)];
+        const FaceParameter& o = uv[quadIndex(p, i, j)];
+        const FaceParameter& a = uv[quadIndex(p, i + 1, j)];
+        const FaceParameter& b = uv[quadIndex(p, i, j + 1)];
         const double cross = (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
         if (!std::isfinite(cross) || cross == 0.0) return false;
         const int here = cross > 0.0 ? 1 : -1;
