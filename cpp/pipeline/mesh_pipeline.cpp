@@ -212,11 +212,11 @@ struct CurvedState {
   }
 };
 
-// Layers of neighbours around a repair round's new elements that the optimiser moves too.
 // Sweeps without fewer invalid elements after which the optimiser gives the mesh to the repair
 // rounds (the optimiser alone waits 10).
 constexpr int kPipelineStuckWindow = 5;
 
+// Layers of neighbours around a repair round's new elements that the optimiser moves too.
 constexpr int kRepairRegionLayers = 4;
 // Poor elements below this certified scaled Jacobian join the region too.
 constexpr double kRepairRegionThreshold = 0.2;
@@ -242,8 +242,9 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
   state.linear = std::move(linear);
   checkHighOrderMemory(state.linear, options.order);
   OptimiserCancel cancel(observer);
-  // Elevates to `order`, takes what it can from `previous` (its mesh of that order) and
-  // optimises (the whole mesh, or around what changed).
+  // For `mesh`, just elevated to `order`: takes the curved nodes of unchanged cells from
+  // `before` (previous's mesh of that order, if any) and optimises the whole mesh, or only
+  // around what changed.
   const auto curveAt = [&](int order, Mesh& mesh, const Mesh* before, const char* stage) {
     std::vector<char> fresh;  // the optimiser's region seed: empty for the whole mesh
     if (before != nullptr) {
