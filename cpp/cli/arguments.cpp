@@ -198,6 +198,16 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
       throw UsageError{"--repair-rounds must be from 0 to " + std::to_string(kMaxRepairRounds) +
                        ", got " + v};
   });
+  table.value({"--bl-faces"},
+              [&cmd](const std::string&, const std::string& v) { cmd.blFaces = v; });
+  table.value({"--bl-thickness"},
+              [&cmd](const std::string&, const std::string& v) { cmd.blThickness = v; });
+  table.value({"--bl-layers"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.blLayers = parseInteger(o, v);
+  });
+  table.value({"--bl-progression"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.blProgression = parseNumber(o, v);
+  });
   table.flag({"--verbose", "-v"}, [&cmd] { ++cmd.verbosity; });
   table.flag({"-vv"}, [&cmd] { cmd.verbosity += 2; });
   cmd.input = onlyInput(table.parse(args, 1, "mesh"), "mesh", "an INPUT CAD or .mcf file");
@@ -360,6 +370,11 @@ options:
       --repair-rounds N  at most N repair rounds while elements are not proven valid
                       (split their edges on curved faces, or refine around them; then curve,
                       optimise and check again); default 3, 0 for none
+      --bl-faces LIST     boundary layer on these CAD faces (FaceN numbers: 1,8 or 11-12)
+      --bl-thickness T    its total thickness: a number or an expression of x, y, z
+      --bl-layers N       thin layers it is split into (default 2; 1..100)
+      --bl-progression R  height ratio of consecutive layers, from the wall (default 2)
+                      (the macro layer is curved and optimised with the rest, then split)
   -o, --output FILE   write the mesh: .msh (Gmsh 4.1), .vtu (VTK), .xml (Nektar++); repeatable
       --binary        binary MSH, raw appended VTU data
       --compressed    compressed Nektar++ XML (B64Z-LittleEndian)

@@ -40,6 +40,11 @@ struct MeshCommand {
   int verbosity = 0;           // -v: 1, -vv: 2
   int optimiseIterations = 0;  // --optimise: 100, --maxiter N
   int repairRounds = 3;        // --repair-rounds N, 0..kMaxRepairRounds
+  // --bl-faces, --bl-thickness, --bl-layers, --bl-progression: a boundary layer (each
+  // overrides the .mcf's BndLayer* key).
+  std::optional<std::string> blFaces, blThickness;
+  std::optional<int> blLayers;
+  std::optional<double> blProgression;
   CommonOptions common;
 };
 

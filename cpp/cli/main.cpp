@@ -111,6 +111,21 @@ int runMesh(const homesh::MeshCommand& cmd) {
   options.verbosity = cmd.verbosity;
   options.optimiseIterations = cmd.optimiseIterations;
   options.repairRounds = cmd.repairRounds;
+  if (cmd.blFaces || cmd.blThickness || cmd.blLayers || cmd.blProgression) {
+    homesh::BoundaryLayerParameters bl =
+        options.boundaryLayer.value_or(homesh::BoundaryLayerParameters{});
+    if (!options.boundaryLayer) {  // NekMesh's defaults
+      bl.layers = 2;
+      bl.progression = 2.0;
+    }
+    if (cmd.blFaces) bl.faces = homesh::parseIndexList(*cmd.blFaces, "--bl-faces");
+    if (cmd.blThickness) bl.thickness = *cmd.blThickness;
+    if (cmd.blLayers) bl.layers = *cmd.blLayers;
+    if (cmd.blProgression) bl.progression = *cmd.blProgression;
+    if (bl.faces.empty()) throw homesh::ParameterError("a boundary layer needs --bl-faces");
+    if (bl.thickness.empty()) throw homesh::ParameterError("a boundary layer needs --bl-thickness");
+    options.boundaryLayer = bl;
+  }
   StderrProgress progress;
   homesh::PipelineObserver* observer = c.quiet ? nullptr : &progress;
   homesh::MeshResult result = homesh::runMeshPipeline(setup.source, options, observer);
@@ -122,6 +137,15 @@ int runMesh(const homesh::MeshCommand& cmd) {
                  "%.4f; %zu invalid\n",
                  result.mesh.numNodes(), result.mesh.numElements(), result.mesh.order,
                  result.quality.scaled.min, result.quality.scaled.mean, result.quality.invalid);
+    if (result.boundaryLayer) {
+      const homesh::BoundaryLayerRecord& b = *result.boundaryLayer;
+      std::fprintf(stderr,
+                   "homesh: boundary layer: %zu macro prisms split into %d layers, height %g to "
+                   "%g, first layer %g to %g; shrunk on %zu faces; macro mesh worst %.4f\n",
+                   b.prisms, b.parameters.layers, b.thicknessMin, b.thicknessMax, b.firstHeightMin,
+                   b.firstHeightMax, b.shrunk.size(),
+                   result.macroQuality ? result.macroQuality->scaled.min : 0.0);
+    }
     for (std::size_t k = 0; k < result.rounds.size(); ++k) {
       const homesh::RepairRound& r = result.rounds[k];
       std::fprintf(stderr,

@@ -63,4 +63,8 @@ struct Mesh {
   void checkConsistency() const;
 };
 
+// Drops the nodes no element uses (a source's high-order nodes after an order change, a macro
+// layer's inner nodes after its split) and renumbers the rest in their original order.
+void compactNodes(Mesh& mesh);
+
 }  // namespace homesh

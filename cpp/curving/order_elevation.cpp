@@ -548,32 +548,6 @@ class BoundaryPlacer {
   }
 };
 
-// Drops the nodes no cell uses (the source's high-order nodes after an order change) and
-// renumbers the rest in their original order.
-void compactNodes(Mesh& mesh) {
-  std::vector<std::int64_t> newId(mesh.numNodes(), -1);
-  for (const ElementBlock& block : mesh.blocks)
-    for (const std::int64_t id : block.nodes) newId[id] = 0;
-  std::int64_t next = 0;
-  for (std::size_t i = 0; i < newId.size(); ++i) {
-    if (newId[i] < 0) continue;
-    newId[i] = next;
-    const auto j = static_cast<std::size_t>(next++);
-    for (int c = 0; c < 3; ++c) mesh.xyz[3 * j + c] = mesh.xyz[3 * i + c];
-    mesh.nodeCadDim[j] = mesh.nodeCadDim[i];
-    mesh.nodeCadIndex[j] = mesh.nodeCadIndex[i];
-    mesh.nodeCadParam[2 * j] = mesh.nodeCadParam[2 * i];
-    mesh.nodeCadParam[2 * j + 1] = mesh.nodeCadParam[2 * i + 1];
-  }
-  const auto n = static_cast<std::size_t>(next);
-  mesh.xyz.resize(3 * n);
-  mesh.nodeCadDim.resize(n);
-  mesh.nodeCadIndex.resize(n);
-  mesh.nodeCadParam.resize(2 * n);
-  for (ElementBlock& block : mesh.blocks)
-    for (std::int64_t& id : block.nodes) id = newId[id];
-}
-
 }  // namespace
 
 Mesh changeOrder(const Mesh& mesh, int order, const CadModel* cad, CurvingStats* stats) {

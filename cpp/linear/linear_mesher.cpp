@@ -245,4 +245,97 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
   return mesh;
 }
 
+ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_t, 3>>& boundary,
+                            const LinearMeshOptions& options, int solid) {
+  if (boundary.empty()) throw MeshingError("no surface to fill with tetrahedra");
+  // Gmsh tags are the node ids + 1 (tags start at 1); its new nodes get larger tags.
+  std::vector<char> used(mesh.numNodes(), 0);
+  for (const auto& t : boundary)
+    for (const std::int64_t v : t) used.at(static_cast<std::size_t>(v)) = 1;
+  std::vector<std::size_t> tags;
+  std::vector<double> coords;
+  for (std::size_t i = 0; i < used.size(); ++i) {
+    if (used[i] == 0) continue;
+    tags.push_back(i + 1);
+    coords.insert(coords.end(), mesh.xyz.begin() + static_cast<std::ptrdiff_t>(3 * i),
+                  mesh.xyz.begin() + static_cast<std::ptrdiff_t>(3 * i + 3));
+  }
+  std::vector<std::size_t> triangles;
+  triangles.reserve(3 * boundary.size());
+  for (const auto& t : boundary)
+    for (const std::int64_t v : t) triangles.push_back(static_cast<std::size_t>(v) + 1);
+
+  ElementBlock tets;
+  tets.type = CellType::Tetrahedron;
+  const double maxSize = options.sizeField ? options.maxSize : options.size;
+  GmshSession session(options.verbosity, 1);
+  withGmshErrors("filling the volume inside the boundary layer", [&] {
+    gmsh::model::add("homesh-fill");
+    gmsh::model::addDiscreteEntity(2, 1);
+    gmsh::model::mesh::addNodes(2, 1, tags, coords);
+    gmsh::model::mesh::addElementsByType(1, kGmshTriangle, {}, triangles);
+    // A volume bounded by a discrete surface without parametrisation: Gmsh meshes the volume
+    // and leaves the surface mesh alone.
+    const int loop = gmsh::model::geo::addSurfaceLoop({1});
+    const int volume = gmsh::model::geo::addVolume({loop});
+    gmsh::model::geo::synchronize();
+    gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
+    gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+    gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 1);
+    if (maxSize > 0.0) gmsh::option::setNumber("Mesh.MeshSizeMax", maxSize);
+    gmsh::option::setNumber("Mesh.ElementOrder", 1);
+    try {
+      gmsh::model::mesh::generate(3);
+    } catch (const std::string& message) {
+      throw MeshingError("Gmsh could not fill the volume inside the boundary layer: " + message +
+                         " (the layer's top surface may intersect itself or the walls)");
+    }
+    // Gmsh may renumber the nodes after meshing: the surface's are found again by their
+    // coordinates, which it does not change.
+    std::map<std::array<double, 3>, std::int64_t> byPoint;
+    for (std::size_t i = 0; i < used.size(); ++i)
+      if (used[i] != 0)
+        byPoint.emplace(
+            std::array<double, 3>{mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]},
+            static_cast<std::int64_t>(i));
+    std::map<std::size_t, std::int64_t> fresh;
+    std::vector<std::size_t> nodeTagsOut;
+    std::vector<double> nodeCoords, params;
+    gmsh::model::mesh::getNodes(nodeTagsOut, nodeCoords, params, 2, 1, false, false);
+    for (std::size_t i = 0; i < nodeTagsOut.size(); ++i) {
+      const auto it =
+          byPoint.find({nodeCoords[3 * i], nodeCoords[3 * i + 1], nodeCoords[3 * i + 2]});
+      if (it == byPoint.end())
+        throw MeshingError("Gmsh moved or added a node on the surface inside the boundary layer");
+      fresh[nodeTagsOut[i]] = it->second;
+    }
+    gmsh::model::mesh::getNodes(nodeTagsOut, nodeCoords, params, 3, volume, false, false);
+    for (std::size_t i = 0; i < nodeTagsOut.size(); ++i)
+      fresh[nodeTagsOut[i]] = mesh.addNode(&nodeCoords[3 * i], 3, solid, kNaN, kNaN);
+    std::vector<int> types;
+    std::vector<std::vector<std::size_t>> elementTags, nodeTags;
+    gmsh::model::mesh::getElements(types, elementTags, nodeTags, 3, volume);
+    for (std::size_t k = 0; k < types.size(); ++k) {
+      if (types[k] != kGmshTetrahedron)
+        throw MeshingError("Gmsh filled the volume with elements of type " +
+                           std::to_string(types[k]) + " where only tetrahedra were expected");
+      for (const std::size_t tag : nodeTags[k]) {
+        const auto it = fresh.find(tag);
+        if (it == fresh.end())
+          throw MeshingError("Gmsh's volume fill refers to unknown node " + std::to_string(tag));
+        tets.nodes.push_back(it->second);
+      }
+      tets.entity.insert(tets.entity.end(), nodeTags[k].size() / 4, solid);
+    }
+  });
+  if (tets.count() == 0) throw MeshingError("Gmsh made no tetrahedra inside the boundary layer");
+  for (std::size_t e = 0; e < tets.count(); ++e) {
+    std::int64_t* t = tets.nodes.data() + 4 * e;
+    const Eigen::Vector3d a = point(mesh, t[0]);
+    if ((point(mesh, t[1]) - a).cross(point(mesh, t[2]) - a).dot(point(mesh, t[3]) - a) < 0.0)
+      std::swap(t[1], t[2]);
+  }
+  return tets;
+}
+
 }  // namespace homesh

@@ -9,7 +9,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <functional>
+#include <vector>
 
 #include "cad/cad_model.hpp"
 #include "core/mesh.hpp"
@@ -36,5 +38,14 @@ struct LinearMeshOptions {
 // mesh every time. Throws ParameterError (bad size), CadError (nothing meshable) or
 // MeshingError.
 Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options);
+
+// Tetrahedra filling the volume enclosed by `boundary`, a closed surface of triangles on
+// existing nodes of `mesh`, which Gmsh keeps as it is (no node added or moved on it). New
+// interior nodes are appended to `mesh` (CAD dimension 3, solid `solid`); the tetrahedra are
+// positively oriented. Sizes grow from the boundary's edge lengths, at most options.maxSize (or
+// options.size). Throws MeshingError when Gmsh cannot fill the surface (it is not closed, or
+// intersects itself).
+ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_t, 3>>& boundary,
+                            const LinearMeshOptions& options, int solid);
 
 }  // namespace homesh

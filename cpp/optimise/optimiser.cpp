@@ -505,6 +505,14 @@ class Optimiser {
     result_.regionElements =
         static_cast<std::size_t>(std::count(in.begin(), in.end(), static_cast<char>(1)));
     chooseSlidingNodes(boundary);
+    if (!options_.fixedNodes.empty()) {
+      if (options_.fixedNodes.size() != mesh_.numNodes())
+        throw ParameterError("the optimiser's fixed-node mask has " +
+                             std::to_string(options_.fixedNodes.size()) + " entries for " +
+                             std::to_string(mesh_.numNodes()) + " nodes");
+      for (std::size_t node = 0; node < mesh_.numNodes(); ++node)
+        if (options_.fixedNodes[node] != 0) boundary[node] = 1;
+    }
     std::vector<char> touched(totalElements_, 0);  // the element contains a free node
     for (std::size_t node = 0; node < mesh_.numNodes(); ++node) {
       if (boundary[node] != 0 || incidenceStart_[node] == incidenceStart_[node + 1]) continue;

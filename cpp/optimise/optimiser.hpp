@@ -91,6 +91,9 @@ struct OptimiserOptions {
   // CAD: this can untangle elements with two faces on a curved interface, but the interface
   // no longer follows its geometry exactly.
   bool freeInterfaces = false;
+  // Nodes that stay where they are (1 per node; empty: none), whatever their kind: a macro
+  // boundary layer keeps the shape its growth gave it (linear/boundary_layer.hpp).
+  std::vector<char> fixedNodes;
 
   // Throws ParameterError naming the offending option.
   void validate() const;

@@ -59,9 +59,47 @@ CaseSetup setupCase(const std::string& input) {
   } else if (!mcf.refinementLines.empty()) {
     throw ParameterError(input + ": REFINEMENT needs MinDelta, MaxDelta and EPS in PARAMETERS");
   }
-  if (mcf.hasBoundaryLayer())
-    setup.notices.push_back(std::filesystem::path(input).filename().string() + ": MeshType " +
-                            mcf.meshType + ": boundary layers are not made yet; the mesh has none");
+  if (mcf.hasBoundaryLayer()) {
+    const std::string file = std::filesystem::path(input).filename().string();
+    if (mcf.is2D()) {
+      setup.notices.push_back(file + ": MeshType " + mcf.meshType +
+                              ": 2D boundary layers are not made yet; the mesh has none");
+      return setup;
+    }
+    const auto& keys = mcf.boundaryLayer;
+    BoundaryLayerParameters bl;
+    bl.layers = 2;  // NekMesh's defaults
+    bl.progression = 2.0;
+    bl.faces = parseIndexList(keys.at("BndLayerSurfaces"), input + ": BndLayerSurfaces");
+    bl.thickness = keys.at("BndLayerThickness");
+    if (keys.count("BndLayerLayers") != 0) {
+      const std::string& v = keys.at("BndLayerLayers");
+      std::size_t used = 0;
+      try {
+        bl.layers = std::stoi(v, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != v.size())
+        throw ParameterError(input + ": BndLayerLayers '" + v + "' is not an integer");
+    }
+    if (keys.count("BndLayerProgression") != 0) {
+      const std::string& v = keys.at("BndLayerProgression");
+      std::size_t used = 0;
+      try {
+        bl.progression = std::stod(v, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != v.size())
+        throw ParameterError(input + ": BndLayerProgression '" + v + "' is not a number");
+    }
+    for (const auto& [key, value] : keys)
+      if (key != "BndLayerSurfaces" && key != "BndLayerThickness" && key != "BndLayerLayers" &&
+          key != "BndLayerProgression")
+        setup.notices.push_back(file + ": PARAMETERS " + key + " is not used yet and is ignored");
+    setup.options.boundaryLayer = bl;
+  }
   return setup;
 }
 

@@ -34,6 +34,7 @@ void MeshingOptions::validate() const {
   if (repairRounds < 0 || repairRounds > kMaxRepairRounds)
     throw ParameterError("repair rounds must be from 0 to " + std::to_string(kMaxRepairRounds) +
                          ", got " + std::to_string(repairRounds));
+  if (boundaryLayer) boundaryLayer->validate();
   if (size && !octreeOutput.empty())
     throw ParameterError("writing the sizing octree needs octree sizing, not a uniform size");
   if (size && sizing)
@@ -200,6 +201,8 @@ struct CurvedState {
   QualitySummary quality;
   std::optional<OptimiserResult> optimiser;
   std::size_t reused = 0;  // elements that took their curved nodes from the round before
+  std::optional<BoundaryLayerRecord> layer;  // how the linear mesh's macro layer was grown
+  bool layerReleased = false;  // the optimiser moved the macro layer around invalid elements
   // Above kContinuationOrder with the optimiser: the mesh of that order, optimised, that the
   // final order started from (empty otherwise).
   Mesh lowOrder;
@@ -220,6 +223,21 @@ constexpr int kPipelineStuckWindow = 5;
 constexpr int kRepairRegionLayers = 4;
 // Poor elements below this certified scaled Jacobian join the region too.
 constexpr double kRepairRegionThreshold = 0.2;
+
+// The nodes of a macro boundary layer's prisms (empty when there are none).
+std::vector<char> layerNodes(const Mesh& mesh) {
+  std::vector<char> fixed;
+  for (const ElementBlock& b : mesh.blocks) {
+    if (b.type != CellType::Prism) continue;
+    fixed.resize(mesh.numNodes(), 0);
+    for (const std::int64_t id : b.nodes) fixed[static_cast<std::size_t>(id)] = 1;
+  }
+  return fixed;
+}
+
+// Layers of neighbours around the elements still invalid with the macro layer fixed, whose nodes
+// (the layer's included) a second optimiser run may move.
+constexpr int kLayerReleaseLayers = 4;
 
 OptimiserOptions pipelineOptimiserOptions(const MeshingOptions& options) {
   OptimiserOptions o;
@@ -261,8 +279,33 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
       o.regionLayers = kRepairRegionLayers;
       o.regionThreshold = kRepairRegionThreshold;
     }
+    // The macro layer keeps the shape its growth and blend gave it (its split then has the
+    // heights asked for) while the rest adapts; only where elements stay invalid is it
+    // released, around them, and its inner nodes blended again afterwards.
+    o.fixedNodes = layerNodes(mesh);
     std::optional<OptimiserResult> r = optimiseMesh(mesh, o, &cancel, &cad);
     if (r->cancelled) throw CancelledError("cancelled during optimise");
+    if (!o.fixedNodes.empty() && r->invalidAfter + r->undecidedAfter > 0) {
+      OptimiserOptions around = o;
+      around.fixedNodes.clear();
+      around.regionSeed.assign(mesh.numElements(), 0);  // the elements not valid ...
+      around.regionLayers = kLayerReleaseLayers;        // ... and their neighbours
+      const OptimiserResult second = optimiseMesh(mesh, around, &cancel, &cad);
+      if (second.cancelled) throw CancelledError("cancelled during optimise");
+      blendLayerInteriors(mesh, &cad, false);
+      r->iterations += second.iterations;
+      r->history.insert(r->history.end(), second.history.begin(), second.history.end());
+      r->invalidAfter = second.invalidAfter;
+      r->undecidedAfter = second.undecidedAfter;
+      r->worstAfter = second.worstAfter;
+      r->nodalWorstAfter = second.nodalWorstAfter;
+      r->energyAfter = second.energyAfter;
+      r->stopReason = second.stopReason;
+      r->seconds += second.seconds;
+      r->sweepSeconds += second.sweepSeconds;
+      r->visits += second.visits;
+      if (order == options.order) state.layerReleased = true;
+    }
     if (clocked) clock->done();
     return r;
   };
@@ -271,6 +314,7 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
   if (options.optimiseIterations > 0 && options.order > kContinuationOrder) {
     if (clocked) clock.emplace("high_order", timings, observer);
     state.lowOrder = elevateOrder(state.linear, kContinuationOrder, &cad);
+    blendLayerInteriors(state.lowOrder, &cad);
     if (clocked) clock->done();
     state.lowOrderOptimiser = curveAt(
         kContinuationOrder, state.lowOrder,
@@ -281,6 +325,7 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
   } else {
     if (clocked) clock.emplace("high_order", timings, observer);
     state.mesh = elevateOrder(state.linear, options.order, &cad);
+    blendLayerInteriors(state.mesh, &cad);
   }
   if (clocked) clock->done();
   state.optimiser = curveAt(options.order, state.mesh,
@@ -322,12 +367,26 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   } else {
     linearOptions.size = *options.size;
   }
-  StageClock linear("linear", result.timings, observer);
-  Mesh linearMesh = generateLinearMesh(*result.cad, linearOptions);
-  linear.done();
+  // The linear mesh, with its macro boundary layer when one is asked for (timed as its own
+  // stage the first time; within the round in repair rounds).
+  std::optional<BoundaryLayerRecord> layer;
+  const auto makeLinear = [&](const LinearMeshOptions& o, bool clocked) {
+    std::optional<StageClock> clock;
+    if (clocked) clock.emplace("linear", result.timings, observer);
+    Mesh mesh = generateLinearMesh(*result.cad, o);
+    if (clocked) clock->done();
+    if (!options.boundaryLayer) return mesh;
+    if (clocked) clock.emplace("boundary_layer", result.timings, observer);
+    layer.emplace();
+    mesh = growBoundaryLayer(mesh, *result.cad, *options.boundaryLayer, o, *layer);
+    if (clocked) clock->done();
+    return mesh;
+  };
+  Mesh linearMesh = makeLinear(linearOptions, true);
 
   CurvedState best =
       curve(std::move(linearMesh), options, *result.cad, result.timings, observer, true);
+  best.layer = layer;
   // Repair rounds: each works from the previous round's mesh; the best state is kept.
   std::vector<RefinementSource> sources;  // accumulated over the refine rounds
   std::optional<CurvedState> last;        // the last round's state when it was not kept
@@ -343,7 +402,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     // Every flagged cell gets edges to split or a refinement sphere: the plan is never empty.
     const RepairPlan plan = planRepair(from.linear, from.quality.validity, *result.cad);
     Mesh next;
-    if (!plan.splits.empty() && !splitFailed) {
+    if (!plan.splits.empty() && !splitFailed && !options.boundaryLayer) {
       // Local: only the cells around the split edges change; the rest wait for the next round.
       next = from.linear;
       record.edgesSplit = applySplits(next, plan.splits, *result.cad);
@@ -369,10 +428,11 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       refined.sizeField = cappedSizeField(refined.sizeField, sources);
       for (const RefinementSource& src : sources)
         refined.minSize = std::min(refined.minSize, src.delta);
-      next = generateLinearMesh(*result.cad, refined);
+      next = makeLinear(refined, false);
     }
     CurvedState state =
         curve(std::move(next), options, *result.cad, result.timings, observer, false, &from);
+    state.layer = layer;
     record.reused = state.reused;
     record.invalidAfter = state.quality.invalid;
     record.undecidedAfter = state.quality.undecided;
@@ -395,6 +455,19 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   result.quality = std::move(best.quality);
   result.optimiser = std::move(best.optimiser);
   result.lowOrderOptimiser = std::move(best.lowOrderOptimiser);
+  result.boundaryLayer = std::move(best.layer);
+  if (result.boundaryLayer) result.boundaryLayer->releasedAroundInvalid = best.layerReleased;
+
+  if (options.boundaryLayer) {
+    StageClock split("split_layers", result.timings, observer);
+    LayerSplitStats stats;
+    result.mesh = splitBoundaryLayer(result.mesh, options.boundaryLayer->splitCoordinates(),
+                                     result.cad.get(), &stats);
+    result.layerSplit = stats;
+    result.macroQuality = std::move(result.quality);
+    result.quality = evaluateQuality(result.mesh, options.threads);
+    split.done();
+  }
 
   StageClock geometry("geometry", result.timings, observer);
   result.geometry = measureGeometryAccuracy(result.mesh, *result.cad, options.threads);

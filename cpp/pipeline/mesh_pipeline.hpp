@@ -17,7 +17,9 @@
 #include "cad/cad_model.hpp"
 #include "cad/naca_aerofoil.hpp"
 #include "core/mesh.hpp"
+#include "curving/layer_split.hpp"
 #include "io/mesh_writers.hpp"
+#include "linear/boundary_layer.hpp"
 #include "optimise/optimiser.hpp"
 #include "pipeline/repair.hpp"
 #include "quality/geometry_accuracy.hpp"
@@ -54,6 +56,9 @@ struct MeshingOptions {
   // each splits the offending linear cells' edges on curved faces (or refines around them),
   // then curves, optimises and checks again. 0: none.
   int repairRounds = 3;
+  // A macro boundary layer on these CAD faces (linear/boundary_layer.hpp), curved and optimised
+  // with the rest and split into its thin layers last (curving/layer_split.hpp).
+  std::optional<BoundaryLayerParameters> boundaryLayer;
 
   // Throws ParameterError naming the offending parameter.
   void validate() const;
@@ -150,17 +155,26 @@ struct MeshResult {
   std::optional<SizingResult> sizing;        // when the sizes came from the octree
   std::optional<GeometryAccuracy> geometry;  // boundary against the CAD (a mesh made from CAD)
   std::vector<RepairRound> rounds;           // the repair rounds run, in order
+  // With a boundary layer: how the macro layer of the kept mesh was grown, the certified
+  // quality of its macro (unsplit) mesh, and how it was split.
+  std::optional<BoundaryLayerRecord> boundaryLayer;
+  std::optional<QualitySummary> macroQuality;
+  std::optional<LayerSplitStats> layerSplit;
   StageTimings timings;
   MeshingOptions options;
 };
 
-// Runs every stage: CAD, sizing, linear mesh, elevation, optimiser (optional), quality, then
+// Runs every stage: CAD, sizing, linear mesh, boundary layer (optional: "boundary_layer"),
+// elevation, optimiser (optional), quality, then
 // up to options.repairRounds repair rounds while an element is not proven valid (stages
 // "repair 1", ...): each locates those elements in the linear mesh, splits or refines there
 // (planRepair), and elevates, optimises and evaluates the new linear mesh; the next round works
 // from that mesh, except after a split that made the mesh worse than the best: then it refines
-// around the best mesh's offenders instead. The result is the best mesh seen: fewest elements not
-// proven valid, then the best worst scaled Jacobian (a round never makes the result worse). Throws
+// around the best mesh's offenders instead (always, with a boundary layer: its linear mesh and
+// layer are made again). The result is the best mesh seen: fewest elements not
+// proven valid, then the best worst scaled Jacobian (a round never makes the result worse); with
+// a boundary layer, its macro prisms are then split ("split_layers") and the quality is that of
+// the split mesh. Throws
 // ParameterError, IoError, CadError, MeshingError or CancelledError.
 MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
                            PipelineObserver* observer = nullptr);

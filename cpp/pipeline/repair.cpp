@@ -160,17 +160,32 @@ std::optional<CurvedFaceEdge> CurvedFaceEdges::longestOnFace(std::size_t cell) c
 
 RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
                       const CadModel& cad) {
-  const CurvedFaceEdges finder(linear, cad);
-  const std::vector<const std::int64_t*> cells = cellsOf(linear);
+  // Cells of every shape, in element order; splits only in an all-simplex mesh.
+  std::vector<const std::int64_t*> cells;
+  std::vector<int> vertexCount;
+  bool simplex = true;
+  for (const ElementBlock& block : linear.blocks) {
+    if (cellDimension(block.type) != linear.dim) continue;
+    if (block.order != 1)
+      throw ParameterError("repair needs a linear mesh, got order " + std::to_string(block.order));
+    const int nv = cellNumVertices(block.type);
+    simplex = simplex && nv == linear.dim + 1;
+    for (std::size_t e = 0; e < block.count(); ++e) {
+      cells.push_back(block.element(e));
+      vertexCount.push_back(nv);
+    }
+  }
   if (validity.size() != cells.size())
     throw ParameterError("repair: " + std::to_string(validity.size()) +
                          " verdicts for a linear mesh of " + std::to_string(cells.size()) +
                          " cells");
+  std::optional<CurvedFaceEdges> finder;
+  if (simplex) finder.emplace(linear, cad);
   RepairPlan plan;
   std::set<MeshEdge> planned;
-  const int nv = linear.dim + 1;
   for (std::size_t c = 0; c < cells.size(); ++c) {
     if (validity[c] == Validity::Valid) continue;
+    const int nv = vertexCount[c];
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     double longest = 0.0, total = 0.0;
     int edgeCount = 0;
@@ -186,9 +201,12 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
     const RefinementSource sphere =
         RefinementSource::sphere(centroid, longest, 0.5 * total / edgeCount);
     plan.allSources.push_back(sphere);
-    std::vector<CurvedFaceEdge> edges = finder.interior(c);
-    if (edges.empty())
-      if (const auto onFace = finder.longestOnFace(c)) edges.push_back(*onFace);
+    std::vector<CurvedFaceEdge> edges;
+    if (finder) {
+      edges = finder->interior(c);
+      if (edges.empty())
+        if (const auto onFace = finder->longestOnFace(c)) edges.push_back(*onFace);
+    }
     if (!edges.empty()) {
       ++plan.splitCells;
       for (const CurvedFaceEdge& e : edges)

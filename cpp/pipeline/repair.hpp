@@ -83,7 +83,8 @@ struct RepairPlan {
 // those split; else one with an edge on a curved face gets its longest such edge split (the
 // face's triangles there are halved, which halves the sagitta curving has to follow); else it
 // gets a sphere of radius its longest edge, centred at its centroid, of size half its mean edge
-// length. Throws ParameterError when `validity` does not match the linear mesh's cell count.
+// length. A mesh with other cells than simplices (a boundary layer's prisms) gets spheres only.
+// Throws ParameterError when `validity` does not match the linear mesh's cell count.
 RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
                       const CadModel& cad);
 

@@ -170,6 +170,50 @@ std::string predictReportJson(const SizingResult& sizing, const std::string& inp
   return json.str();
 }
 
+void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
+  const BoundaryLayerRecord& r = *result.boundaryLayer;
+  json.beginObject("boundary_layer");
+  json.numbers("faces",
+               std::vector<std::size_t>(r.parameters.faces.begin(), r.parameters.faces.end()));
+  json.value("thickness", r.parameters.thickness);
+  json.value("layers", static_cast<std::size_t>(r.parameters.layers));
+  json.value("progression", r.parameters.progression);
+  json.beginObject("height");
+  json.value("min", r.thicknessMin);
+  json.value("max", r.thicknessMax);
+  json.endObject();
+  json.beginObject("first_height");
+  json.value("min", r.firstHeightMin);
+  json.value("max", r.firstHeightMax);
+  json.endObject();
+  json.beginArray("shrunk");
+  for (const LayerShrink& s : r.shrunk) {
+    json.beginObject();
+    json.value("face", static_cast<std::size_t>(s.face));
+    json.numbers("where", std::vector<double>(s.where.begin(), s.where.end()));
+    json.value("factor", s.factor);
+    json.value("nodes", s.nodes);
+    json.endObject();
+  }
+  json.endArray();
+  json.value("macro_prisms", r.prisms);
+  json.value("side_quadrilaterals", r.sideQuadrilaterals);
+  json.value("wall_nodes", r.wallNodes);
+  json.value("shrink_passes", static_cast<std::size_t>(r.shrinkPasses));
+  json.value("released_around_invalid", r.releasedAroundInvalid);
+  if (result.macroQuality) {
+    json.value("macro_worst_scaled_jacobian", result.macroQuality->scaled.min);
+    json.value("macro_invalid", result.macroQuality->invalid);
+    json.value("macro_undecided", result.macroQuality->undecided);
+  }
+  if (result.layerSplit) {
+    json.value("split_projected_nodes", result.layerSplit->projected);
+    json.value("split_max_projection", result.layerSplit->maxProjection);
+  }
+  json.value("seconds", r.seconds);
+  json.endObject();
+}
+
 std::string meshReportJson(const MeshResult& result, const std::string& input) {
   JsonWriter json;
   json.beginObject();
@@ -191,6 +235,7 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
     appendOptimiser(json, *result.lowOrderOptimiser,
                     "optimiser_order_" + std::to_string(kContinuationOrder));
   appendRepairRounds(json, result.rounds);
+  if (result.boundaryLayer) appendBoundaryLayer(json, result);
   json.beginObject("timings_s");
   for (const auto& [stage, s] : result.timings.seconds) json.value(stage, s);
   json.endObject();

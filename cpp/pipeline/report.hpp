@@ -30,6 +30,11 @@ void appendCounts(JsonWriter& json, const Mesh& mesh);
 // CAD normals, the sample counts and where the worst distance and angle were found.
 void appendGeometry(JsonWriter& json, const GeometryAccuracy& geometry);
 
+// Appends "boundary_layer": the parameters, the macro heights grown, the first split layer's
+// height, where the layer was shrunk (per face: smallest factor, where, how many wall nodes),
+// the macro mesh's certified quality and the split's projections onto the CAD.
+void appendBoundaryLayer(JsonWriter& json, const MeshResult& result);
+
 // Appends "sizing": the parameters, the prediction and the octree's statistics.
 void appendSizing(JsonWriter& json, const SizingResult& sizing);
 
