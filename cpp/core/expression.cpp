@@ -1,5 +1,6 @@
 #include "core/expression.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -60,7 +61,7 @@ class Parser {
                          " at character " + std::to_string(pos_ + 1));
   }
   void skip() {
-    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_])) != 0) ++pos_;
   }
   bool eat(char c) {
     skip();
@@ -119,7 +120,7 @@ class Parser {
       if (!eat(')')) fail("missing ')'");
       return inner;
     }
-    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') {
+    if (std::isdigit(static_cast<unsigned char>(c)) != 0 || c == '.') {
       const char* begin = s_.c_str() + pos_;
       char* end = nullptr;
       const double v = std::strtod(begin, &end);
@@ -127,9 +128,9 @@ class Parser {
       pos_ += static_cast<std::size_t>(end - begin);
       return add(Op::Number, -1, -1, v);
     }
-    if (std::isalpha(static_cast<unsigned char>(c))) {
+    if (std::isalpha(static_cast<unsigned char>(c)) != 0) {
       std::string name;
-      while (pos_ < s_.size() && std::isalnum(static_cast<unsigned char>(s_[pos_])))
+      while (pos_ < s_.size() && std::isalnum(static_cast<unsigned char>(s_[pos_])) != 0)
         name += s_[pos_++];
       if (name == "x") return add(Op::X);
       if (name == "y") return add(Op::Y);
@@ -205,9 +206,9 @@ double Expression::operator()(double x, double y, double z) const {
 }
 
 bool Expression::isConstant() const {
-  for (const Node& n : nodes_)
-    if (n.op == Op::X || n.op == Op::Y || n.op == Op::Z) return false;
-  return true;
+  return std::none_of(nodes_.begin(), nodes_.end(), [](const Node& n) {
+    return n.op == Op::X || n.op == Op::Y || n.op == Op::Z;
+  });
 }
 
 }  // namespace homesh

@@ -72,8 +72,11 @@ std::vector<int> parseIndexList(const std::string& text, const std::string& what
       continue;
     }
     const int a = number(item.substr(0, dash)), b = number(item.substr(dash + 1));
-    if (b < a || b - a > 100000)
-      throw ParameterError(what + " '" + text + "': range " + item + " is empty or too long");
+    if (b < a || b - a > 100000) {
+      std::string message = what;
+      message.append(" '").append(text).append("': range '").append(item);
+      throw ParameterError(message.append("' is empty or too long"));
+    }
     for (int v = a; v <= b; ++v) out.insert(v);
   }
   if (out.empty()) throw ParameterError(what + " is empty");
@@ -127,12 +130,12 @@ bool segmentCrosses(const Vec& p, const Vec& q, const Vec& a, const Vec& b, cons
 // Scaled Jacobian at the six corners of the linear prism (wall a, b, c; tops A, B, C), smallest.
 double prismCornerQuality(const std::array<Vec, 6>& v) {
   double worst = 1.0;
-  for (int top = 0; top < 2; ++top) {
-    const Vec& o = v[static_cast<std::size_t>(3 * top)];
-    const Vec dx = v[static_cast<std::size_t>(3 * top + 1)] - o;
-    const Vec dy = v[static_cast<std::size_t>(3 * top + 2)] - o;
-    for (int k = 0; k < 3; ++k) {
-      const Vec dz = v[static_cast<std::size_t>(3 + k)] - v[static_cast<std::size_t>(k)];
+  for (std::size_t top = 0; top < 2; ++top) {
+    const Vec& o = v[3 * top];
+    const Vec dx = v[3 * top + 1] - o;
+    const Vec dy = v[3 * top + 2] - o;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Vec dz = v[3 + k] - v[k];
       const double scale = dx.norm() * dy.norm() * dz.norm();
       worst = std::min(worst, scale > 0.0 ? dx.cross(dy).dot(dz) / scale : -1.0);
     }
