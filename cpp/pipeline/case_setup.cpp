@@ -97,7 +97,10 @@ CaseSetup setupCase(const std::string& input) {
     for (const auto& [key, value] : keys)
       if (key != "BndLayerSurfaces" && key != "BndLayerThickness" && key != "BndLayerLayers" &&
           key != "BndLayerProgression")
-        setup.notices.push_back(file + ": PARAMETERS " + key + " is not used yet and is ignored");
+        setup.notices.push_back(std::string(file)
+                                    .append(": PARAMETERS ")
+                                    .append(key)
+                                    .append(" is not used yet and is ignored"));
     setup.options.boundaryLayer = bl;
   }
   return setup;
