@@ -114,17 +114,11 @@ int runMesh(const homesh::MeshCommand& cmd) {
   if (cmd.blFaces || cmd.blThickness || cmd.blLayers || cmd.blProgression) {
     homesh::BoundaryLayerParameters bl =
         options.boundaryLayer.value_or(homesh::BoundaryLayerParameters{});
-    if (!options.boundaryLayer) {  // NekMesh's defaults
-      bl.layers = 2;
-      bl.progression = 2.0;
-    }
     if (cmd.blFaces) bl.faces = homesh::parseIndexList(*cmd.blFaces, "--bl-faces");
     if (cmd.blThickness) bl.thickness = *cmd.blThickness;
     if (cmd.blLayers) bl.layers = *cmd.blLayers;
     if (cmd.blProgression) bl.progression = *cmd.blProgression;
-    if (bl.faces.empty()) throw homesh::ParameterError("a boundary layer needs --bl-faces");
-    if (bl.thickness.empty()) throw homesh::ParameterError("a boundary layer needs --bl-thickness");
-    options.boundaryLayer = bl;
+    options.boundaryLayer = bl;  // checked with the other options by the pipeline
   }
   StderrProgress progress;
   homesh::PipelineObserver* observer = c.quiet ? nullptr : &progress;

@@ -226,6 +226,16 @@ void Reader::readParameters(const XmlElement& section) {
     if (blKey) {
       if (trim(value).empty()) fail(where + " is empty");
       case_.boundaryLayer[key] = trim(value);
+      if (key == "BndLayerLayers") {
+        const auto layers = toInt(value);
+        if (!layers || *layers < 1)
+          fail(where + " must be a positive integer, got '" + excerpt(trim(value)) + "'");
+        case_.boundaryLayerLayers = *layers;
+      } else if (key == "BndLayerProgression") {
+        const double r = number(value, where);
+        if (!(r > 0.0)) fail(where + " must be positive, got " + formatNumber(r));
+        case_.boundaryLayerProgression = r;
+      }
     } else if (key == "Order") {
       const auto order = toInt(value);
       if (!order) fail(where + " must be an integer, got '" + excerpt(trim(value)) + "'");

@@ -40,6 +40,8 @@ struct McfCase {
   // BndLayerThickness (may be an expression), BndLayerLayers, BndLayerProgression,
   // BndLayerAdjustment, SpaceOutBndLayer, NoSpaceOutSurf.
   std::map<std::string, std::string> boundaryLayer;
+  std::optional<int> boundaryLayerLayers;             // BndLayerLayers, parsed (>= 1)
+  std::optional<double> boundaryLayerProgression;     // BndLayerProgression, parsed (> 0)
   std::optional<double> xmin, ymin, xmax, ymax, aoa;  // NACA box and angle of attack (degrees)
   std::set<std::string> boolParameters;               // every name in BOOLPARAMETERS
   std::vector<RefinementLine> refinementLines;

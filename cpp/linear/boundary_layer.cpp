@@ -17,13 +17,14 @@
 namespace homesh {
 
 void BoundaryLayerParameters::validate() const {
-  if (faces.empty()) throw ParameterError("boundary layer: no faces given (BndLayerSurfaces)");
+  if (faces.empty())
+    throw ParameterError("boundary layer: no faces given (--bl-faces, BndLayerSurfaces)");
   for (const int f : faces)
     if (f < 1)
       throw ParameterError("boundary-layer face " + std::to_string(f) +
                            " does not exist (faces are numbered from 1)");
   if (thickness.empty())
-    throw ParameterError("boundary layer: no thickness given (BndLayerThickness)");
+    throw ParameterError("boundary layer: no thickness given (--bl-thickness, BndLayerThickness)");
   Expression::parse(thickness, "boundary-layer thickness");
   if (layers < 1 || layers > kMaxBoundaryLayers)
     throw ParameterError("boundary-layer layers must be from 1 to " +
@@ -200,6 +201,13 @@ class LayerGrower {
   };
   std::vector<SideNode> side_;
   std::map<std::int64_t, std::size_t> sideIndex_;
+  // Every surface triangle where it was, its face and bounding box: what the layer's normals
+  // must not cross (built once; the shrink passes test against it).
+  struct Walls {
+    std::vector<Tri> triangles;
+    std::vector<int> faces;
+    std::vector<std::pair<Vec, Vec>> boxes;
+  } walls_;
 
   void extractSurface(const Mesh& volume) {
     if (volume.dim != 3)
@@ -292,6 +300,18 @@ class LayerGrower {
           faces.push_back(sideFace_[t]);
       }
     findSideNodes();
+    walls_.triangles = layerTris_;
+    walls_.triangles.insert(walls_.triangles.end(), sideTris_.begin(), sideTris_.end());
+    walls_.faces = layerFace_;
+    walls_.faces.insert(walls_.faces.end(), sideFace_.begin(), sideFace_.end());
+    for (const Tri& t : walls_.triangles) {
+      Vec lo = at(out_, t[0]), hi = lo;
+      for (std::size_t k = 1; k < 3; ++k) {
+        lo = lo.cwiseMin(at(out_, t[k]));
+        hi = hi.cwiseMax(at(out_, t[k]));
+      }
+      walls_.boxes.emplace_back(lo, hi);
+    }
   }
 
   // The side faces' inner nodes within kSideRings edges of a wall node that climbs them.
@@ -534,19 +554,9 @@ class LayerGrower {
       }
     }
     // The normal, extended, must not cross a wall that is not around the node.
-    std::vector<std::pair<Vec, Vec>> boxes;
-    std::vector<Tri> all = layerTris_;
-    all.insert(all.end(), sideTris_.begin(), sideTris_.end());
-    std::vector<int> allFace = layerFace_;
-    allFace.insert(allFace.end(), sideFace_.begin(), sideFace_.end());
-    for (const Tri& t : all) {
-      Vec lo = at(out_, t[0]), hi = lo;
-      for (int k = 1; k < 3; ++k) {
-        lo = lo.cwiseMin(at(out_, t[static_cast<std::size_t>(k)]));
-        hi = hi.cwiseMax(at(out_, t[static_cast<std::size_t>(k)]));
-      }
-      boxes.emplace_back(lo, hi);
-    }
+    const std::vector<Tri>& all = walls_.triangles;
+    const std::vector<int>& allFace = walls_.faces;
+    const std::vector<std::pair<Vec, Vec>>& boxes = walls_.boxes;
     for (std::size_t i = 0; i < wall_.size(); ++i) {
       const WallNode& w = wall_[i];
       const Vec p = at(out_, w.id);

@@ -114,17 +114,24 @@ Eigen::Vector3d point(const Mesh& mesh, std::int64_t i) {
   return {mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]};
 }
 
+// Makes every tetrahedron positively oriented.
+void orientTetrahedra(const Mesh& mesh, ElementBlock& tets) {
+  for (std::size_t e = 0; e < tets.count(); ++e) {
+    std::int64_t* t = tets.nodes.data() + 4 * e;
+    const Eigen::Vector3d a = point(mesh, t[0]);
+    if ((point(mesh, t[1]) - a).cross(point(mesh, t[2]) - a).dot(point(mesh, t[3]) - a) < 0.0)
+      std::swap(t[1], t[2]);
+  }
+}
+
 // Makes every tetrahedron positively oriented and every boundary triangle that bounds exactly one
 // tetrahedron point out of it.
 void orientVolumeMesh(Mesh& mesh, ElementBlock& tets, ElementBlock& tris) {
   using Face = std::array<std::int64_t, 3>;
+  orientTetrahedra(mesh, tets);
   std::map<Face, std::vector<std::int64_t>> opposite;  // sorted face -> opposite vertices
   for (std::size_t e = 0; e < tets.count(); ++e) {
-    std::int64_t* t = tets.nodes.data() + 4 * e;
-    const Eigen::Vector3d a = point(mesh, t[0]);
-    const double volume =
-        (point(mesh, t[1]) - a).cross(point(mesh, t[2]) - a).dot(point(mesh, t[3]) - a);
-    if (volume < 0.0) std::swap(t[1], t[2]);
+    const std::int64_t* t = tets.nodes.data() + 4 * e;
     for (int skip = 0; skip < 4; ++skip) {
       Face f;
       int n = 0;
@@ -329,12 +336,7 @@ ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_
     }
   });
   if (tets.count() == 0) throw MeshingError("Gmsh made no tetrahedra inside the boundary layer");
-  for (std::size_t e = 0; e < tets.count(); ++e) {
-    std::int64_t* t = tets.nodes.data() + 4 * e;
-    const Eigen::Vector3d a = point(mesh, t[0]);
-    if ((point(mesh, t[1]) - a).cross(point(mesh, t[2]) - a).dot(point(mesh, t[3]) - a) < 0.0)
-      std::swap(t[1], t[2]);
-  }
+  orientTetrahedra(mesh, tets);
   return tets;
 }
 

@@ -68,32 +68,10 @@ CaseSetup setupCase(const std::string& input) {
     }
     const auto& keys = mcf.boundaryLayer;
     BoundaryLayerParameters bl;
-    bl.layers = 2;  // NekMesh's defaults
-    bl.progression = 2.0;
     bl.faces = parseIndexList(keys.at("BndLayerSurfaces"), input + ": BndLayerSurfaces");
     bl.thickness = keys.at("BndLayerThickness");
-    if (keys.count("BndLayerLayers") != 0) {
-      const std::string& v = keys.at("BndLayerLayers");
-      std::size_t used = 0;
-      try {
-        bl.layers = std::stoi(v, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != v.size())
-        throw ParameterError(input + ": BndLayerLayers '" + v + "' is not an integer");
-    }
-    if (keys.count("BndLayerProgression") != 0) {
-      const std::string& v = keys.at("BndLayerProgression");
-      std::size_t used = 0;
-      try {
-        bl.progression = std::stod(v, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != v.size())
-        throw ParameterError(input + ": BndLayerProgression '" + v + "' is not a number");
-    }
+    if (mcf.boundaryLayerLayers) bl.layers = *mcf.boundaryLayerLayers;
+    if (mcf.boundaryLayerProgression) bl.progression = *mcf.boundaryLayerProgression;
     for (const auto& [key, value] : keys)
       if (key != "BndLayerSurfaces" && key != "BndLayerThickness" && key != "BndLayerLayers" &&
           key != "BndLayerProgression")

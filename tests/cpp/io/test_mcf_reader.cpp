@@ -111,6 +111,8 @@ TEST(McfReader, ReadsThe2DAerofoilAndT106Cases) {
   EXPECT_EQ(a.boundaryLayer.at("BndLayerThickness"), "0.1");
   EXPECT_EQ(a.boundaryLayer.at("BndLayerLayers"), "6");
   EXPECT_EQ(a.boundaryLayer.at("BndLayerProgression"), "1.5");
+  EXPECT_EQ(a.boundaryLayerLayers, 6);
+  EXPECT_EQ(a.boundaryLayerProgression, 1.5);
   EXPECT_TRUE(a.boolParameters.empty());  // an empty BOOLPARAMETERS
   EXPECT_TRUE(a.notices.empty());
 
@@ -288,6 +290,10 @@ TEST(McfReader, RejectsMissingAndBadValues) {
   EXPECT_ERROR_HAS(writeMcf(withParameters("<P PARAM=\"Order\" VALUE=\"3\"/>"
                                            "<P PARAM=\"Order\" VALUE=\"4\"/>")),
                    "PARAMETERS Order is given twice");
+  EXPECT_ERROR_HAS(writeMcf(withParameters("<P PARAM=\"BndLayerLayers\" VALUE=\"six\"/>")),
+                   "PARAMETERS BndLayerLayers must be a positive integer, got 'six'");
+  EXPECT_ERROR_HAS(writeMcf(withParameters("<P PARAM=\"BndLayerProgression\" VALUE=\"0\"/>")),
+                   "PARAMETERS BndLayerProgression must be positive, got 0");
   EXPECT_ERROR_HAS(writeMcf(withParameters("<P VALUE=\"4\"/>")),
                    "PARAMETERS: a <P> has no PARAM attribute");
   EXPECT_ERROR_HAS(writeMcf("<PARAMETERS/>"), "no <INFORMATION> in <MESHING>");
