@@ -316,7 +316,8 @@ def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_o
 
 
 def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
-         optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=3):
+         optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=3,
+         boundary_layer=None):
     """Meshes a CAD shape with curved elements of the given order.
 
     shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
@@ -339,6 +340,13 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
               each splits the offending linear elements' edges on curved CAD faces (or refines
               around them), then curves, optimises and checks again (stages "repair 1", ...;
               ``report()["rounds"]``). 0: none.
+    boundary_layer
+              a 3D boundary layer: ``{"faces": [1, 8], "thickness": 0.04, "layers": 6,
+              "progression": 1.5}`` (faces as FreeCAD numbers them, FaceN; thickness a number
+              or an expression of x, y, z such as ``"0.01+0.05*x"``; layers and progression
+              optional, 2 and 2 by default as in NekMesh). A macro prism layer is grown,
+              curved and optimised with the rest, then split (``report()["boundary_layer"]``).
+              For a NekMesh .mcf file, its BndLayer* keys are used when this is None.
 
     Raises ParameterError, FileError, CadError, MeshingError or CancelledError.
     """
@@ -359,14 +367,53 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     if size is not None and sizing is not None:
         raise ParameterError("give either size (uniform) or the sizing octree parameters")
 
+    layer = _boundary_layer(boundary_layer)
+
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
         core = _core.mesh_brep(value, label, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds)
+                               sizing, repair_rounds, layer)
     else:
         core = _core.mesh_file(value, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds)
+                               sizing, repair_rounds, layer)
     return HighOrderMesh(core)
+
+
+_BOUNDARY_LAYER_KEYS = ("faces", "thickness", "layers", "progression")
+
+
+def _boundary_layer(spec):
+    """The boundary-layer dict the core takes (keys and types checked here, ranges by the
+    core), or None."""
+    if spec is None:
+        return None
+    if not isinstance(spec, dict):
+        raise ParameterError("boundary_layer must be a dict with faces and thickness, got %r"
+                             % (spec,))
+    unknown = sorted(set(spec) - set(_BOUNDARY_LAYER_KEYS))
+    if unknown:
+        raise ParameterError("boundary_layer: unknown key %r (keys: %s)"
+                             % (unknown[0], ", ".join(_BOUNDARY_LAYER_KEYS)))
+    for key in ("faces", "thickness"):
+        if key not in spec:
+            raise ParameterError("boundary_layer needs %r" % key)
+    faces = spec["faces"]
+    if isinstance(faces, numbers.Integral) and not isinstance(faces, bool):
+        faces = [faces]
+    out = {"faces": [_check_int("boundary_layer faces", f) for f in faces]}
+    thickness = spec["thickness"]
+    if isinstance(thickness, bool) or not isinstance(thickness, (numbers.Real, str)):
+        raise ParameterError("boundary_layer thickness must be a number or an expression of "
+                             "x, y, z, got %r" % (thickness,))
+    out["thickness"] = thickness if isinstance(thickness, str) else repr(float(thickness))
+    if "layers" in spec:
+        out["layers"] = _check_int("boundary_layer layers", spec["layers"])
+    if "progression" in spec:
+        r = spec["progression"]
+        if isinstance(r, bool) or not isinstance(r, numbers.Real):
+            raise ParameterError("boundary_layer progression must be a number, got %r" % (r,))
+        out["progression"] = float(r)
+    return out
 
 
 _INT32_MAX = 2**31 - 1

@@ -23,13 +23,29 @@ def triangle_lattice(level):
     return np.array(points, dtype=float), np.array(tris, dtype=np.int64)
 
 
-def curved_triangles(nodes, elements, order, level):
-    """Samples curved triangles (Gmsh order) on a level-``level`` lattice.
+def quad_lattice(level):
+    """Reference points and sub-triangles of a quadrilateral split ``level`` times per edge."""
+    n = level + 1
+    points = [(i / level, j / level) for j in range(n) for i in range(n)]
+    tris = []
+    for j in range(level):
+        for i in range(level):
+            a, b, c, d = j * n + i, j * n + i + 1, (j + 1) * n + i + 1, (j + 1) * n + i
+            tris += [(a, b, c), (a, c, d)]
+    return np.array(points, dtype=float), np.array(tris, dtype=np.int64)
+
+
+_LATTICE = {"tri": triangle_lattice, "quad": quad_lattice}
+_CORNERS = {"tri": 3, "quad": 4}
+
+
+def curved_faces(nodes, elements, order, level, element_type="tri"):
+    """Samples curved triangles or quadrilaterals (Gmsh order) on a level-``level`` lattice.
 
     Returns (points (E*k, 3), triangles (E*t, 3) indices into points, owner (E*t,) element).
     """
-    ref, sub = triangle_lattice(level)
-    basis = _core.lagrange_basis("tri", order, ref)          # (k, nodes per element)
+    ref, sub = _LATTICE[element_type](level)
+    basis = _core.lagrange_basis(element_type, order, ref)   # (k, nodes per element)
     points = np.einsum("kn,enc->ekc", basis, nodes[elements])  # (E, k, 3)
     count = len(elements)
     offsets = (np.arange(count) * len(ref))[:, None, None]
@@ -38,14 +54,16 @@ def curved_triangles(nodes, elements, order, level):
     return points.reshape(-1, 3), triangles, owner
 
 
-def triangle_edges(elements, order):
-    """Unique edges of triangles (Gmsh order) as order-P line elements (Gmsh line order)."""
+def face_edges(elements, order, element_type="tri"):
+    """Unique edges of triangles or quadrilaterals (Gmsh order: corners, then the nodes of
+    edge 0-1, 1-2, ... in turn) as order-P line elements (Gmsh line order)."""
     p = order
+    corners = _CORNERS[element_type]
     seen = {}
     for element in elements:
-        for k in range(3):
-            a, b = int(element[k]), int(element[(k + 1) % 3])
-            inner = [int(n) for n in element[3 + k * (p - 1): 3 + (k + 1) * (p - 1)]]
+        for k in range(corners):
+            a, b = int(element[k]), int(element[(k + 1) % corners])
+            inner = [int(n) for n in element[corners + k * (p - 1): corners + (k + 1) * (p - 1)]]
             key = (min(a, b), max(a, b))
             if key not in seen:
                 seen[key] = [a, b] + inner
@@ -59,18 +77,25 @@ def curved_polylines(nodes, lines, order, level):
     return np.einsum("kn,lnc->lkc", basis, nodes[lines])
 
 
-def face_owners(elements, element_type, faces):
-    """For each boundary triangle (corner nodes = first 3 entries), the index of a volume
-    element having it as a face, or -1."""
-    if element_type != "tet":
-        return np.full(len(faces), -1, dtype=np.int64)
-    corners = elements[:, :4]
+# Faces of each volume shape by corner (Gmsh corner order).
+_VOLUME_FACES = {
+    "tet": ((0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)),
+    "prism": ((0, 1, 2), (3, 4, 5), (0, 1, 4, 3), (1, 2, 5, 4), (2, 0, 3, 5)),
+    "hex": ((0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)),
+}
+
+
+def face_owners(element_blocks, faces, corners):
+    """For each boundary face (its first ``corners`` entries are its corners), the index (over
+    all volume elements, block after block) of a volume element having it as a face, or -1."""
     lookup = {}
-    for e, t in enumerate(corners):
-        for skip in range(4):
-            key = tuple(sorted(int(t[i]) for i in range(4) if i != skip))
-            lookup.setdefault(key, e)
-    return np.array([lookup.get(tuple(sorted(int(x) for x in f[:3])), -1) for f in faces],
+    first = 0
+    for block in element_blocks:
+        for e, element in enumerate(block.elements):
+            for face in _VOLUME_FACES.get(block.element_type, ()):
+                lookup.setdefault(tuple(sorted(int(element[i]) for i in face)), first + e)
+        first += len(block.elements)
+    return np.array([lookup.get(tuple(sorted(int(x) for x in f[:corners])), -1) for f in faces],
                     dtype=np.int64)
 
 
@@ -88,8 +113,8 @@ def quality_colors(values):
 def surface_and_edges(mesh, level=None):
     """Display geometry of a :class:`homesh.HighOrderMesh`.
 
-    The drawn surface is the boundary triangles (3D) or the triangles themselves (2D), coloured
-    by the scaled Jacobian of the element they belong to. Returns a dict with ``points``,
+    The drawn surface is the boundary triangles and quadrilaterals (3D) or the elements
+    themselves (2D), coloured by the scaled Jacobian of the element they belong to. Returns a dict with ``points``,
     ``triangles``, ``colors`` (per triangle), ``edge_points`` and ``edge_polylines``
     (each row indexes edge_points).
     """
@@ -97,17 +122,28 @@ def surface_and_edges(mesh, level=None):
     level = level or max(2, 2 * order)
     quality = mesh.quality()["scaled_jacobian"]
     if mesh.dim == 3:
-        blocks = [b.elements for b in mesh.boundary if b.element_type == "tri"]
-        per_face = (order + 1) * (order + 2) // 2
-        faces = np.concatenate(blocks) if blocks else np.zeros((0, per_face), dtype=np.int64)
-        owners = face_owners(mesh.elements, mesh.element_type, faces)
-        face_quality = np.where(owners >= 0, quality[np.maximum(owners, 0)], 1.0)
+        groups = [(b.element_type, b.elements) for b in mesh.boundary
+                  if b.element_type in _LATTICE]
     else:
-        faces = mesh.elements
-        face_quality = quality
-    points, triangles, owner = curved_triangles(mesh.nodes, faces, order, level)
-    colors = quality_colors(face_quality)[owner]
-    edges = triangle_edges(faces, order)
+        groups = [(b.element_type, b.elements) for b in mesh.element_blocks]
+    points, triangles, colors, edges = [], [], [], []
+    first = 0  # 2D: the group's first element among all elements
+    for element_type, faces in groups:
+        if mesh.dim == 3:
+            owners = face_owners(mesh.element_blocks, faces, _CORNERS[element_type])
+            face_quality = np.where(owners >= 0, quality[np.maximum(owners, 0)], 1.0)
+        else:
+            face_quality = quality[first:first + len(faces)]
+            first += len(faces)
+        p, t, owner = curved_faces(mesh.nodes, faces, order, level, element_type)
+        triangles.append(t + sum(len(x) for x in points))
+        points.append(p)
+        colors.append(quality_colors(face_quality)[owner])
+        edges.append(face_edges(faces, order, element_type))
+    points = np.concatenate(points) if points else np.zeros((0, 3))
+    triangles = np.concatenate(triangles) if triangles else np.zeros((0, 3), dtype=np.int64)
+    colors = np.concatenate(colors) if colors else np.zeros((0, 3))
+    edges = np.concatenate(edges) if edges else np.zeros((0, order + 1), dtype=np.int64)
     polylines = curved_polylines(mesh.nodes, edges, order, level)
     edge_points = polylines.reshape(-1, 3)
     edge_index = np.arange(len(edge_points)).reshape(len(edges), level + 1)

@@ -327,9 +327,24 @@ SizingParameters sizingFrom(const bp::dict& d) {
   return p;
 }
 
+// The boundary layer of a dict the Python layer checked for its keys and types (homesh/api.py
+// _boundary_layer): "faces" (list of int), "thickness" (text), "layers", "progression".
+BoundaryLayerParameters boundaryLayerFrom(const bp::dict& d) {
+  BoundaryLayerParameters p;
+  const bp::object faces = d["faces"];
+  for (bp::ssize_t i = 0; i < bp::len(faces); ++i) p.faces.push_back(bp::extract<int>(faces[i]));
+  p.thickness = bp::extract<std::string>(d["thickness"]);
+  if (d.has_key("layers")) p.layers = bp::extract<int>(d["layers"]);
+  if (d.has_key("progression")) p.progression = bp::extract<double>(d["progression"]);
+  return p;
+}
+
 MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity,
-                           int optimise, const bp::object& sizing, int repairRounds) {
+                           int optimise, const bp::object& sizing, int repairRounds,
+                           const bp::object& boundaryLayer) {
   MeshingOptions options;
+  if (!boundaryLayer.is_none())
+    options.boundaryLayer = boundaryLayerFrom(bp::extract<bp::dict>(boundaryLayer));
   options.optimiseIterations = optimise;
   options.repairRounds = repairRounds;
   options.order = order;
@@ -380,21 +395,23 @@ PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::o
 // A CAD file or a NekMesh .mcf case: a case's CAD and sizes (unless given here) are used.
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
                 int verbosity, bp::object progress, int optimise, const bp::object& sizing,
-                int repairRounds) {
+                int repairRounds, const bp::object& boundaryLayer) {
   const CaseSetup setup = setupCase(path);
   MeshingOptions options =
-      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds);
+      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds, boundaryLayer);
   if (!options.size && !options.sizing) options.sizing = setup.options.sizing;
+  if (!options.boundaryLayer) options.boundaryLayer = setup.options.boundaryLayer;
   options.expectedDimension = setup.options.expectedDimension;
   return runPipeline(setup.source, options, std::move(progress));
 }
 
 PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
                 int threads, int verbosity, bp::object progress, int optimise,
-                const bp::object& sizing, int repairRounds) {
-  return runPipeline(CadSource::brepText(text, name),
-                     makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds),
-                     std::move(progress));
+                const bp::object& sizing, int repairRounds, const bp::object& boundaryLayer) {
+  return runPipeline(
+      CadSource::brepText(text, name),
+      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds, boundaryLayer),
+      std::move(progress));
 }
 
 // Rebuilds a mesh (without CAD) from the arrays PyMesh exposes, and evaluates its quality.
@@ -533,14 +550,16 @@ BOOST_PYTHON_MODULE(_core) {
       .def("report_json", &PyMesh::reportJson)
       .def("optimise", &PyMesh::optimise);
 
-  bp::def("mesh_file", &meshFile,
-          (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
-           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
-           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = 3));
+  bp::def(
+      "mesh_file", &meshFile,
+      (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"), bp::arg("verbosity"),
+       bp::arg("progress"), bp::arg("optimise") = 0, bp::arg("sizing") = bp::object(),
+       bp::arg("repair_rounds") = 3, bp::arg("boundary_layer") = bp::object()));
   bp::def("mesh_brep", &meshBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
            bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
-           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = 3));
+           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = 3,
+           bp::arg("boundary_layer") = bp::object()));
   bp::def("predict_file", &predictFile,
           (bp::arg("path"), bp::arg("sizing") = bp::object(), bp::arg("octree_path") = "",
            bp::arg("threads") = 1));

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import homesh
+from conftest import ROOT
 from homesh import tessellation
 
 
@@ -217,3 +218,52 @@ def test_tessellation_follows_the_curved_surface(sphere):
     edge_radius = np.linalg.norm(geometry["edge_points"], axis=1)
     assert np.max(np.abs(edge_radius - 1.0)) < bound
     assert geometry["edge_polylines"].shape[1] == 7
+
+
+CYLINDER = ROOT.parent / "shared" / "peer-cases" / "nekmesh" / "meshgen"
+
+
+def test_boundary_layer_argument_and_mcf_keys():
+    # The cylinder STEP read as is (millimetres): a 40 mm layer on the cylinder's two faces,
+    # 3 layers growing by 1.2 from the wall.
+    m = homesh.mesh(str(CYLINDER / "3d_bl_cyl.stp"), order=2, optimise=50, threads=2,
+                    boundary_layer={"faces": [1, 8], "thickness": 40, "layers": 3,
+                                    "progression": 1.2})
+    report = m.report()
+    layer = report["boundary_layer"]
+    assert layer["faces"] == [1, 8] and layer["layers"] == 3
+    assert report["elements"]["prism"] == 3 * layer["macro_prisms"] > 0
+    # First layer: 40 (1 - 1.2) / (1 - 1.2^3), to rounding of a few ulps.
+    assert layer["first_height"]["min"] == pytest.approx(40 * 0.2 / (1.2 ** 3 - 1), rel=1e-12)
+    assert m.quality()["invalid_elements"] == 0
+    blocks = {b.element_type for b in m.element_blocks}
+    assert blocks == {"tet", "prism"}
+    # Drawn: the walls' triangles and the layer's side quadrilaterals (on the end planes z = 0
+    # and 500), each owned by a prism or tetrahedron; two sub-triangles per quad lattice cell.
+    level = 3
+    geometry = tessellation.surface_and_edges(m, level=level)
+    faces = {b.element_type: b.elements for b in m.boundary}
+    assert len(geometry["triangles"]) == \
+        level ** 2 * len(faces["tri"]) + 2 * level ** 2 * len(faces["quad"])
+    for kind, corners in (("tri", 3), ("quad", 4)):
+        assert (tessellation.face_owners(m.element_blocks, faces[kind], corners) >= 0).all()
+    quad_points = geometry["points"][-len(faces["quad"]) * (level + 1) ** 2:]
+    # On the planes to the rounding of the Lagrange sums of coordinates up to ~1e3 (1e-9 mm).
+    assert np.all(np.minimum(abs(quad_points[:, 2]), abs(quad_points[:, 2] - 500)) < 1e-9)
+    # A .mcf's BndLayer keys are used when no boundary_layer is given.
+    c = homesh.mesh(str(CYLINDER / "3d_bl_cyl.mcf"), order=2, optimise=50, threads=2)
+    assert c.report()["boundary_layer"]["layers"] == 6
+
+
+@pytest.mark.parametrize("spec, message", [
+    ({"faces": [1]}, "needs 'thickness'"),
+    ({"faces": [1, 8], "thickness": 40, "layer": 3}, "unknown key 'layer'"),
+    ({"faces": [9], "thickness": 1}, "face 9 does not exist"),
+    ({"faces": [1], "thickness": "x*"}, "not an expression of x, y, z"),
+    ({"faces": [1], "thickness": True}, "must be a number or an expression"),
+    ({"faces": [1], "thickness": 1, "layers": 0}, "layers must be from 1 to 100"),
+    (5, "must be a dict"),
+])
+def test_bad_boundary_layers_are_named(spec, message):
+    with pytest.raises(homesh.ParameterError, match=message):
+        homesh.mesh(str(CYLINDER / "3d_bl_cyl.stp"), order=2, boundary_layer=spec)
