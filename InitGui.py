@@ -17,7 +17,7 @@ class HOMeshWorkbench(FreeCADGui.Workbench):
 
     def Initialize(self):
         import homesh.freecad.commands  # noqa: F401  (registers the commands)
-        commands = ["HOMesh_HighOrderMesh", "HOMesh_Sizing"]
+        commands = ["HOMesh_HighOrderMesh", "HOMesh_Sizing", "HOMesh_BoundaryLayer"]
         self.appendToolbar("HOMesh", commands)
         self.appendMenu("&HOMesh", commands)
 

@@ -4,7 +4,7 @@ import FreeCAD
 import FreeCADGui
 
 from . import resources
-from .objects import is_sizing
+from .objects import TYPE_HIGH_ORDER_MESH, is_sizing
 
 
 def _selected_sizing_object():
@@ -97,5 +97,60 @@ class CommandSizing:
             doc.commitTransaction()
 
 
+def _selected_faces():
+    """(object, ["FaceN", ...]) when faces of one object are selected (and nothing else), else
+    None."""
+    selection = FreeCADGui.Selection.getSelectionEx()
+    if len(selection) != 1:
+        return None
+    names = list(selection[0].SubElementNames)
+    if not names or not all(n.startswith("Face") for n in names):
+        return None
+    return selection[0].Object, names
+
+
+class CommandBoundaryLayer:
+    """Creates a BoundaryLayer object on the selected faces (thickness a hundredth of the
+    shape's bounding-box diagonal, 2 layers, progression 2), links it from the shape's
+    high-order mesh when there is exactly one, and recomputes."""
+
+    def GetResources(self):
+        return {
+            "Pixmap": resources.icon("homesh_layer.svg"),
+            "MenuText": "Boundary layer",
+            "ToolTip": "Add a boundary layer on the selected faces: prisms grown from them, "
+                       "curved with the mesh and split into thin layers (set Thickness, Layers "
+                       "and Progression in its properties)",
+        }
+
+    def IsActive(self):
+        return FreeCAD.ActiveDocument is not None and _selected_faces() is not None
+
+    def Activated(self):
+        selected = _selected_faces()
+        if selected is None:
+            FreeCAD.Console.PrintError("HOMesh: select faces of one shape first\n")
+            return
+        part, faces = selected
+        thickness = "%.4g" % (part.Shape.BoundBox.DiagonalLength / 100.0)
+        meshes = [o for o in part.Document.Objects
+                  if getattr(getattr(o, "Proxy", None), "Type", None) == TYPE_HIGH_ORDER_MESH
+                  and o.Part == part]
+        doc = FreeCAD.ActiveDocument
+        doc.openTransaction("Boundary layer")
+        try:
+            FreeCADGui.addModule("homesh.freecad")
+            FreeCADGui.doCommand(
+                "_layer = homesh.freecad.make_boundary_layer(App.ActiveDocument, "
+                "App.ActiveDocument.getObject(%r), %r, %r)" % (part.Name, faces, thickness))
+            if len(meshes) == 1:
+                FreeCADGui.doCommand("App.ActiveDocument.getObject(%r).BoundaryLayer = _layer"
+                                     % meshes[0].Name)
+            FreeCADGui.doCommand("App.ActiveDocument.recompute()")
+        finally:
+            doc.commitTransaction()
+
+
 FreeCADGui.addCommand("HOMesh_HighOrderMesh", CommandHighOrderMesh())
+FreeCADGui.addCommand("HOMesh_BoundaryLayer", CommandBoundaryLayer())
 FreeCADGui.addCommand("HOMesh_Sizing", CommandSizing())

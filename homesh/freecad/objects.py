@@ -4,7 +4,9 @@ The proxies only hold properties and run the core; drawing lives in viewprovider
 mesh is stored inside the .FCStd as a compressed array file (property MeshData), so reopening a
 document shows and exports the mesh without recomputing it. A Sizing object holds the sizing
 octree's parameters (MinDelta, MaxDelta, Eps, refinement spheres) and predicts the element count;
-a HighOrderMesh whose Sizing property links to it meshes with that octree.
+a HighOrderMesh whose Sizing property links to it meshes with that octree. A BoundaryLayer object
+holds the faces (picked by selecting them), thickness, layers and progression of a boundary
+layer; a HighOrderMesh whose BoundaryLayer property links to it grows, curves and splits it.
 """
 
 import os
@@ -15,16 +17,20 @@ import FreeCAD
 
 TYPE_HIGH_ORDER_MESH = "HOMesh::HighOrderMesh"
 TYPE_SIZING = "HOMesh::Sizing"
+TYPE_BOUNDARY_LAYER = "HOMesh::BoundaryLayer"
 
 _RESULT_PROPERTIES = ("NumNodes", "NumElements", "MinScaledJacobian", "InvalidElements")
 
 
-def make_high_order_mesh(doc, part, order=4, size=0.0, name="HighOrderMesh", sizing=None):
+def make_high_order_mesh(doc, part, order=4, size=0.0, name="HighOrderMesh", sizing=None,
+                         boundary_layer=None):
     """Adds a HighOrderMesh object meshing ``part`` (a document object with a Shape).
 
     ``size`` 0 means automatic: the sizing octree of ``sizing`` (a Sizing object, see
     :func:`make_sizing`) if given, else the automatic sizing octree (MaxDelta a twentieth of the
-    bounding-box diagonal, MinDelta a twentieth of that, EPS 0.05). The caller recomputes.
+    bounding-box diagonal, MinDelta a twentieth of that, EPS 0.05). ``boundary_layer``: a
+    BoundaryLayer object on faces of ``part`` (:func:`make_boundary_layer`). The caller
+    recomputes.
     """
     obj = doc.addObject("App::FeaturePython", name)
     HighOrderMeshProxy(obj)
@@ -32,6 +38,7 @@ def make_high_order_mesh(doc, part, order=4, size=0.0, name="HighOrderMesh", siz
     obj.Order = order
     obj.Size = size
     obj.Sizing = sizing
+    obj.BoundaryLayer = boundary_layer
     if FreeCAD.GuiUp:
         from .viewproviders import ViewProviderHighOrderMesh
         ViewProviderHighOrderMesh(obj.ViewObject)
@@ -115,6 +122,10 @@ class HighOrderMeshProxy(_Proxy):
                             "their edges on curved faces or refine around them, then curve, "
                             "optimise and check again); 0: none")
             obj.RepairRounds = (3, 0, 20, 1)
+        if "BoundaryLayer" not in have:
+            obj.addProperty("App::PropertyLink", "BoundaryLayer", "Mesh",
+                            "Optional HOMesh BoundaryLayer object: prisms grown from its faces "
+                            "of Part, curved and optimised with the rest, then split")
         if "MeshData" not in have:
             obj.addProperty("App::PropertyFileIncluded", "MeshData", "Result",
                             "The curved mesh, stored in the document")
@@ -148,11 +159,17 @@ class HighOrderMeshProxy(_Proxy):
                 raise ValueError("%s: Sizing must link to a HOMesh Sizing object, not %s"
                                  % (obj.Label, obj.Sizing.Label))
             sizing = sizing_arguments(obj.Sizing)
+        layer = None
+        if obj.BoundaryLayer is not None:
+            if not is_boundary_layer(obj.BoundaryLayer):
+                raise ValueError("%s: BoundaryLayer must link to a HOMesh BoundaryLayer object, "
+                                 "not %s" % (obj.Label, obj.BoundaryLayer.Label))
+            layer = boundary_layer_arguments(obj.BoundaryLayer, obj.Part)
         progress = _Progress(obj.Label)
         try:
             mesh = homesh.mesh(shape, order=obj.Order, size=size, progress=progress,
                                name=obj.Part.Label, optimise=obj.OptimiserIterations,
-                               repair_rounds=obj.RepairRounds, **sizing)
+                               repair_rounds=obj.RepairRounds, boundary_layer=layer, **sizing)
         except homesh.HOMeshError as e:
             FreeCAD.Console.PrintError("HOMesh: %s: %s\n" % (obj.Label, e))
             raise
@@ -326,6 +343,117 @@ class SizingProxy(_Proxy):
                       % (obj.PredictedElements, sizing["min_delta"], sizing["max_delta"],
                          obj.OctreeLeaves))
         FreeCAD.Console.PrintMessage("HOMesh: %s: %s\n" % (obj.Label, obj.Status))
+
+
+def make_boundary_layer(doc, part, faces, thickness, layers=2, progression=2.0,
+                        name="BoundaryLayer"):
+    """Adds a BoundaryLayer object on ``faces`` of ``part`` (FreeCAD's numbers, 1 for Face1, or
+    names "Face1"): ``thickness`` a length in the model's units or an expression of x, y, z
+    (text), split into ``layers`` layers whose heights grow by ``progression`` from the wall.
+    Link it from a HighOrderMesh's BoundaryLayer property. The caller recomputes.
+    """
+    obj = doc.addObject("App::FeaturePython", name)
+    BoundaryLayerProxy(obj)
+    obj.Faces = (part, [f if isinstance(f, str) else "Face%d" % f for f in faces])
+    obj.Thickness = str(thickness)
+    obj.Layers = layers
+    obj.Progression = progression
+    return obj
+
+
+def is_boundary_layer(obj):
+    """Whether ``obj`` is a HOMesh BoundaryLayer object."""
+    return getattr(getattr(obj, "Proxy", None), "Type", None) == TYPE_BOUNDARY_LAYER
+
+
+def boundary_layer_arguments(obj, part=None):
+    """The ``boundary_layer`` argument of :func:`homesh.mesh` a BoundaryLayer object stands for.
+
+    Raises ValueError naming the object and the property when its faces are missing, are not
+    faces, or (with ``part``) belong to another object than the one meshed.
+    """
+    linked = obj.Faces
+    if not linked or linked[0] is None:
+        raise ValueError("%s: no faces (select faces of the shape and set Faces)" % obj.Label)
+    owner, names = linked[0], list(linked[1])
+    if part is not None and owner != part:
+        raise ValueError("%s: its faces belong to %s, but the mesh is of %s"
+                         % (obj.Label, owner.Label, part.Label))
+    faces = []
+    for name in names:
+        if not name.startswith("Face") or not name[4:].isdigit():
+            raise ValueError("%s: Faces must name faces (Face1, Face2, ...), got %r"
+                             % (obj.Label, name))
+        faces.append(int(name[4:]))
+    if not faces:
+        raise ValueError("%s: no faces (select faces of the shape and set Faces)" % obj.Label)
+    text = obj.Thickness.strip()
+    try:
+        thickness = float(text)
+    except ValueError:
+        thickness = text  # an expression of x, y, z: the core parses it and names any error
+    return {"faces": sorted(set(faces)), "thickness": thickness, "layers": int(obj.Layers),
+            "progression": float(obj.Progression)}
+
+
+class BoundaryLayerProxy(_Proxy):
+    """Proxy of an App::FeaturePython holding a boundary layer's parameters; recomputing checks
+    them and gives the first layer's height (for a constant thickness)."""
+
+    Type = TYPE_BOUNDARY_LAYER
+
+    def __init__(self, obj):
+        obj.Proxy = self
+        self.add_properties(obj)
+
+    @staticmethod
+    def add_properties(obj):
+        """Adds missing properties and makes the outputs read-only; safe to call again."""
+        have = obj.PropertiesList
+        if "Faces" not in have:
+            obj.addProperty("App::PropertyLinkSub", "Faces", "Layer",
+                            "Faces of the meshed shape that carry the layer (select them)")
+        if "Thickness" not in have:
+            obj.addProperty("App::PropertyString", "Thickness", "Layer",
+                            "Total thickness in the model's units, or an expression of x, y, z "
+                            "such as 0.01+0.05*x")
+        if "Layers" not in have:
+            obj.addProperty("App::PropertyIntegerConstraint", "Layers", "Layer",
+                            "Thin layers the macro layer is split into (1 to 100)")
+            obj.Layers = (2, 1, 100, 1)
+        if "Progression" not in have:
+            obj.addProperty("App::PropertyFloatConstraint", "Progression", "Layer",
+                            "Height ratio of consecutive layers, from the wall (0.01 to 100)")
+            obj.Progression = (2.0, 0.01, 100.0, 0.1)
+        for prop, kind, doc in (
+                ("FirstLayerHeight", "App::PropertyFloat",
+                 "Height of the wall layer for a constant thickness (0 for an expression)"),
+                ("Status", "App::PropertyString", "Summary, or why the parameters are wrong")):
+            if prop not in have:
+                obj.addProperty(kind, prop, "Result", doc)
+            obj.setEditorMode(prop, 1)  # read-only
+
+    def onDocumentRestored(self, obj):
+        self.add_properties(obj)
+
+    def execute(self, obj):
+        try:
+            args = boundary_layer_arguments(obj)
+            if not args["thickness"]:
+                raise ValueError("%s: no Thickness given" % obj.Label)
+        except ValueError as e:
+            obj.FirstLayerHeight = 0.0
+            obj.Status = "Failed: %s" % e
+            FreeCAD.Console.PrintError("HOMesh: %s\n" % e)
+            raise
+        n, r, t = args["layers"], args["progression"], args["thickness"]
+        first = 0.0
+        if isinstance(t, float):
+            first = t / n if r == 1.0 else t * (1.0 - r) / (1.0 - r ** n)
+        obj.FirstLayerHeight = first
+        obj.Status = ("%d faces of %s, thickness %s, %d layers, progression %g%s"
+                      % (len(args["faces"]), obj.Faces[0].Label, t, n, r,
+                         ", first layer %.4g" % first if first else ""))
 
 
 class _Progress:

@@ -68,6 +68,26 @@ try:
     # The fitted isometric view of the 4 x 4 x 2 part fills about a third of the image; a view
     # without the mesh has no such pixels at all. 0.15 does not depend on rounding.
     assert fraction > 0.15, "the mesh is not visible in the 3D view"
+
+    # A boundary layer on the hole: the face picked in the selection, the toolbar command,
+    # the mesh recomputed with prisms and drawn again (layer.png).
+    (hole,) = [i + 1 for i, f in enumerate(cut.Shape.Faces)
+               if f.Surface.__class__.__name__ == "Cylinder"]
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(cut, "Face%d" % hole)
+    FreeCADGui.runCommand("HOMesh_BoundaryLayer")
+    assert mesh.BoundaryLayer is not None, "the command did not link the layer to the mesh"
+    assert mesh.isValid() and mesh.InvalidElements == 0, "the mesh with a layer is not valid"
+    import homesh.freecad
+    prisms = homesh.freecad.get_mesh(mesh).report()["elements"]["prism"]
+    assert prisms > 0, "no prisms in the mesh"
+    print("HOMesh GUI smoke: with a boundary layer: %d elements (%d prisms), worst %.3f"
+          % (mesh.NumElements, prisms, mesh.MinScaledJacobian))
+    view.viewTop()
+    view.fitAll()
+    for _ in range(10):
+        QtWidgets.QApplication.processEvents()
+    view.saveImage(os.path.join(out, "layer.png"), 800, 600, "White")
     status = 0
 except Exception:
     traceback.print_exc()
