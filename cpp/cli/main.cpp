@@ -142,6 +142,11 @@ int runMesh(const homesh::MeshCommand& cmd) {
     }
     for (std::size_t k = 0; k < result.rounds.size(); ++k) {
       const homesh::RepairRound& r = result.rounds[k];
+      if (!r.failure.empty()) {
+        std::fprintf(stderr, "homesh: repair %zu: %s %zu elements failed: %s\n", k + 1,
+                     r.action.c_str(), r.elements, r.failure.c_str());
+        continue;
+      }
       std::fprintf(stderr,
                    "homesh: repair %zu: %zu invalid, %zu undecided -> %s %zu elements -> %zu "
                    "invalid, %zu undecided (%zu elements, %zu reused)%s\n",

@@ -90,8 +90,11 @@ using Tri = std::array<std::int64_t, 3>;
 using Vec = Eigen::Vector3d;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-constexpr int kNormalSmoothing = 10;      // relaxation passes of the growth directions
-constexpr double kVisibility = 0.2;       // a direction must see every facet around it this much
+constexpr int kNormalSmoothing = 10;  // relaxation passes of the growth directions
+constexpr double kVisibility = 0.2;   // a direction must see every facet around it this much
+// A layer face and a face without a layer whose CAD normals at a common node are within 6
+// degrees (|cos| above this) meet tangentially: the layer cannot climb the other face there.
+constexpr double kTangentFaces = 0.9945;
 constexpr int kMaxShrinkPasses = 40;      // 0.7^40 ~ 6e-7: a layer that thin is no layer
 constexpr double kShrinkStep = 0.7;       // height factor of a node flagged in a pass
 constexpr double kGrading = 1.25;         // neighbouring heights differ at most by this ratio
@@ -447,11 +450,23 @@ class LayerGrower {
         sum -= angle * facetNormal(t);
       }
       w.d = constrain(w, sum);
-      if (w.d.isZero())
-        throw MeshingError("no boundary layer can grow at " + where(w) + " on Face" +
-                           std::to_string(w.face) + ": the layer face is tangent to Face" +
-                           std::to_string(w.sideFaces.empty() ? 0 : w.sideFaces[0]) +
-                           ", which has no layer");
+      // Kept on a face without a layer that continues the layer face smoothly (a fillet's
+      // neighbour), the direction runs along the wall: no height makes such prisms valid.
+      bool tangent = w.d.isZero();
+      const Vec x = at(out_, w.id);
+      for (const int s : w.sideFaces)
+        tangent = tangent || std::fabs(faceNormal(w.face, x).dot(faceNormal(s, x))) > kTangentFaces;
+      if (tangent) {
+        std::string faces;
+        for (const int f : w.sideFaces)
+          faces.append(faces.empty() ? "Face" : " and Face").append(std::to_string(f));
+        throw MeshingError(
+            "no boundary layer can grow at " + where(w) + " on Face" + std::to_string(w.face) +
+            ": it meets " + faces +
+            (w.sideFaces.size() == 1 ? ", which has no layer," : ", which have no layer,") +
+            " (nearly) tangentially; put the layer on " +
+            (w.sideFaces.size() == 1 ? "that face" : "those faces") + " too");
+      }
     }
     // Relax: each direction towards the mean of its neighbours', kept where every facet around
     // still sees it.

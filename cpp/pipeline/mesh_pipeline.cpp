@@ -428,7 +428,17 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       refined.sizeField = cappedSizeField(refined.sizeField, sources);
       for (const RefinementSource& src : sources)
         refined.minSize = std::min(refined.minSize, src.delta);
-      next = makeLinear(refined, false);
+      try {
+        next = makeLinear(refined, false);
+      } catch (const MeshingError& e) {
+        // The refined mesh (or its layer) could not be made: the rounds end, the best stays.
+        record.failure = e.what();
+        record.seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        result.rounds.push_back(record);
+        clock.done();
+        break;
+      }
     }
     CurvedState state =
         curve(std::move(next), options, *result.cad, result.timings, observer, false, &from);

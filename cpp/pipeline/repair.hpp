@@ -40,6 +40,7 @@ struct RepairRound {
   std::size_t reused = 0;  // of those, elements whose curved nodes came from the round before
   bool kept = false;       // the round's mesh is no worse than the best before it and was kept
   double seconds = 0.0;
+  std::string failure;  // why the round's mesh could not be made (the rounds then stop)
 };
 
 struct CurvedFaceEdge {

@@ -332,6 +332,7 @@ void appendRepairRounds(JsonWriter& json, const std::vector<RepairRound>& rounds
     json.value("mesh_elements", r.meshElements);
     json.value("reused_elements", r.reused);
     json.value("kept", r.kept);
+    if (!r.failure.empty()) json.value("failure", r.failure);
     json.value("seconds", r.seconds);
     json.endObject();
   }

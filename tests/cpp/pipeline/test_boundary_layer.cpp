@@ -152,6 +152,26 @@ TEST(BoundaryLayer, MissingFacesAndBadThicknessesAreNamed) {
   }
 }
 
+// The bracket's hole (Face3) runs into Face1 tangentially: no height of prism is valid there,
+// and the message says which face should carry the layer too.
+TEST(BoundaryLayer, ATangentNeighbourWithoutALayerIsNamed) {
+  MeshingOptions options;  // automatic sizing, as `homesh mesh` without sizes
+  options.order = 1;
+  BoundaryLayerParameters p;
+  p.faces = {3, 6};
+  p.thickness = "0.5";
+  options.boundaryLayer = p;
+  try {
+    runMeshPipeline(CadSource::file(std::string(HOMESH_SOURCE_DIR) + "/examples/bracket.step"),
+                    options);
+    ADD_FAILURE();
+  } catch (const MeshingError& e) {
+    EXPECT_NE(std::string(e.what()).find("meets Face1, which has no layer, (nearly) tangentially"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // NekMesh's 3d_bl_cyl case: a cylinder (faces 1 and 8) in a box, thickness 0.04, 6 layers,
 // progression 1.5, at order 2 with the optimiser (as README's example runs it).
 class CylinderCase : public ::testing::Test {
