@@ -56,16 +56,16 @@ class LayerSplitter {
 
   Mesh run() {
     for (const ElementBlock& b : macro_.blocks)
-      if (b.type == CellType::Prism) pairWallAndTop(b);
+      if (layerCell(b)) pairWallAndTop(b);
     for (const ElementBlock& b : macro_.blocks) {
-      if (b.type == CellType::Prism)
-        out_.blocks.push_back(splitPrisms(b));
+      if (layerCell(b))
+        out_.blocks.push_back(splitCells(b));
       else if (b.type != CellType::Quadrilateral && b.type != CellType::Line)
         out_.blocks.push_back(b);
     }
     // Faces, then curves: a node on both ends on its curve.
     for (const ElementBlock& b : macro_.blocks)
-      if (b.type == CellType::Quadrilateral) out_.blocks.push_back(splitSides(b));
+      if (b.type == CellType::Quadrilateral && !layerCell(b)) out_.blocks.push_back(splitSides(b));
     for (const ElementBlock& b : macro_.blocks)
       if (b.type == CellType::Line) out_.blocks.push_back(splitSides(b));
     compactNodes(out_);
@@ -85,18 +85,28 @@ class LayerSplitter {
   std::map<std::int64_t, double> height_;  // wall vertex -> macro layer height there
   std::vector<char> projected_;
 
+  // The macro layer's cells: prisms in 3D (wall 0, 1, 2; tops 3, 4, 5), quadrilaterals in 2D
+  // (wall 0, 1; tops 3 above 0 and 2 above 1).
+  bool layerCell(const ElementBlock& b) const {
+    return (b.type == CellType::Prism && macro_.dim == 3) ||
+           (b.type == CellType::Quadrilateral && macro_.dim == 2);
+  }
+  static int wallVertices(const ElementBlock& b) { return b.type == CellType::Prism ? 3 : 2; }
+  static std::int64_t topVertex(const ElementBlock& b, const std::int64_t* v, int k) {
+    return b.type == CellType::Prism ? v[k + 3] : v[3 - k];
+  }
+
   void pairWallAndTop(const ElementBlock& b) {
     for (std::size_t e = 0; e < b.count(); ++e) {
       const std::int64_t* v = b.element(e);
-      for (int k = 0; k < 3; ++k) {
-        const auto [it, fresh] = topOf_.emplace(v[k], v[k + 3]);
-        if (!fresh && it->second != v[k + 3])
+      for (int k = 0; k < wallVertices(b); ++k) {
+        const std::int64_t top = topVertex(b, v, k);
+        const auto [it, fresh] = topOf_.emplace(v[k], top);
+        if (!fresh && it->second != top)
           throw MeshingError("boundary-layer split: wall node " + std::to_string(v[k]) +
                              " has two top nodes");
-        const double h =
-            (Eigen::Vector3d(&macro_.xyz[3 * v[k + 3]]) - Eigen::Vector3d(&macro_.xyz[3 * v[k]]))
-                .norm();
-        height_[v[k]] = h;
+        height_[v[k]] =
+            (Eigen::Vector3d(&macro_.xyz[3 * top]) - Eigen::Vector3d(&macro_.xyz[3 * v[k]])).norm();
       }
     }
   }
@@ -106,22 +116,27 @@ class LayerSplitter {
     return z_[kk] + (z_[kk + 1] - z_[kk]) * a / p_;
   }
 
-  ElementBlock splitPrisms(const ElementBlock& b) {
-    const ReferenceElement& ref = ReferenceElement::get(CellType::Prism, p_);
+  ElementBlock splitCells(const ElementBlock& b) {
+    const bool prism = b.type == CellType::Prism;
+    const ReferenceElement& ref = ReferenceElement::get(b.type, p_);
     const std::map<LatticePoint, int> index = latticeIndex(ref);
     const int nn = ref.numNodes();
+    const int dim = ref.dim();
+    const auto across = static_cast<std::size_t>(dim - 1);  // the lattice axis across the layer
     ElementBlock out;
-    out.type = CellType::Prism;
+    out.type = b.type;
     out.order = p_;
     out.nodes.resize(b.count() * static_cast<std::size_t>(n_) * static_cast<std::size_t>(nn));
     out.entity.resize(b.count() * static_cast<std::size_t>(n_));
     Eigen::MatrixXd x(nn, 3);
     for (int k = 0; k < n_; ++k) {
-      // Basis of the macro prism at the k-th thin prism's nodes.
-      Eigen::MatrixXd points(nn, 3);
+      // Basis of the macro cell at the k-th thin cell's nodes.
+      Eigen::MatrixXd points(nn, dim);
       for (int r = 0; r < nn; ++r) {
         const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
-        points.row(r) << double(c[0]) / p_, double(c[1]) / p_, zAt(k, c[2]);
+        for (std::size_t a = 0; a < across; ++a)
+          points(r, static_cast<Eigen::Index>(a)) = double(c[a]) / p_;
+        points(r, static_cast<Eigen::Index>(across)) = zAt(k, c[across]);
       }
       const Eigen::MatrixXd values = ref.valuesAt(points);
       for (std::size_t e = 0; e < b.count(); ++e) {
@@ -131,12 +146,15 @@ class LayerSplitter {
         out.entity[sub] = b.entity[e];
         for (int r = 0; r < nn; ++r) {
           const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
-          const std::int64_t level = std::int64_t(k) * p_ + c[2];
+          const std::int64_t level = std::int64_t(k) * p_ + c[across];
           const NodeKey key =
-              makeKey({{{v[0], p_ - c[0] - c[1]}, {v[1], c[0]}, {v[2], c[1]}}}, level);
+              prism ? makeKey({{{v[0], p_ - c[0] - c[1]}, {v[1], c[0]}, {v[2], c[1]}}}, level)
+                    : makeKey({{{v[0], p_ - c[0]}, {v[1], c[0]}, {kNone, 0}}}, level);
           std::int64_t id = 0;
           if (level == 0 || level == std::int64_t(n_) * p_) {
-            id = v[index.at({c[0], c[1], level == 0 ? 0 : p_})];
+            LatticePoint m = c;
+            m[across] = level == 0 ? 0 : p_;
+            id = v[index.at(m)];
             nodes_.emplace(key, id);
           } else {
             const auto it = nodes_.find(key);
@@ -150,7 +168,7 @@ class LayerSplitter {
               }
               const Eigen::RowVector3d p = values.row(r) * x;
               const double xyz[3] = {p(0), p(1), p(2)};
-              id = out_.addNode(xyz, 3, b.entity[e], std::nan(""), std::nan(""));
+              id = out_.addNode(xyz, macro_.dim, b.entity[e], std::nan(""), std::nan(""));
               nodes_.emplace(key, id);
             }
           }
@@ -158,7 +176,7 @@ class LayerSplitter {
         }
       }
     }
-    stats_.prisms += b.count();
+    stats_.prisms += b.count();  // (quadrilaterals in 2D)
     return out;
   }
 
@@ -279,10 +297,36 @@ class LayerSplitter {
 
 }  // namespace
 
+namespace {
+
+// The unit normal of a layer cell's curved wall (a prism's triangle at zeta 0; in 2D a
+// quadrilateral's edge, in the plane) at wall coordinates (a, b), on the side of `towards`.
+Eigen::Vector3d wallNormal(const Mesh& mesh, const ReferenceElement& ref, const std::int64_t* v,
+                           double a, double b, const Eigen::Vector3d& towards) {
+  const bool prism = ref.type() == CellType::Prism;
+  const double xi[3] = {a, prism ? b : 0.0, 0.0};
+  Eigen::VectorXd values;
+  Eigen::MatrixXd gradients;
+  ref.evaluate(xi, values, gradients);
+  Eigen::Vector3d du = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
+  for (int i = 0; i < ref.numNodes(); ++i) {
+    const Eigen::Vector3d x(&mesh.xyz[3 * static_cast<std::size_t>(v[i])]);
+    du += gradients(i, 0) * x;
+    if (prism) dv += gradients(i, 1) * x;
+  }
+  const Eigen::Vector3d plane(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
+  Eigen::Vector3d n = prism ? du.cross(dv) : plane.cross(du);
+  if (!(n.norm() > 0.0)) return Eigen::Vector3d::Zero();
+  n.normalize();
+  return n.dot(towards) < 0.0 ? Eigen::Vector3d(-n) : n;
+}
+
+}  // namespace
+
 void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops) {
   std::vector<char> done(mesh.numNodes(), 0);
   const auto setOnCad = [&](std::size_t id, const Eigen::Vector3d& x) {
-    if (mesh.nodeCadDim[id] == 2 && cad != nullptr) {
+    if (mesh.dim == 3 && mesh.nodeCadDim[id] == 2 && cad != nullptr) {
       std::optional<std::array<double, 2>> guess;
       if (std::isfinite(mesh.nodeCadParam[2 * id]) && std::isfinite(mesh.nodeCadParam[2 * id + 1]))
         guess = std::array<double, 2>{mesh.nodeCadParam[2 * id], mesh.nodeCadParam[2 * id + 1]};
@@ -295,58 +339,70 @@ void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops) {
     }
     for (std::size_t d = 0; d < 3; ++d) mesh.xyz[3 * id + d] = x(static_cast<Eigen::Index>(d));
   };
-  // Nodes this pass may place: inside the solid, or on a face (projected back onto it).
+  // Nodes this may place: inside the domain, or (3D, with the CAD) on a face, projected back.
   const auto movable = [&](std::size_t id) {
-    return mesh.nodeCadDim[id] == 3 || (mesh.nodeCadDim[id] == 2 && cad != nullptr);
+    return mesh.nodeCadDim[id] == mesh.dim ||
+           (mesh.dim == 3 && mesh.nodeCadDim[id] == 2 && cad != nullptr);
   };
-  Eigen::VectorXd values;
-  Eigen::MatrixXd gradients;
   for (int pass = tops ? 0 : 1; pass < 2; ++pass)  // tops first: the inner levels blend to them
     for (const ElementBlock& b : mesh.blocks) {
-      if (b.type != CellType::Prism || b.order < 2) continue;
+      // The layer's cells: prisms (wall 0, 1, 2, tops 3, 4, 5), in 2D quadrilaterals (wall 0,
+      // 1, tops 3, 2); the lattice axis across the layer is the last.
+      const bool prism = b.type == CellType::Prism && mesh.dim == 3;
+      const bool quad = b.type == CellType::Quadrilateral && mesh.dim == 2;
+      if ((!prism && !quad) || b.order < 2) continue;
       const int p = b.order;
-      const ReferenceElement& ref = ReferenceElement::get(CellType::Prism, p);
+      const int walls = prism ? 3 : 2;
+      const std::size_t across = prism ? 2 : 1;
+      const ReferenceElement& ref = ReferenceElement::get(b.type, p);
       const std::map<LatticePoint, int> index = latticeIndex(ref);
       for (std::size_t e = 0; e < b.count(); ++e) {
         const std::int64_t* v = b.element(e);
         const auto x = [&](std::int64_t n) {
           return Eigen::Vector3d(&mesh.xyz[3 * static_cast<std::size_t>(n)]);
         };
+        const auto top = [&](int k) { return prism ? v[k + 3] : v[3 - k]; };
         for (int r = 0; r < ref.numNodes(); ++r) {
           const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
           const auto id = static_cast<std::size_t>(v[r]);
           const bool vertex =
-              (c[0] == 0 || c[0] == p) && (c[1] == 0 || c[1] == p) && c[0] + c[1] <= p;
-          if (c[2] == 0 || !movable(id) || done[id] != 0 || (pass == 0) != (c[2] == p)) continue;
+              prism ? (c[0] == 0 || c[0] == p) && (c[1] == 0 || c[1] == p) && c[0] + c[1] <= p
+                    : c[0] == 0 || c[0] == p;
+          if (c[across] == 0 || !movable(id) || done[id] != 0 || (pass == 0) != (c[across] == p))
+            continue;
           if (pass == 0 && vertex) continue;
           done[id] = 1;
-          const std::int64_t w = v[index.at({c[0], c[1], 0})];
+          LatticePoint wallPoint = c;
+          wallPoint[across] = 0;
+          const std::int64_t w = v[index.at(wallPoint)];
           if (pass == 0) {
-            // The top is the wall offset along the wall's own normal by the height interpolated
-            // from the vertices: parallel to the curved wall at every node.
-            const double xi[3] = {double(c[0]) / p, double(c[1]) / p, 0.0};
-            ref.evaluate(xi, values, gradients);
-            Eigen::Vector3d du = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
-            for (int i = 0; i < ref.numNodes(); ++i) {
-              du += gradients(i, 0) * x(v[i]);
-              dv += gradients(i, 1) * x(v[i]);
-            }
-            const double l[3] = {double(p - c[0] - c[1]) / p, double(c[0]) / p, double(c[1]) / p};
+            // The top is the wall node offset along the wall's own normal there, corrected by
+            // the vertices' deviations of their climbs from the wall normal (interpolated), by
+            // the interpolated height: parallel to the curved wall, meeting the top vertices.
+            const double l[3] = {prism ? double(p - c[0] - c[1]) / p : double(p - c[0]) / p,
+                                 double(c[0]) / p, prism ? double(c[1]) / p : 0.0};
+            const double corner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
             Eigen::Vector3d rise = Eigen::Vector3d::Zero();
             double h = 0.0;
-            for (int k = 0; k < 3; ++k) {
-              rise += l[k] * (x(v[k + 3]) - x(v[k]));
-              h += l[k] * (x(v[k + 3]) - x(v[k])).norm();
+            for (int k = 0; k < walls; ++k) {
+              rise += l[k] * (x(top(k)) - x(v[k]));
+              h += l[k] * (x(top(k)) - x(v[k])).norm();
             }
-            Eigen::Vector3d n = du.cross(dv);
-            if (!(n.norm() > 0.0)) continue;
-            n.normalize();
-            if (n.dot(rise) < 0.0) n = -n;
-            setOnCad(id, x(w) + h * n);
+            Eigen::Vector3d direction =
+                wallNormal(mesh, ref, v, double(c[0]) / p, prism ? double(c[1]) / p : 0.0, rise);
+            for (int k = 0; k < walls; ++k) {
+              const Eigen::Vector3d climb = x(top(k)) - x(v[k]);
+              direction += l[k] * (climb.normalized() -
+                                   wallNormal(mesh, ref, v, corner[k][0], corner[k][1], climb));
+            }
+            if (!(direction.norm() > 0.0)) continue;
+            setOnCad(id, x(w) + h * direction.normalized());
             continue;
           }
-          const std::int64_t t = v[index.at({c[0], c[1], p})];
-          const double s = double(c[2]) / p;
+          LatticePoint topPoint = c;
+          topPoint[across] = p;
+          const std::int64_t t = v[index.at(topPoint)];
+          const double s = double(c[across]) / p;
           setOnCad(id, (1.0 - s) * x(w) + s * x(t));
         }
       }

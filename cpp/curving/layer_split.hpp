@@ -25,15 +25,16 @@ struct LayerSplitStats {
   double maxProjection = 0.0;  // largest move onto the CAD, relative to the layer's height
 };
 
-// Shapes a freshly elevated macro layer after its curved wall: each high-order node of a prism's
-// top (but its vertices) goes to the wall's node below it offset along the wall's normal there
-// by the height interpolated from the vertices (the top runs parallel to the wall), then the
-// nodes between wall and top go to the blend (1 - t) W + t T at the same (xi, eta), t the
-// node's level, so each prism's first split layer has its share of the height everywhere.
-// Nodes on a CAD face (the layer's sides) are projected back onto it (with `cad`; without, they
-// stay); nodes on CAD curves stay. With `tops` false, only the inner nodes are placed (after
-// the optimiser has moved the tops). Straight-sided tops and inner nodes fold the layer where the
-// wall bulges by a large share of its height (a coarse wall around a cylinder).
+// Shapes a freshly elevated macro layer after its curved wall: each high-order node of a cell's
+// top (but its vertices) goes to the wall's node below it, offset by the height and direction
+// interpolated from the vertices' climbs (the top runs parallel to the wall and meets the top
+// vertices), then the nodes between wall and top go to the blend (1 - t) W + t T at the same
+// wall position, t the node's level, so each cell's first split layer has its share of the
+// height everywhere. Cells: prisms (3D), quadrilaterals (2D). Nodes on a CAD face (the layer's
+// sides in 3D) are projected back onto it (with `cad`; without, they stay); nodes on CAD curves
+// stay. With `tops` false, only the inner nodes are placed (after the optimiser has moved the
+// tops). Straight-sided tops and inner nodes fold the layer where the wall bulges by a large
+// share of its height (a coarse wall around a cylinder).
 void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops = true);
 
 // `z`: the split coordinates (BoundaryLayerParameters::splitCoordinates). `cad` may be null

@@ -736,13 +736,380 @@ class LayerGrower {
         lines.nodes.push_back(topId[i]);
         lines.entity.push_back(wall_[i].curve);
       }
-    record_.prisms = prisms.count();
+    record_.cells = prisms.count();
     record_.sideQuadrilaterals = quads.count();
 
     ElementBlock tets = fillTetrahedra(out_, closure, fill, solid_);
     out_.blocks = {std::move(tets), std::move(prisms), std::move(tris)};
     if (quads.count() > 0) out_.blocks.push_back(std::move(quads));
     out_.blocks.push_back(std::move(lines));
+    out_.checkConsistency();
+    return std::move(out_);
+  }
+};
+
+// The 2D layer: quadrilaterals grown from chosen CAD curves of a planar triangle mesh, the
+// rest refilled with triangles. The same steps as in 3D, one dimension down: a wall node on a
+// curve without a layer climbs it, and the climb becomes a line of that curve.
+class LayerGrower2D {
+ public:
+  LayerGrower2D(const Mesh& planar, const CadModel& cad, const BoundaryLayerParameters& p,
+                BoundaryLayerRecord& record)
+      : cad_(cad),
+        p_(p),
+        record_(record),
+        thickness_(Expression::parse(p.thickness, "boundary-layer thickness")),
+        normal_(planar.planeNormal[0], planar.planeNormal[1], planar.planeNormal[2]) {
+    extract(planar);
+  }
+
+  Mesh run(const LinearMeshOptions& fill) {
+    directions();
+    shrink();
+    return assemble(fill);
+  }
+
+ private:
+  struct WallNode {
+    std::int64_t id = 0;
+    int curve = 0;      // a layer curve through the node (for the report)
+    int sideCurve = 0;  // the curve without a layer it climbs (0: none)
+    Vec d = Vec::Zero();
+    double full = 0.0, factor = 1.0;
+    Vec top = Vec::Zero();
+    double t = kNaN;  // the top's parameter on sideCurve
+    std::vector<std::size_t> neighbours;
+    std::vector<Vec> inward;  // inward unit normals of its wall segments
+  };
+  using Seg = std::array<std::int64_t, 2>;
+
+  const CadModel& cad_;
+  const BoundaryLayerParameters& p_;
+  BoundaryLayerRecord& record_;
+  Expression thickness_;
+  Vec normal_;
+  Mesh out_;
+  int face_ = 1;
+  std::vector<Seg> wallSegs_, sideSegs_;
+  std::vector<int> wallCurve_, sideCurve_;
+  std::vector<WallNode> wall_;
+  std::map<std::int64_t, std::size_t> wallIndex_;
+
+  std::string where(const WallNode& w) const {
+    const Vec x = at(out_, w.id);
+    std::ostringstream s;
+    s.precision(6);
+    s << "(" << x.x() << ", " << x.y() << ", " << x.z() << ")";
+    return s.str();
+  }
+
+  void extract(const Mesh& planar) {
+    std::set<int> faces;
+    for (const ElementBlock& b : planar.blocks)
+      if (b.type == CellType::Triangle) faces.insert(b.entity.begin(), b.entity.end());
+    if (faces.size() != 1)
+      throw ParameterError("2D boundary layers need a model with one face; " + cad_.sourceName() +
+                           " has " + std::to_string(faces.size()));
+    face_ = *faces.begin();
+    const int ne = cad_.numEdges();
+    std::set<int> layer;
+    for (const int f : p_.faces) {
+      if (f > ne)
+        throw ParameterError("boundary-layer curve " + std::to_string(f) +
+                             " does not exist: " + cad_.sourceName() + " has " +
+                             std::to_string(ne) + " edges (a 2D layer grows from curves, EdgeN)");
+      layer.insert(f);
+    }
+    // Each boundary segment's inward side: the third vertex of its triangle.
+    std::map<Seg, std::int64_t> opposite;
+    for (const ElementBlock& b : planar.blocks)
+      if (b.type == CellType::Triangle)
+        for (std::size_t e = 0; e < b.count(); ++e) {
+          const std::int64_t* t = b.element(e);
+          for (int k = 0; k < 3; ++k) {
+            Seg s{t[k], t[(k + 1) % 3]};
+            std::sort(s.begin(), s.end());
+            opposite[s] = t[(k + 2) % 3];
+          }
+        }
+    std::vector<std::int64_t> newId(planar.numNodes(), -1);
+    out_.dim = 2;
+    out_.order = 1;
+    out_.planeNormal = planar.planeNormal;
+    for (std::size_t i = 0; i < planar.numNodes(); ++i)
+      if (planar.nodeCadDim[i] < 2)
+        newId[i] = out_.addNode(&planar.xyz[3 * i], planar.nodeCadDim[i], planar.nodeCadIndex[i],
+                                planar.nodeCadParam[2 * i], planar.nodeCadParam[2 * i + 1]);
+    std::set<int> seen;
+    std::vector<Vec> inward;
+    for (const ElementBlock& b : planar.blocks) {
+      if (b.type != CellType::Line) continue;
+      for (std::size_t e = 0; e < b.count(); ++e) {
+        const std::int64_t* l = b.element(e);
+        const Seg s{newId[static_cast<std::size_t>(l[0])], newId[static_cast<std::size_t>(l[1])]};
+        if (s[0] < 0 || s[1] < 0) throw MeshingError("a boundary line uses a node inside the face");
+        if (layer.count(b.entity[e]) == 0) {
+          sideSegs_.push_back(s);
+          sideCurve_.push_back(b.entity[e]);
+          continue;
+        }
+        Seg key{l[0], l[1]};
+        std::sort(key.begin(), key.end());
+        const auto it = opposite.find(key);
+        if (it == opposite.end()) throw MeshingError("a boundary line has no triangle");
+        const Vec a = at(planar, l[0]), t = at(planar, l[1]) - a;
+        Vec n = normal_.cross(t).normalized();
+        if (n.dot(at(planar, it->second) - a) < 0.0) n = -n;
+        wallSegs_.push_back(s);
+        wallCurve_.push_back(b.entity[e]);
+        inward.push_back(n);
+        seen.insert(b.entity[e]);
+      }
+    }
+    for (const int f : layer)
+      if (seen.count(f) == 0)
+        throw ParameterError("boundary-layer curve " + std::to_string(f) + " of " +
+                             cad_.sourceName() + " has no boundary lines (not on the face?)");
+    for (std::size_t s = 0; s < wallSegs_.size(); ++s)
+      for (const std::int64_t v : wallSegs_[s]) {
+        const auto [it, fresh] = wallIndex_.emplace(v, wall_.size());
+        if (fresh) {
+          WallNode w;
+          w.id = v;
+          w.curve = wallCurve_[s];
+          wall_.push_back(w);
+        }
+        wall_[it->second].inward.push_back(inward[s]);
+      }
+    for (const Seg& s : wallSegs_) {
+      wall_[wallIndex_.at(s[0])].neighbours.push_back(wallIndex_.at(s[1]));
+      wall_[wallIndex_.at(s[1])].neighbours.push_back(wallIndex_.at(s[0]));
+    }
+    for (std::size_t s = 0; s < sideSegs_.size(); ++s)
+      for (int k = 0; k < 2; ++k) {
+        const auto it = wallIndex_.find(sideSegs_[s][static_cast<std::size_t>(k)]);
+        if (it == wallIndex_.end()) continue;
+        WallNode& w = wall_[it->second];
+        if (w.sideCurve != 0 && w.sideCurve != sideCurve_[s])
+          throw MeshingError("no boundary layer can grow at " + where(w) + ": Edge" +
+                             std::to_string(w.sideCurve) + " and Edge" +
+                             std::to_string(sideCurve_[s]) + ", which have no layer, meet there");
+        w.sideCurve = sideCurve_[s];
+        // The climb's direction: along the side segment, away from the node.
+        w.d =
+            (at(out_, sideSegs_[s][static_cast<std::size_t>(1 - k)]) - at(out_, w.id)).normalized();
+      }
+  }
+
+  double visibility(const WallNode& w, const Vec& d) const {
+    double worst = 1.0;
+    for (const Vec& n : w.inward) worst = std::min(worst, n.dot(d));
+    return worst;
+  }
+
+  void directions() {
+    for (WallNode& w : wall_) {
+      if (w.sideCurve != 0) {
+        if (visibility(w, w.d) < 1.0 - kTangentFaces)
+          throw MeshingError("no boundary layer can grow at " + where(w) + " on Edge" +
+                             std::to_string(w.curve) + ": it meets Edge" +
+                             std::to_string(w.sideCurve) +
+                             ", which has no layer, (nearly) tangentially; put the layer on "
+                             "that curve too");
+        continue;
+      }
+      Vec sum = Vec::Zero();
+      for (const Vec& n : w.inward) sum += n;
+      w.d = sum.normalized();
+    }
+    for (int pass = 0; pass < kNormalSmoothing; ++pass) {
+      std::vector<Vec> next(wall_.size());
+      for (std::size_t i = 0; i < wall_.size(); ++i) {
+        const WallNode& w = wall_[i];
+        Vec sum = w.d;
+        for (const std::size_t n : w.neighbours) sum += wall_[n].d;
+        const Vec d = sum.normalized();
+        next[i] = w.sideCurve == 0 && visibility(w, d) >= std::min(kVisibility, visibility(w, w.d))
+                      ? d
+                      : w.d;
+      }
+      for (std::size_t i = 0; i < wall_.size(); ++i) wall_[i].d = next[i];
+    }
+    for (WallNode& w : wall_) {
+      const Vec x = at(out_, w.id);
+      w.full = thickness_(x.x(), x.y(), x.z());
+      if (!(w.full > 0.0) || !std::isfinite(w.full))
+        throw ParameterError("boundary-layer thickness '" + p_.thickness + "' is " +
+                             formatNumber(w.full) + " at " + where(w) + " on Edge" +
+                             std::to_string(w.curve) +
+                             ": it must be positive on every layer curve");
+    }
+  }
+
+  void place(WallNode& w) const {
+    const Vec target = at(out_, w.id) + w.factor * w.full * w.d;
+    if (w.sideCurve == 0) {
+      w.top = target;
+      return;
+    }
+    const CurveProjection proj = cad_.projectOnCurve(w.sideCurve, target);
+    w.top = proj.point;
+    w.t = proj.t;
+  }
+
+  // Corner Jacobians of the quadrilateral (a, b, B, A) in the plane, scaled, smallest.
+  double quadCorners(const Vec& a, const Vec& b, const Vec& tb, const Vec& ta) const {
+    const std::array<Vec, 4> v{a, b, tb, ta};
+    double worst = 1.0;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Vec e1 = v[(k + 1) % 4] - v[k], e2 = v[(k + 3) % 4] - v[k];
+      const double scale = e1.norm() * e2.norm();
+      worst = std::min(worst, scale > 0.0 ? e1.cross(e2).dot(normal_) / scale : -1.0);
+    }
+    return worst;
+  }
+
+  std::map<std::size_t, std::string> offenders() const {
+    std::map<std::size_t, std::string> bad;
+    for (const Seg& s : wallSegs_) {
+      const std::size_t i = wallIndex_.at(s[0]), j = wallIndex_.at(s[1]);
+      const Vec a = at(out_, s[0]), b = at(out_, s[1]);
+      double q = quadCorners(a, b, wall_[j].top, wall_[i].top);
+      q = std::max(q, quadCorners(b, a, wall_[i].top, wall_[j].top));  // either orientation
+      if (q < kMinPrismCorner)
+        for (const std::size_t n : {i, j}) bad.emplace(n, "a quadrilateral folds");
+    }
+    for (std::size_t s = 0; s < sideSegs_.size(); ++s)
+      for (int k = 0; k < 2; ++k) {
+        const auto it = wallIndex_.find(sideSegs_[s][static_cast<std::size_t>(k)]);
+        if (it == wallIndex_.end() || wall_[it->second].sideCurve != sideCurve_[s]) continue;
+        const Vec v = at(out_, sideSegs_[s][static_cast<std::size_t>(k)]);
+        const Vec w = at(out_, sideSegs_[s][static_cast<std::size_t>(1 - k)]);
+        if ((w - wall_[it->second].top).dot(w - v) < 0.3 * (w - v).squaredNorm())
+          bad.emplace(it->second, "the layer reaches past the next node of Edge" +
+                                      std::to_string(sideCurve_[s]));
+      }
+    // The normal, extended, must not cross a boundary segment that is not around the node.
+    std::vector<Seg> all = wallSegs_;
+    all.insert(all.end(), sideSegs_.begin(), sideSegs_.end());
+    for (std::size_t i = 0; i < wall_.size(); ++i) {
+      const WallNode& w = wall_[i];
+      const Vec p = at(out_, w.id), q = p + kRayReach * (w.top - p);
+      for (std::size_t s = 0; s < all.size(); ++s) {
+        if (all[s][0] == w.id || all[s][1] == w.id) continue;
+        if (s >= wallSegs_.size() && sideCurve_[s - wallSegs_.size()] == w.sideCurve) continue;
+        const Vec a = at(out_, all[s][0]), b = at(out_, all[s][1]);
+        // p + u (q - p) = a + v (b - a), in the plane.
+        const Vec r = q - p, e = b - a;
+        const double den = r.cross(e).dot(normal_);
+        if (std::fabs(den) <= 1e-14 * r.norm() * e.norm()) continue;
+        const double u = (a - p).cross(e).dot(normal_) / den;
+        const double v = (a - p).cross(r).dot(normal_) / den;
+        if (u > 1e-9 && u < 1.0 && v >= 0.0 && v <= 1.0) {
+          bad.emplace(i,
+                      "the layer would reach Edge" +
+                          std::to_string(s < wallSegs_.size() ? wallCurve_[s]
+                                                              : sideCurve_[s - wallSegs_.size()]));
+          break;
+        }
+      }
+    }
+    return bad;
+  }
+
+  void shrink() {
+    for (WallNode& w : wall_) place(w);
+    for (int pass = 0;; ++pass) {
+      const std::map<std::size_t, std::string> bad = offenders();
+      if (bad.empty()) {
+        record_.shrinkPasses = pass;
+        return;
+      }
+      if (pass == kMaxShrinkPasses) {
+        const WallNode& w = wall_[bad.begin()->first];
+        throw MeshingError("the boundary layer on Edge" + std::to_string(w.curve) +
+                           " cannot be grown at " + where(w) + ": " + bad.begin()->second +
+                           " even at " + formatNumber(w.factor) + " of the thickness");
+      }
+      for (const auto& [i, why] : bad) wall_[i].factor *= kShrinkStep;
+      for (bool changed = true; changed;) {
+        changed = false;
+        for (WallNode& w : wall_)
+          for (const std::size_t n : w.neighbours) {
+            const double cap = kGrading * wall_[n].factor * wall_[n].full;
+            if (w.factor * w.full > cap * (1.0 + 1e-12)) {
+              w.factor = cap / w.full;
+              changed = true;
+            }
+          }
+      }
+      for (WallNode& w : wall_) place(w);
+    }
+  }
+
+  Mesh assemble(const LinearMeshOptions& fill) {
+    const std::vector<double> z = p_.splitCoordinates();
+    record_.parameters = p_;
+    record_.wallNodes = wall_.size();
+    record_.thicknessMin = std::numeric_limits<double>::infinity();
+    record_.thicknessMax = 0.0;
+    std::map<int, LayerShrink> shrunk;
+    std::vector<std::int64_t> topId(wall_.size());
+    for (std::size_t i = 0; i < wall_.size(); ++i) {
+      const WallNode& w = wall_[i];
+      const double h = (w.top - at(out_, w.id)).norm();
+      record_.thicknessMin = std::min(record_.thicknessMin, h);
+      record_.thicknessMax = std::max(record_.thicknessMax, h);
+      if (w.factor < 0.999) {
+        LayerShrink& s = shrunk[w.curve];
+        s.face = w.curve;
+        ++s.nodes;
+        if (s.nodes == 1 || w.factor < s.factor) {
+          s.factor = w.factor;
+          const Vec x = at(out_, w.id);
+          s.where = {x.x(), x.y(), x.z()};
+        }
+      }
+      const double xyz[3] = {w.top.x(), w.top.y(), w.top.z()};
+      topId[i] = w.sideCurve != 0 ? out_.addNode(xyz, 1, w.sideCurve, w.t, kNaN)
+                                  : out_.addNode(xyz, 2, face_, kNaN, kNaN);
+    }
+    record_.firstHeightMin = record_.thicknessMin * z[1];
+    record_.firstHeightMax = record_.thicknessMax * z[1];
+    for (auto& [curve, s] : shrunk) record_.shrunk.push_back(s);
+    const auto top = [&](std::int64_t v) {
+      const auto it = wallIndex_.find(v);
+      return it == wallIndex_.end() ? v : topId[it->second];
+    };
+    ElementBlock quads, lines;
+    quads.type = CellType::Quadrilateral;
+    lines.type = CellType::Line;
+    std::vector<std::array<std::int64_t, 2>> closure;
+    for (std::size_t s = 0; s < wallSegs_.size(); ++s) {
+      std::int64_t a = wallSegs_[s][0], b = wallSegs_[s][1];
+      // Counter-clockwise around the plane normal: wall a -> b, then the tops back.
+      const Vec e1 = at(out_, b) - at(out_, a), e2 = at(out_, top(a)) - at(out_, a);
+      if (e1.cross(e2).dot(normal_) < 0.0) std::swap(a, b);
+      for (const std::int64_t v : {a, b, top(b), top(a)}) quads.nodes.push_back(v);
+      quads.entity.push_back(face_);
+      closure.push_back({top(a), top(b)});
+      lines.nodes.insert(lines.nodes.end(), {wallSegs_[s][0], wallSegs_[s][1]});
+      lines.entity.push_back(wallCurve_[s]);
+    }
+    for (std::size_t s = 0; s < sideSegs_.size(); ++s) {
+      const std::array<std::int64_t, 2> moved{top(sideSegs_[s][0]), top(sideSegs_[s][1])};
+      closure.push_back(moved);
+      lines.nodes.insert(lines.nodes.end(), moved.begin(), moved.end());
+      lines.entity.push_back(sideCurve_[s]);
+    }
+    for (std::size_t i = 0; i < wall_.size(); ++i)
+      if (wall_[i].sideCurve != 0) {
+        lines.nodes.insert(lines.nodes.end(), {wall_[i].id, topId[i]});
+        lines.entity.push_back(wall_[i].sideCurve);
+      }
+    record_.cells = quads.count();
+    ElementBlock tris = fillTriangles(out_, closure, fill, face_);
+    out_.blocks = {std::move(tris), std::move(quads), std::move(lines)};
     out_.checkConsistency();
     return std::move(out_);
   }
@@ -756,7 +1123,8 @@ Mesh growBoundaryLayer(const Mesh& volume, const CadModel& cad,
   parameters.validate();
   const auto start = std::chrono::steady_clock::now();
   record = BoundaryLayerRecord();
-  Mesh mesh = LayerGrower(volume, cad, parameters, record).run(fill);
+  Mesh mesh = volume.dim == 2 ? LayerGrower2D(volume, cad, parameters, record).run(fill)
+                              : LayerGrower(volume, cad, parameters, record).run(fill);
   record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return mesh;
 }

@@ -61,7 +61,8 @@ struct BoundaryLayerRecord {
   double thicknessMin = 0, thicknessMax = 0;      // macro heights grown at the wall nodes
   double firstHeightMin = 0, firstHeightMax = 0;  // of the first (wall) split layer
   std::vector<LayerShrink> shrunk;
-  std::size_t prisms = 0, sideQuadrilaterals = 0, wallNodes = 0;
+  std::size_t cells = 0;  // macro cells: prisms (3D), quadrilaterals (2D)
+  std::size_t sideQuadrilaterals = 0, wallNodes = 0;
   int shrinkPasses = 0;
   // The optimiser keeps the macro layer as grown; true when elements stayed invalid and it was
   // let move around them (the first-layer height there is no longer the one asked for).

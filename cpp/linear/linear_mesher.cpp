@@ -340,4 +340,127 @@ ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_
   return tets;
 }
 
+ElementBlock fillTriangles(Mesh& mesh, const std::vector<std::array<std::int64_t, 2>>& boundary,
+                           const LinearMeshOptions& options, int face) {
+  // The segments as closed loops: every node on exactly two of them.
+  std::map<std::int64_t, std::vector<std::size_t>> at;
+  for (std::size_t s = 0; s < boundary.size(); ++s)
+    for (const std::int64_t v : boundary[s]) at[v].push_back(s);
+  for (const auto& [node, segments] : at)
+    if (segments.size() != 2)
+      throw MeshingError("the region inside the boundary layer is not closed: node " +
+                         std::to_string(node) + " ends " + std::to_string(segments.size()) +
+                         " boundary segments");
+  std::vector<std::vector<std::int64_t>> loops;
+  std::vector<char> used(boundary.size(), 0);
+  for (std::size_t first = 0; first < boundary.size(); ++first) {
+    if (used[first] != 0) continue;
+    std::vector<std::int64_t> loop{boundary[first][0]};
+    std::size_t s = first;
+    std::int64_t next = boundary[first][1];
+    used[first] = 1;
+    while (next != loop.front()) {
+      loop.push_back(next);
+      const std::vector<std::size_t>& two = at[next];
+      s = two[0] == s ? two[1] : two[0];
+      used[s] = 1;
+      next = boundary[s][0] == next ? boundary[s][1] : boundary[s][0];
+    }
+    loops.push_back(std::move(loop));
+  }
+  // The outer loop has the largest bounding box.
+  std::size_t outer = 0;
+  double largest = -1.0;
+  for (std::size_t l = 0; l < loops.size(); ++l) {
+    Eigen::Vector3d lo = point(mesh, loops[l][0]), hi = lo;
+    for (const std::int64_t v : loops[l]) {
+      lo = lo.cwiseMin(point(mesh, v));
+      hi = hi.cwiseMax(point(mesh, v));
+    }
+    if ((hi - lo).norm() > largest) {
+      largest = (hi - lo).norm();
+      outer = l;
+    }
+  }
+
+  ElementBlock tris;
+  tris.type = CellType::Triangle;
+  const double maxSize = options.sizeField ? options.maxSize : options.size;
+  GmshSession session(options.verbosity, 1);
+  withGmshErrors("filling the region inside the boundary layer", [&] {
+    gmsh::model::add("homesh-fill-2d");
+    std::map<std::array<double, 3>, std::int64_t> byPoint;
+    std::vector<int> curveLoops;
+    std::size_t tag = 1;
+    for (std::size_t l = 0; l < loops.size(); ++l) {
+      const int curve = static_cast<int>(l) + 1;
+      gmsh::model::addDiscreteEntity(1, curve);
+      std::vector<std::size_t> tags, lines;
+      std::vector<double> coords;
+      for (const std::int64_t v : loops[l]) {
+        tags.push_back(tag++);
+        const Eigen::Vector3d x = point(mesh, v);
+        coords.insert(coords.end(), {x.x(), x.y(), x.z()});
+        byPoint.emplace(std::array<double, 3>{x.x(), x.y(), x.z()}, v);
+      }
+      for (std::size_t k = 0; k < tags.size(); ++k)
+        lines.insert(lines.end(), {tags[k], tags[(k + 1) % tags.size()]});
+      gmsh::model::mesh::addNodes(1, curve, tags, coords);
+      gmsh::model::mesh::addElementsByType(curve, kGmshLine, {}, lines);
+      curveLoops.push_back(gmsh::model::geo::addCurveLoop({curve}));
+    }
+    std::vector<int> surfaceLoops{curveLoops[outer]};
+    for (std::size_t l = 0; l < curveLoops.size(); ++l)
+      if (l != outer) surfaceLoops.push_back(curveLoops[l]);
+    const int surface = gmsh::model::geo::addPlaneSurface(surfaceLoops);
+    gmsh::model::geo::synchronize();
+    gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
+    gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+    gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 1);
+    if (maxSize > 0.0) gmsh::option::setNumber("Mesh.MeshSizeMax", maxSize);
+    gmsh::option::setNumber("Mesh.ElementOrder", 1);
+    try {
+      gmsh::model::mesh::generate(2);
+    } catch (const std::string& message) {
+      throw MeshingError("Gmsh could not fill the region inside the boundary layer: " + message +
+                         " (the layer's top may cross itself or a wall)");
+    }
+    std::map<std::size_t, std::int64_t> fresh;
+    std::vector<std::size_t> nodeTags;
+    std::vector<double> nodeCoords, params;
+    for (std::size_t l = 0; l < loops.size(); ++l) {
+      gmsh::model::mesh::getNodes(nodeTags, nodeCoords, params, 1, static_cast<int>(l) + 1, true,
+                                  false);
+      for (std::size_t i = 0; i < nodeTags.size(); ++i) {
+        const auto it =
+            byPoint.find({nodeCoords[3 * i], nodeCoords[3 * i + 1], nodeCoords[3 * i + 2]});
+        if (it == byPoint.end())
+          throw MeshingError("Gmsh moved or added a node on the boundary inside the layer");
+        fresh[nodeTags[i]] = it->second;
+      }
+    }
+    gmsh::model::mesh::getNodes(nodeTags, nodeCoords, params, 2, surface, false, false);
+    for (std::size_t i = 0; i < nodeTags.size(); ++i)
+      fresh[nodeTags[i]] = mesh.addNode(&nodeCoords[3 * i], 2, face, kNaN, kNaN);
+    std::vector<int> types;
+    std::vector<std::vector<std::size_t>> elementTags, elementNodes;
+    gmsh::model::mesh::getElements(types, elementTags, elementNodes, 2, surface);
+    for (std::size_t k = 0; k < types.size(); ++k) {
+      if (types[k] != kGmshTriangle)
+        throw MeshingError("Gmsh filled the region with elements of type " +
+                           std::to_string(types[k]) + " where only triangles were expected");
+      for (const std::size_t t : elementNodes[k]) {
+        const auto it = fresh.find(t);
+        if (it == fresh.end())
+          throw MeshingError("Gmsh's fill refers to unknown node " + std::to_string(t));
+        tris.nodes.push_back(it->second);
+      }
+      tris.entity.insert(tris.entity.end(), elementNodes[k].size() / 3, face);
+    }
+  });
+  if (tris.count() == 0) throw MeshingError("Gmsh made no triangles inside the boundary layer");
+  orientPlanarMesh(mesh, tris);
+  return tris;
+}
+
 }  // namespace homesh

@@ -45,6 +45,14 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options);
 // positively oriented. Sizes grow from the boundary's edge lengths, at most options.maxSize (or
 // options.size). Throws MeshingError when Gmsh cannot fill the surface (it is not closed, or
 // intersects itself).
+// Triangles filling the planar region enclosed by `boundary`, closed loops of segments on
+// existing nodes of `mesh` (one outer loop, the others holes), which Gmsh keeps as they are. New
+// nodes are appended (CAD dimension 2, face `face`, no parameters); the triangles are oriented
+// counter-clockwise around mesh.planeNormal. Sizes as for fillTetrahedra. Throws MeshingError
+// when the segments do not form closed loops or Gmsh cannot fill them.
+ElementBlock fillTriangles(Mesh& mesh, const std::vector<std::array<std::int64_t, 2>>& boundary,
+                           const LinearMeshOptions& options, int face);
+
 ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_t, 3>>& boundary,
                             const LinearMeshOptions& options, int solid);
 

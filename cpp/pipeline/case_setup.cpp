@@ -61,11 +61,6 @@ CaseSetup setupCase(const std::string& input) {
   }
   if (mcf.hasBoundaryLayer()) {
     const std::string file = std::filesystem::path(input).filename().string();
-    if (mcf.is2D()) {
-      setup.notices.push_back(file + ": MeshType " + mcf.meshType +
-                              ": 2D boundary layers are not made yet; the mesh has none");
-      return setup;
-    }
     const auto& keys = mcf.boundaryLayer;
     BoundaryLayerParameters bl;
     bl.faces = parseIndexList(keys.at("BndLayerSurfaces"), input + ": BndLayerSurfaces");

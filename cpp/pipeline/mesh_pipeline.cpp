@@ -224,11 +224,13 @@ constexpr int kRepairRegionLayers = 4;
 // Poor elements below this certified scaled Jacobian join the region too.
 constexpr double kRepairRegionThreshold = 0.2;
 
-// The nodes of a macro boundary layer's prisms (empty when there are none).
+// The nodes of a macro boundary layer's prisms (2D: quadrilaterals; empty when there are none).
 std::vector<char> layerNodes(const Mesh& mesh) {
   std::vector<char> fixed;
   for (const ElementBlock& b : mesh.blocks) {
-    if (b.type != CellType::Prism) continue;
+    const bool cell = (b.type == CellType::Prism && mesh.dim == 3) ||
+                      (b.type == CellType::Quadrilateral && mesh.dim == 2);
+    if (!cell) continue;
     fixed.resize(mesh.numNodes(), 0);
     for (const std::int64_t id : b.nodes) fixed[static_cast<std::size_t>(id)] = 1;
   }

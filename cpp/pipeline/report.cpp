@@ -196,7 +196,7 @@ void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
     json.endObject();
   }
   json.endArray();
-  json.value("macro_prisms", r.prisms);
+  json.value("macro_cells", r.cells);
   json.value("side_quadrilaterals", r.sideQuadrilaterals);
   json.value("wall_nodes", r.wallNodes);
   json.value("shrink_passes", static_cast<std::size_t>(r.shrinkPasses));

@@ -98,13 +98,14 @@ class CommandSizing:
 
 
 def _selected_faces():
-    """(object, ["FaceN", ...]) when faces of one object are selected (and nothing else), else
-    None."""
+    """(object, ["FaceN", ...]) when faces of one object are selected (or edges, for a layer on
+    a planar shape; nothing else), else None."""
     selection = FreeCADGui.Selection.getSelectionEx()
     if len(selection) != 1:
         return None
     names = list(selection[0].SubElementNames)
-    if not names or not all(n.startswith("Face") for n in names):
+    if not names or not (all(n.startswith("Face") for n in names) or
+                         all(n.startswith("Edge") for n in names)):
         return None
     return selection[0].Object, names
 

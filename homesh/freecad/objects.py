@@ -348,7 +348,7 @@ class SizingProxy(_Proxy):
 def make_boundary_layer(doc, part, faces, thickness, layers=2, progression=2.0,
                         name="BoundaryLayer"):
     """Adds a BoundaryLayer object on ``faces`` of ``part`` (FreeCAD's numbers, 1 for Face1, or
-    names "Face1"): ``thickness`` a length in the model's units or an expression of x, y, z
+    names "Face1"; for a planar shape edges, named "Edge1"): ``thickness`` a length in the model's units or an expression of x, y, z
     (text), split into ``layers`` layers whose heights grow by ``progression`` from the wall.
     Link it from a HighOrderMesh's BoundaryLayer property. The caller recomputes.
     """
@@ -379,12 +379,18 @@ def boundary_layer_arguments(obj, part=None):
     if part is not None and owner != part:
         raise ValueError("%s: its faces belong to %s, but the mesh is of %s"
                          % (obj.Label, owner.Label, part.Label))
+    # Faces of a solid (3D), or edges of a planar shape (2D: the layer grows from curves).
+    kind = "Edge" if names and names[0].startswith("Edge") else "Face"
     faces = []
     for name in names:
-        if not name.startswith("Face") or not name[4:].isdigit():
-            raise ValueError("%s: Faces must name faces (Face1, Face2, ...), got %r"
+        if not name.startswith(kind) or not name[len(kind):].isdigit():
+            raise ValueError("%s: Faces must name faces (Face1, Face2, ...), or for a planar "
+                             "shape edges (Edge1, ...), all of one kind; got %r"
                              % (obj.Label, name))
-        faces.append(int(name[4:]))
+        faces.append(int(name[len(kind):]))
+    if kind == "Edge" and getattr(owner, "Shape", None) is not None and owner.Shape.Solids:
+        raise ValueError("%s: Faces must name faces of a solid (Face1, Face2, ...); edges carry "
+                         "a layer only on a planar shape, got %r" % (obj.Label, names[0]))
     if not faces:
         raise ValueError("%s: no faces (select faces of the shape and set Faces)" % obj.Label)
     text = obj.Thickness.strip()
@@ -412,7 +418,8 @@ class BoundaryLayerProxy(_Proxy):
         have = obj.PropertiesList
         if "Faces" not in have:
             obj.addProperty("App::PropertyLinkSub", "Faces", "Layer",
-                            "Faces of the meshed shape that carry the layer (select them)")
+                            "Faces of the meshed shape that carry the layer (select them); for "
+                            "a planar shape, its edges")
         if "Thickness" not in have:
             obj.addProperty("App::PropertyString", "Thickness", "Layer",
                             "Total thickness in the model's units, or an expression of x, y, z "

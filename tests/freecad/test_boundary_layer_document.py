@@ -48,7 +48,7 @@ class BoundaryLayerObject(unittest.TestCase):
         report = m.report()
         self.assertEqual(report["boundary_layer"]["faces"], [self.face])
         self.assertEqual(report["elements"]["prism"],
-                         3 * report["boundary_layer"]["macro_prisms"])
+                         3 * report["boundary_layer"]["macro_cells"])
         self.assertGreater(report["elements"]["prism"], 0)
         self.assertEqual(mesh.InvalidElements, 0)
         self.assertGreater(mesh.MinScaledJacobian, 0.0)

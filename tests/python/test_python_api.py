@@ -232,7 +232,7 @@ def test_boundary_layer_argument_and_mcf_keys():
     report = m.report()
     layer = report["boundary_layer"]
     assert layer["faces"] == [1, 8] and layer["layers"] == 3
-    assert report["elements"]["prism"] == 3 * layer["macro_prisms"] > 0
+    assert report["elements"]["prism"] == 3 * layer["macro_cells"] > 0
     # First layer: 40 (1 - 1.2) / (1 - 1.2^3), to rounding of a few ulps.
     assert layer["first_height"]["min"] == pytest.approx(40 * 0.2 / (1.2 ** 3 - 1), rel=1e-12)
     assert m.quality()["invalid_elements"] == 0

@@ -27,7 +27,12 @@ def _report(result):
     return report
 
 
-@pytest.mark.parametrize("case", ["3d_bl_cyl", "2d_bl_t106", "2d_bl_naca0012"])
+# Layers per case: BndLayerLayers where the .mcf gives it, else NekMesh's default 2.
+BL_CASES = {"3d_bl_cyl": ([1, 8], 6), "2d_bl_aerofoil": ([2, 4], 6), "2d_bl_t106": ([11, 12], 2),
+            "2d_bl_naca0012": ([5, 6], 2)}
+
+
+@pytest.mark.parametrize("case", ["3d_sphere"] + sorted(BL_CASES))
 def test_mcf_case_meshes_with_its_prediction(homesh_bin, tmp_path, case):
     msh = tmp_path / (case + ".msh")
     # No repair rounds: the element count is the linear mesher's, the one predicted.
@@ -40,20 +45,20 @@ def test_mcf_case_meshes_with_its_prediction(homesh_bin, tmp_path, case):
     mesh = meshio.read(msh)
     kind = "tetra10" if case.startswith("3d") else "triangle6"
     assert sum(len(b.data) for b in mesh.cells if b.type == kind) == cells
-    if case.startswith("3d"):
-        # The 3D layer is made: 6 layers of prisms (BndLayerLayers) over the macro layer, which
-        # takes the place of some of the predicted tetrahedra.
+    if case in BL_CASES:
+        # The layer is made (BndLayer* keys): its macro cells, each split into the layers asked
+        # for, in place of some of the predicted cells (so no count comparison here).
+        faces, layers = BL_CASES[case]
         layer = report["boundary_layer"]
-        assert layer["faces"] == [1, 8] and layer["layers"] == 6
-        assert report["elements"]["prism"] == 6 * layer["macro_prisms"] > 0
-        assert sum(len(b.data) for b in mesh.cells if b.type == "wedge18") == \
-            report["elements"]["prism"]
+        assert layer["faces"] == faces and layer["layers"] == layers
+        split, kind = ("prism", "wedge18") if case.startswith("3d") else ("quad", "quad9")
+        assert report["elements"][split] == layers * layer["macro_cells"] > 0
+        assert sum(len(b.data) for b in mesh.cells if b.type == kind) == report["elements"][split]
+        assert "not made yet" not in result.stderr
         return
     # The prediction's promised 10 %; measured 0.99 .. 1.055, moving by <= 2 % (3D) when the
     # CAD's last bits change (docs/testing.md).
     assert abs(report["predicted_elements"] / cells - 1.0) <= 0.10
-    # The 2D boundary layer is not made yet: said, not silently dropped.
-    assert "boundary layers are not made yet" in result.stderr
 
 
 def test_predict_prints_the_count_and_writes_the_octree(homesh_bin, tmp_path):
@@ -146,13 +151,19 @@ def test_python_predict_matches_the_mesh(data):
 def test_python_reads_mcf_cases():
     import homesh
 
-    case = MESHGEN / "2d_bl_t106.mcf"
+    case = MESHGEN / "3d_sphere.mcf"
     report = homesh.predict(case, threads=2)
-    assert report["sizing"]["min_delta"] == 0.01 and report["sizing"]["max_delta"] == 0.5
-    mesh = homesh.mesh(case, order=2)
+    assert report["sizing"]["min_delta"] == 0.04 and report["sizing"]["max_delta"] == 0.2
+    mesh = homesh.mesh(case, order=1, threads=2)
     made = mesh.report()
     assert made["predicted_elements"] == report["predicted_elements"]
-    assert abs(made["predicted_elements"] / made["elements"]["tri"] - 1) <= 0.10
+    assert abs(made["predicted_elements"] / made["elements"]["tet"] - 1) <= 0.10
+    # A 2D case's sizes and boundary layer (BndLayerSurfaces 11-12, thickness 0.01+0.05*x).
+    t106 = homesh.mesh(MESHGEN / "2d_bl_t106.mcf", order=2, optimise=20, threads=2).report()
+    assert t106["sizing"]["min_delta"] == 0.01 and t106["sizing"]["max_delta"] == 0.5
+    assert t106["boundary_layer"]["faces"] == [11, 12]
+    assert t106["boundary_layer"]["thickness"] == "0.01+0.05*x"
+    assert t106["elements"]["quad"] == 2 * t106["boundary_layer"]["macro_cells"] > 0
 
 
 def test_case_and_octree_output_are_checked_first(homesh_bin, tmp_path):

@@ -20,9 +20,12 @@ std::string peerCase(const std::string& name) {
   return std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/meshgen/" + name + ".mcf";
 }
 
+// The case's linear mesh without its boundary layer: what the sizing predicts (a layer takes the
+// place of some of the predicted elements; its own tests are pipeline/test_boundary_layer.cpp).
 MeshResult meshCase(const std::string& name, int order = 1) {
   CaseSetup setup = setupCase(peerCase(name));
   setup.options.order = order;
+  setup.options.boundaryLayer.reset();
   return runMeshPipeline(setup.source, setup.options);
 }
 
