@@ -147,6 +147,76 @@ double prismCornerQuality(const std::array<Vec, 6>& v) {
   return worst;
 }
 
+// "(x, y, z)" for messages.
+std::string pointText(const Vec& x) {
+  std::ostringstream s;
+  s.precision(6);
+  s << "(" << x.x() << ", " << x.y() << ", " << x.z() << ")";
+  return s.str();
+}
+
+// Shrinks the flagged wall nodes (Node: factor, full, neighbours) by kShrinkStep and grades the
+// rest (no height more than kGrading times a neighbour's), re-placing every node with
+// `placeAll`, until `offenders` (node index -> why) flags none. Returns the passes taken; throws
+// MeshingError with `describe(node)` (where the layer is) after kMaxShrinkPasses.
+template <class Node, class Offenders, class PlaceAll, class Describe>
+int shrinkUntilClear(std::vector<Node>& nodes, Offenders offenders, PlaceAll placeAll,
+                     Describe describe) {
+  placeAll();
+  for (int pass = 0;; ++pass) {
+    const std::map<std::size_t, std::string> bad = offenders();
+    if (bad.empty()) return pass;
+    if (pass == kMaxShrinkPasses) {
+      const Node& w = nodes[bad.begin()->first];
+      throw MeshingError("the boundary layer on " + describe(w) + ": " + bad.begin()->second +
+                         " even at " + formatNumber(w.factor) + " of the thickness");
+    }
+    for (const auto& [i, why] : bad) nodes[i].factor *= kShrinkStep;
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (Node& w : nodes)
+        for (const std::size_t n : w.neighbours) {
+          const double cap = kGrading * nodes[n].factor * nodes[n].full;
+          if (w.factor * w.full > cap * (1.0 + 1e-12)) {
+            w.factor = cap / w.full;
+            changed = true;
+          }
+        }
+    }
+    placeAll();
+  }
+}
+
+// The record's macro heights, first-layer heights and shrink entries (per layer face or curve,
+// `entity(node)`: the smallest factor, where, how many nodes) from the grown wall nodes.
+template <class Node, class Entity>
+void recordHeights(BoundaryLayerRecord& record, const BoundaryLayerParameters& p, const Mesh& mesh,
+                   const std::vector<Node>& nodes, Entity entity) {
+  record.parameters = p;
+  record.wallNodes = nodes.size();
+  record.thicknessMin = std::numeric_limits<double>::infinity();
+  record.thicknessMax = 0.0;
+  std::map<int, LayerShrink> shrunk;
+  for (const Node& w : nodes) {
+    const double h = (w.top - at(mesh, w.id)).norm();
+    record.thicknessMin = std::min(record.thicknessMin, h);
+    record.thicknessMax = std::max(record.thicknessMax, h);
+    if (w.factor >= 0.999) continue;
+    LayerShrink& s = shrunk[entity(w)];
+    s.face = entity(w);
+    ++s.nodes;
+    if (s.nodes == 1 || w.factor < s.factor) {
+      s.factor = w.factor;
+      const Vec x = at(mesh, w.id);
+      s.where = {x.x(), x.y(), x.z()};
+    }
+  }
+  const double first = p.splitCoordinates()[1];
+  record.firstHeightMin = record.thicknessMin * first;
+  record.firstHeightMax = record.thicknessMax * first;
+  for (auto& [face, s] : shrunk) record.shrunk.push_back(s);
+}
+
 class LayerGrower {
  public:
   LayerGrower(const Mesh& volume, const CadModel& cad, const BoundaryLayerParameters& p,
@@ -377,13 +447,7 @@ class LayerGrower {
     return (at(out_, f[1]) - at(out_, f[0])).cross(at(out_, f[2]) - at(out_, f[0])).normalized();
   }
 
-  std::string where(const WallNode& w) const {
-    const Vec x = at(out_, w.id);
-    std::ostringstream s;
-    s.precision(6);
-    s << "(" << x.x() << ", " << x.y() << ", " << x.z() << ")";
-    return s.str();
-  }
+  std::string where(const WallNode& w) const { return pointText(at(out_, w.id)); }
 
   Vec faceNormal(int face, const Vec& x) const {
     const SurfaceProjection proj = cad_.projectOnSurface(face, x);
@@ -595,61 +659,22 @@ class LayerGrower {
   }
 
   void shrink() {
-    for (WallNode& w : wall_) place(w);
-    relaxSide();
-    for (int pass = 0;; ++pass) {
-      const std::map<std::size_t, std::string> bad = offenders();
-      if (bad.empty()) {
-        record_.shrinkPasses = pass;
-        return;
-      }
-      if (pass == kMaxShrinkPasses) {
-        const WallNode& w = wall_[bad.begin()->first];
-        throw MeshingError("the boundary layer on Face" + std::to_string(w.face) +
-                           " cannot be grown at " + where(w) + ": " + bad.begin()->second +
-                           " even at " + formatNumber(w.factor) + " of the thickness");
-      }
-      for (const auto& [i, why] : bad) wall_[i].factor *= kShrinkStep;
-      // Grade: no height more than kGrading times a neighbour's.
-      for (bool changed = true; changed;) {
-        changed = false;
-        for (WallNode& w : wall_)
-          for (const std::size_t n : w.neighbours) {
-            const double cap = kGrading * wall_[n].factor * wall_[n].full;
-            if (w.factor * w.full > cap * (1.0 + 1e-12)) {
-              w.factor = cap / w.full;
-              changed = true;
-            }
-          }
-      }
-      for (WallNode& w : wall_) place(w);
-      relaxSide();
-    }
+    record_.shrinkPasses = shrinkUntilClear(
+        wall_, [this] { return offenders(); },
+        [this] {
+          for (WallNode& w : wall_) place(w);
+          relaxSide();
+        },
+        [this](const WallNode& w) {
+          return "Face" + std::to_string(w.face) + " cannot be grown at " + where(w);
+        });
   }
 
   Mesh assemble(const LinearMeshOptions& fill) {
-    const std::vector<double> z = p_.splitCoordinates();
-    record_.parameters = p_;
-    record_.wallNodes = wall_.size();
-    record_.thicknessMin = std::numeric_limits<double>::infinity();
-    record_.thicknessMax = 0.0;
-    std::map<int, LayerShrink> shrunk;
+    recordHeights(record_, p_, out_, wall_, [](const WallNode& w) { return w.face; });
     std::vector<std::int64_t> topId(wall_.size());
     for (std::size_t i = 0; i < wall_.size(); ++i) {
       const WallNode& w = wall_[i];
-      const double h = (w.top - at(out_, w.id)).norm();
-      record_.thicknessMin = std::min(record_.thicknessMin, h);
-      record_.thicknessMax = std::max(record_.thicknessMax, h);
-      if (w.factor < 0.999) {
-        LayerShrink& s = shrunk[w.face];
-        s.face = w.face;
-        ++s.nodes;
-        if (s.nodes == 1 || w.factor < s.factor) {
-          s.factor = w.factor;
-          const Vec x = at(out_, w.id);
-          s.where = {x.x(), x.y(), x.z()};
-        }
-      }
       const double xyz[3] = {w.top.x(), w.top.y(), w.top.z()};
       if (w.sideFaces.size() == 1)
         topId[i] = out_.addNode(xyz, 2, w.sideFaces[0], w.u, w.v);
@@ -664,9 +689,6 @@ class LayerGrower {
       out_.nodeCadParam[2 * i] = s.u;
       out_.nodeCadParam[2 * i + 1] = s.v;
     }
-    record_.firstHeightMin = record_.thicknessMin * z[1];
-    record_.firstHeightMax = record_.thicknessMax * z[1];
-    for (auto& [face, s] : shrunk) record_.shrunk.push_back(s);
     const auto top = [&](std::int64_t v) {
       const auto it = wallIndex_.find(v);
       return it == wallIndex_.end() ? v : topId[it->second];
@@ -795,13 +817,7 @@ class LayerGrower2D {
   std::vector<WallNode> wall_;
   std::map<std::int64_t, std::size_t> wallIndex_;
 
-  std::string where(const WallNode& w) const {
-    const Vec x = at(out_, w.id);
-    std::ostringstream s;
-    s.precision(6);
-    s << "(" << x.x() << ", " << x.y() << ", " << x.z() << ")";
-    return s.str();
-  }
+  std::string where(const WallNode& w) const { return pointText(at(out_, w.id)); }
 
   void extract(const Mesh& planar) {
     std::set<int> faces;
@@ -1018,65 +1034,25 @@ class LayerGrower2D {
   }
 
   void shrink() {
-    for (WallNode& w : wall_) place(w);
-    for (int pass = 0;; ++pass) {
-      const std::map<std::size_t, std::string> bad = offenders();
-      if (bad.empty()) {
-        record_.shrinkPasses = pass;
-        return;
-      }
-      if (pass == kMaxShrinkPasses) {
-        const WallNode& w = wall_[bad.begin()->first];
-        throw MeshingError("the boundary layer on Edge" + std::to_string(w.curve) +
-                           " cannot be grown at " + where(w) + ": " + bad.begin()->second +
-                           " even at " + formatNumber(w.factor) + " of the thickness");
-      }
-      for (const auto& [i, why] : bad) wall_[i].factor *= kShrinkStep;
-      for (bool changed = true; changed;) {
-        changed = false;
-        for (WallNode& w : wall_)
-          for (const std::size_t n : w.neighbours) {
-            const double cap = kGrading * wall_[n].factor * wall_[n].full;
-            if (w.factor * w.full > cap * (1.0 + 1e-12)) {
-              w.factor = cap / w.full;
-              changed = true;
-            }
-          }
-      }
-      for (WallNode& w : wall_) place(w);
-    }
+    record_.shrinkPasses = shrinkUntilClear(
+        wall_, [this] { return offenders(); },
+        [this] {
+          for (WallNode& w : wall_) place(w);
+        },
+        [this](const WallNode& w) {
+          return "Edge" + std::to_string(w.curve) + " cannot be grown at " + where(w);
+        });
   }
 
   Mesh assemble(const LinearMeshOptions& fill) {
-    const std::vector<double> z = p_.splitCoordinates();
-    record_.parameters = p_;
-    record_.wallNodes = wall_.size();
-    record_.thicknessMin = std::numeric_limits<double>::infinity();
-    record_.thicknessMax = 0.0;
-    std::map<int, LayerShrink> shrunk;
+    recordHeights(record_, p_, out_, wall_, [](const WallNode& w) { return w.curve; });
     std::vector<std::int64_t> topId(wall_.size());
     for (std::size_t i = 0; i < wall_.size(); ++i) {
       const WallNode& w = wall_[i];
-      const double h = (w.top - at(out_, w.id)).norm();
-      record_.thicknessMin = std::min(record_.thicknessMin, h);
-      record_.thicknessMax = std::max(record_.thicknessMax, h);
-      if (w.factor < 0.999) {
-        LayerShrink& s = shrunk[w.curve];
-        s.face = w.curve;
-        ++s.nodes;
-        if (s.nodes == 1 || w.factor < s.factor) {
-          s.factor = w.factor;
-          const Vec x = at(out_, w.id);
-          s.where = {x.x(), x.y(), x.z()};
-        }
-      }
       const double xyz[3] = {w.top.x(), w.top.y(), w.top.z()};
       topId[i] = w.sideCurve != 0 ? out_.addNode(xyz, 1, w.sideCurve, w.t, kNaN)
                                   : out_.addNode(xyz, 2, face_, kNaN, kNaN);
     }
-    record_.firstHeightMin = record_.thicknessMin * z[1];
-    record_.firstHeightMax = record_.thicknessMax * z[1];
-    for (auto& [curve, s] : shrunk) record_.shrunk.push_back(s);
     const auto top = [&](std::int64_t v) {
       const auto it = wallIndex_.find(v);
       return it == wallIndex_.end() ? v : topId[it->second];

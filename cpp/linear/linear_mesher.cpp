@@ -252,6 +252,67 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
   return mesh;
 }
 
+namespace {
+
+// Meshes the current Gmsh model's entity of dimension `dim` inside its discrete boundary, which
+// Gmsh keeps as it is; sizes grow from the boundary's edge lengths, at most `maxSize` (> 0).
+void generateFill(int dim, double maxSize, const std::string& what) {
+  gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
+  gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+  gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 1);
+  if (maxSize > 0.0) gmsh::option::setNumber("Mesh.MeshSizeMax", maxSize);
+  gmsh::option::setNumber("Mesh.ElementOrder", 1);
+  try {
+    gmsh::model::mesh::generate(dim);
+  } catch (const std::string& message) {
+    throw MeshingError("Gmsh could not fill " + what + ": " + message +
+                       " (the layer's top may cross itself or a wall)");
+  }
+}
+
+// Reads a fill back: the nodes of the boundary entities (dimension dim - 1) are found again
+// among `known` by their coordinates (Gmsh may renumber; it does not move them), the fill's own
+// nodes are appended to `mesh` (CAD dimension dim, entity `entity`), and its cells, which must
+// all be of `gmshType`, appended to `cells` with entity `entity`.
+void readFill(Mesh& mesh, const std::map<std::array<double, 3>, std::int64_t>& known,
+              const std::vector<int>& boundary, int dim, int tag, int gmshType, int entity,
+              ElementBlock& cells) {
+  std::map<std::size_t, std::int64_t> fresh;
+  std::vector<std::size_t> nodeTags;
+  std::vector<double> coords, params;
+  for (const int b : boundary) {
+    gmsh::model::mesh::getNodes(nodeTags, coords, params, dim - 1, b, true, false);
+    for (std::size_t i = 0; i < nodeTags.size(); ++i) {
+      const auto it = known.find({coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]});
+      if (it == known.end())
+        throw MeshingError("Gmsh moved or added a node on the boundary inside the layer");
+      fresh[nodeTags[i]] = it->second;
+    }
+  }
+  gmsh::model::mesh::getNodes(nodeTags, coords, params, dim, tag, false, false);
+  for (std::size_t i = 0; i < nodeTags.size(); ++i)
+    fresh[nodeTags[i]] = mesh.addNode(&coords[3 * i], dim, entity, kNaN, kNaN);
+  std::vector<int> types;
+  std::vector<std::vector<std::size_t>> elementTags, elementNodes;
+  gmsh::model::mesh::getElements(types, elementTags, elementNodes, dim, tag);
+  const auto nv = static_cast<std::size_t>(cellNumVertices(cells.type));
+  for (std::size_t k = 0; k < types.size(); ++k) {
+    if (types[k] != gmshType)
+      throw MeshingError("Gmsh filled the layer's inside with elements of type " +
+                         std::to_string(types[k]) + " where only " + cellShortName(cells.type) +
+                         "s were expected");
+    for (const std::size_t t : elementNodes[k]) {
+      const auto it = fresh.find(t);
+      if (it == fresh.end())
+        throw MeshingError("Gmsh's fill refers to unknown node " + std::to_string(t));
+      cells.nodes.push_back(it->second);
+    }
+    cells.entity.insert(cells.entity.end(), elementNodes[k].size() / nv, entity);
+  }
+}
+
+}  // namespace
+
 ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_t, 3>>& boundary,
                             const LinearMeshOptions& options, int solid) {
   if (boundary.empty()) throw MeshingError("no surface to fill with tetrahedra");
@@ -286,54 +347,14 @@ ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_
     const int loop = gmsh::model::geo::addSurfaceLoop({1});
     const int volume = gmsh::model::geo::addVolume({loop});
     gmsh::model::geo::synchronize();
-    gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 1);
-    if (maxSize > 0.0) gmsh::option::setNumber("Mesh.MeshSizeMax", maxSize);
-    gmsh::option::setNumber("Mesh.ElementOrder", 1);
-    try {
-      gmsh::model::mesh::generate(3);
-    } catch (const std::string& message) {
-      throw MeshingError("Gmsh could not fill the volume inside the boundary layer: " + message +
-                         " (the layer's top surface may intersect itself or the walls)");
-    }
-    // Gmsh may renumber the nodes after meshing: the surface's are found again by their
-    // coordinates, which it does not change.
-    std::map<std::array<double, 3>, std::int64_t> byPoint;
+    generateFill(3, maxSize, "the volume inside the boundary layer");
+    std::map<std::array<double, 3>, std::int64_t> known;
     for (std::size_t i = 0; i < used.size(); ++i)
       if (used[i] != 0)
-        byPoint.emplace(
+        known.emplace(
             std::array<double, 3>{mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]},
             static_cast<std::int64_t>(i));
-    std::map<std::size_t, std::int64_t> fresh;
-    std::vector<std::size_t> nodeTagsOut;
-    std::vector<double> nodeCoords, params;
-    gmsh::model::mesh::getNodes(nodeTagsOut, nodeCoords, params, 2, 1, false, false);
-    for (std::size_t i = 0; i < nodeTagsOut.size(); ++i) {
-      const auto it =
-          byPoint.find({nodeCoords[3 * i], nodeCoords[3 * i + 1], nodeCoords[3 * i + 2]});
-      if (it == byPoint.end())
-        throw MeshingError("Gmsh moved or added a node on the surface inside the boundary layer");
-      fresh[nodeTagsOut[i]] = it->second;
-    }
-    gmsh::model::mesh::getNodes(nodeTagsOut, nodeCoords, params, 3, volume, false, false);
-    for (std::size_t i = 0; i < nodeTagsOut.size(); ++i)
-      fresh[nodeTagsOut[i]] = mesh.addNode(&nodeCoords[3 * i], 3, solid, kNaN, kNaN);
-    std::vector<int> types;
-    std::vector<std::vector<std::size_t>> elementTags, nodeTags;
-    gmsh::model::mesh::getElements(types, elementTags, nodeTags, 3, volume);
-    for (std::size_t k = 0; k < types.size(); ++k) {
-      if (types[k] != kGmshTetrahedron)
-        throw MeshingError("Gmsh filled the volume with elements of type " +
-                           std::to_string(types[k]) + " where only tetrahedra were expected");
-      for (const std::size_t tag : nodeTags[k]) {
-        const auto it = fresh.find(tag);
-        if (it == fresh.end())
-          throw MeshingError("Gmsh's volume fill refers to unknown node " + std::to_string(tag));
-        tets.nodes.push_back(it->second);
-      }
-      tets.entity.insert(tets.entity.end(), nodeTags[k].size() / 4, solid);
-    }
+    readFill(mesh, known, {1}, 3, volume, kGmshTetrahedron, solid, tets);
   });
   if (tets.count() == 0) throw MeshingError("Gmsh made no tetrahedra inside the boundary layer");
   orientTetrahedra(mesh, tets);
@@ -414,49 +435,10 @@ ElementBlock fillTriangles(Mesh& mesh, const std::vector<std::array<std::int64_t
       if (l != outer) surfaceLoops.push_back(curveLoops[l]);
     const int surface = gmsh::model::geo::addPlaneSurface(surfaceLoops);
     gmsh::model::geo::synchronize();
-    gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 1);
-    if (maxSize > 0.0) gmsh::option::setNumber("Mesh.MeshSizeMax", maxSize);
-    gmsh::option::setNumber("Mesh.ElementOrder", 1);
-    try {
-      gmsh::model::mesh::generate(2);
-    } catch (const std::string& message) {
-      throw MeshingError("Gmsh could not fill the region inside the boundary layer: " + message +
-                         " (the layer's top may cross itself or a wall)");
-    }
-    std::map<std::size_t, std::int64_t> fresh;
-    std::vector<std::size_t> nodeTags;
-    std::vector<double> nodeCoords, params;
-    for (std::size_t l = 0; l < loops.size(); ++l) {
-      gmsh::model::mesh::getNodes(nodeTags, nodeCoords, params, 1, static_cast<int>(l) + 1, true,
-                                  false);
-      for (std::size_t i = 0; i < nodeTags.size(); ++i) {
-        const auto it =
-            byPoint.find({nodeCoords[3 * i], nodeCoords[3 * i + 1], nodeCoords[3 * i + 2]});
-        if (it == byPoint.end())
-          throw MeshingError("Gmsh moved or added a node on the boundary inside the layer");
-        fresh[nodeTags[i]] = it->second;
-      }
-    }
-    gmsh::model::mesh::getNodes(nodeTags, nodeCoords, params, 2, surface, false, false);
-    for (std::size_t i = 0; i < nodeTags.size(); ++i)
-      fresh[nodeTags[i]] = mesh.addNode(&nodeCoords[3 * i], 2, face, kNaN, kNaN);
-    std::vector<int> types;
-    std::vector<std::vector<std::size_t>> elementTags, elementNodes;
-    gmsh::model::mesh::getElements(types, elementTags, elementNodes, 2, surface);
-    for (std::size_t k = 0; k < types.size(); ++k) {
-      if (types[k] != kGmshTriangle)
-        throw MeshingError("Gmsh filled the region with elements of type " +
-                           std::to_string(types[k]) + " where only triangles were expected");
-      for (const std::size_t t : elementNodes[k]) {
-        const auto it = fresh.find(t);
-        if (it == fresh.end())
-          throw MeshingError("Gmsh's fill refers to unknown node " + std::to_string(t));
-        tris.nodes.push_back(it->second);
-      }
-      tris.entity.insert(tris.entity.end(), elementNodes[k].size() / 3, face);
-    }
+    generateFill(2, maxSize, "the region inside the boundary layer");
+    std::vector<int> curves;
+    for (std::size_t l = 0; l < loops.size(); ++l) curves.push_back(static_cast<int>(l) + 1);
+    readFill(mesh, byPoint, curves, 2, surface, kGmshTriangle, face, tris);
   });
   if (tris.count() == 0) throw MeshingError("Gmsh made no triangles inside the boundary layer");
   orientPlanarMesh(mesh, tris);
