@@ -135,10 +135,12 @@ int runMesh(const homesh::MeshCommand& cmd) {
       const homesh::BoundaryLayerRecord& b = *result.boundaryLayer;
       std::fprintf(stderr,
                    "homesh: boundary layer: %zu macro %s split into %d layers, height %g to %g, "
-                   "first layer %g to %g; shrunk on %zu %s; macro mesh worst %.4f\n",
+                   "first layer %g to %g (worst %.2f %% off); shrunk on %zu %s; macro mesh worst "
+                   "%.4f\n",
                    b.cells, result.mesh.dim == 3 ? "prisms" : "quadrilaterals", b.parameters.layers,
                    b.thicknessMin, b.thicknessMax, b.firstHeightMin, b.firstHeightMax,
-                   b.shrunk.size(), result.mesh.dim == 3 ? "faces" : "curves",
+                   100.0 * b.firstHeightDeviation, b.shrunk.size(),
+                   result.mesh.dim == 3 ? "faces" : "curves",
                    result.macroQuality ? result.macroQuality->scaled.min : 0.0);
     }
     for (std::size_t k = 0; k < result.rounds.size(); ++k) {

@@ -7,8 +7,10 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <set>
 
 #include "core/error.hpp"
+#include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 
 namespace homesh {
@@ -39,13 +41,37 @@ std::map<LatticePoint, int> latticeIndex(const ReferenceElement& ref) {
   return index;
 }
 
+// The unit normal of a layer cell's curved wall (a prism's triangle at zeta 0; in 2D a
+// quadrilateral's edge, in the plane) at wall coordinates (a, b), on the side of `towards`.
+Eigen::Vector3d wallNormal(const Mesh& mesh, const ReferenceElement& ref, const std::int64_t* v,
+                           double a, double b, const Eigen::Vector3d& towards) {
+  const bool prism = ref.type() == CellType::Prism;
+  const double xi[3] = {a, prism ? b : 0.0, 0.0};
+  Eigen::VectorXd values;
+  Eigen::MatrixXd gradients;
+  ref.evaluate(xi, values, gradients);
+  Eigen::Vector3d du = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
+  for (int i = 0; i < ref.numNodes(); ++i) {
+    const Eigen::Vector3d x(&mesh.xyz[3 * static_cast<std::size_t>(v[i])]);
+    du += gradients(i, 0) * x;
+    if (prism) dv += gradients(i, 1) * x;
+  }
+  const Eigen::Vector3d plane(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
+  Eigen::Vector3d n = prism ? du.cross(dv) : plane.cross(du);
+  if (!(n.norm() > 0.0)) return Eigen::Vector3d::Zero();
+  n.normalize();
+  return n.dot(towards) < 0.0 ? Eigen::Vector3d(-n) : n;
+}
+
 class LayerSplitter {
  public:
   LayerSplitter(const Mesh& macro, const std::vector<double>& z, const CadModel* cad,
-                LayerSplitStats& stats)
+                const LayerHeights* heights, LayerSplitStats& stats)
       : macro_(macro),
         z_(z),
         cad_(cad),
+        grown_(heights != nullptr ? &heights->grown : nullptr),
+        plain_(heights != nullptr ? heights->plain : std::set<std::int64_t>()),
         stats_(stats),
         p_(macro.order),
         n_(static_cast<int>(z.size()) - 1) {
@@ -56,7 +82,10 @@ class LayerSplitter {
 
   Mesh run() {
     for (const ElementBlock& b : macro_.blocks)
-      if (layerCell(b)) pairWallAndTop(b);
+      if (layerCell(b)) {
+        pairWallAndTop(b);
+        addWallNormals(b);
+      }
     for (const ElementBlock& b : macro_.blocks) {
       if (layerCell(b))
         out_.blocks.push_back(splitCells(b));
@@ -70,6 +99,8 @@ class LayerSplitter {
       if (b.type == CellType::Line) out_.blocks.push_back(splitSides(b));
     compactNodes(out_);
     out_.checkConsistency();
+    measureFirstLayer();
+    stats_.plainColumns = plain_.size();
     return std::move(out_);
   }
 
@@ -77,10 +108,14 @@ class LayerSplitter {
   const Mesh& macro_;
   const std::vector<double>& z_;
   const CadModel* cad_;
+  const std::vector<double>* grown_;  // wall vertex -> height as grown (NaN elsewhere), or null
+  std::set<std::int64_t> plain_;      // wall nodes whose columns are split at z as they are
   LayerSplitStats& stats_;
   int p_, n_;
   Mesh out_;
-  std::map<std::int64_t, std::int64_t> topOf_;  // wall vertex -> top vertex
+  std::map<std::int64_t, Eigen::Vector3d> normals_;  // wall node -> sum of its cells' normals
+  std::map<std::int64_t, int> normalCount_;          // wall node -> cells summed there
+  std::map<std::int64_t, std::int64_t> topOf_;       // wall vertex -> top vertex
   std::map<NodeKey, std::int64_t> nodes_;
   std::map<std::int64_t, double> height_;  // wall vertex -> macro layer height there
   std::vector<char> projected_;
@@ -116,6 +151,158 @@ class LayerSplitter {
     return z_[kk] + (z_[kk + 1] - z_[kk]) * a / p_;
   }
 
+  // The height a wall point's layer was grown to: the wall vertices' heights interpolated
+  // linearly (barycentric `l`), as blendLayerInteriors places the tops; NaN without them.
+  double grownHeight(const std::int64_t* v, int walls, const double* l) const {
+    if (grown_ == nullptr) return std::nan("");
+    double h = 0.0;
+    for (int k = 0; k < walls; ++k) {
+      const auto id = static_cast<std::size_t>(v[k]);
+      h += l[k] * (id < grown_->size() ? (*grown_)[id] : std::nan(""));
+    }
+    return h;
+  }
+
+  // How the column of nodes above the wall node at lattice point `c` (across coordinate 0) of
+  // cell `v` is split: at the levels z_0 = 0 < ... < z_n = 1 of the macro map, then shifted.
+  // The column runs straight from wall W to top T (blendLayerInteriors), so a level s lies at
+  // the height s H above the wall, H = (T - W) . n along the wall normal n (averaged over the
+  // cells at the node). With the grown heights H*, the first level is s_1 = z_1 H* / H, so the
+  // first layer has the height asked for even where the optimiser has moved the top; the
+  // others keep their progression in what remains. s_1 is kept within [z_1 / 2, 2 z_1] (and
+  // below the second level's share) so the levels stay ordered. Where the top has also slid
+  // sideways (T - W not along n), the first level's node is moved by `shift` onto the normal
+  // through W (its tangential offset, s_1 times that of the top, would otherwise change the
+  // height measured between the nodes), the shift fading linearly to 0 at wall and top. A node
+  // shared by neighbours takes the column of the first cell that reaches it.
+  struct Column {
+    std::vector<double> levels;
+    Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+    double shiftAt(double s) const {
+      const double s1 = levels[1];
+      return s <= s1 ? s / s1 : levels.size() > 2 ? (1.0 - s) / (1.0 - s1) : 0.0;
+    }
+  };
+  std::map<std::int64_t, Column> columns_;      // wall node -> how its column is split
+  static constexpr double kMaxShiftLean = 1.0;  // tangent of the lean: 45 degrees
+  const Column& column(const ElementBlock& b, const std::map<LatticePoint, int>& index,
+                       const std::int64_t* v, LatticePoint c) {
+    const std::size_t across = b.type == CellType::Prism ? 2 : 1;
+    c[across] = 0;
+    const std::int64_t w = v[index.at(c)];
+    const auto found = columns_.find(w);
+    if (found != columns_.end()) return found->second;
+    Column col;
+    col.levels = z_;
+    const bool prism = b.type == CellType::Prism;
+    const double l[3] = {prism ? double(p_ - c[0] - c[1]) / p_ : double(p_ - c[0]) / p_,
+                         double(c[0]) / p_, prism ? double(c[1]) / p_ : 0.0};
+    const double target = grownHeight(v, wallVertices(b), l);
+    const auto normal = normals_.find(w);
+    if (n_ > 1 && plain_.count(w) == 0 && std::isfinite(target) && target > 0.0 &&
+        normal != normals_.end() && normal->second.norm() > 0.0) {
+      LatticePoint t = c;
+      t[across] = p_;
+      const Eigen::Vector3d x0(&macro_.xyz[3 * static_cast<std::size_t>(w)]);
+      const Eigen::Vector3d rise =
+          Eigen::Vector3d(&macro_.xyz[3 * static_cast<std::size_t>(v[index.at(t)])]) - x0;
+      const Eigen::Vector3d n = normal->second.normalized();
+      const double height = rise.dot(n);
+      if (height > 0.0) {
+        const double z1 = z_[1];
+        const double first =
+            std::clamp(z1 * target / height, 0.5 * z1, std::min(2.0 * z1, 0.5 * (z1 + z_[2])));
+        for (std::size_t k = 1; k + 1 < col.levels.size(); ++k)
+          col.levels[k] = first + (z_[k] - z1) * (1.0 - first) / (1.0 - z1);
+        // Only where the column leans by less than kMaxShiftLean: at a sharp corner the column
+        // follows the corner's bisector by design, and no shift gives both walls their height.
+        // (Where the adjusted column makes a thin cell invalid, the pipeline splits it plain.)
+        const Eigen::Vector3d lean = rise - height * n;
+        if (lean.norm() < kMaxShiftLean * height) col.shift = -first * lean;
+      }
+    }
+    return columns_.emplace(w, std::move(col)).first->second;
+  }
+
+  // Sums the wall normals of every layer cell at each of its wall nodes (normals_).
+  void addWallNormals(const ElementBlock& b) {
+    const ReferenceElement& ref = ReferenceElement::get(b.type, p_);
+    const std::map<LatticePoint, int> index = latticeIndex(ref);
+    const std::size_t across = b.type == CellType::Prism ? 2 : 1;
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      const std::int64_t* v = b.element(e);
+      for (int r = 0; r < ref.numNodes(); ++r) {
+        LatticePoint c = ref.lattice()[static_cast<std::size_t>(r)];
+        if (c[across] != 0) continue;
+        c[across] = p_;
+        const Eigen::Vector3d rise =
+            Eigen::Vector3d(&macro_.xyz[3 * static_cast<std::size_t>(v[index.at(c)])]) -
+            Eigen::Vector3d(&macro_.xyz[3 * static_cast<std::size_t>(v[r])]);
+        const Eigen::Vector3d n = wallNormal(macro_, ref, v, double(c[0]) / p_,
+                                             across == 2 ? double(c[1]) / p_ : 0.0, rise);
+        auto [it, fresh] = normals_.emplace(v[r], n);
+        if (!fresh) it->second += n;
+        ++normalCount_[v[r]];
+      }
+    }
+  }
+
+  // Whether the walls of the cells around wall vertex `w` meet at a sharp corner: their
+  // normals there spread by more than about 30 degrees (their mean is shorter than cos 15).
+  bool atCorner(std::int64_t w) const {
+    const auto n = normals_.find(w);
+    const auto count = normalCount_.find(w);
+    if (n == normals_.end() || count == normalCount_.end()) return false;
+    return n->second.norm() < kCornerMeanNormal * count->second;
+  }
+  static constexpr double kCornerMeanNormal = 0.966;  // cos 15 degrees
+
+  // The first split layer's height along the wall normal at the wall's quadrature points
+  // (exact to degree 2P), in stats_: its range and, with grown heights, its worst deviation
+  // from z_1 H*.
+  void measureFirstLayer() {
+    for (const ElementBlock& b : out_.blocks) {
+      if (!layerCell(b)) continue;
+      const bool prism = b.type == CellType::Prism;
+      const ReferenceElement& ref = ReferenceElement::get(b.type, p_);
+      const QuadratureRule rule =
+          quadratureRule(prism ? CellType::Triangle : CellType::Line, 2 * p_);
+      Eigen::VectorXd values;
+      Eigen::MatrixXd gradients;
+      for (std::size_t e = 0; e < b.count(); e += static_cast<std::size_t>(n_)) {
+        const std::int64_t* v = b.element(e);  // the column's first layer
+        bool corner = false;
+        for (int k = 0; k < wallVertices(b); ++k) corner = corner || atCorner(v[k]);
+        if (corner) ++stats_.cornerCells;
+        for (int q = 0; q < rule.size(); ++q) {
+          const auto qq = static_cast<std::size_t>(q);
+          const double a = rule.points[qq * static_cast<std::size_t>(rule.dim)];
+          const double bb = prism ? rule.points[qq * 2 + 1] : 0.0;
+          Eigen::Vector3d bottom = Eigen::Vector3d::Zero(), top = Eigen::Vector3d::Zero();
+          for (const double zeta : {0.0, 1.0}) {
+            const double xi[3] = {a, prism ? bb : zeta, zeta};
+            ref.evaluate(xi, values, gradients);
+            for (int i = 0; i < ref.numNodes(); ++i)
+              (zeta == 0.0 ? bottom : top) +=
+                  values(i) * Eigen::Vector3d(&out_.xyz[3 * static_cast<std::size_t>(v[i])]);
+          }
+          const double h = (top - bottom).dot(wallNormal(out_, ref, v, a, bb, top - bottom));
+          const double l[3] = {prism ? 1.0 - a - bb : 1.0 - a, a, bb};
+          const double target = z_[1] * grownHeight(v, wallVertices(b), l);
+          if (stats_.firstHeightMeasured == 0) stats_.firstHeightMin = stats_.firstHeightMax = h;
+          stats_.firstHeightMin = std::min(stats_.firstHeightMin, h);
+          stats_.firstHeightMax = std::max(stats_.firstHeightMax, h);
+          ++stats_.firstHeightMeasured;
+          if (std::isfinite(target) && target > 0.0) {
+            double& worst =
+                corner ? stats_.firstHeightCornerDeviation : stats_.firstHeightDeviation;
+            worst = std::max(worst, std::fabs(h / target - 1.0));
+          }
+        }
+      }
+    }
+  }
+
   ElementBlock splitCells(const ElementBlock& b) {
     const bool prism = b.type == CellType::Prism;
     const ReferenceElement& ref = ReferenceElement::get(b.type, p_);
@@ -129,18 +316,21 @@ class LayerSplitter {
     out.nodes.resize(b.count() * static_cast<std::size_t>(n_) * static_cast<std::size_t>(nn));
     out.entity.resize(b.count() * static_cast<std::size_t>(n_));
     Eigen::MatrixXd x(nn, 3);
+    Eigen::MatrixXd points(nn, dim);
     for (int k = 0; k < n_; ++k) {
-      // Basis of the macro cell at the k-th thin cell's nodes.
-      Eigen::MatrixXd points(nn, dim);
-      for (int r = 0; r < nn; ++r) {
-        const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
-        for (std::size_t a = 0; a < across; ++a)
-          points(r, static_cast<Eigen::Index>(a)) = double(c[a]) / p_;
-        points(r, static_cast<Eigen::Index>(across)) = zAt(k, c[across]);
-      }
-      const Eigen::MatrixXd values = ref.valuesAt(points);
       for (std::size_t e = 0; e < b.count(); ++e) {
         const std::int64_t* v = b.element(e);
+        // The macro cell's basis at the k-th thin cell's nodes, on its columns' levels.
+        for (int r = 0; r < nn; ++r) {
+          const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
+          const std::vector<double>& z = column(b, index, v, c).levels;
+          const auto kk = static_cast<std::size_t>(k);
+          for (std::size_t a = 0; a < across; ++a)
+            points(r, static_cast<Eigen::Index>(a)) = double(c[a]) / p_;
+          points(r, static_cast<Eigen::Index>(across)) =
+              z[kk] + (z[kk + 1] - z[kk]) * c[across] / p_;
+        }
+        const Eigen::MatrixXd values = ref.valuesAt(points);
         bool gathered = false;
         const std::size_t sub = e * static_cast<std::size_t>(n_) + static_cast<std::size_t>(k);
         out.entity[sub] = b.entity[e];
@@ -166,7 +356,10 @@ class LayerSplitter {
                   for (int d = 0; d < 3; ++d) x(i, d) = macro_.xyz[3 * v[i] + d];
                 gathered = true;
               }
-              const Eigen::RowVector3d p = values.row(r) * x;
+              const Column& col = column(b, index, v, c);
+              const Eigen::RowVector3d p =
+                  values.row(r) * x +
+                  col.shift.transpose() * col.shiftAt(points(r, static_cast<Eigen::Index>(across)));
               const double xyz[3] = {p(0), p(1), p(2)};
               id = out_.addNode(xyz, macro_.dim, b.entity[e], std::nan(""), std::nan(""));
               nodes_.emplace(key, id);
@@ -297,32 +490,6 @@ class LayerSplitter {
 
 }  // namespace
 
-namespace {
-
-// The unit normal of a layer cell's curved wall (a prism's triangle at zeta 0; in 2D a
-// quadrilateral's edge, in the plane) at wall coordinates (a, b), on the side of `towards`.
-Eigen::Vector3d wallNormal(const Mesh& mesh, const ReferenceElement& ref, const std::int64_t* v,
-                           double a, double b, const Eigen::Vector3d& towards) {
-  const bool prism = ref.type() == CellType::Prism;
-  const double xi[3] = {a, prism ? b : 0.0, 0.0};
-  Eigen::VectorXd values;
-  Eigen::MatrixXd gradients;
-  ref.evaluate(xi, values, gradients);
-  Eigen::Vector3d du = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
-  for (int i = 0; i < ref.numNodes(); ++i) {
-    const Eigen::Vector3d x(&mesh.xyz[3 * static_cast<std::size_t>(v[i])]);
-    du += gradients(i, 0) * x;
-    if (prism) dv += gradients(i, 1) * x;
-  }
-  const Eigen::Vector3d plane(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
-  Eigen::Vector3d n = prism ? du.cross(dv) : plane.cross(du);
-  if (!(n.norm() > 0.0)) return Eigen::Vector3d::Zero();
-  n.normalize();
-  return n.dot(towards) < 0.0 ? Eigen::Vector3d(-n) : n;
-}
-
-}  // namespace
-
 void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops) {
   std::vector<char> done(mesh.numNodes(), 0);
   const auto setOnCad = [&](std::size_t id, const Eigen::Vector3d& x) {
@@ -410,9 +577,89 @@ void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops) {
 }
 
 Mesh splitBoundaryLayer(const Mesh& macro, const std::vector<double>& z, const CadModel* cad,
-                        LayerSplitStats* stats) {
+                        LayerSplitStats* stats, const LayerHeights* heights) {
   LayerSplitStats local;
-  return LayerSplitter(macro, z, cad, stats != nullptr ? *stats : local).run();
+  return LayerSplitter(macro, z, cad, heights, stats != nullptr ? *stats : local).run();
+}
+
+void keepColumnsPlain(const Mesh& macro, int layers, std::size_t element, LayerHeights& heights) {
+  std::size_t base = 0;
+  for (const ElementBlock& b : macro.blocks) {
+    if (cellDimension(b.type) != macro.dim) continue;
+    const bool cell = (b.type == CellType::Prism && macro.dim == 3) ||
+                      (b.type == CellType::Quadrilateral && macro.dim == 2);
+    const std::size_t count = b.count() * static_cast<std::size_t>(cell ? layers : 1);
+    if (element >= base + count) {
+      base += count;
+      continue;
+    }
+    if (!cell) return;
+    const std::size_t e = (element - base) / static_cast<std::size_t>(layers);
+    const ReferenceElement& ref = ReferenceElement::get(b.type, b.order);
+    const std::size_t across = b.type == CellType::Prism ? 2 : 1;
+    for (int r = 0; r < ref.numNodes(); ++r)
+      if (ref.lattice()[static_cast<std::size_t>(r)][across] == 0)
+        heights.plain.insert(b.element(e)[r]);
+    return;
+  }
+}
+
+std::vector<double> layerTopNormals(const Mesh& mesh) {
+  std::vector<double> normals(3 * mesh.numNodes(), 0.0);
+  std::vector<char> top(mesh.numNodes(), 0);
+  for (const ElementBlock& b : mesh.blocks) {
+    const bool prism = b.type == CellType::Prism && mesh.dim == 3;
+    const bool quad = b.type == CellType::Quadrilateral && mesh.dim == 2;
+    if (!prism && !quad) continue;
+    const int p = b.order;
+    const std::size_t across = prism ? 2 : 1;
+    const ReferenceElement& ref = ReferenceElement::get(b.type, p);
+    const std::map<LatticePoint, int> index = latticeIndex(ref);
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      const std::int64_t* v = b.element(e);
+      for (int r = 0; r < ref.numNodes(); ++r) {
+        LatticePoint c = ref.lattice()[static_cast<std::size_t>(r)];
+        if (c[across] != p) continue;
+        const auto id = static_cast<std::size_t>(v[r]);
+        c[across] = 0;
+        const Eigen::Vector3d rise =
+            Eigen::Vector3d(&mesh.xyz[3 * id]) -
+            Eigen::Vector3d(&mesh.xyz[3 * static_cast<std::size_t>(v[index.at(c)])]);
+        const Eigen::Vector3d n =
+            wallNormal(mesh, ref, v, double(c[0]) / p, prism ? double(c[1]) / p : 0.0, rise);
+        for (std::size_t d = 0; d < 3; ++d) normals[3 * id + d] += n(static_cast<Eigen::Index>(d));
+        top[id] = 1;
+      }
+    }
+  }
+  for (std::size_t id = 0; id < mesh.numNodes(); ++id) {
+    const Eigen::Vector3d n(&normals[3 * id]);
+    const double length = n.norm();
+    for (std::size_t d = 0; d < 3; ++d)
+      normals[3 * id + d] =
+          top[id] != 0 && length > 0.0 ? normals[3 * id + d] / length : std::nan("");
+  }
+  return normals;
+}
+
+std::vector<double> grownLayerHeights(const Mesh& linear) {
+  std::vector<double> heights(linear.numNodes(), std::nan(""));
+  for (const ElementBlock& b : linear.blocks) {
+    const bool prism = b.type == CellType::Prism && linear.dim == 3;
+    const bool quad = b.type == CellType::Quadrilateral && linear.dim == 2;
+    if (!prism && !quad) continue;
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      const std::int64_t* v = b.element(e);
+      for (int k = 0; k < (prism ? 3 : 2); ++k) {
+        const std::int64_t t = prism ? v[k + 3] : v[3 - k];
+        heights[static_cast<std::size_t>(v[k])] =
+            (Eigen::Vector3d(&linear.xyz[3 * static_cast<std::size_t>(t)]) -
+             Eigen::Vector3d(&linear.xyz[3 * static_cast<std::size_t>(v[k])]))
+                .norm();
+      }
+    }
+  }
+  return heights;
 }
 
 }  // namespace homesh

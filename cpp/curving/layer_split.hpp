@@ -4,14 +4,20 @@
 // 0, 1, 2, as linear/boundary_layer.hpp makes it) at the coordinates z_0 = 0 < ... < z_n = 1;
 // each new node is the macro prism's own curved map at its reference point, so each thin prism
 // is a sub-map of the macro one (valid where the macro prism is, its Jacobian scaled by
-// z_{k+1} - z_k). Nodes shared by neighbours (on the prisms' side faces and edges) are made once,
-// identified by the wall vertices' integer weights and the level across the layer. The layer's
-// side quadrilaterals and its climbing lines on the CAD are split alike, and their new nodes are
-// projected onto their CAD face or curve (from the interpolated point, which lies within the
-// macro element's interpolation error of it). Tetrahedra and triangles are kept.
+// z_{k+1} - z_k). With the heights the layer was grown to, the levels are set per column of
+// nodes instead, so that the first layer keeps its asked height where the optimiser moved the
+// macro layer's top (the thin cells then interpolate the macro map on slightly curved level
+// surfaces; the split mesh is certified again either way). Nodes shared by neighbours (on the
+// prisms' side faces and edges) are made once, identified by the wall vertices' integer weights and
+// the level across the layer. The layer's side quadrilaterals and its climbing lines on the CAD are
+// split alike, and their new nodes are projected onto their CAD face or curve (from the
+// interpolated point, which lies within the macro element's interpolation error of it). Tetrahedra
+// and triangles are kept.
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <set>
 #include <vector>
 
 #include "cad/cad_model.hpp"
@@ -23,6 +29,16 @@ struct LayerSplitStats {
   std::size_t prisms = 0, quadrilaterals = 0, lines = 0;  // macro elements split
   std::size_t projected = 0;                              // new nodes on a CAD face or curve
   double maxProjection = 0.0;  // largest move onto the CAD, relative to the layer's height
+  // The first layer's height along the wall normal at the wall's quadrature points (degree
+  // 2P): its range over the points measured and, with grown heights, the worst relative
+  // deviation from z_1 times the grown height interpolated there (0 without them), on the
+  // smooth wall and in the cells with a vertex at a sharp corner (where the walls' normals
+  // spread by more than 30 degrees: there the column follows the corner's bisector, and the
+  // height along each wall's normal falls towards the corner by design).
+  std::size_t firstHeightMeasured = 0, cornerCells = 0;
+  double firstHeightCornerDeviation = 0.0;
+  std::size_t plainColumns = 0;  // columns split at z unchanged (LayerHeights::plain)
+  double firstHeightMin = 0.0, firstHeightMax = 0.0, firstHeightDeviation = 0.0;
 };
 
 // Shapes a freshly elevated macro layer after its curved wall: each high-order node of a cell's
@@ -37,10 +53,32 @@ struct LayerSplitStats {
 // share of its height (a coarse wall around a cylinder).
 void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops = true);
 
+// The heights a split keeps: `grown`, grownLayerHeights of the linear mesh the layer was grown
+// in (whose vertex ids the macro mesh keeps); the columns above the wall nodes in `plain` are
+// split at z unchanged (where an adjusted column made a thin cell invalid).
+struct LayerHeights {
+  std::vector<double> grown;
+  std::set<std::int64_t> plain;
+};
+
 // `z`: the split coordinates (BoundaryLayerParameters::splitCoordinates). `cad` may be null
-// (no projection). Throws MeshingError when a side quadrilateral or line does not follow the
-// prisms' wall-to-top pairs.
+// (no projection). With `heights`, per-column levels and shifts as above. Throws MeshingError
+// when a side quadrilateral or line does not follow the prisms' wall-to-top pairs.
 Mesh splitBoundaryLayer(const Mesh& macro, const std::vector<double>& z, const CadModel* cad,
-                        LayerSplitStats* stats = nullptr);
+                        LayerSplitStats* stats = nullptr, const LayerHeights* heights = nullptr);
+
+// Adds to heights.plain the wall nodes of the macro cell that split element `element` (an
+// index among the split mesh's elements, in block order, `layers` thin cells per macro cell)
+// came from; nothing for an element outside the layer.
+void keepColumnsPlain(const Mesh& macro, int layers, std::size_t element, LayerHeights& heights);
+
+// Per node (3 values): for the nodes of a macro layer's top (prisms' and, in 2D,
+// quadrilaterals' far side), the unit wall normal below them (averaged over the cells sharing
+// the node); NaN for every other node. OptimiserOptions::normalLocked takes it.
+std::vector<double> layerTopNormals(const Mesh& mesh);
+
+// Per node of a linear mesh with a macro layer: the distance from each wall vertex to its top
+// vertex (the height grown there), NaN for every other node.
+std::vector<double> grownLayerHeights(const Mesh& linear);
 
 }  // namespace homesh

@@ -34,6 +34,20 @@ void BoundaryLayerParameters::validate() const {
                          formatNumber(progression));
 }
 
+const char* layerReleaseName(LayerRelease release) {
+  switch (release) {
+    case LayerRelease::Parallel:
+      return "parallel";
+    case LayerRelease::Sides:
+      return "parallel_and_sides";
+    case LayerRelease::Free:
+      return "free";
+    case LayerRelease::None:
+      break;
+  }
+  return "none";
+}
+
 std::vector<double> BoundaryLayerParameters::splitCoordinates() const {
   std::vector<double> z(static_cast<std::size_t>(layers) + 1, 0.0);
   double step = 1.0, total = 0.0;

@@ -56,17 +56,31 @@ struct LayerShrink {
   std::size_t nodes = 0;          // wall nodes of the face whose height was reduced
 };
 
+// How far the optimiser let a macro layer's top move (BoundaryLayerRecord::release).
+enum class LayerRelease { None, Parallel, Sides, Free };
+// "none", "parallel", "parallel_and_sides", "free"
+const char* layerReleaseName(LayerRelease release);
+
 struct BoundaryLayerRecord {
   BoundaryLayerParameters parameters;
-  double thicknessMin = 0, thicknessMax = 0;      // macro heights grown at the wall nodes
-  double firstHeightMin = 0, firstHeightMax = 0;  // of the first (wall) split layer
+  double thicknessMin = 0, thicknessMax = 0;  // macro heights grown at the wall nodes
+  // The first (wall) split layer's height: as planned from the grown heights; after the
+  // split, as measured along the wall normal at the wall's quadrature points, with its worst
+  // relative deviation from the planned height there (layer_split.hpp).
+  // (the worst deviation on the smooth wall; at sharp corners apart, see LayerSplitStats).
+  double firstHeightMin = 0, firstHeightMax = 0, firstHeightDeviation = 0;
+  double firstHeightCornerDeviation = 0;
+  std::size_t cornerCells = 0;
   std::vector<LayerShrink> shrunk;
   std::size_t cells = 0;  // macro cells: prisms (3D), quadrilaterals (2D)
   std::size_t sideQuadrilaterals = 0, wallNodes = 0;
   int shrinkPasses = 0;
-  // The optimiser keeps the macro layer as grown; true when elements stayed invalid and it was
-  // let move around them (the first-layer height there is no longer the one asked for).
-  bool releasedAroundInvalid = false;
+  // The optimiser keeps the macro layer as grown unless elements stay invalid; then it lets the
+  // layer's top move around them, first parallel to the wall (the heights stay; its nodes on
+  // the layer's side faces fixed, then sliding on them), then, if still needed, freely (the split
+  // then sets its levels per column so that the first layer keeps its height where it can; the
+  // outer layers absorb the change).
+  LayerRelease release = LayerRelease::None;
   double seconds = 0.0;
 };
 

@@ -298,6 +298,7 @@ class Optimiser {
   OptimiserResult result_;
 
   Eigen::Matrix<double, D, 3> frame_;  // rows: the coordinate axes (in 2D, of the plane)
+  std::vector<Vec> lockedNormal_;      // per node (in the frame), NaN where free; or empty
   std::vector<Vec> position_;          // node coordinates in the frame, of the working node set
   std::vector<Vec> start_;             // equispaced node coordinates last written to mesh_.xyz
   std::vector<Block<D>> blocks_;
@@ -512,6 +513,18 @@ class Optimiser {
                              std::to_string(mesh_.numNodes()) + " nodes");
       for (std::size_t node = 0; node < mesh_.numNodes(); ++node)
         if (options_.fixedNodes[node] != 0) boundary[node] = 1;
+    }
+    if (!options_.normalLocked.empty()) {
+      if (options_.normalLocked.size() != 3 * mesh_.numNodes())
+        throw ParameterError("the optimiser's locked normals have " +
+                             std::to_string(options_.normalLocked.size()) + " entries for " +
+                             std::to_string(mesh_.numNodes()) + " nodes (3 each)");
+      lockedNormal_.assign(mesh_.numNodes(), Vec::Constant(std::nan("")));
+      for (std::size_t node = 0; node < mesh_.numNodes(); ++node) {
+        const Eigen::Vector3d n(&options_.normalLocked[3 * node]);
+        const Vec local = frame_ * n;
+        if (n.allFinite() && local.norm() > 0.0) lockedNormal_[node] = local.normalized();
+      }
     }
     std::vector<char> touched(totalElements_, 0);  // the element contains a free node
     for (std::size_t node = 0; node < mesh_.numNodes(); ++node) {
@@ -743,8 +756,26 @@ class Optimiser {
     if (slide_[node] != 0) return slide<Fn>(node, pts, eps, e0, magnitude, grad, hess);
     Vec step;
     double slope = 0.0;
-    if (!newtonStep(hess, grad, step, slope) || !resolvable(slope, magnitude, pts.size()))
+    if (!lockedNormal_.empty() && lockedNormal_[node].allFinite()) {
+      // Newton in the plane perpendicular to the locked direction.
+      const Vec n = lockedNormal_[node];
+      Eigen::Matrix<double, D, D - 1> t;
+      if constexpr (D == 2) {
+        t.col(0) = Vec(-n(1), n(0));
+      } else {
+        const Vec a = std::abs(n(0)) < 0.9 ? Vec::UnitX() : Vec::UnitY();
+        t.col(0) = n.cross(a).normalized();
+        t.col(1) = n.cross(Vec(t.col(0)));
+      }
+      const Eigen::Matrix<double, D - 1, 1> g = t.transpose() * grad;
+      Eigen::Matrix<double, D - 1, 1> s;
+      if (!newtonStep(Eigen::Matrix<double, D - 1, D - 1>(t.transpose() * hess * t), g, s, slope) ||
+          !resolvable(slope, magnitude, pts.size()))
+        return 0.0;
+      step = t * s;
+    } else if (!newtonStep(hess, grad, step, slope) || !resolvable(slope, magnitude, pts.size())) {
       return 0.0;
+    }
     double alpha = 1.0;
     for (int ls = 0; ls < kLineSearchSteps; ++ls, alpha *= 0.5) {
       const Vec d = alpha * step;

@@ -94,6 +94,13 @@ struct OptimiserOptions {
   // Nodes that stay where they are (1 per node; empty: none), whatever their kind: a macro
   // boundary layer keeps the shape its growth gave it (linear/boundary_layer.hpp).
   std::vector<char> fixedNodes;
+  // Nodes that move only perpendicular to a direction (3 values per node, NaN for a node
+  // without one; empty: none): a macro boundary layer's top, released around invalid
+  // elements, slides parallel to its wall and keeps its height above it. Applies to nodes
+  // inside the domain (a node sliding on the CAD keeps its own constraint), exactly where the
+  // optimiser moves the mesh's own nodes (with CAD or a region, as the pipeline's release has);
+  // without, it moves its working node set's (GLL) nodes, and the written ones follow them.
+  std::vector<double> normalLocked;
 
   // Throws ParameterError naming the offending option.
   void validate() const;

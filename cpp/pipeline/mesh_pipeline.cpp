@@ -202,7 +202,9 @@ struct CurvedState {
   std::optional<OptimiserResult> optimiser;
   std::size_t reused = 0;  // elements that took their curved nodes from the round before
   std::optional<BoundaryLayerRecord> layer;  // how the linear mesh's macro layer was grown
-  bool layerReleased = false;  // the optimiser moved the macro layer around invalid elements
+  // How far the optimiser moved the macro layer around elements it could not make valid
+  // otherwise (at the final order or, with continuation, at the low order).
+  LayerRelease layerRelease = LayerRelease::None;
   // Above kContinuationOrder with the optimiser: the mesh of that order, optimised, that the
   // final order started from (empty otherwise).
   Mesh lowOrder;
@@ -236,6 +238,10 @@ std::vector<char> layerNodes(const Mesh& mesh) {
   }
   return fixed;
 }
+
+// Splits of the boundary layer after the first that set more columns plain (each around the
+// thin cells the one before left invalid or poor).
+constexpr int kPlainSplitAttempts = 3;
 
 // Layers of neighbours around the elements still invalid with the macro layer fixed, whose nodes
 // (the layer's included) a second optimiser run may move.
@@ -287,9 +293,21 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
     o.fixedNodes = layerNodes(mesh);
     std::optional<OptimiserResult> r = optimiseMesh(mesh, o, &cancel, &cad);
     if (r->cancelled) throw CancelledError("cancelled during optimise");
-    if (!o.fixedNodes.empty() && r->invalidAfter + r->undecidedAfter > 0) {
+    // Released in steps, each only if elements are still not valid: the layer's top slides
+    // parallel to the wall (its heights stay) with its nodes on the CAD (the layer's sides)
+    // fixed, then with those sliding on their faces too, then the top moves freely.
+    for (const LayerRelease step :
+         {LayerRelease::Parallel, LayerRelease::Sides, LayerRelease::Free}) {
+      if (o.fixedNodes.empty() || r->invalidAfter + r->undecidedAfter == 0) break;
       OptimiserOptions around = o;
       around.fixedNodes.clear();
+      if (step != LayerRelease::Free) around.normalLocked = layerTopNormals(mesh);
+      if (step == LayerRelease::Parallel) {
+        around.fixedNodes.assign(mesh.numNodes(), 0);
+        for (std::size_t i = 0; i < mesh.numNodes(); ++i)
+          if (std::isfinite(around.normalLocked[3 * i]) && mesh.nodeCadDim[i] < mesh.dim)
+            around.fixedNodes[i] = 1;
+      }
       around.regionSeed.assign(mesh.numElements(), 0);  // the elements not valid ...
       around.regionLayers = kLayerReleaseLayers;        // ... and their neighbours
       const OptimiserResult second = optimiseMesh(mesh, around, &cancel, &cad);
@@ -306,7 +324,7 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
       r->seconds += second.seconds;
       r->sweepSeconds += second.sweepSeconds;
       r->visits += second.visits;
-      if (order == options.order) state.layerReleased = true;
+      state.layerRelease = std::max(state.layerRelease, step);
     }
     if (clocked) clock->done();
     return r;
@@ -468,16 +486,40 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   result.optimiser = std::move(best.optimiser);
   result.lowOrderOptimiser = std::move(best.lowOrderOptimiser);
   result.boundaryLayer = std::move(best.layer);
-  if (result.boundaryLayer) result.boundaryLayer->releasedAroundInvalid = best.layerReleased;
+  if (result.boundaryLayer) result.boundaryLayer->release = best.layerRelease;
 
   if (options.boundaryLayer) {
     StageClock split("split_layers", result.timings, observer);
-    LayerSplitStats stats;
-    result.mesh = splitBoundaryLayer(result.mesh, options.boundaryLayer->splitCoordinates(),
-                                     result.cad.get(), &stats);
-    result.layerSplit = stats;
+    // Split with the columns adjusted to the grown heights; where that makes thin cells
+    // invalid, or worse than half the macro mesh's worst (the plain split, a sub-map of each
+    // macro cell, keeps that), their columns are split plain and the split made again.
+    const Mesh macro = std::move(result.mesh);
     result.macroQuality = std::move(result.quality);
-    result.quality = evaluateQuality(result.mesh, options.threads);
+    const double poor = 0.5 * std::max(result.macroQuality->scaled.min, 0.0);
+    const int layers = options.boundaryLayer->layers;
+    LayerHeights heights{grownLayerHeights(best.linear), {}};
+    LayerSplitStats stats;
+    for (int attempt = 0;; ++attempt) {
+      stats = LayerSplitStats();
+      result.mesh = splitBoundaryLayer(macro, options.boundaryLayer->splitCoordinates(),
+                                       result.cad.get(), &stats, &heights);
+      result.quality = evaluateQuality(result.mesh, options.threads);
+      if (attempt == kPlainSplitAttempts) break;
+      const std::size_t before = heights.plain.size();
+      for (std::size_t e = 0; e < result.quality.validity.size(); ++e)
+        if (result.quality.validity[e] != Validity::Valid ||
+            result.quality.scaledJacobian[e] < poor)
+          keepColumnsPlain(macro, layers, e, heights);
+      if (heights.plain.size() == before) break;  // none (left) in the layer
+    }
+    result.layerSplit = stats;
+    if (result.boundaryLayer && stats.firstHeightMeasured > 0) {
+      result.boundaryLayer->firstHeightMin = stats.firstHeightMin;
+      result.boundaryLayer->firstHeightMax = stats.firstHeightMax;
+      result.boundaryLayer->firstHeightDeviation = stats.firstHeightDeviation;
+      result.boundaryLayer->firstHeightCornerDeviation = stats.firstHeightCornerDeviation;
+      result.boundaryLayer->cornerCells = stats.cornerCells;
+    }
     split.done();
   }
 

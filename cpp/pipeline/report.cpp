@@ -185,6 +185,9 @@ void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
   json.beginObject("first_height");
   json.value("min", r.firstHeightMin);
   json.value("max", r.firstHeightMax);
+  json.value("worst_deviation", r.firstHeightDeviation);
+  json.value("corner_cells", r.cornerCells);
+  json.value("worst_deviation_at_corners", r.firstHeightCornerDeviation);
   json.endObject();
   json.beginArray("shrunk");
   for (const LayerShrink& s : r.shrunk) {
@@ -200,7 +203,8 @@ void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
   json.value("side_quadrilaterals", r.sideQuadrilaterals);
   json.value("wall_nodes", r.wallNodes);
   json.value("shrink_passes", static_cast<std::size_t>(r.shrinkPasses));
-  json.value("released_around_invalid", r.releasedAroundInvalid);
+  json.value("released_around_invalid", r.release != LayerRelease::None);
+  json.value("release", std::string(layerReleaseName(r.release)));
   if (result.macroQuality) {
     json.value("macro_worst_scaled_jacobian", result.macroQuality->scaled.min);
     json.value("macro_invalid", result.macroQuality->invalid);
@@ -209,6 +213,7 @@ void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
   if (result.layerSplit) {
     json.value("split_projected_nodes", result.layerSplit->projected);
     json.value("split_max_projection", result.layerSplit->maxProjection);
+    json.value("split_plain_columns", result.layerSplit->plainColumns);
   }
   json.value("seconds", r.seconds);
   json.endObject();

@@ -247,6 +247,45 @@ TEST(Optimiser, RegionRestrictsTheMovingNodes) {
   EXPECT_GT(optimiseMesh(all, options).freeNodes, r.freeNodes);
 }
 
+// A boundary layer's top released around invalid elements slides parallel to its wall: a node
+// with a locked direction moves only perpendicular to it (to rounding), the rest as before.
+TEST(Optimiser, LockedNodesMoveOnlyPerpendicularToTheirDirection) {
+  Mesh mesh = readMesh(peer("varopti_cube_sphere.msh"));
+  const Mesh input = mesh;
+  OptimiserOptions options;
+  options.maxIterations = 3;
+  options.regionThreshold = 1.0;  // every element: the optimiser works on the mesh's own nodes
+  options.normalLocked.assign(3 * mesh.numNodes(), std::nan(""));
+  const Eigen::Vector3d n = Eigen::Vector3d(1.0, 2.0, 2.0) / 3.0;
+  for (std::size_t i = 0; i < mesh.numNodes(); i += 2)  // every other node
+    for (int d = 0; d < 3; ++d) options.normalLocked[3 * i + static_cast<std::size_t>(d)] = n(d);
+  const OptimiserResult r = optimiseMesh(mesh, options);
+  std::size_t lockedMoved = 0, freeMoved = 0;
+  double worstAlong = 0.0, scale = 0.0;
+  for (std::size_t i = 0; i < mesh.numNodes(); ++i) {
+    const Eigen::Vector3d move =
+        Eigen::Vector3d(&mesh.xyz[3 * i]) - Eigen::Vector3d(&input.xyz[3 * i]);
+    if (move.isZero(0.0)) continue;
+    scale = std::max(scale, Eigen::Vector3d(&input.xyz[3 * i]).norm());
+    if (i % 2 == 0) {
+      ++lockedMoved;
+      worstAlong = std::max(worstAlong, std::fabs(move.dot(n)));
+    } else {
+      ++freeMoved;
+    }
+  }
+  EXPECT_GT(lockedMoved, 100U);
+  EXPECT_GT(freeMoved, 100U);
+  // Each accepted step is t s with t perpendicular to n: its component along n is rounding of
+  // the coordinates (a few units of 1e-16 of their size per step, three sweeps plus focus).
+  EXPECT_LE(worstAlong, 1e-13 * scale);
+  EXPECT_EQ(r.invalidAfter, 0U);
+  EXPECT_GT(r.worstAfter, r.worstBefore);
+  options.normalLocked.resize(5);
+  Mesh again = input;
+  EXPECT_THROW(optimiseMesh(again, options), ParameterError);
+}
+
 TEST(Optimiser, BadOptionsAreRefused) {
   Mesh mesh = elevateOrder(twoTetrahedra(1), 2, nullptr);
   OptimiserOptions options;
