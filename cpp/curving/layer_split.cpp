@@ -18,6 +18,10 @@ namespace {
 
 constexpr std::int64_t kNone = std::numeric_limits<std::int64_t>::max();
 
+// A wall node is at a sharp corner when the mean of its cells' unit wall normals is shorter than
+// this (cos 15 degrees: the normals spread by more than about 30 degrees).
+constexpr double kCornerMeanNormal = 0.966;
+
 // A node of the split layer: up to three wall vertices with integer weights (summing to the
 // order P) and the level across the layer, 0 (wall) .. n P (top).
 using NodeKey = std::array<std::int64_t, 7>;
@@ -255,7 +259,6 @@ class LayerSplitter {
     if (n == normals_.end() || count == normalCount_.end()) return false;
     return n->second.norm() < kCornerMeanNormal * count->second;
   }
-  static constexpr double kCornerMeanNormal = 0.966;  // cos 15 degrees
 
   // The first split layer's height along the wall normal at the wall's quadrature points
   // (exact to degree 2P), in stats_: its range and, with grown heights, its worst deviation
@@ -606,7 +609,7 @@ void keepColumnsPlain(const Mesh& macro, int layers, std::size_t element, LayerH
 
 std::vector<double> layerTopNormals(const Mesh& mesh) {
   std::vector<double> normals(3 * mesh.numNodes(), 0.0);
-  std::vector<char> top(mesh.numNodes(), 0);
+  std::vector<int> top(mesh.numNodes(), 0);  // cells summed at the node
   for (const ElementBlock& b : mesh.blocks) {
     const bool prism = b.type == CellType::Prism && mesh.dim == 3;
     const bool quad = b.type == CellType::Quadrilateral && mesh.dim == 2;
@@ -628,16 +631,18 @@ std::vector<double> layerTopNormals(const Mesh& mesh) {
         const Eigen::Vector3d n =
             wallNormal(mesh, ref, v, double(c[0]) / p, prism ? double(c[1]) / p : 0.0, rise);
         for (std::size_t d = 0; d < 3; ++d) normals[3 * id + d] += n(static_cast<Eigen::Index>(d));
-        top[id] = 1;
+        ++top[id];
       }
     }
   }
   for (std::size_t id = 0; id < mesh.numNodes(); ++id) {
     const Eigen::Vector3d n(&normals[3 * id]);
     const double length = n.norm();
+    // Above a sharp corner (the cells' normals spread by more than about 30 degrees) the
+    // column follows the corner's bisector and no plane keeps both walls' heights: free.
+    const bool smooth = length >= kCornerMeanNormal * top[id] && length > 0.0;
     for (std::size_t d = 0; d < 3; ++d)
-      normals[3 * id + d] =
-          top[id] != 0 && length > 0.0 ? normals[3 * id + d] / length : std::nan("");
+      normals[3 * id + d] = top[id] != 0 && smooth ? normals[3 * id + d] / length : std::nan("");
   }
   return normals;
 }

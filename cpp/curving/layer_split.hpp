@@ -74,7 +74,9 @@ void keepColumnsPlain(const Mesh& macro, int layers, std::size_t element, LayerH
 
 // Per node (3 values): for the nodes of a macro layer's top (prisms' and, in 2D,
 // quadrilaterals' far side), the unit wall normal below them (averaged over the cells sharing
-// the node); NaN for every other node. OptimiserOptions::normalLocked takes it.
+// the node); NaN for every other node and for nodes above a sharp corner (the cells' normals
+// spread by more than about 30 degrees: they may move freely). OptimiserOptions::normalLocked
+// takes it.
 std::vector<double> layerTopNormals(const Mesh& mesh);
 
 // Per node of a linear mesh with a macro layer: the distance from each wall vertex to its top
