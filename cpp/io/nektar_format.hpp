@@ -38,6 +38,9 @@ inline constexpr const char* kTriEvenlySpaced = "NodalTriEvenlySpaced";
 inline constexpr std::int64_t kEvenlySpacedId = 17;
 inline constexpr std::int64_t kTriEvenlySpacedId = 24;
 inline constexpr std::int64_t kGaussLobattoLegendreId = 4;
+inline constexpr const char* kGaussLobattoLegendre = "GaussLobattoLegendre";
+inline constexpr std::int64_t kTriElecId = 22;  // NodalTriElec, as NekMesh writes triangles
+inline constexpr std::int64_t kTriFeketeId = 23;
 
 // Element letters: 3D A (tetrahedron), R (prism), H (hexahedron); faces and 2D elements T, Q.
 char letter(CellType type);

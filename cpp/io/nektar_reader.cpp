@@ -16,6 +16,7 @@
 
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 #include "io/nektar_format.hpp"
 #include "io/xml_document.hpp"
@@ -41,7 +42,48 @@ struct Element {
 
 struct Curve {
   std::vector<Point> points;
+  std::string type;  // Nektar++'s points type (PolyEvenlySpaced, GaussLobattoLegendre, ...)
 };
+
+// The name of a Nektar++ 5.x PointsType value as a compressed CURVED record stores it.
+std::string pointsTypeName(std::int64_t value) {
+  switch (value) {
+    case nektar::kEvenlySpacedId:
+      return nektar::kEvenlySpaced;
+    case nektar::kTriEvenlySpacedId:
+      return nektar::kTriEvenlySpaced;
+    case nektar::kGaussLobattoLegendreId:
+      return nektar::kGaussLobattoLegendre;
+    case nektar::kTriElecId:
+      return "NodalTriElec";
+    case nektar::kTriFeketeId:
+      return "NodalTriFekete";
+    default:
+      return "points type " + std::to_string(value);
+  }
+}
+
+// The n Gauss-Lobatto-Legendre points on [0, 1] (the ends and the Gauss-Jacobi(1, 1) points).
+std::vector<double> lobattoPoints(int n) {
+  std::vector<double> x, w;
+  if (n > 2) gaussJacobi(n - 2, 1.0, 1.0, x, w);
+  std::vector<double> t{0.0};
+  for (const double z : x) t.push_back(0.5 * (z + 1.0));
+  t.push_back(1.0);
+  return t;
+}
+
+// Values at `to` of the polynomial through (from[k], v[k]) (Lagrange form).
+Point interpolate(const std::vector<double>& from, const std::vector<Point>& v, double to) {
+  Point sum = Point::Zero();
+  for (std::size_t k = 0; k < from.size(); ++k) {
+    double l = 1.0;
+    for (std::size_t j = 0; j < from.size(); ++j)
+      if (j != k) l *= (to - from[j]) / (from[k] - from[j]);
+    sum += l * v[k];
+  }
+  return sum;
+}
 
 class Reader {
  public:
@@ -97,6 +139,11 @@ class Reader {
       CellType type, const std::vector<int>& v,
       const std::map<std::vector<int>, std::vector<std::int64_t>>& faceByVertices);
   void fill(CellType type, const std::vector<std::int64_t>& nodes);
+  void toEvenlySpaced();
+  void fillPrism(const ReferenceElement& ref, const std::map<Lattice, std::int64_t>& at,
+                 const std::vector<int>& unknown);
+  void fillTransfinite(CellType type, const ReferenceElement& ref,
+                       const std::map<Lattice, std::int64_t>& at, const std::vector<int>& unknown);
 
   std::string path_;
   int dim_ = 3;
@@ -357,6 +404,7 @@ void Reader::readCurves(const XmlElement& section) {
                 index.size())
           fail(what + " points outside DATAPOINTS/INDEX");
         Curve curve;
+        curve.type = pointsTypeName(c.pointsType);
         for (std::int64_t k = 0; k < c.numPoints; ++k) {
           const std::int64_t at = index[static_cast<std::size_t>(c.offset + k)];
           if (at < 0 || static_cast<std::uint64_t>(at) >= points.size())
@@ -380,6 +428,7 @@ void Reader::readCurves(const XmlElement& section) {
     const std::vector<double> v = numbers(child->text, what);
     if (v.size() % 3 != 0) fail(what + " has a point with fewer than 3 coordinates");
     Curve c;
+    c.type = child->attribute("TYPE", nektar::kEvenlySpaced);
     for (std::size_t k = 0; k + 2 < v.size(); k += 3)
       c.points.emplace_back(v[k], v[k + 1], v[k + 2]);
     (edge ? edgeCurves_ : faceCurves_)[entity] = c;
@@ -454,6 +503,13 @@ std::vector<int> Reader::elementVertices(const Element& e) const {
       const int e8 = sharedEdge(f[2], f[4]);
       const int v1 = common(e0, e1), v0 = otherEnd(e0, v1), v2 = otherEnd(e1, v1);
       const int v3 = otherEnd(e2, v2), v4 = common(e8, e4), v5 = otherEnd(e8, v4);
+      // Nektar++ builds each triangular face around the prism's apex vertices (4 and 5) and
+      // refuses the element ("orientation of triangular face ... is inconsistent") unless each
+      // apex is its triangle's own third vertex (the one its edge loop reaches last).
+      if (face(f[1]).vertices.at(2) != v4 || face(f[3]).vertices.at(2) != v5)
+        fail("prism " + std::to_string(e.id) + ": its apex vertices (" + std::to_string(v4) + ", " +
+             std::to_string(v5) +
+             ") are not the third vertices of its triangular faces, which Nektar++ refuses");
       // Nektar++ (v0..v5) to Gmsh: triangles (v4 v1 v0) and (v5 v2 v3).
       return {v4, v1, v0, v5, v2, v3};
     }
@@ -561,6 +617,14 @@ void Reader::fill(CellType type, const std::vector<std::int64_t>& nodes) {
     if (!known_[nodes[n]]) unknown.push_back(n);
   }
   if (unknown.empty()) return;
+  if (type == CellType::Prism) {
+    fillPrism(ref, at, unknown);
+    return;
+  }
+  if (type == CellType::Quadrilateral || type == CellType::Hexahedron) {
+    fillTransfinite(type, ref, at, unknown);
+    return;
+  }
   std::vector<Lattice> stencil{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   if (type == CellType::Triangle || type == CellType::Tetrahedron || type == CellType::Prism)
     stencil.push_back({1, -1, 0});
@@ -595,6 +659,157 @@ void Reader::fill(CellType type, const std::vector<std::int64_t>& nodes) {
   for (const int u : unknown) known_[nodes[u]] = true;
 }
 
+// A quadrilateral's (hexahedron's) unknown nodes by transfinite (Coons, Gordon-Hall)
+// interpolation with linear blending of its edges (faces): exactly what Nektar++ builds, whose
+// expansion of the map has no interior modes (its modes are products of 1D modes, the
+// boundary ones those with a linear factor, so the map without interior modes is this blend).
+void Reader::fillTransfinite(CellType type, const ReferenceElement& ref,
+                             const std::map<Lattice, std::int64_t>& at,
+                             const std::vector<int>& unknown) {
+  const int p = order_;
+  const int dims = type == CellType::Hexahedron ? 3 : 2;
+  const auto x = [&](const Lattice& l) {
+    return Point(Eigen::Map<const Point>(&mesh_.xyz[3 * at.at(l)]));
+  };
+  for (const int u : unknown) {
+    const Lattice& l = ref.lattice()[u];
+    // Sum over the subsets S of the axes (not empty) of (-1)^(|S|+1) times the blend that
+    // takes the axes in S to their ends (weights 1 - t, t) and keeps the others.
+    Point sum = Point::Zero();
+    for (int mask = 1; mask < (1 << dims); ++mask) {
+      const int size = __builtin_popcount(static_cast<unsigned>(mask));
+      const double sign = size % 2 == 1 ? 1.0 : -1.0;
+      for (int ends = 0; ends < (1 << dims); ++ends) {
+        if ((ends & ~mask) != 0) continue;  // only the axes in S take an end
+        Lattice m = l;
+        double w = 1.0;
+        for (int d = 0; d < dims; ++d) {
+          if ((mask & (1 << d)) == 0) continue;
+          const double t = double(l[static_cast<std::size_t>(d)]) / p;
+          const bool high = (ends & (1 << d)) != 0;
+          m[static_cast<std::size_t>(d)] = high ? p : 0;
+          w *= high ? t : 1.0 - t;
+        }
+        if (w != 0.0) sum += sign * w * x(m);
+      }
+    }
+    double* out = &mesh_.xyz[3 * at.at(l)];
+    for (int c = 0; c < 3; ++c) out[c] = sum[c];
+  }
+  for (const int u : unknown) known_[at.at(ref.lattice()[u])] = true;
+}
+
+// A prism's unknown nodes by transfinite (Gordon-Hall) interpolation: at level k of p, the
+// blend (1 - s) B + s T of the bottom and top triangles' nodes above and below (s = k / p),
+// corrected by how far the side faces at that level depart from the same blend, that
+// correction extended into the triangle harmonically (each interior value the mean of its six
+// lattice neighbours). A prism whose columns are straight (a boundary layer's) is rebuilt
+// exactly, as in Nektar++, whose expansion of such a map has no interior modes; averaging
+// across a thin curved prism instead (the plain harmonic extension) moves its interior by the
+// wall's sagitta and inverts it.
+void Reader::fillPrism(const ReferenceElement& ref, const std::map<Lattice, std::int64_t>& at,
+                       const std::vector<int>& unknown) {
+  const int p = order_;
+  const auto x = [&](int a, int b, int c) {
+    return Point(Eigen::Map<const Point>(&mesh_.xyz[3 * at.at({a, b, c})]));
+  };
+  std::vector<char> levelDone(static_cast<std::size_t>(p + 1), 0);
+  for (const int u : unknown) {
+    const int k = ref.lattice()[u][2];
+    if (k <= 0 || k >= p || levelDone[static_cast<std::size_t>(k)] != 0) continue;
+    levelDone[static_cast<std::size_t>(k)] = 1;
+    const double s = double(k) / p;
+    // The correction at this level: known on the triangle's ring, 0 inside to start.
+    std::map<std::pair<int, int>, Point> delta;
+    for (int a = 0; a <= p; ++a)
+      for (int b = 0; a + b <= p; ++b) {
+        const bool ring = a == 0 || b == 0 || a + b == p;
+        delta[{a, b}] =
+            ring ? Point(x(a, b, k) - (1 - s) * x(a, b, 0) - s * x(a, b, p)) : Point(Point::Zero());
+      }
+    double scale = 0.0;
+    for (const auto& [ab, d] : delta) scale = std::max(scale, d.norm());
+    const int steps[6][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, -1}, {-1, 1}};
+    for (int sweep = 0; sweep < 10000 && scale > 0.0; ++sweep) {
+      double change = 0.0;
+      for (auto& [ab, d] : delta) {
+        const auto [a, b] = ab;
+        if (a == 0 || b == 0 || a + b == p) continue;
+        Point sum = Point::Zero();
+        for (const auto& st : steps) sum += delta.at({a + st[0], b + st[1]});
+        const Point next = sum / 6.0;
+        change = std::max(change, (next - d).norm());
+        d = next;
+      }
+      if (change <= 1e-15 * scale) break;
+    }
+    for (int a = 1; a < p; ++a)
+      for (int b = 1; a + b < p; ++b) {
+        const Point v = (1 - s) * x(a, b, 0) + s * x(a, b, p) + delta.at({a, b});
+        double* out = &mesh_.xyz[3 * at.at({a, b, k})];
+        for (int c = 0; c < 3; ++c) out[c] = v[c];
+      }
+  }
+  for (const int u : unknown) known_[at.at(ref.lattice()[u])] = true;
+}
+
+// The curves' points at our node positions (equispaced), from the points types Nektar++ and
+// NekMesh write: edges and quadrilaterals at Gauss-Lobatto-Legendre points are resampled
+// through their interpolating polynomial (exact: the same polynomial). A triangle's
+// electrostatic or Fekete interior points (NekMesh writes NodalTriElec) have no closed form
+// here: its interior is rebuilt from its edges (fill) and the file's interior points are not
+// used. Other points types are refused.
+void Reader::toEvenlySpaced() {
+  const std::size_t n = static_cast<std::size_t>(order_) + 1;
+  std::vector<double> even(n);
+  for (std::size_t k = 0; k < n; ++k) even[k] = double(k) / order_;
+  const std::vector<double> lobatto = lobattoPoints(order_ + 1);
+  // The polynomial through `v` at the GLL points, at the equispaced points.
+  const auto resample = [&](const std::vector<Point>& v) {
+    std::vector<Point> out;
+    out.reserve(n);
+    for (const double t : even) out.push_back(interpolate(lobatto, v, t));
+    return out;
+  };
+  for (auto& [id, c] : edgeCurves_) {
+    if (c.type == nektar::kEvenlySpaced) continue;
+    if (c.type != nektar::kGaussLobattoLegendre)
+      fail("edge " + std::to_string(id) + "'s curve has " + c.type + ", not supported");
+    c.points = resample(c.points);
+    c.type = nektar::kEvenlySpaced;
+  }
+  std::vector<int> dropped;
+  for (auto& [id, c] : faceCurves_) {
+    if (c.type == nektar::kEvenlySpaced || c.type == nektar::kTriEvenlySpaced) continue;
+    const bool quad = c.points.size() == n * n;
+    if (quad && c.type == nektar::kGaussLobattoLegendre) {
+      std::vector<Point> rows;  // the first direction resampled, row by row
+      rows.reserve(n * n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto from = c.points.begin() + static_cast<std::ptrdiff_t>(i * n);
+        const std::vector<Point> row =
+            resample(std::vector<Point>(from, from + static_cast<std::ptrdiff_t>(n)));
+        rows.insert(rows.end(), row.begin(), row.end());
+      }
+      std::vector<Point> out(n * n);
+      for (std::size_t j = 0; j < n; ++j) {
+        std::vector<Point> column;
+        column.reserve(n);
+        for (std::size_t i = 0; i < n; ++i) column.push_back(rows[i * n + j]);
+        const std::vector<Point> resampled = resample(column);
+        for (std::size_t i = 0; i < n; ++i) out[i * n + j] = resampled[i];
+      }
+      c.points = std::move(out);
+      c.type = nektar::kEvenlySpaced;
+    } else if (!quad && (c.type == "NodalTriElec" || c.type == "NodalTriFekete")) {
+      dropped.push_back(id);
+    } else {
+      fail("face " + std::to_string(id) + "'s curve has " + c.type + ", not supported");
+    }
+  }
+  for (const int id : dropped) faceCurves_.erase(id);
+}
+
 Mesh Reader::read() {
   std::ifstream in(path_);
   if (!in) throw IoError("mesh file '" + path_ + "' cannot be read");
@@ -627,6 +842,7 @@ Mesh Reader::read() {
     if (static_cast<int>(c.points.size()) != order_ + 1)
       fail("curved edges have different numbers of points");
   if (order_ < 1 || order_ > kMaxOrder) fail("curves of order " + std::to_string(order_));
+  toEvenlySpaced();
   mesh_.dim = dim_;
   mesh_.order = order_;
   for (const auto& [id, p] : vertices_) vertexNode_[id] = newNode(p, true);

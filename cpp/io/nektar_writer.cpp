@@ -48,6 +48,7 @@ class Builder {
   explicit Builder(const Mesh& mesh) : mesh_(mesh), p_(mesh.order) {
     for (const ElementBlock& block : mesh.blocks)
       if (block.order != p_) throw ParameterError("Nektar++ output needs one element order");
+    numberVertices();
     for (const ElementBlock& block : mesh.blocks) {
       if (cellDimension(block.type) != mesh.dim) continue;
       const ReferenceElement& ref = ReferenceElement::get(block.type, p_);
@@ -77,6 +78,39 @@ class Builder {
  private:
   Point nodePoint(std::int64_t node) const {
     return {mesh_.xyz[3 * node], mesh_.xyz[3 * node + 1], mesh_.xyz[3 * node + 2]};
+  }
+
+  // Vertex ids, given before any element is added. Nektar++ builds a prism's triangular faces
+  // around its apex vertices (4 and 5), and reads a shared triangle's own orientation (vertex
+  // order by ascending id) only if each apex has the highest id of its triangle. Vertices
+  // joined by a prism's edge between its triangles (a boundary layer's columns) are numbered
+  // as one run, the runs in order of their smallest node: then the column of a prism holding
+  // the highest id holds it in both triangles, and that column is the apex (addElement).
+  // Other vertices are numbered in node order among the runs.
+  void numberVertices() {
+    std::map<std::int64_t, std::int64_t> parent;  // union-find over vertex nodes
+    const auto find = [&](std::int64_t n) {
+      auto it = parent.try_emplace(n, n).first;
+      while (it->second != it->first) it = parent.find(it->second);
+      return it->first;
+    };
+    for (const ElementBlock& block : mesh_.blocks) {
+      if (cellDimension(block.type) != mesh_.dim) continue;
+      const int nv = cellNumVertices(block.type);
+      for (std::size_t e = 0; e < block.count(); ++e) {
+        const std::int64_t* nodes = block.element(e);
+        for (int k = 0; k < nv; ++k) find(nodes[k]);
+        if (block.type != CellType::Prism) continue;
+        for (int k = 0; k < 3; ++k) {
+          const std::int64_t a = find(nodes[k]), b = find(nodes[k + 3]);
+          if (a != b) parent[std::max(a, b)] = std::min(a, b);
+        }
+      }
+    }
+    std::map<std::int64_t, std::vector<std::int64_t>> runs;  // smallest node -> its run
+    for (const auto& entry : parent) runs[find(entry.first)].push_back(entry.first);
+    for (const auto& [root, nodes] : runs)
+      for (const std::int64_t n : nodes) vertex(n);
   }
 
   int vertex(std::int64_t node) {

@@ -8,8 +8,10 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <gp_Pln.hxx>
 #include <map>
+#include <sstream>
 
 #include "core/error.hpp"
 #include "curving/order_elevation.hpp"
@@ -319,6 +321,83 @@ TEST(NektarXml, RoundTripsPlainAndCompressed) {
                     kJacobianBoundTolerance);
       }
     }
+}
+
+// NekMesh writes curved edges at Gauss-Lobatto-Legendre points (TYPE="GaussLobattoLegendre")
+// and triangles at electrostatic points (NodalTriElec); read as if equispaced, its meshes came
+// out tangled (its 3d_bl_cyl: every prism inverted; the sphere in a box at order 6: 294 invalid
+// where Nektar++ finds 10). A straight tetrahedron at order 4 whose edge 0-1 bulges along the
+// parabola x(t) = a + t (b - a) + 4 t (1 - t) h, given at the 5 GLL points: the equispaced
+// nodes read back are the same parabola's, to rounding; an electrostatic triangle's interior
+// points are not used (rebuilt from the edges), and an unknown points type is refused.
+TEST(NektarXml, CurvesAtGaussLobattoPointsAreResampledExactly) {
+  const std::vector<double> gll{0.0, 0.5 - std::sqrt(21.0) / 14.0, 0.5,
+                                0.5 + std::sqrt(21.0) / 14.0, 1.0};  // on [0, 1], 5 points
+  const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), h(0, -0.1, 0.05);
+  const auto curve = [&](double t) {
+    return Eigen::Vector3d(a + t * (b - a) + 4 * t * (1 - t) * h);
+  };
+  std::ostringstream pts;
+  pts.precision(17);
+  for (const double t : gll)
+    pts << curve(t).x() << ' ' << curve(t).y() << ' ' << curve(t).z() << ' ';
+  const auto file = [&](const std::string& edgeType, const std::string& faceCurve) {
+    std::ostringstream x;
+    x << R"(<NEKTAR><GEOMETRY DIM="3" SPACE="3"><VERTEX><V ID="0">0 0 0</V><V ID="1">1 0 0</V>)"
+      << R"(<V ID="2">0 1 0</V><V ID="3">0 0 1</V></VERTEX><EDGE><E ID="0">0 1</E>)"
+      << R"(<E ID="1">1 2</E><E ID="2">0 2</E><E ID="3">0 3</E><E ID="4">1 3</E>)"
+      << R"(<E ID="5">2 3</E></EDGE><FACE><T ID="0">0 1 2</T><T ID="1">0 4 3</T>)"
+      << R"(<T ID="2">1 5 4</T><T ID="3">2 5 3</T></FACE><ELEMENT><A ID="0">0 1 2 3</A>)"
+      << R"(</ELEMENT><CURVED><E ID="0" EDGEID="0" NUMPOINTS="5" TYPE=")" << edgeType << R"(">)"
+      << pts.str() << "</E>" << faceCurve
+      << R"(</CURVED><COMPOSITE><C ID="0"> A[0] </C></COMPOSITE><DOMAIN> C[0] </DOMAIN>)"
+      << "</GEOMETRY></NEKTAR>";
+    std::string path = (test::tempDir() / "gll.xml").string();
+    std::ofstream(path) << x.str();
+    return path;
+  };
+  const Mesh m = readMesh(file("GaussLobattoLegendre", ""));
+  ASSERT_EQ(m.order, 4);
+  const ElementBlock& tets = m.blocks[0];
+  ASSERT_EQ(tets.type, CellType::Tetrahedron);
+  const ReferenceElement& ref = ReferenceElement::get(CellType::Tetrahedron, 4);
+  std::size_t checked = 0;
+  for (int n = 0; n < ref.numNodes(); ++n) {
+    const LatticePoint& l = ref.lattice()[static_cast<std::size_t>(n)];
+    const Eigen::Vector3d x(&m.xyz[3 * static_cast<std::size_t>(tets.element(0)[n])]);
+    // The nodes on the line from (0, 0, 0) to (1, 0, 0): the curved edge, wherever the reader
+    // put its vertices in the element.
+    if (l[1] != 0 || l[2] != 0) continue;
+    const Eigen::Vector3d v0(&m.xyz[3 * static_cast<std::size_t>(tets.element(0)[0])]);
+    const Eigen::Vector3d v1(&m.xyz[3 * static_cast<std::size_t>(tets.element(0)[1])]);
+    if (!((v0 - a).norm() == 0.0 && (v1 - b).norm() == 0.0)) continue;
+    // Lagrange weights of 5 points summing values of size 1: rounding of a few ulps.
+    EXPECT_LE((x - curve(double(l[0]) / 4)).norm(), 1e-14) << "lattice " << l[0];
+    ++checked;
+  }
+  if (checked == 0) {  // the edge is another pair of the element's vertices: find it by position
+    for (int k = 1; k < 4; ++k) {
+      const double t = double(k) / 4;
+      bool found = false;
+      for (int n = 0; n < ref.numNodes(); ++n)
+        found =
+            found ||
+            (Eigen::Vector3d(&m.xyz[3 * static_cast<std::size_t>(tets.element(0)[n])]) - curve(t))
+                    .norm() <= 1e-14;
+      EXPECT_TRUE(found) << "the parabola's point at t = " << t;
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 3U);
+  EXPECT_EQ(evaluateQuality(m).invalid, 0U);
+  // A triangle at electrostatic points: its points are not used, the element still reads.
+  std::ostringstream tri;
+  tri << R"(<F ID="1" FACEID="0" NUMPOINTS="15" TYPE="NodalTriElec">)";
+  for (int k = 0; k < 15; ++k) tri << "9 9 9 ";  // nonsense: must not be used
+  tri << "</F>";
+  const Mesh withTriangle = readMesh(file("GaussLobattoLegendre", tri.str()));
+  for (const double c : withTriangle.xyz) EXPECT_LT(c, 2.0);
+  EXPECT_THROW(readMesh(file("GaussRadauMLegendre", "")), IoError);
 }
 
 TEST(PeerMeshes, WorstScaledJacobianAgreesWithGmsh) {

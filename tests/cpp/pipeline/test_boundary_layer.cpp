@@ -235,6 +235,74 @@ TEST_F(CylinderCase, IsCertifiedValidWithTheRequestedLayersInEveryWallColumn) {
 // 4.1 %, against 9.7 % with the levels alone and 13 % with the top moving freely). The
 // report's own figure (LayerSplitStats) is checked against this independent one.
 constexpr double kEndBand = 0.05;
+// The Nektar++ XML of the order-4 cylinder read back: the same elements, and every node the file
+// stores (vertices, edge and face points: all but the interior of each 3D element, which
+// Nektar++ rebuilds from the faces itself) bit for bit among the same element's nodes.
+// Nektar++'s own reader refused this file until the writer numbered the layer's columns as
+// runs (a prism's triangles need their apex vertices to carry their highest ids); NekMesh's
+// jac module now reads it and finds no negative Jacobian (bench/boundary_layer with NEKMESH).
+TEST(BoundaryLayer, NektarXmlOfTheSplitLayerReadsBackEveryStoredNodeExactly) {
+  CaseSetup setup = setupCase(kCylinderCase);
+  setup.options.order = 4;
+  setup.options.optimiseIterations = 0;  // the geometry as split; the optimiser is not the point
+  setup.options.repairRounds = 0;
+  const MeshResult r = runMeshPipeline(setup.source, setup.options);
+  const Mesh& a = r.mesh;
+  const auto dir = test::tempDir();
+  const std::string path = (dir / "cyl4.xml").string();
+  writeMeshFiles(r, {path});
+  const Mesh b = readMesh(path);
+  ASSERT_EQ(b.order, 4);
+  // a's 3D elements by their sorted vertex coordinates.
+  using Key = std::vector<std::array<double, 3>>;
+  const auto key = [](const Mesh& m, const std::int64_t* v, int nv) {
+    Key k;
+    for (int i = 0; i < nv; ++i)
+      k.push_back({m.xyz[3 * v[i]], m.xyz[3 * v[i] + 1], m.xyz[3 * v[i] + 2]});
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  std::map<Key, const std::int64_t*> elements;
+  std::map<CellType, std::size_t> countA, countB;
+  for (const ElementBlock& blk : a.blocks)
+    if (cellDimension(blk.type) == 3)
+      for (std::size_t e = 0; e < blk.count(); ++e, ++countA[blk.type])
+        elements[key(a, blk.element(e), cellNumVertices(blk.type))] = blk.element(e);
+  std::size_t stored = 0, interior = 0;
+  for (const ElementBlock& blk : b.blocks) {
+    if (cellDimension(blk.type) != 3) continue;
+    const ReferenceElement& ref = ReferenceElement::get(blk.type, 4);
+    for (std::size_t e = 0; e < blk.count(); ++e, ++countB[blk.type]) {
+      const std::int64_t* v = blk.element(e);
+      const auto it = elements.find(key(b, v, cellNumVertices(blk.type)));
+      ASSERT_NE(it, elements.end()) << "an element of the file is not in the mesh written";
+      std::set<std::array<double, 3>> nodesA;
+      for (int i = 0; i < ref.numNodes(); ++i) {
+        const std::int64_t n = it->second[i];
+        nodesA.insert({a.xyz[3 * n], a.xyz[3 * n + 1], a.xyz[3 * n + 2]});
+      }
+      for (int i = 0; i < ref.numNodes(); ++i) {
+        const LatticePoint& l = ref.lattice()[static_cast<std::size_t>(i)];
+        const bool inside = blk.type == CellType::Prism
+                                ? l[0] > 0 && l[1] > 0 && l[0] + l[1] < 4 && l[2] > 0 && l[2] < 4
+                                : l[0] > 0 && l[1] > 0 && l[2] > 0 && l[0] + l[1] + l[2] < 4;
+        if (inside) {
+          ++interior;
+          continue;
+        }
+        ++stored;
+        const std::int64_t n = v[i];
+        EXPECT_EQ(nodesA.count({b.xyz[3 * n], b.xyz[3 * n + 1], b.xyz[3 * n + 2]}), 1U)
+            << "node " << i << " of a " << cellShortName(blk.type);
+      }
+    }
+  }
+  EXPECT_EQ(countA, countB);
+  EXPECT_GT(countB[CellType::Prism], 0U);
+  EXPECT_GT(stored, 0U);
+  EXPECT_GT(interior, 0U);
+}
+
 TEST(BoundaryLayer, FirstLayerHeightAlongTheWallNormalIsWithinFivePercent) {
   double worstNearEnds = 0.0;
   CaseSetup setup = setupCase(kCylinderCase);
