@@ -412,15 +412,21 @@ TEST_F(CylinderCase, NektarAndGmshFilesCarryThePrismsAndReadBack) {
 namespace homesh {
 namespace {
 
-// NekMesh's 2d_bl_aerofoil case: a layer of thickness 0.1 on the aerofoil's two curves (Edge2,
-// Edge4), 6 layers, progression 1.5, at order 4 with the optimiser.
-TEST(BoundaryLayer2D, AerofoilIsValidWithSixQuadrilateralsOnEveryWallLineAndItsFirstHeight) {
+// NekMesh's meshgen case NAME.mcf at order 4 with the optimiser (100 sweeps, 2 threads): the
+// acceptance's path.
+MeshResult meshPeerCaseAtOrder4(const std::string& name) {
   CaseSetup setup =
-      setupCase(std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/meshgen/2d_bl_aerofoil.mcf");
+      setupCase(std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/meshgen/" + name + ".mcf");
   setup.options.order = 4;
   setup.options.optimiseIterations = 100;
   setup.options.threads = 2;
-  const MeshResult r = runMeshPipeline(setup.source, setup.options);
+  return runMeshPipeline(setup.source, setup.options);
+}
+
+// NekMesh's 2d_bl_aerofoil case: a layer of thickness 0.1 on the aerofoil's two curves (Edge2,
+// Edge4), 6 layers, progression 1.5, at order 4 with the optimiser.
+TEST(BoundaryLayer2D, AerofoilIsValidWithSixQuadrilateralsOnEveryWallLineAndItsFirstHeight) {
+  const MeshResult r = meshPeerCaseAtOrder4("2d_bl_aerofoil");
   ASSERT_TRUE(r.boundaryLayer.has_value());
   EXPECT_EQ(r.mesh.dim, 2);
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
@@ -494,12 +500,7 @@ TEST(BoundaryLayer2D, AerofoilIsValidWithSixQuadrilateralsOnEveryWallLineAndItsF
 // blade's sharpest turns free), so the split keeps the first layer's heights, and the split is
 // certified valid.
 TEST(BoundaryLayer2D, T106IsValidWithTheLayerReleasedOnlyParallelToTheWall) {
-  CaseSetup setup =
-      setupCase(std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/meshgen/2d_bl_t106.mcf");
-  setup.options.order = 4;
-  setup.options.optimiseIterations = 100;
-  setup.options.threads = 2;
-  const MeshResult r = runMeshPipeline(setup.source, setup.options);
+  const MeshResult r = meshPeerCaseAtOrder4("2d_bl_t106");
   ASSERT_TRUE(r.boundaryLayer.has_value());
   ASSERT_TRUE(r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
