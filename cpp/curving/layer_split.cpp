@@ -14,6 +14,12 @@
 #include "element/reference_element.hpp"
 
 namespace homesh {
+
+bool isLayerCell(const Mesh& mesh, const ElementBlock& block) {
+  return (block.type == CellType::Prism && mesh.dim == 3) ||
+         (block.type == CellType::Quadrilateral && mesh.dim == 2);
+}
+
 namespace {
 
 constexpr std::int64_t kNone = std::numeric_limits<std::int64_t>::max();
@@ -67,6 +73,46 @@ Eigen::Vector3d wallNormal(const Mesh& mesh, const ReferenceElement& ref, const 
   return n.dot(towards) < 0.0 ? Eigen::Vector3d(-n) : n;
 }
 
+// Calls visit(wall, top, normal) for every column of nodes of every layer cell of `mesh`: the
+// wall node, the top node above it, and the cell's unit wall normal there (towards the top).
+template <class Visit>
+void forEachColumn(const Mesh& mesh, Visit&& visit) {
+  for (const ElementBlock& b : mesh.blocks) {
+    if (!isLayerCell(mesh, b)) continue;
+    const int p = b.order;
+    const bool prism = b.type == CellType::Prism;
+    const std::size_t across = prism ? 2 : 1;
+    const ReferenceElement& ref = ReferenceElement::get(b.type, p);
+    const std::map<LatticePoint, int> index = latticeIndex(ref);
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      const std::int64_t* v = b.element(e);
+      for (int r = 0; r < ref.numNodes(); ++r) {
+        LatticePoint c = ref.lattice()[static_cast<std::size_t>(r)];
+        if (c[across] != 0) continue;
+        c[across] = p;
+        const std::int64_t top = v[index.at(c)];
+        const Eigen::Vector3d rise = Eigen::Vector3d(&mesh.xyz[3 * static_cast<std::size_t>(top)]) -
+                                     Eigen::Vector3d(&mesh.xyz[3 * static_cast<std::size_t>(v[r])]);
+        visit(v[r], top,
+              wallNormal(mesh, ref, v, double(c[0]) / p, prism ? double(c[1]) / p : 0.0, rise));
+      }
+    }
+  }
+}
+
+// The unit normals of the cells meeting at a node, summed.
+struct NormalSum {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  void add(const Eigen::Vector3d& n) {
+    sum += n;
+    ++count;
+  }
+  // A sharp corner: the normals spread by more than about 30 degrees (their mean is shorter
+  // than cos 15 degrees).
+  bool sharp() const { return sum.norm() < kCornerMeanNormal * count; }
+};
+
 class LayerSplitter {
  public:
   LayerSplitter(const Mesh& macro, const std::vector<double>& z, const CadModel* cad,
@@ -86,10 +132,10 @@ class LayerSplitter {
 
   Mesh run() {
     for (const ElementBlock& b : macro_.blocks)
-      if (layerCell(b)) {
-        pairWallAndTop(b);
-        addWallNormals(b);
-      }
+      if (layerCell(b)) pairWallAndTop(b);
+    forEachColumn(macro_, [this](std::int64_t wall, std::int64_t, const Eigen::Vector3d& n) {
+      normals_[wall].add(n);
+    });
     for (const ElementBlock& b : macro_.blocks) {
       if (layerCell(b))
         out_.blocks.push_back(splitCells(b));
@@ -117,19 +163,15 @@ class LayerSplitter {
   LayerSplitStats& stats_;
   int p_, n_;
   Mesh out_;
-  std::map<std::int64_t, Eigen::Vector3d> normals_;  // wall node -> sum of its cells' normals
-  std::map<std::int64_t, int> normalCount_;          // wall node -> cells summed there
-  std::map<std::int64_t, std::int64_t> topOf_;       // wall vertex -> top vertex
+  std::map<std::int64_t, NormalSum> normals_;   // wall node -> its cells' wall normals
+  std::map<std::int64_t, std::int64_t> topOf_;  // wall vertex -> top vertex
   std::map<NodeKey, std::int64_t> nodes_;
   std::map<std::int64_t, double> height_;  // wall vertex -> macro layer height there
   std::vector<char> projected_;
 
   // The macro layer's cells: prisms in 3D (wall 0, 1, 2; tops 3, 4, 5), quadrilaterals in 2D
   // (wall 0, 1; tops 3 above 0 and 2 above 1).
-  bool layerCell(const ElementBlock& b) const {
-    return (b.type == CellType::Prism && macro_.dim == 3) ||
-           (b.type == CellType::Quadrilateral && macro_.dim == 2);
-  }
+  bool layerCell(const ElementBlock& b) const { return isLayerCell(macro_, b); }
   static int wallVertices(const ElementBlock& b) { return b.type == CellType::Prism ? 3 : 2; }
   static std::int64_t topVertex(const ElementBlock& b, const std::int64_t* v, int k) {
     return b.type == CellType::Prism ? v[k + 3] : v[3 - k];
@@ -204,13 +246,13 @@ class LayerSplitter {
     const double target = grownHeight(v, wallVertices(b), l);
     const auto normal = normals_.find(w);
     if (n_ > 1 && plain_.count(w) == 0 && std::isfinite(target) && target > 0.0 &&
-        normal != normals_.end() && normal->second.norm() > 0.0) {
+        normal != normals_.end() && normal->second.sum.norm() > 0.0) {
       LatticePoint t = c;
       t[across] = p_;
       const Eigen::Vector3d x0(&macro_.xyz[3 * static_cast<std::size_t>(w)]);
       const Eigen::Vector3d rise =
           Eigen::Vector3d(&macro_.xyz[3 * static_cast<std::size_t>(v[index.at(t)])]) - x0;
-      const Eigen::Vector3d n = normal->second.normalized();
+      const Eigen::Vector3d n = normal->second.sum.normalized();
       const double height = rise.dot(n);
       if (height > 0.0) {
         const double z1 = z_[1];
@@ -228,36 +270,10 @@ class LayerSplitter {
     return columns_.emplace(w, std::move(col)).first->second;
   }
 
-  // Sums the wall normals of every layer cell at each of its wall nodes (normals_).
-  void addWallNormals(const ElementBlock& b) {
-    const ReferenceElement& ref = ReferenceElement::get(b.type, p_);
-    const std::map<LatticePoint, int> index = latticeIndex(ref);
-    const std::size_t across = b.type == CellType::Prism ? 2 : 1;
-    for (std::size_t e = 0; e < b.count(); ++e) {
-      const std::int64_t* v = b.element(e);
-      for (int r = 0; r < ref.numNodes(); ++r) {
-        LatticePoint c = ref.lattice()[static_cast<std::size_t>(r)];
-        if (c[across] != 0) continue;
-        c[across] = p_;
-        const Eigen::Vector3d rise =
-            Eigen::Vector3d(&macro_.xyz[3 * static_cast<std::size_t>(v[index.at(c)])]) -
-            Eigen::Vector3d(&macro_.xyz[3 * static_cast<std::size_t>(v[r])]);
-        const Eigen::Vector3d n = wallNormal(macro_, ref, v, double(c[0]) / p_,
-                                             across == 2 ? double(c[1]) / p_ : 0.0, rise);
-        auto [it, fresh] = normals_.emplace(v[r], n);
-        if (!fresh) it->second += n;
-        ++normalCount_[v[r]];
-      }
-    }
-  }
-
-  // Whether the walls of the cells around wall vertex `w` meet at a sharp corner: their
-  // normals there spread by more than about 30 degrees (their mean is shorter than cos 15).
+  // Whether the walls of the cells around wall vertex `w` meet at a sharp corner.
   bool atCorner(std::int64_t w) const {
     const auto n = normals_.find(w);
-    const auto count = normalCount_.find(w);
-    if (n == normals_.end() || count == normalCount_.end()) return false;
-    return n->second.norm() < kCornerMeanNormal * count->second;
+    return n != normals_.end() && n->second.sharp();
   }
 
   // The first split layer's height along the wall normal at the wall's quadrature points
@@ -518,9 +534,8 @@ void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops) {
     for (const ElementBlock& b : mesh.blocks) {
       // The layer's cells: prisms (wall 0, 1, 2, tops 3, 4, 5), in 2D quadrilaterals (wall 0,
       // 1, tops 3, 2); the lattice axis across the layer is the last.
-      const bool prism = b.type == CellType::Prism && mesh.dim == 3;
-      const bool quad = b.type == CellType::Quadrilateral && mesh.dim == 2;
-      if ((!prism && !quad) || b.order < 2) continue;
+      if (!isLayerCell(mesh, b) || b.order < 2) continue;
+      const bool prism = b.type == CellType::Prism;
       const int p = b.order;
       const int walls = prism ? 3 : 2;
       const std::size_t across = prism ? 2 : 1;
@@ -589,8 +604,7 @@ void keepColumnsPlain(const Mesh& macro, int layers, std::size_t element, LayerH
   std::size_t base = 0;
   for (const ElementBlock& b : macro.blocks) {
     if (cellDimension(b.type) != macro.dim) continue;
-    const bool cell = (b.type == CellType::Prism && macro.dim == 3) ||
-                      (b.type == CellType::Quadrilateral && macro.dim == 2);
+    const bool cell = isLayerCell(macro, b);
     const std::size_t count = b.count() * static_cast<std::size_t>(cell ? layers : 1);
     if (element >= base + count) {
       base += count;
@@ -608,41 +622,17 @@ void keepColumnsPlain(const Mesh& macro, int layers, std::size_t element, LayerH
 }
 
 std::vector<double> layerTopNormals(const Mesh& mesh) {
-  std::vector<double> normals(3 * mesh.numNodes(), 0.0);
-  std::vector<int> top(mesh.numNodes(), 0);  // cells summed at the node
-  for (const ElementBlock& b : mesh.blocks) {
-    const bool prism = b.type == CellType::Prism && mesh.dim == 3;
-    const bool quad = b.type == CellType::Quadrilateral && mesh.dim == 2;
-    if (!prism && !quad) continue;
-    const int p = b.order;
-    const std::size_t across = prism ? 2 : 1;
-    const ReferenceElement& ref = ReferenceElement::get(b.type, p);
-    const std::map<LatticePoint, int> index = latticeIndex(ref);
-    for (std::size_t e = 0; e < b.count(); ++e) {
-      const std::int64_t* v = b.element(e);
-      for (int r = 0; r < ref.numNodes(); ++r) {
-        LatticePoint c = ref.lattice()[static_cast<std::size_t>(r)];
-        if (c[across] != p) continue;
-        const auto id = static_cast<std::size_t>(v[r]);
-        c[across] = 0;
-        const Eigen::Vector3d rise =
-            Eigen::Vector3d(&mesh.xyz[3 * id]) -
-            Eigen::Vector3d(&mesh.xyz[3 * static_cast<std::size_t>(v[index.at(c)])]);
-        const Eigen::Vector3d n =
-            wallNormal(mesh, ref, v, double(c[0]) / p, prism ? double(c[1]) / p : 0.0, rise);
-        for (std::size_t d = 0; d < 3; ++d) normals[3 * id + d] += n(static_cast<Eigen::Index>(d));
-        ++top[id];
-      }
-    }
-  }
-  for (std::size_t id = 0; id < mesh.numNodes(); ++id) {
-    const Eigen::Vector3d n(&normals[3 * id]);
-    const double length = n.norm();
-    // Above a sharp corner (the cells' normals spread by more than about 30 degrees) the
-    // column follows the corner's bisector and no plane keeps both walls' heights: free.
-    const bool smooth = length >= kCornerMeanNormal * top[id] && length > 0.0;
+  std::map<std::int64_t, NormalSum> tops;
+  forEachColumn(
+      mesh, [&](std::int64_t, std::int64_t top, const Eigen::Vector3d& n) { tops[top].add(n); });
+  std::vector<double> normals(3 * mesh.numNodes(), std::nan(""));
+  for (const auto& [id, n] : tops) {
+    // Above a sharp corner the column follows the corner's bisector and no plane keeps both
+    // walls' heights: free.
+    if (n.sharp() || !(n.sum.norm() > 0.0)) continue;
+    const Eigen::Vector3d unit = n.sum.normalized();
     for (std::size_t d = 0; d < 3; ++d)
-      normals[3 * id + d] = top[id] != 0 && smooth ? normals[3 * id + d] / length : std::nan("");
+      normals[3 * static_cast<std::size_t>(id) + d] = unit(static_cast<Eigen::Index>(d));
   }
   return normals;
 }
@@ -650,9 +640,8 @@ std::vector<double> layerTopNormals(const Mesh& mesh) {
 std::vector<double> grownLayerHeights(const Mesh& linear) {
   std::vector<double> heights(linear.numNodes(), std::nan(""));
   for (const ElementBlock& b : linear.blocks) {
-    const bool prism = b.type == CellType::Prism && linear.dim == 3;
-    const bool quad = b.type == CellType::Quadrilateral && linear.dim == 2;
-    if (!prism && !quad) continue;
+    if (!isLayerCell(linear, b)) continue;
+    const bool prism = b.type == CellType::Prism;
     for (std::size_t e = 0; e < b.count(); ++e) {
       const std::int64_t* v = b.element(e);
       for (int k = 0; k < (prism ? 3 : 2); ++k) {

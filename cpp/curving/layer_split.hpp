@@ -25,6 +25,10 @@
 
 namespace homesh {
 
+// Whether the block holds a macro layer's cells: prisms in 3D, quadrilaterals in 2D (whose
+// other quadrilaterals, in 3D, are the layer's sides on the CAD).
+bool isLayerCell(const Mesh& mesh, const ElementBlock& block);
+
 struct LayerSplitStats {
   std::size_t prisms = 0, quadrilaterals = 0, lines = 0;  // macro elements split
   std::size_t projected = 0;                              // new nodes on a CAD face or curve

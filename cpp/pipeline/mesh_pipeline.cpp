@@ -230,9 +230,7 @@ constexpr double kRepairRegionThreshold = 0.2;
 std::vector<char> layerNodes(const Mesh& mesh) {
   std::vector<char> fixed;
   for (const ElementBlock& b : mesh.blocks) {
-    const bool cell = (b.type == CellType::Prism && mesh.dim == 3) ||
-                      (b.type == CellType::Quadrilateral && mesh.dim == 2);
-    if (!cell) continue;
+    if (!isLayerCell(mesh, b)) continue;
     fixed.resize(mesh.numNodes(), 0);
     for (const std::int64_t id : b.nodes) fixed[static_cast<std::size_t>(id)] = 1;
   }
