@@ -131,15 +131,16 @@ int runMesh(const homesh::MeshCommand& cmd) {
                  "%.4f; %zu invalid\n",
                  result.mesh.numNodes(), result.mesh.numElements(), result.mesh.order,
                  result.quality.scaled.min, result.quality.scaled.mean, result.quality.invalid);
-    if (result.boundaryLayer) {
+    if (result.boundaryLayer && result.layerSplit) {
       const homesh::BoundaryLayerRecord& b = *result.boundaryLayer;
+      const homesh::LayerSplitStats& s = *result.layerSplit;
       std::fprintf(stderr,
                    "homesh: boundary layer: %zu macro %s split into %d layers, height %g to %g, "
                    "first layer %g to %g (worst %.2f %% off); shrunk on %zu %s; macro mesh worst "
                    "%.4f\n",
                    b.cells, result.mesh.dim == 3 ? "prisms" : "quadrilaterals", b.parameters.layers,
-                   b.thicknessMin, b.thicknessMax, b.firstHeightMin, b.firstHeightMax,
-                   100.0 * b.firstHeightDeviation, b.shrunk.size(),
+                   b.thicknessMin, b.thicknessMax, s.firstHeightMin, s.firstHeightMax,
+                   100.0 * s.firstHeightDeviation, b.shrunk.size(),
                    result.mesh.dim == 3 ? "faces" : "curves",
                    result.macroQuality ? result.macroQuality->scaled.min : 0.0);
     }

@@ -225,9 +225,6 @@ void recordHeights(BoundaryLayerRecord& record, const BoundaryLayerParameters& p
       s.where = {x.x(), x.y(), x.z()};
     }
   }
-  const double first = p.splitCoordinates()[1];
-  record.firstHeightMin = record.thicknessMin * first;
-  record.firstHeightMax = record.thicknessMax * first;
   for (auto& [face, s] : shrunk) record.shrunk.push_back(s);
 }
 

@@ -64,13 +64,7 @@ const char* layerReleaseName(LayerRelease release);
 struct BoundaryLayerRecord {
   BoundaryLayerParameters parameters;
   double thicknessMin = 0, thicknessMax = 0;  // macro heights grown at the wall nodes
-  // The first (wall) split layer's height: as planned from the grown heights; after the
-  // split, as measured along the wall normal at the wall's quadrature points, with its worst
-  // relative deviation from the planned height there (layer_split.hpp).
-  // (the worst deviation on the smooth wall; at sharp corners apart, see LayerSplitStats).
-  double firstHeightMin = 0, firstHeightMax = 0, firstHeightDeviation = 0;
-  double firstHeightCornerDeviation = 0;
-  std::size_t cornerCells = 0;
+  // (The first split layer's height, as measured, is the split's: LayerSplitStats.)
   std::vector<LayerShrink> shrunk;
   std::size_t cells = 0;  // macro cells: prisms (3D), quadrilaterals (2D)
   std::size_t sideQuadrilaterals = 0, wallNodes = 0;

@@ -511,13 +511,6 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       if (heights.plain.size() == before) break;  // none (left) in the layer
     }
     result.layerSplit = stats;
-    if (result.boundaryLayer && stats.firstHeightMeasured > 0) {
-      result.boundaryLayer->firstHeightMin = stats.firstHeightMin;
-      result.boundaryLayer->firstHeightMax = stats.firstHeightMax;
-      result.boundaryLayer->firstHeightDeviation = stats.firstHeightDeviation;
-      result.boundaryLayer->firstHeightCornerDeviation = stats.firstHeightCornerDeviation;
-      result.boundaryLayer->cornerCells = stats.cornerCells;
-    }
     split.done();
   }
 

@@ -182,13 +182,16 @@ void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
   json.value("min", r.thicknessMin);
   json.value("max", r.thicknessMax);
   json.endObject();
-  json.beginObject("first_height");
-  json.value("min", r.firstHeightMin);
-  json.value("max", r.firstHeightMax);
-  json.value("worst_deviation", r.firstHeightDeviation);
-  json.value("corner_cells", r.cornerCells);
-  json.value("worst_deviation_at_corners", r.firstHeightCornerDeviation);
-  json.endObject();
+  if (result.layerSplit) {  // measured on the split layer (layer_split.hpp)
+    const LayerSplitStats& s = *result.layerSplit;
+    json.beginObject("first_height");
+    json.value("min", s.firstHeightMin);
+    json.value("max", s.firstHeightMax);
+    json.value("worst_deviation", s.firstHeightDeviation);
+    json.value("corner_cells", s.cornerCells);
+    json.value("worst_deviation_at_corners", s.firstHeightCornerDeviation);
+    json.endObject();
+  }
   json.beginArray("shrunk");
   for (const LayerShrink& s : r.shrunk) {
     json.beginObject();

@@ -311,6 +311,7 @@ TEST(BoundaryLayer, FirstLayerHeightAlongTheWallNormalIsWithinFivePercent) {
   setup.options.threads = 2;
   const MeshResult r = runMeshPipeline(setup.source, setup.options);
   ASSERT_TRUE(r.boundaryLayer.has_value());
+  ASSERT_TRUE(r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
   const double expected = 0.04 * (1 - 1.5) / (1 - std::pow(1.5, 6));
   const Mesh& m = r.mesh;
@@ -366,10 +367,10 @@ TEST(BoundaryLayer, FirstLayerHeightAlongTheWallNormalIsWithinFivePercent) {
   RecordProperty("first_layer_height_worst_near_the_ends", std::to_string(worstNearEnds));
   // The report measures the same at the same points (with its own normals): equal to what
   // rounding and the normal's orientation leave.
-  EXPECT_NEAR(r.boundaryLayer->firstHeightDeviation, std::max(worst, worstNearEnds), 1e-9);
-  EXPECT_EQ(r.boundaryLayer->cornerCells, 0U);  // the cylinder's wall has no sharp corner
-  EXPECT_LE(r.boundaryLayer->firstHeightMin, expected * (1 + 0.05));
-  EXPECT_GE(r.boundaryLayer->firstHeightMin, expected * (1 - 0.05));
+  EXPECT_NEAR(r.layerSplit->firstHeightDeviation, std::max(worst, worstNearEnds), 1e-9);
+  EXPECT_EQ(r.layerSplit->cornerCells, 0U);  // the cylinder's wall has no sharp corner
+  EXPECT_LE(r.layerSplit->firstHeightMin, expected * (1 + 0.05));
+  EXPECT_GE(r.layerSplit->firstHeightMin, expected * (1 - 0.05));
 }
 
 TEST_F(CylinderCase, SplitNodesLieOnTheCadAndTheReportSaysSo) {
@@ -511,14 +512,14 @@ TEST(BoundaryLayer2D, T106IsValidWithTheLayerReleasedOnlyParallelToTheWall) {
   EXPECT_EQ(r.boundaryLayer->release, LayerRelease::Parallel);
   // The thinnest first layer is the leading edge's, 0.01 / 3 (2 layers, progression 2), within
   // the deviation the report gives.
-  EXPECT_GE(r.boundaryLayer->firstHeightMin,
+  EXPECT_GE(r.layerSplit->firstHeightMin,
             0.01 / 3 *
-                (1 - std::max(r.boundaryLayer->firstHeightDeviation,
-                              r.boundaryLayer->firstHeightCornerDeviation)));
+                (1 - std::max(r.layerSplit->firstHeightDeviation,
+                              r.layerSplit->firstHeightCornerDeviation)));
   RecordProperty("first_layer_height_worst_deviation",
-                 std::to_string(r.boundaryLayer->firstHeightDeviation));
+                 std::to_string(r.layerSplit->firstHeightDeviation));
   RecordProperty("first_layer_height_worst_deviation_at_corners",
-                 std::to_string(r.boundaryLayer->firstHeightCornerDeviation));
+                 std::to_string(r.layerSplit->firstHeightCornerDeviation));
   RecordProperty("plain_columns", std::to_string(r.layerSplit->plainColumns));
 }
 
