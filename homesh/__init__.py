@@ -17,6 +17,7 @@ process down.
 from ._core import (  # noqa: F401  (re-exported)
     CadError,
     CancelledError,
+    CancelToken,
     FileError,
     HOMeshError,
     MeshingError,
@@ -28,6 +29,7 @@ from .api import BoundaryBlock, HighOrderMesh, load, mesh, predict, read  # noqa
 __all__ = [
     "BoundaryBlock",
     "CadError",
+    "CancelToken",
     "CancelledError",
     "FileError",
     "HOMeshError",

@@ -317,7 +317,7 @@ def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_o
 
 def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
          optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=3,
-         boundary_layer=None):
+         boundary_layer=None, cancel=None):
     """Meshes a CAD shape with curved elements of the given order.
 
     shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
@@ -329,8 +329,15 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
               automatic sizing. ``report()`` then has "predicted_elements" and "sizing".
     threads   threads the core may use.
     progress  optional ``callable(stage, seconds)``: called with ``seconds=None`` when a stage
-              starts and with its duration when it ends. Raising inside it cancels the job
-              (:class:`CancelledError`).
+              starts and with its duration when it ends. A callable of four parameters,
+              ``(stage, seconds, fraction, detail)``, is also called within stages (the linear
+              mesher per dimension, the optimiser per sweep) with ``seconds=None``, the
+              estimated ``fraction`` of the stage done and ``detail`` in words. Raising inside
+              it cancels the job (:class:`CancelledError`). It is called on the thread that
+              runs :func:`mesh`.
+    cancel    optional :class:`CancelToken`: ``cancel.cancel()`` from another thread (a GUI's
+              Cancel button while a worker thread runs this) stops the job within a fraction
+              of a second with :class:`CancelledError`; the core runs with the GIL released.
     name      how error messages call a shape given as an object or BRep text (for example
               the FreeCAD object's label); default "the shape".
     optimise  > 0: after curving, at most this many sweeps of the variational optimiser
@@ -363,6 +370,9 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
             raise ParameterError("size must be a positive length, got %g" % size)
     if progress is not None and not callable(progress):
         raise ParameterError("progress must be callable")
+    if cancel is not None and not isinstance(cancel, _core.CancelToken):
+        raise ParameterError("cancel must be a homesh.CancelToken, got %r" % (cancel,))
+    progress = _four_argument_progress(progress)
     sizing = _sizing(min_delta, max_delta, eps, sources)
     if size is not None and sizing is not None:
         raise ParameterError("give either size (uniform) or the sizing octree parameters")
@@ -372,11 +382,33 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
         core = _core.mesh_brep(value, label, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds, layer)
+                               sizing, repair_rounds, layer, cancel)
     else:
         core = _core.mesh_file(value, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds, layer)
+                               sizing, repair_rounds, layer, cancel)
     return HighOrderMesh(core)
+
+
+def _four_argument_progress(progress):
+    """The core calls ``progress(stage, seconds, fraction, detail)``; a callable taking two
+    parameters gets only the stage starts and ends, as before."""
+    if progress is None:
+        return None
+    import inspect
+    try:
+        parameters = inspect.signature(progress).parameters.values()
+    except (TypeError, ValueError):  # a builtin without a signature: assume the old form
+        parameters = ()
+    positional = [p for p in parameters
+                  if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    if any(p.kind == p.VAR_POSITIONAL for p in parameters) or len(positional) >= 4:
+        return progress
+
+    def stages_only(stage, seconds, fraction, detail):
+        if seconds is not None or fraction == 0.0 and not detail:
+            progress(stage, seconds)
+
+    return stages_only
 
 
 _BOUNDARY_LAYER_KEYS = ("faces", "thickness", "layers", "progression")

@@ -6,6 +6,7 @@
 #include <map>
 
 #include "core/error.hpp"
+#include "core/parameters.hpp"
 #include "optimise/functional.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 
@@ -31,6 +32,15 @@ int parseInteger(const std::string& option, const std::string& text) {
   if (digits.empty() || ec != std::errc() || ptr != end)
     throw UsageError{option + " expects an integer, got '" + text + "'"};
   return v;
+}
+
+// `text` parsed as the parameter `key` of core/parameters.hpp and checked against its range.
+double parseParameter(const std::string& key, const std::string& option, const std::string& text) {
+  const ParameterDefinition& p = parameterDefinition(key);
+  const double value = p.kind == ParameterKind::Integer ? parseInteger(option, text)
+                                                         : parseNumber(option, text);
+  if (!inRange(p, value)) throw UsageError{option + " must be " + rangeText(p) + ", got " + text};
+  return value;
 }
 
 // Options of one command: flags and options with a value, by every spelling.
@@ -73,9 +83,7 @@ class OptionTable {
 
 void addCommon(OptionTable& table, CommonOptions& c, bool outputs, bool report) {
   table.value({"--threads", "-j"}, [&c](const std::string& o, const std::string& v) {
-    c.threads = parseInteger(o, v);
-    if (c.threads < 1 || c.threads > kMaxThreads)
-      throw UsageError{"--threads must be from 1 to " + std::to_string(kMaxThreads) + ", got " + v};
+    c.threads = static_cast<int>(parseParameter("threads", o, v));
   });
   table.flag({"--quiet", "-q"}, [&c] { c.quiet = true; });
   if (outputs) {
@@ -116,20 +124,14 @@ std::vector<double> parseList(const std::string& option, const std::string& text
 }
 
 void addSizing(OptionTable& table, SizingFlags& f) {
-  const auto positive = [](const std::string& o, const std::string& v) {
-    const double x = parseNumber(o, v);
-    if (!(x > 0.0)) throw UsageError{o + " must be a positive number, got " + v};
-    return x;
-  };
-  table.value({"--min-delta"}, [&f, positive](const std::string& o, const std::string& v) {
-    f.minDelta = positive(o, v);
+  table.value({"--min-delta"}, [&f](const std::string& o, const std::string& v) {
+    f.minDelta = parseParameter("min_delta", o, v);
   });
-  table.value({"--max-delta"}, [&f, positive](const std::string& o, const std::string& v) {
-    f.maxDelta = positive(o, v);
+  table.value({"--max-delta"}, [&f](const std::string& o, const std::string& v) {
+    f.maxDelta = parseParameter("max_delta", o, v);
   });
   table.value({"--eps"}, [&f](const std::string& o, const std::string& v) {
-    f.eps = parseNumber(o, v);
-    if (!(*f.eps > 0.0 && *f.eps <= 1.0)) throw UsageError{"--eps must lie in (0, 1], got " + v};
+    f.eps = parseParameter("eps", o, v);
   });
   const auto check = [](const std::string& o, const RefinementSource& s) {
     try {
@@ -176,13 +178,10 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   OptionTable table;
   addCommon(table, cmd.common, true, true);
   table.value({"--order", "-p"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.order = parseInteger(o, v);
-    if (*cmd.order < 1 || *cmd.order > 10)
-      throw UsageError{"--order must be from 1 to 10, got " + v};
+    cmd.order = static_cast<int>(parseParameter("order", o, v));
   });
   table.value({"--size", "-s"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.size = parseNumber(o, v);
-    if (!(*cmd.size > 0.0)) throw UsageError{"--size must be a positive length, got " + v};
+    cmd.size = parseParameter("size", o, v);
   });
   addSizing(table, cmd.sizing);
   bool optimise = false;
@@ -193,20 +192,17 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
     if (*maxiter < 1) throw UsageError{"--maxiter must be >= 1, got " + v};
   });
   table.value({"--repair-rounds"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.repairRounds = parseInteger(o, v);
-    if (cmd.repairRounds < 0 || cmd.repairRounds > kMaxRepairRounds)
-      throw UsageError{"--repair-rounds must be from 0 to " + std::to_string(kMaxRepairRounds) +
-                       ", got " + v};
+    cmd.repairRounds = static_cast<int>(parseParameter("repair_rounds", o, v));
   });
   table.value({"--bl-faces"},
               [&cmd](const std::string&, const std::string& v) { cmd.blFaces = v; });
   table.value({"--bl-thickness"},
               [&cmd](const std::string&, const std::string& v) { cmd.blThickness = v; });
   table.value({"--bl-layers"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.blLayers = parseInteger(o, v);
+    cmd.blLayers = static_cast<int>(parseParameter("layers", o, v));
   });
   table.value({"--bl-progression"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.blProgression = parseNumber(o, v);
+    cmd.blProgression = parseParameter("progression", o, v);
   });
   table.flag({"--verbose", "-v"}, [&cmd] { ++cmd.verbosity; });
   table.flag({"-vv"}, [&cmd] { cmd.verbosity += 2; });
@@ -269,9 +265,7 @@ OptimiseCommand parseOptimise(const std::vector<std::string>& args) {
     if (cmd.tolerance < 0.0) throw UsageError{"--tolerance must be >= 0, got " + v};
   });
   table.value({"--order", "-p"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.order = parseInteger(o, v);
-    if (*cmd.order < 1 || *cmd.order > 10)
-      throw UsageError{"--order must be from 1 to 10, got " + v};
+    cmd.order = static_cast<int>(parseParameter("order", o, v));
   });
   table.value({"--region"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.regionThreshold = parseNumber(o, v);

@@ -39,7 +39,7 @@ struct MeshCommand {
   SizingFlags sizing;
   int verbosity = 0;           // -v: 1, -vv: 2
   int optimiseIterations = 0;  // --optimise: 100, --maxiter N
-  int repairRounds = 3;        // --repair-rounds N, 0..kMaxRepairRounds
+  int repairRounds = 3;        // --repair-rounds N, range in core/parameters.hpp
   // --bl-faces, --bl-thickness, --bl-layers, --bl-progression: a boundary layer (each
   // overrides the .mcf's BndLayer* key).
   std::optional<std::string> blFaces, blThickness;

@@ -13,6 +13,7 @@
 #include "core/error.hpp"
 #include "core/expression.hpp"
 #include "core/format.hpp"
+#include "core/parameters.hpp"
 
 namespace homesh {
 
@@ -26,12 +27,8 @@ void BoundaryLayerParameters::validate() const {
   if (thickness.empty())
     throw ParameterError("boundary layer: no thickness given (--bl-thickness, BndLayerThickness)");
   Expression::parse(thickness, "boundary-layer thickness");
-  if (layers < 1 || layers > kMaxBoundaryLayers)
-    throw ParameterError("boundary-layer layers must be from 1 to " +
-                         std::to_string(kMaxBoundaryLayers) + ", got " + std::to_string(layers));
-  if (!(progression > 0.0) || !std::isfinite(progression) || progression > 100.0)
-    throw ParameterError("boundary-layer progression must be a ratio in (0, 100], got " +
-                         formatNumber(progression));
+  checkParameter("layers", layers);
+  checkParameter("progression", progression);
 }
 
 const char* layerReleaseName(LayerRelease release) {

@@ -209,7 +209,12 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
       return sizeAt(Eigen::Vector3d(x, y, z));
     });
     try {
-      gmsh::model::mesh::generate(dim);
+      // One dimension at a time (what generate(dim) does), so progress and cancellation can
+      // come between them.
+      for (int d = 1; d <= dim; ++d) {
+        gmsh::model::mesh::generate(d);
+        if (options.dimensionDone) options.dimensionDone(d, dim);
+      }
     } catch (const std::string& message) {
       throw MeshingError(
           "Gmsh could not mesh " + cad.sourceName() +

@@ -184,7 +184,14 @@ class Optimiser {
           break;
         }
         const auto s0 = Clock::now();
-        const Moves moved = sweep();
+        Moves moved;
+        try {
+          moved = sweep();
+        } catch (const CancelledError&) {  // asked between colour groups: the best is kept
+          result_.cancelled = true;
+          result_.stopReason = "cancelled";
+          break;
+        }
         result_.sweepSeconds += since(s0);
         IterationRecord record = summarise(it, moved.absolute, t0);
         record.maxRelativeMove = moved.relative;
@@ -915,11 +922,20 @@ class Optimiser {
     std::size_t visits = 0;
     FirstFailure failure;
     const std::int64_t colours = static_cast<std::int64_t>(starts.size()) - 1;
+    const bool observed = observer_ != nullptr;
+    bool cancel = false;  // shared: one thread asks, the barrier after `single` publishes it
 #pragma omp parallel num_threads(options_.threads) reduction(max : moved, relative) \
     reduction(+ : visits)
     {
       std::vector<PointRef> pts;
       for (std::int64_t c = 0; c < colours; ++c) {
+        if (observed) {
+          // A sweep of a large high-order mesh takes seconds: a cancel request is honoured
+          // between colour groups, every thread leaving the loop together.
+#pragma omp single
+          cancel = observer_->cancelRequested();
+          if (cancel) break;
+        }
         const auto lo = static_cast<std::int64_t>(starts[c]);
         const auto hi = static_cast<std::int64_t>(starts[c + 1]);
 #pragma omp for schedule(dynamic, 8)
@@ -938,6 +954,8 @@ class Optimiser {
       }
     }
     failure.rethrow();
+    // run() keeps its best state: a half-done sweep is never kept.
+    if (cancel) throw CancelledError("cancelled during an optimiser sweep");
     return {moved, relative, visits};
   }
 

@@ -143,7 +143,8 @@ struct OptimiserResult {
   std::vector<IterationRecord> history;
 };
 
-// Receives the state after each sweep; may ask to stop (the best state so far is kept).
+// Receives the state after each sweep; may ask to stop (the best state so far is kept), which
+// is honoured between colour groups of a sweep, so within a fraction of one.
 class OptimiserObserver {
  public:
   virtual ~OptimiserObserver() = default;

@@ -12,6 +12,7 @@
 #include "cad/model_dimension.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "core/parameters.hpp"
 #include "curving/order_elevation.hpp"
 #include "linear/linear_mesher.hpp"
 #include "pipeline/curved_reuse.hpp"
@@ -21,19 +22,11 @@
 namespace homesh {
 
 void MeshingOptions::validate() const {
-  if (order < 1 || order > 10)
-    throw ParameterError("order must be an integer from 1 to 10, got " + std::to_string(order));
-  if (size && (!(*size > 0.0) || !std::isfinite(*size)))
-    throw ParameterError("size must be a positive length, got " + formatNumber(*size));
-  if (threads < 1 || threads > kMaxThreads)
-    throw ParameterError("threads must be from 1 to " + std::to_string(kMaxThreads) + ", got " +
-                         std::to_string(threads));
-  if (optimiseIterations < 0)
-    throw ParameterError("optimiser iterations must be >= 0, got " +
-                         std::to_string(optimiseIterations));
-  if (repairRounds < 0 || repairRounds > kMaxRepairRounds)
-    throw ParameterError("repair rounds must be from 0 to " + std::to_string(kMaxRepairRounds) +
-                         ", got " + std::to_string(repairRounds));
+  checkParameter("order", order);
+  if (size) checkParameter("size", *size);
+  checkParameter("threads", threads);
+  checkParameter("optimise", optimiseIterations);
+  checkParameter("repair_rounds", repairRounds);
   if (boundaryLayer) boundaryLayer->validate();
   if (size && !octreeOutput.empty())
     throw ParameterError("writing the sizing octree needs octree sizing, not a uniform size");
@@ -180,15 +173,39 @@ void checkHighOrderMemory(const Mesh& linear, int order) {
   }
 }
 
-// Forwards the pipeline's cancel request to the optimiser (checked before every sweep).
-class OptimiserCancel : public OptimiserObserver {
+// Forwards the pipeline's cancel request to the optimiser (checked between colour groups) and
+// reports each sweep as progress of `stage`.
+class OptimiserProgress : public OptimiserObserver {
  public:
-  explicit OptimiserCancel(PipelineObserver* observer) : observer_(observer) {}
+  OptimiserProgress(PipelineObserver* observer, std::string stage, int maxIterations)
+      : observer_(observer), stage_(std::move(stage)), maxIterations_(maxIterations) {}
   bool cancelRequested() override { return observer_ != nullptr && observer_->cancelRequested(); }
+  void iterationFinished(const IterationRecord& r) override {
+    if (observer_ == nullptr) return;
+    std::ostringstream detail;
+    detail.precision(3);
+    detail << stage_ << " sweep " << r.iteration << ": worst scaled Jacobian " << r.worst << ", "
+           << r.invalid << " invalid";
+    observer_->stageProgress(stage_, static_cast<double>(r.iteration) / maxIterations_,
+                             detail.str());
+  }
 
  private:
   PipelineObserver* observer_;
+  std::string stage_;
+  int maxIterations_;
 };
+
+// Reports each dimension the linear mesher finishes and stops between them when asked.
+std::function<void(int, int)> linearProgress(PipelineObserver* observer) {
+  if (observer == nullptr) return {};
+  return [observer](int dim, int of) {
+    static const char* const kWhat[] = {"", "curves", "surfaces", "volumes"};
+    observer->stageProgress("linear", static_cast<double>(dim) / of,
+                            std::string(kWhat[dim]) + " meshed");
+    if (observer->cancelRequested()) throw CancelledError("cancelled during the linear mesh");
+  };
+}
 
 }  // namespace
 
@@ -265,7 +282,6 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
   CurvedState state;
   state.linear = std::move(linear);
   checkHighOrderMemory(state.linear, options.order);
-  OptimiserCancel cancel(observer);
   // For `mesh`, just elevated to `order`: takes the curved nodes of unchanged cells from
   // `before` (previous's mesh of that order, if any) and optimises the whole mesh, or only
   // around what changed.
@@ -289,6 +305,7 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
     // heights asked for) while the rest adapts; only where elements stay invalid is it
     // released, around them, and its inner nodes blended again afterwards.
     o.fixedNodes = layerNodes(mesh);
+    OptimiserProgress cancel(observer, stage, o.maxIterations);
     std::optional<OptimiserResult> r = optimiseMesh(mesh, o, &cancel, &cad);
     if (r->cancelled) throw CancelledError("cancelled during optimise");
     // Released in steps, each only if elements are still not valid: the layer's top slides
@@ -371,6 +388,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
 
   LinearMeshOptions linearOptions;
   linearOptions.verbosity = options.verbosity;
+  linearOptions.dimensionDone = linearProgress(observer);
   if (options.sizing) {
     StageClock sizing("sizing", result.timings, observer);
     result.sizing = runSizing(*result.cad, *options.sizing, options.threads);

@@ -29,8 +29,6 @@
 
 namespace homesh {
 
-inline constexpr int kMaxThreads = 1024;
-inline constexpr int kMaxRepairRounds = 20;
 // With the optimiser, orders above this are first curved and optimised at this order, then
 // raised (curving/order_elevation.hpp's changeOrder) and optimised again: the low order
 // untangles the interior with a fraction of the nodes and a far better conditioned problem
@@ -45,14 +43,14 @@ struct MeshingOptions {
   std::optional<SizingParameters> sizing;  // 0 deltas: automatic (completeSizing)
   std::optional<int> expectedDimension;    // 2 or 3 (a .mcf's MeshType): checked on the CAD
   std::string octreeOutput;                // when set: the octree's leaves, written after sizing
-  int threads = 1;                         // threads the stages may use, 1..kMaxThreads
+  int threads = 1;                         // threads the stages may use, range in core/parameters.hpp
   int verbosity = 0;                       // 0 silent; 1 Gmsh's warnings; 2 Gmsh's information
   // > 0: after elevation, at most this many sweeps of the variational optimiser (hyperelastic,
   // boundary nodes sliding on the CAD; optimise/optimiser.hpp), stopping earlier once the mesh
   // is proven valid and no longer improving (OptimiserOptions: "energy", or "stalled" with
   // stall 0.001).
   int optimiseIterations = 0;
-  // Repair rounds (pipeline/repair.hpp) while elements are not proven valid, 0..kMaxRepairRounds:
+  // Repair rounds (pipeline/repair.hpp) while elements are not proven valid, range in core/parameters.hpp:
   // each splits the offending linear cells' edges on curved faces (or refines around them),
   // then curves, optimises and checks again. 0: none.
   int repairRounds = 3;
@@ -135,12 +133,18 @@ struct StageTimings {
   double total() const;
 };
 
-// Receives progress; may ask to stop, which is honoured when a stage starts or ends (the run
-// then throws CancelledError and returns nothing).
+// Receives progress; may ask to stop, which is honoured when a stage starts or ends, between
+// the linear mesher's dimensions and between the optimiser's colour groups (the run then throws
+// CancelledError and returns nothing). Every call comes from the thread that runs the pipeline;
+// cancelRequested may be asked often and should be cheap.
 class PipelineObserver {
  public:
   virtual ~PipelineObserver() = default;
   virtual void stageStarted(const std::string& /*stage*/) {}
+  // Within a stage: `fraction` of its work done (0..1, an estimate: the optimiser counts sweeps
+  // against its most, and usually stops earlier) and what was just done, in words.
+  virtual void stageProgress(const std::string& /*stage*/, double /*fraction*/,
+                             const std::string& /*detail*/) {}
   virtual void stageFinished(const std::string& /*stage*/, double /*seconds*/) {}
   virtual bool cancelRequested() { return false; }
 };

@@ -8,6 +8,8 @@
 
 #include <boost/python.hpp>
 #include <boost/python/numpy.hpp>
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/parameters.hpp"
 #include "core/version.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
@@ -92,33 +95,63 @@ std::string takePythonError() {
   return text;
 }
 
-// Calls progress(stage, seconds_or_None); an exception in the callback cancels the job.
-// Called with the GIL released; never lets an exception escape into the pipeline.
+// homesh._core.CancelToken: set from any thread (a GUI's Cancel button) while a job runs with
+// the GIL released; the job reads it without the GIL, between stages, the linear mesher's
+// dimensions and the optimiser's colour groups.
+class CancelToken {
+ public:
+  void cancel() { cancelled_.store(true); }
+  bool cancelled() const { return cancelled_.load(); }
+
+ private:
+  std::atomic<bool> cancelled_{false};
+};
+
+// Calls progress(stage, seconds_or_None, fraction, detail): when a stage starts (None, 0, ""),
+// within it (None, fraction, what was done) and when it ends (its seconds, 1, ""). An exception
+// in the callback, or the token's cancel(), cancels the job. Called with the GIL released;
+// never lets an exception escape into the pipeline.
 class PythonProgress : public PipelineObserver {
  public:
-  explicit PythonProgress(bp::object callback) : callback_(std::move(callback)) {}
-  void stageStarted(const std::string& stage) override { call(stage, nullptr); }
-  void stageFinished(const std::string& stage, double seconds) override { call(stage, &seconds); }
-  bool cancelRequested() override { return !failure_.empty(); }
+  PythonProgress(bp::object callback, const CancelToken* token)
+      : callback_(std::move(callback)), token_(token) {}
+  void stageStarted(const std::string& stage) override { call(stage, nullptr, 0.0, ""); }
+  void stageProgress(const std::string& stage, double fraction,
+                     const std::string& detail) override {
+    call(stage, nullptr, fraction, detail);
+  }
+  void stageFinished(const std::string& stage, double seconds) override {
+    call(stage, &seconds, 1.0, "");
+  }
+  bool cancelRequested() override {
+    return (token_ != nullptr && token_->cancelled()) || failed_.load();
+  }
   const std::string& failure() const { return failure_; }
 
  private:
-  void call(const std::string& stage, const double* seconds) noexcept {
+  void call(const std::string& stage, const double* seconds, double fraction,
+            const std::string& detail) noexcept {
     if (!failure_.empty()) return;
     const AcquireGil gil;
     if (callback_.is_none()) return;
     try {
-      callback_(stage, seconds != nullptr ? bp::object(*seconds) : bp::object());
+      callback_(stage, seconds != nullptr ? bp::object(*seconds) : bp::object(),
+                std::min(1.0, std::max(0.0, fraction)), detail);
     } catch (const bp::error_already_set&) {
       const std::string text = takePythonError();
       failure_ = "progress callback raised an exception" + (text.empty() ? "" : ": " + text);
+      failed_.store(true);
     } catch (...) {
       PyErr_Clear();
       failure_ = "progress callback failed";
+      failed_.store(true);
     }
   }
   bp::object callback_;
+  const CancelToken* token_;
   std::string failure_;
+  // Set with failure_: cancelRequested may be asked from any of the optimiser's threads.
+  std::atomic<bool> failed_{false};
 };
 
 template <class T>
@@ -379,8 +412,46 @@ std::string predictBrep(const std::string& text, const std::string& name, const 
   return predict(setup, sizing, octreePath, name, threads);
 }
 
-PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::object progress) {
-  PythonProgress observer(std::move(progress));
+// The parameter table (core/parameters.hpp) as a list of dicts: key, property, option, label,
+// kind ("integer", "real", "length"), min, max (inf: none), min_exclusive, default,
+// zero_is_automatic, group, doc,
+// range (in words).
+bp::list parameters() {
+  bp::list out;
+  for (const ParameterDefinition& p : parameterDefinitions()) {
+    bp::dict d;
+    d["key"] = p.key;
+    d["property"] = p.property;
+    d["option"] = p.option;
+    d["label"] = p.label;
+    d["kind"] = p.kind == ParameterKind::Integer ? "integer"
+                : p.kind == ParameterKind::Length ? "length"
+                                                  : "real";
+    d["min"] = p.min;
+    d["max"] = p.max;
+    d["min_exclusive"] = p.minExclusive;
+    d["default"] = p.defaultValue;
+    d["zero_is_automatic"] = p.zeroIsAutomatic;
+    d["group"] = p.group;
+    d["doc"] = p.doc;
+    d["range"] = rangeText(p);
+    out.append(d);
+  }
+  return out;
+}
+
+// The token behind a `cancel` argument (None or a CancelToken); the caller's argument keeps it
+// alive for the call.
+const CancelToken* cancelTokenOf(const bp::object& cancel) {
+  if (cancel.is_none()) return nullptr;
+  bp::extract<const CancelToken&> token(cancel);
+  if (!token.check()) throw ParameterError("cancel must be a homesh CancelToken or None");
+  return &token();
+}
+
+PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::object progress,
+                   const bp::object& cancel) {
+  PythonProgress observer(std::move(progress), cancelTokenOf(cancel));
   std::unique_ptr<MeshResult> result;
   try {
     const ReleaseGil nogil;
@@ -395,23 +466,24 @@ PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::o
 // A CAD file or a NekMesh .mcf case: a case's CAD and sizes (unless given here) are used.
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
                 int verbosity, bp::object progress, int optimise, const bp::object& sizing,
-                int repairRounds, const bp::object& boundaryLayer) {
+                int repairRounds, const bp::object& boundaryLayer, const bp::object& cancel) {
   const CaseSetup setup = setupCase(path);
   MeshingOptions options =
       makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds, boundaryLayer);
   if (!options.size && !options.sizing) options.sizing = setup.options.sizing;
   if (!options.boundaryLayer) options.boundaryLayer = setup.options.boundaryLayer;
   options.expectedDimension = setup.options.expectedDimension;
-  return runPipeline(setup.source, options, std::move(progress));
+  return runPipeline(setup.source, options, std::move(progress), cancel);
 }
 
 PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
                 int threads, int verbosity, bp::object progress, int optimise,
-                const bp::object& sizing, int repairRounds, const bp::object& boundaryLayer) {
+                const bp::object& sizing, int repairRounds, const bp::object& boundaryLayer,
+                const bp::object& cancel) {
   return runPipeline(
       CadSource::brepText(text, name),
       makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds, boundaryLayer),
-      std::move(progress));
+      std::move(progress), cancel);
 }
 
 // Rebuilds a mesh (without CAD) from the arrays PyMesh exposes, and evaluates its quality.
@@ -526,6 +598,13 @@ BOOST_PYTHON_MODULE(_core) {
   registerTranslator<IoError>(gFileError);
   registerTranslator<CancelledError>(gCancelledError);
 
+  bp::class_<CancelToken, boost::noncopyable>(
+      "CancelToken",
+      "Pass as mesh(..., cancel=token); token.cancel() from any thread stops the job within a "
+      "fraction of a second (CancelledError)")
+      .def("cancel", &CancelToken::cancel)
+      .add_property("cancelled", &CancelToken::cancelled);
+
   bp::class_<PyMesh>("Mesh", bp::no_init)
       .add_property("order", &PyMesh::order)
       .add_property("dim", &PyMesh::dim)
@@ -554,18 +633,20 @@ BOOST_PYTHON_MODULE(_core) {
       "mesh_file", &meshFile,
       (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"), bp::arg("verbosity"),
        bp::arg("progress"), bp::arg("optimise") = 0, bp::arg("sizing") = bp::object(),
-       bp::arg("repair_rounds") = 3, bp::arg("boundary_layer") = bp::object()));
+       bp::arg("repair_rounds") = 3, bp::arg("boundary_layer") = bp::object(),
+       bp::arg("cancel") = bp::object()));
   bp::def("mesh_brep", &meshBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
            bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
            bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = 3,
-           bp::arg("boundary_layer") = bp::object()));
+           bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object()));
   bp::def("predict_file", &predictFile,
           (bp::arg("path"), bp::arg("sizing") = bp::object(), bp::arg("octree_path") = "",
            bp::arg("threads") = 1));
   bp::def("predict_brep", &predictBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
            bp::arg("octree_path") = "", bp::arg("threads") = 1));
+  bp::def("parameters", &parameters);
   bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("threads") = 1));
   bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
   bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));

@@ -265,7 +265,7 @@ def test_boundary_layer_argument_and_mcf_keys():
     ({"faces": [9], "thickness": 1}, "face 9 does not exist"),
     ({"faces": [1], "thickness": "x*"}, "not an expression of x, y, z"),
     ({"faces": [1], "thickness": True}, "must be a number or an expression"),
-    ({"faces": [1], "thickness": 1, "layers": 0}, "layers must be from 1 to 100"),
+    ({"faces": [1], "thickness": 1, "layers": 0}, "layers must be an integer from 1 to 100"),
     (5, "must be a dict"),
 ])
 def test_bad_boundary_layers_are_named(spec, message):

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <BRepTools.hxx>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "pipeline/mesh_pipeline.hpp"
@@ -78,6 +79,62 @@ TEST(MeshPipeline, ObserverCanCancelBetweenStages) {
       runMeshPipeline(CadSource::brepText(test::brepText(test::sphere(1.0))), options, &observer),
       CancelledError);
   EXPECT_EQ(observer.finished, 2);
+}
+
+// Progress within stages: the linear mesher reports each dimension, the optimiser each sweep,
+// with fractions that rise; a cancel asked during the optimiser's second sweep ends the run
+// there (between colour groups), with CancelledError and no result.
+class SweepObserver : public PipelineObserver {
+ public:
+  explicit SweepObserver(bool cancelInFirstSweep) : cancelInFirstSweep_(cancelInFirstSweep) {}
+  void stageStarted(const std::string& stage) override { optimising = stage == "optimise"; }
+  void stageProgress(const std::string& stage, double fraction,
+                     const std::string& detail) override {
+    events.emplace_back(stage, fraction, detail);
+    if (stage == "optimise") ++sweeps;
+  }
+  // The optimiser asks once before each sweep and once per colour group inside it: from the
+  // second question on (the first colour group of sweep 1), the answer is yes.
+  bool cancelRequested() override {
+    if (!cancelInFirstSweep_ || !optimising) return false;
+    return ++askedWhileOptimising >= 2;
+  }
+  std::vector<std::tuple<std::string, double, std::string>> events;
+  int sweeps = 0, askedWhileOptimising = 0;
+  bool optimising = false;
+
+ private:
+  bool cancelInFirstSweep_;
+};
+
+TEST(MeshPipeline, StagesReportProgressAndCancelWithinTheOptimiser) {
+  MeshingOptions options;
+  options.order = 4;
+  options.size = 0.5;
+  options.optimiseIterations = 3;
+  options.repairRounds = 0;
+  const std::string brep = test::brepText(test::sphere(1.0));
+  {
+    SweepObserver observer(false);
+    runMeshPipeline(CadSource::brepText(brep), options, &observer);
+    std::vector<double> linear, optimise;
+    for (const auto& [stage, fraction, detail] : observer.events) {
+      EXPECT_FALSE(detail.empty());
+      if (stage == "linear") linear.push_back(fraction);
+      if (stage == "optimise") optimise.push_back(fraction);
+    }
+    // Curves, surfaces and volumes: a third each.
+    EXPECT_EQ(linear, (std::vector<double>{1.0 / 3.0, 2.0 / 3.0, 1.0}));
+    ASSERT_GE(optimise.size(), 1u);
+    for (std::size_t i = 0; i < optimise.size(); ++i)
+      EXPECT_DOUBLE_EQ(optimise[i], static_cast<double>(i + 1) / 3.0);  // sweep k of 3
+  }
+  {
+    SweepObserver observer(true);
+    EXPECT_THROW(runMeshPipeline(CadSource::brepText(brep), options, &observer), CancelledError);
+    EXPECT_EQ(observer.sweeps, 0);  // stopped inside sweep 1, which never finished
+    EXPECT_EQ(observer.askedWhileOptimising, 2);
+  }
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/parameters.hpp"
 #include "curving/order_elevation.hpp"
 #include "linear/edge_split.hpp"
 #include "linear/linear_mesher.hpp"
@@ -286,7 +287,7 @@ TEST(RepairRounds, RoundsAreValidated) {
   MeshingOptions options;
   options.repairRounds = -1;
   EXPECT_THROW(options.validate(), ParameterError);
-  options.repairRounds = kMaxRepairRounds + 1;
+  options.repairRounds = static_cast<int>(parameterDefinition("repair_rounds").max) + 1;
   EXPECT_THROW(options.validate(), ParameterError);
   options.repairRounds = 0;
   EXPECT_NO_THROW(options.validate());

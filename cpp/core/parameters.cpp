@@ -1,0 +1,79 @@
+#include "core/parameters.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "core/error.hpp"
+#include "core/format.hpp"
+
+namespace homesh {
+
+namespace {
+constexpr double kNoLimit = std::numeric_limits<double>::infinity();
+}  // namespace
+
+const std::vector<ParameterDefinition>& parameterDefinitions() {
+  static const std::vector<ParameterDefinition> table = {
+      {"order", "Order", "--order", "order", ParameterKind::Integer, 1, 10, false, 4, false, "mesh",
+       "Polynomial order of the elements"},
+      {"size", "Size", "--size", "size", ParameterKind::Length, 0, kNoLimit, true, 0, true, "mesh",
+       "Uniform target element size (0 in FreeCAD: the sizing octree)"},
+      {"optimise", "OptimiserIterations", "--maxiter", "optimiser iterations",
+       ParameterKind::Integer, 0, 10000, false, 20, false, "mesh",
+       "Most sweeps of the variational optimiser after curving (0: none); it stops earlier "
+       "once the mesh is valid and no longer improving"},
+      {"repair_rounds", "RepairRounds", "--repair-rounds", "repair rounds", ParameterKind::Integer,
+       0, 20, false, 3, false, "mesh",
+       "Most repair rounds while elements are not proven valid (split or refine around them, "
+       "curve, optimise and check again)"},
+      {"threads", "Threads", "-j", "threads", ParameterKind::Integer, 1, 1024, false, 1, false, "mesh",
+       "Threads the sizing octree and the optimiser use"},
+      {"min_delta", "MinDelta", "--min-delta", "MinDelta", ParameterKind::Length, 0, kNoLimit, true,
+       0, true, "sizing", "Smallest element size, at high curvature"},
+      {"max_delta", "MaxDelta", "--max-delta", "MaxDelta", ParameterKind::Length, 0, kNoLimit,
+       true, 0, true, "sizing", "Largest element size"},
+      {"eps", "Eps", "--eps", "EPS", ParameterKind::Real, 0, 1, true, 0.05, false, "sizing",
+       "Sagitta ratio: on a surface of curvature radius R the size is 2 R sqrt(eps (2 - eps))"},
+      {"layers", "Layers", "--bl-layers", "boundary-layer layers", ParameterKind::Integer, 1, 100,
+       false, 2, false, "boundary_layer", "Thin layers the macro layer is split into"},
+      {"progression", "Progression", "--bl-progression", "boundary-layer progression",
+       ParameterKind::Real, 0, 100, true, 2, false, "boundary_layer",
+       "Height ratio of consecutive layers, from the wall"},
+  };
+  return table;
+}
+
+const ParameterDefinition& parameterDefinition(const std::string& key) {
+  for (const ParameterDefinition& p : parameterDefinitions())
+    if (key == p.key) return p;
+  throw std::out_of_range("no parameter '" + key + "'");
+}
+
+std::string rangeText(const ParameterDefinition& p) {
+  const bool integer = p.kind == ParameterKind::Integer;
+  const std::string what = integer                           ? "an integer"
+                           : p.kind == ParameterKind::Length ? "a length"
+                                                             : "a number";
+  if (std::isinf(p.max))
+    return what + (p.minExclusive ? " > " : " >= ") + formatNumber(p.min);
+  if (integer || !p.minExclusive)
+    return what + " from " + formatNumber(p.min) + " to " + formatNumber(p.max);
+  return what + " in (" + formatNumber(p.min) + ", " + formatNumber(p.max) + "]";
+}
+
+bool inRange(const ParameterDefinition& p, double value) {
+  if (std::isnan(value)) return false;
+  if (p.kind == ParameterKind::Integer && value != std::floor(value)) return false;
+  if (p.minExclusive ? !(value > p.min) : !(value >= p.min)) return false;
+  return value <= p.max;
+}
+
+void checkParameter(const std::string& key, double value) {
+  const ParameterDefinition& p = parameterDefinition(key);
+  if (!inRange(p, value))
+    throw ParameterError(std::string(p.label) + " must be " + rangeText(p) + ", got " +
+                         formatNumber(value));
+}
+
+}  // namespace homesh
