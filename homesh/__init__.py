@@ -24,7 +24,8 @@ from ._core import (  # noqa: F401  (re-exported)
     ParameterError,
     __version__,
 )
-from .api import BoundaryBlock, HighOrderMesh, load, mesh, predict, read  # noqa: F401
+from .api import (  # noqa: F401
+    BoundaryBlock, HighOrderMesh, load, mesh, parameters, predict, read)
 
 __all__ = [
     "BoundaryBlock",
@@ -38,6 +39,7 @@ __all__ = [
     "ParameterError",
     "load",
     "mesh",
+    "parameters",
     "predict",
     "read",
 ]

@@ -186,6 +186,21 @@ class HighOrderMesh:
             raise FileError("cannot write '%s': %s" % (path, e.strerror)) from None
 
 
+_PARAMETERS = None
+
+
+def parameters():
+    """The core's one parameter table: a list of dicts with key (the keyword of :func:`mesh`),
+    property (the FreeCAD property), option (the command line's), label, kind ("integer",
+    "real", "length"), min, max, min_exclusive, default, zero_is_automatic, group, doc and
+    range (in words). The core, the command line and the FreeCAD objects all check against
+    it."""
+    global _PARAMETERS
+    if _PARAMETERS is None:
+        _PARAMETERS = [dict(p) for p in _core.parameters()]
+    return [dict(p) for p in _PARAMETERS]
+
+
 def read(path, threads=1):
     """Reads a mesh file: .msh (Gmsh 2.2 or 4.1, ASCII or binary) or .xml (Nektar++, plain or
     compressed), and evaluates its quality."""

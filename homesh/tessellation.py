@@ -110,17 +110,108 @@ def quality_colors(values):
     return colors
 
 
-def surface_and_edges(mesh, level=None):
+MEASURES = {"Scaled Jacobian": "scaled_jacobian", "Distortion": "distortion"}
+
+
+def element_values(mesh, measure="Scaled Jacobian"):
+    """Per element (block after block) the measure drawn: the certified scaled Jacobian or
+    the sampled distortion quality (both 1 ideal, <= 0 inverted)."""
+    return np.asarray(mesh.quality()[MEASURES[measure]], dtype=float)
+
+
+def _reference_face_points(element_type, face, level):
+    """Reference coordinates of a level-``level`` lattice on one face of a volume shape
+    (corner indices ``face``), and its sub-triangles."""
+    corners = np.asarray(_core.reference_nodes(element_type, 1), dtype=float)[list(face)]
+    if len(face) == 3:
+        ref, sub = triangle_lattice(level)
+        s, t = ref[:, :1], ref[:, 1:]
+        points = corners[0] + s * (corners[1] - corners[0]) + t * (corners[2] - corners[0])
+    else:
+        ref, sub = quad_lattice(level)
+        s, t = ref[:, :1], ref[:, 1:]
+        points = ((1 - s) * (1 - t) * corners[0] + s * (1 - t) * corners[1]
+                  + s * t * corners[2] + (1 - s) * t * corners[3])
+    return points, sub
+
+
+def element_surfaces(mesh, selected, level=None, measure="Scaled Jacobian"):
+    """Display geometry of the chosen elements themselves (indices over all elements, block
+    after block): every face of each chosen volume element (3D) or the chosen elements (2D),
+    sampled through the element's own map, so the inside of the mesh can be seen. Same dict
+    as :func:`surface_and_edges` (edges: the chosen elements' face boundaries)."""
+    order = mesh.order
+    level = level or max(2, 2 * order)
+    values = element_values(mesh, measure)
+    selected = np.asarray(sorted(set(int(i) for i in selected)), dtype=np.int64)
+    points, triangles, colors, polylines = [], [], [], []
+    count = 0
+    first = 0
+    for block in mesh.element_blocks:
+        n = len(block.elements)
+        mine = selected[(selected >= first) & (selected < first + n)] - first
+        first += n
+        if len(mine) == 0:
+            continue
+        nodes = mesh.nodes[block.elements[mine]]  # (e, k, 3)
+        block_values = values[mine + first - n]
+        faces = _VOLUME_FACES.get(block.element_type) if mesh.dim == 3 else None
+        lattices = ([_reference_face_points(block.element_type, f, level) for f in faces]
+                    if faces else [_LATTICE[block.element_type](level)])
+        for ref, sub in lattices:
+            basis = _core.lagrange_basis(block.element_type, order, ref)
+            p = np.einsum("kn,enc->ekc", basis, nodes)  # (e, k, 3)
+            offsets = (count + np.arange(len(mine)) * len(ref))[:, None, None]
+            triangles.append((sub[None, :, :] + offsets).reshape(-1, 3))
+            points.append(p.reshape(-1, 3))
+            count += p.shape[0] * p.shape[1]
+            colors.append(np.repeat(quality_colors(block_values), len(sub), axis=0))
+            # The face's boundary, as polylines through the lattice's border points.
+            corners = 3 if len(ref) == (level + 1) * (level + 2) // 2 else 4
+            polylines.append(p[:, _lattice_border(level, corners), :])
+    points = np.concatenate(points) if points else np.zeros((0, 3))
+    triangles = np.concatenate(triangles) if triangles else np.zeros((0, 3), dtype=np.int64)
+    colors = np.concatenate(colors) if colors else np.zeros((0, 3))
+    lines = np.concatenate(polylines) if polylines else np.zeros((0, level + 1, 3))
+    edge_points = lines.reshape(-1, 3)
+    edge_index = np.arange(len(edge_points)).reshape(len(lines), -1)
+    return {"points": points, "triangles": triangles, "colors": colors,
+            "edge_points": edge_points, "edge_polylines": edge_index}
+
+
+def _lattice_border(level, corners):
+    """Indices of a triangle_lattice's or quad_lattice's boundary points, in order round the
+    face and closed."""
+    if corners == 3:
+        # triangle_lattice order: rows j, points i = 0..level-j.
+        index = {}
+        k = 0
+        for j in range(level + 1):
+            for i in range(level + 1 - j):
+                index[(i, j)] = k
+                k += 1
+        loop = ([index[(i, 0)] for i in range(level + 1)]
+                + [index[(level - j, j)] for j in range(1, level + 1)]
+                + [index[(0, j)] for j in range(level - 1, -1, -1)])
+    else:
+        n = level + 1
+        loop = ([i for i in range(n)] + [j * n + level for j in range(1, n)]
+                + [level * n + i for i in range(level - 1, -1, -1)]
+                + [j * n for j in range(level - 1, -1, -1)])
+    return np.asarray(loop, dtype=np.int64)
+
+
+def surface_and_edges(mesh, level=None, measure="Scaled Jacobian"):
     """Display geometry of a :class:`homesh.HighOrderMesh`.
 
     The drawn surface is the boundary triangles and quadrilaterals (3D) or the elements
-    themselves (2D), coloured by the scaled Jacobian of the element they belong to. Returns a dict with ``points``,
-    ``triangles``, ``colors`` (per triangle), ``edge_points`` and ``edge_polylines``
-    (each row indexes edge_points).
+    themselves (2D), coloured by ``measure`` (:data:`MEASURES`) of the element they belong to.
+    Returns a dict with ``points``, ``triangles``, ``colors`` (per triangle), ``edge_points``
+    and ``edge_polylines`` (each row indexes edge_points).
     """
     order = mesh.order
     level = level or max(2, 2 * order)
-    quality = mesh.quality()["scaled_jacobian"]
+    quality = element_values(mesh, measure)
     if mesh.dim == 3:
         groups = [(b.element_type, b.elements) for b in mesh.boundary
                   if b.element_type in _LATTICE]

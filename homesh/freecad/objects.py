@@ -15,6 +15,8 @@ import tempfile
 
 import FreeCAD
 
+from .properties import ParameterGuard, add_parameter_property, allowed, definition
+
 TYPE_HIGH_ORDER_MESH = "HOMesh::HighOrderMesh"
 TYPE_SIZING = "HOMesh::Sizing"
 TYPE_BOUNDARY_LAYER = "HOMesh::BoundaryLayer"
@@ -82,8 +84,18 @@ class _Proxy:
         self.__setstate__(state)
 
 
-class HighOrderMeshProxy(_Proxy):
-    """Proxy of an App::FeaturePython that meshes its ``Part`` with curved elements."""
+class LargeMeshError(ValueError):
+    """The predicted element count exceeds the object's ElementLimit: the GUI asks before going
+    on; in Python, raise ElementLimit (0: no limit) to run it."""
+
+
+class HighOrderMeshProxy(_Proxy, ParameterGuard):
+    """Proxy of an App::FeaturePython that meshes its ``Part`` with curved elements.
+
+    Recomputing meshes synchronously without the GUI, and on a worker thread behind a
+    cancellable progress dialog with it (FreeCAD keeps drawing); the task panel runs the same
+    job (:func:`job_for`) and applies its result (:func:`apply_result`) without a recompute.
+    """
 
     Type = TYPE_HIGH_ORDER_MESH
 
@@ -91,6 +103,7 @@ class HighOrderMeshProxy(_Proxy):
         obj.Proxy = self
         self.mesh = None
         self.add_properties(obj)
+        self.remember(obj)
 
     @staticmethod
     def add_properties(obj):
@@ -98,30 +111,23 @@ class HighOrderMeshProxy(_Proxy):
         have = obj.PropertiesList
         if "Part" not in have:
             obj.addProperty("App::PropertyLink", "Part", "Mesh", "Shape to mesh")
-        if "Order" not in have:
-            obj.addProperty("App::PropertyIntegerConstraint", "Order", "Mesh",
-                            "Polynomial order of the elements (1 to 10)")
-            obj.Order = (4, 1, 10, 1)
-        if "Size" not in have:
-            obj.addProperty("App::PropertyLength", "Size", "Mesh",
-                            "Uniform target element size; 0: the Sizing object's octree if "
-                            "Sizing is set, else the automatic sizing octree")
+        add_parameter_property(obj, "order", "Mesh")
+        add_parameter_property(obj, "size", "Mesh",
+                               " 0: the Sizing object's octree if Sizing is set, else the "
+                               "automatic sizing octree.")
         if "Sizing" not in have:
             obj.addProperty("App::PropertyLink", "Sizing", "Mesh",
                             "Optional HOMesh Sizing object whose octree (MinDelta, MaxDelta, "
                             "Eps, refinement spheres) sizes the elements when Size is 0")
-        if "OptimiserIterations" not in have:
-            obj.addProperty("App::PropertyIntegerConstraint", "OptimiserIterations", "Mesh",
-                            "Most sweeps of the variational optimiser after curving (0: none; "
-                            "it stops earlier once the mesh is valid and no longer improving); "
-                            "boundary nodes slide on the CAD")
-            obj.OptimiserIterations = (20, 0, 1000, 1)
-        if "RepairRounds" not in have:
-            obj.addProperty("App::PropertyIntegerConstraint", "RepairRounds", "Mesh",
-                            "Most repair rounds while elements are not proven valid (split "
-                            "their edges on curved faces or refine around them, then curve, "
-                            "optimise and check again); 0: none")
-            obj.RepairRounds = (3, 0, 20, 1)
+        add_parameter_property(obj, "optimise", "Mesh", " Boundary nodes slide on the CAD.")
+        add_parameter_property(obj, "repair_rounds", "Mesh")
+        add_parameter_property(obj, "threads", "Mesh", " Default: all cores.",
+                               default=os.cpu_count() or 1)
+        if "ElementLimit" not in have:
+            obj.addProperty("App::PropertyInteger", "ElementLimit", "Mesh",
+                            "A run whose predicted linear element count exceeds this asks "
+                            "first (GUI) or fails (Python) until it is raised; 0: no limit")
+            obj.ElementLimit = DEFAULT_ELEMENT_LIMIT
         if "BoundaryLayer" not in have:
             obj.addProperty("App::PropertyLink", "BoundaryLayer", "Mesh",
                             "Optional HOMesh BoundaryLayer object: prisms grown from its faces "
@@ -134,8 +140,12 @@ class HighOrderMeshProxy(_Proxy):
                 ("NumNodes", "App::PropertyInteger", "Number of nodes"),
                 ("NumElements", "App::PropertyInteger", "Number of volume (2D: surface) elements"),
                 ("MinScaledJacobian", "App::PropertyFloat",
-                 "Worst scaled Jacobian (min J / max J); <= 0 means an invalid element"),
-                ("InvalidElements", "App::PropertyInteger", "Elements with non-positive Jacobian")):
+                 "Worst scaled Jacobian (min J / max J, certified); <= 0 means an invalid "
+                 "element"),
+                ("InvalidElements", "App::PropertyInteger", "Elements with non-positive Jacobian"),
+                ("UndecidedElements", "App::PropertyInteger",
+                 "Elements whose validity the certified check could not decide"),
+                ("Status", "App::PropertyString", "Summary of the last run, or why it failed")):
             if prop not in have:
                 obj.addProperty(kind, prop, "Result", doc)
                 obj.setEditorMode(prop, 1)  # read-only
@@ -143,58 +153,197 @@ class HighOrderMeshProxy(_Proxy):
     def onDocumentRestored(self, obj):
         self.mesh = None
         self.add_properties(obj)
+        self.remember(obj)
+
+    def onChanged(self, obj, prop):
+        self.guard(obj, prop)
 
     def execute(self, obj):
         import homesh
         self.mesh = None
-        if obj.Part is None:
-            raise ValueError("%s: no shape to mesh (set its Part property)" % obj.Label)
-        shape = getattr(obj.Part, "Shape", None)
-        if shape is None or shape.isNull():
-            raise ValueError("%s: %s has no shape" % (obj.Label, obj.Part.Label))
-        size = obj.Size.Value if obj.Size.Value > 0 else None
-        sizing = {}
-        if size is None and obj.Sizing is not None:
-            if not is_sizing(obj.Sizing):
-                raise ValueError("%s: Sizing must link to a HOMesh Sizing object, not %s"
-                                 % (obj.Label, obj.Sizing.Label))
-            sizing = sizing_arguments(obj.Sizing)
-        layer = None
-        if obj.BoundaryLayer is not None:
-            if not is_boundary_layer(obj.BoundaryLayer):
-                raise ValueError("%s: BoundaryLayer must link to a HOMesh BoundaryLayer object, "
-                                 "not %s" % (obj.Label, obj.BoundaryLayer.Label))
-            layer = boundary_layer_arguments(obj.BoundaryLayer, obj.Part)
-        progress = _Progress(obj.Label)
         try:
-            mesh = homesh.mesh(shape, order=obj.Order, size=size, progress=progress,
-                               name=obj.Part.Label, optimise=obj.OptimiserIterations,
-                               repair_rounds=obj.RepairRounds, boundary_layer=layer, **sizing)
-        except homesh.HOMeshError as e:
-            FreeCAD.Console.PrintError("HOMesh: %s: %s\n" % (obj.Label, e))
+            job = job_for(obj)
+            predicted = check_element_limit(obj, job)
+        except LargeMeshError as e:
+            if not (FreeCAD.GuiUp and _confirm_large(obj, e)):
+                _fail(obj, e)
+                raise
+            predicted = None
+        except (ValueError, homesh.HOMeshError) as e:
+            _fail(obj, e)
             raise
-        finally:
-            progress.stop()
-        folder = tempfile.mkdtemp(prefix="homesh-")
         try:
-            path = os.path.join(folder, "mesh.npz")
-            mesh.write(path)
-            obj.MeshData = path  # FreeCAD copies the file into the document
-        finally:
-            shutil.rmtree(folder, ignore_errors=True)
-        self.mesh = mesh
-        quality = mesh.quality()
-        obj.NumNodes = mesh.num_nodes
-        obj.NumElements = mesh.num_elements
-        obj.MinScaledJacobian = float(quality["min"])
-        obj.InvalidElements = int(quality["invalid_elements"])
-        FreeCAD.Console.PrintMessage(
-            "HOMesh: %s: %d nodes, %d elements of order %d, worst scaled Jacobian %.3f, "
-            "%d invalid\n" % (obj.Label, mesh.num_nodes, mesh.num_elements, mesh.order,
-                              quality["min"], quality["invalid_elements"]))
+            if FreeCAD.GuiUp:
+                from .job import run_with_progress_dialog
+                mesh = run_with_progress_dialog(job, "Meshing %s" % obj.Label)
+            else:
+                job.start().wait()
+                if job.error is not None:
+                    raise job.error
+                mesh = job.result
+        except homesh.HOMeshError as e:
+            _fail(obj, e)
+            raise
+        apply_result(obj, mesh, predicted, touch=False)
 
     def __setstate__(self, state):
         self.mesh = None
+
+
+DEFAULT_ELEMENT_LIMIT = 2000000
+
+
+def _fail(obj, error):
+    obj.Status = "Failed: %s" % error
+    FreeCAD.Console.PrintError("HOMesh: %s: %s\n" % (obj.Label, error))
+
+
+def _confirm_large(obj, error):
+    from PySide2 import QtWidgets
+    import FreeCADGui
+    answer = QtWidgets.QMessageBox.question(
+        FreeCADGui.getMainWindow(), "HOMesh: large mesh",
+        "%s\n\nMesh it anyway?" % error,
+        QtWidgets.QMessageBox.Yes | QtWidgets.QMessageBox.No, QtWidgets.QMessageBox.No)
+    return answer == QtWidgets.QMessageBox.Yes
+
+
+def mesh_arguments(obj, values=None):
+    """The keyword arguments of :func:`homesh.mesh` that a HighOrderMesh object stands for,
+    with ``values`` ({property: value}, from a task panel) in place of its own properties.
+
+    Raises ValueError naming the object and the property when something is missing or out of
+    range.
+    """
+    values = dict(values or {})
+
+    def get(prop):
+        value = values[prop] if prop in values else getattr(obj, prop)
+        value = float(getattr(value, "Value", value))
+        p = definition(prop)
+        if not allowed(p, value):
+            raise ValueError("%s: %s must be %s, got %g" % (obj.Label, prop, p["range"], value))
+        return value
+
+    size = get("Size")
+    arguments = {"order": int(get("Order")), "size": size if size > 0 else None,
+                 "optimise": int(get("OptimiserIterations")),
+                 "repair_rounds": int(get("RepairRounds")), "threads": int(get("Threads"))}
+    sizing = values.get("Sizing", getattr(obj, "Sizing", None))
+    if arguments["size"] is None and sizing is not None:
+        if not is_sizing(sizing):
+            raise ValueError("%s: Sizing must link to a HOMesh Sizing object, not %s"
+                             % (obj.Label, sizing.Label))
+        arguments.update(sizing_arguments(sizing))
+    if obj.BoundaryLayer is not None:
+        if not is_boundary_layer(obj.BoundaryLayer):
+            raise ValueError("%s: BoundaryLayer must link to a HOMesh BoundaryLayer object, "
+                             "not %s" % (obj.Label, obj.BoundaryLayer.Label))
+        arguments["boundary_layer"] = boundary_layer_arguments(obj.BoundaryLayer, obj.Part)
+    return arguments
+
+
+def part_shape(obj):
+    """The shape a HighOrderMesh meshes; ValueError naming the object when there is none."""
+    if obj.Part is None:
+        raise ValueError("%s: no shape to mesh (set its Part property)" % obj.Label)
+    shape = getattr(obj.Part, "Shape", None)
+    if shape is None or shape.isNull():
+        raise ValueError("%s: %s has no shape" % (obj.Label, obj.Part.Label))
+    return shape
+
+
+def job_for(obj, values=None):
+    """A :class:`job.MeshJob` (not started) for a HighOrderMesh object, with ``values`` from a
+    task panel in place of its properties. The shape is exported here, on the GUI thread."""
+    from .job import MeshJob
+    shape = part_shape(obj)
+    arguments = mesh_arguments(obj, values)
+    job = MeshJob(shape.exportBrepToString(), obj.Part.Label, **arguments)
+    job.values = values or {}
+    return job
+
+
+def predicted_elements(obj, job):
+    """The linear element count the job will make, predicted: the sizing octree's own
+    prediction, or for a uniform size the volume (area) over that of a regular tetrahedron
+    (triangle) of that edge."""
+    import homesh
+    arguments = job.arguments
+    size = arguments.get("size")
+    if size is None:
+        sizing = {k: arguments[k] for k in ("min_delta", "max_delta", "eps", "sources")
+                  if k in arguments}
+        report = homesh.predict(job.brep_text, name=job.name, threads=arguments["threads"],
+                                **sizing)
+        return int(report["predicted_elements"])
+    shape = part_shape(obj)
+    if shape.Solids:
+        return int(shape.Volume / (size ** 3 / (6.0 * 2.0 ** 0.5)))
+    return int(shape.Area / (size ** 2 * 3.0 ** 0.5 / 4.0))
+
+
+def check_element_limit(obj, job):
+    """The predicted count; LargeMeshError when it exceeds the object's ElementLimit."""
+    predicted = predicted_elements(obj, job)
+    limit = int(obj.ElementLimit)
+    if limit > 0 and predicted > limit:
+        raise LargeMeshError(
+            "%s: about %d linear elements predicted, more than ElementLimit (%d); raise "
+            "ElementLimit (0: no limit) or use a larger size" % (obj.Label, predicted, limit))
+    return predicted
+
+
+def apply_result(obj, mesh, predicted=None, touch=True, values=None):
+    """Stores a finished job's mesh in a HighOrderMesh object: the task panel's ``values`` (its
+    parameters, so the object says what made the mesh), the mesh (MeshData, kept in the .FCStd)
+    and the result properties; a warning when elements are invalid or undecided. With ``touch``
+    False (inside execute) FreeCAD clears the touched state itself; else it is cleared here,
+    since the mesh is up to date."""
+    for prop, value in (values or {}).items():
+        if prop != "Sizing":
+            setattr(obj, prop, value)
+    folder = tempfile.mkdtemp(prefix="homesh-")
+    try:
+        path = os.path.join(folder, "mesh.npz")
+        mesh.write(path)
+        obj.MeshData = path  # FreeCAD copies the file into the document
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+    obj.Proxy.mesh = mesh
+    quality = mesh.quality()
+    obj.NumNodes = mesh.num_nodes
+    obj.NumElements = mesh.num_elements
+    obj.MinScaledJacobian = float(quality["min"])
+    obj.InvalidElements = int(quality["invalid_elements"])
+    obj.UndecidedElements = int(quality["undecided_elements"])
+    obj.Status = summary_text(obj, mesh, quality, predicted)
+    if not_valid(obj):
+        FreeCAD.Console.PrintWarning("HOMesh: %s\n" % obj.Status)
+    else:
+        FreeCAD.Console.PrintMessage("HOMesh: %s\n" % obj.Status)
+    if touch:
+        obj.purgeTouched()
+    if FreeCAD.GuiUp and obj.ViewObject is not None:
+        obj.ViewObject.signalChangeIcon()
+
+
+def not_valid(obj):
+    """Whether the object's mesh has elements not proven valid."""
+    return obj.InvalidElements > 0 or obj.UndecidedElements > 0
+
+
+def summary_text(obj, mesh, quality, predicted=None):
+    text = ("%s: %d nodes, %d elements of order %d, worst scaled Jacobian %.3f"
+            % (obj.Label, mesh.num_nodes, mesh.num_elements, mesh.order, quality["min"]))
+    if predicted:
+        text += ", %d linear elements predicted" % predicted
+    if quality["invalid_elements"] or quality["undecided_elements"]:
+        text += (": NOT VALID, %d invalid and %d undecided elements (worst %.3g)"
+                 % (quality["invalid_elements"], quality["undecided_elements"], quality["min"]))
+    else:
+        text += ", all elements proven valid"
+    return text
 
 
 def make_sizing(doc, part, min_delta=0.0, max_delta=0.0, eps=0.05, name="Sizing"):
@@ -254,7 +403,7 @@ def sizing_arguments(obj):
             "eps": float(eps), "sources": sources}
 
 
-class SizingProxy(_Proxy):
+class SizingProxy(_Proxy, ParameterGuard):
     """Proxy of an App::FeaturePython holding the sizing octree's parameters for its ``Part``;
     recomputing predicts the element count (:func:`homesh.predict`).
 
@@ -268,6 +417,7 @@ class SizingProxy(_Proxy):
     def __init__(self, obj):
         obj.Proxy = self
         self.add_properties(obj)
+        self.remember(obj)
 
     @staticmethod
     def add_properties(obj):
@@ -275,17 +425,9 @@ class SizingProxy(_Proxy):
         have = obj.PropertiesList
         if "Part" not in have:
             obj.addProperty("App::PropertyLink", "Part", "Sizing", "Shape whose sizing this is")
-        if "MinDelta" not in have:
-            obj.addProperty("App::PropertyLength", "MinDelta", "Sizing",
-                            "Smallest element size (at high curvature); 0: MaxDelta / 20")
-        if "MaxDelta" not in have:
-            obj.addProperty("App::PropertyLength", "MaxDelta", "Sizing",
-                            "Largest element size; 0: bounding-box diagonal / 20")
-        if "Eps" not in have:
-            obj.addProperty("App::PropertyFloat", "Eps", "Sizing",
-                            "Sagitta ratio, 0 < Eps <= 1: on a surface of curvature radius R "
-                            "the size is 2 R sqrt(Eps (2 - Eps))")
-            obj.Eps = 0.05
+        add_parameter_property(obj, "min_delta", "Sizing", " 0: MaxDelta / 20.")
+        add_parameter_property(obj, "max_delta", "Sizing", " 0: bounding-box diagonal / 20.")
+        add_parameter_property(obj, "eps", "Sizing")
         if "Gradation" not in have:
             obj.addProperty("App::PropertyFloat", "Gradation", "Sizing",
                             "Most change of size per unit distance (fixed)")
@@ -316,6 +458,10 @@ class SizingProxy(_Proxy):
 
     def onDocumentRestored(self, obj):
         self.add_properties(obj)
+        self.remember(obj)
+
+    def onChanged(self, obj, prop):
+        self.guard(obj, prop)
 
     def execute(self, obj):
         import homesh
@@ -402,7 +548,7 @@ def boundary_layer_arguments(obj, part=None):
             "progression": float(obj.Progression)}
 
 
-class BoundaryLayerProxy(_Proxy):
+class BoundaryLayerProxy(_Proxy, ParameterGuard):
     """Proxy of an App::FeaturePython holding a boundary layer's parameters; recomputing checks
     them and gives the first layer's height (for a constant thickness)."""
 
@@ -411,6 +557,7 @@ class BoundaryLayerProxy(_Proxy):
     def __init__(self, obj):
         obj.Proxy = self
         self.add_properties(obj)
+        self.remember(obj)
 
     @staticmethod
     def add_properties(obj):
@@ -424,14 +571,8 @@ class BoundaryLayerProxy(_Proxy):
             obj.addProperty("App::PropertyString", "Thickness", "Layer",
                             "Total thickness in the model's units, or an expression of x, y, z "
                             "such as 0.01+0.05*x")
-        if "Layers" not in have:
-            obj.addProperty("App::PropertyIntegerConstraint", "Layers", "Layer",
-                            "Thin layers the macro layer is split into (1 to 100)")
-            obj.Layers = (2, 1, 100, 1)
-        if "Progression" not in have:
-            obj.addProperty("App::PropertyFloatConstraint", "Progression", "Layer",
-                            "Height ratio of consecutive layers, from the wall (0.01 to 100)")
-            obj.Progression = (2.0, 0.01, 100.0, 0.1)
+        add_parameter_property(obj, "layers", "Layer")
+        add_parameter_property(obj, "progression", "Layer")
         for prop, kind, doc in (
                 ("FirstLayerHeight", "App::PropertyFloat",
                  "Height of the wall layer for a constant thickness (0 for an expression)"),
@@ -442,6 +583,10 @@ class BoundaryLayerProxy(_Proxy):
 
     def onDocumentRestored(self, obj):
         self.add_properties(obj)
+        self.remember(obj)
+
+    def onChanged(self, obj, prop):
+        self.guard(obj, prop)
 
     def execute(self, obj):
         try:
@@ -461,28 +606,3 @@ class BoundaryLayerProxy(_Proxy):
         obj.Status = ("%d faces of %s, thickness %s, %d layers, progression %g%s"
                       % (len(args["faces"]), obj.Faces[0].Label, t, n, r,
                          ", first layer %.4g" % first if first else ""))
-
-
-class _Progress:
-    """Reports pipeline stages to FreeCAD's progress bar (GUI) and report view."""
-
-    STAGES = 4
-
-    def __init__(self, label):
-        self.label = label
-        self.bar = None
-        if FreeCAD.GuiUp:
-            self.bar = FreeCAD.Base.ProgressIndicator()
-            self.bar.start("HOMesh: meshing %s" % label, self.STAGES)
-
-    def __call__(self, stage, seconds):
-        if seconds is None:
-            return
-        FreeCAD.Console.PrintLog("HOMesh: %s: %s %.3f s\n" % (self.label, stage, seconds))
-        if self.bar is not None:
-            self.bar.next()
-
-    def stop(self):
-        if self.bar is not None:
-            self.bar.stop()
-            self.bar = None

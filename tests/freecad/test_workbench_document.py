@@ -108,11 +108,12 @@ class HighOrderMeshObject(unittest.TestCase):
         self.assertEqual(obj.InvalidElements, 0)
         self.assertGreater(obj.MinScaledJacobian, 0.0)
 
-    def test_order_is_constrained(self):
+    def test_order_out_of_range_is_refused_not_clamped(self):
         part = box_with_hole(self.doc)
         obj = homesh.freecad.make_high_order_mesh(self.doc, part)
         obj.Order = 50
-        self.assertEqual(obj.Order, 10)
+        self.assertEqual(obj.Order, 4)
+        self.assertIn("Order = 50 refused", obj.Proxy.refused[-1])
 
     def test_a_failed_recompute_exports_nothing_stale(self):
         part = box_with_hole(self.doc)

@@ -1,0 +1,170 @@
+"""A meshing job on a worker thread, so FreeCAD's GUI keeps drawing and answering while the core
+works (it runs with the GIL released).
+
+The worker only calls :func:`homesh.mesh` on BRep text taken from the shape beforehand (FreeCAD
+objects are touched on the GUI thread only); its progress goes into a queue that the GUI thread
+drains with :meth:`MeshJob.poll` from a timer. :meth:`MeshJob.cancel` sets the core's cancel
+token, which the core reads between stages, Gmsh's dimensions and the optimiser's colour
+groups. Nothing here changes the document: whoever started the job applies the result.
+"""
+
+import queue
+import threading
+import time
+
+import homesh
+
+# Rough shares of the run per stage, for one overall percentage (the optimiser dominates when it
+# runs); stages not listed (repair rounds) take the remainder.
+_STAGE_WEIGHTS = {"cad": 2, "sizing": 3, "linear": 10, "boundary_layer": 5, "high_order": 10,
+                  "optimise_low_order": 20, "raise_order": 3, "optimise": 40, "quality": 4,
+                  "split_layers": 2, "geometry": 2}
+
+
+class MeshJob:
+    """``MeshJob(brep_text, name, **mesh_arguments)``; ``start()``, then ``poll()`` from the GUI
+    thread until ``done``; ``result`` (a :class:`homesh.HighOrderMesh`) or ``error`` (the
+    exception, :class:`homesh.CancelledError` after :meth:`cancel`)."""
+
+    def __init__(self, brep_text, name, **arguments):
+        self.brep_text = brep_text
+        self.name = name
+        self.arguments = arguments
+        self.token = homesh.CancelToken()
+        self.events = queue.Queue()
+        self.result = None
+        self.error = None
+        self.stage = ""
+        self.detail = ""
+        self.stage_fraction = 0.0
+        self.log = []
+        self._finished_weight = 0.0
+        self._thread = None
+        self._start = None
+        self._end = None
+
+    def start(self):
+        self._start = time.monotonic()
+        self._thread = threading.Thread(target=self._run, name="HOMesh " + self.name,
+                                        daemon=True)
+        self._thread.start()
+        return self
+
+    def _run(self):
+        try:
+            self.result = homesh.mesh(self.brep_text, name=self.name, progress=self._progress,
+                                      cancel=self.token, **self.arguments)
+        except BaseException as e:  # noqa: B902 - handed to the GUI thread, never lost
+            self.error = e
+        finally:
+            self._end = time.monotonic()
+            self.events.put(("done",))
+
+    def _progress(self, stage, seconds, fraction, detail):
+        # On the worker thread: only the queue is touched.
+        self.events.put(("progress", stage, seconds, fraction, detail))
+
+    def cancel(self):
+        """Asks the core to stop; the job ends with CancelledError within a fraction of a
+        second (Gmsh's own meshing of one dimension cannot be interrupted)."""
+        self.token.cancel()
+
+    @property
+    def cancelled(self):
+        return self.token.cancelled
+
+    @property
+    def running(self):
+        return self._thread is not None and self._thread.is_alive()
+
+    @property
+    def done(self):
+        return self._end is not None and not self.running
+
+    @property
+    def elapsed(self):
+        if self._start is None:
+            return 0.0
+        return (self._end if self._end is not None else time.monotonic()) - self._start
+
+    @property
+    def fraction(self):
+        """Estimated share of the whole job done, 0..1."""
+        total = sum(_STAGE_WEIGHTS.values())
+        current = _STAGE_WEIGHTS.get(self.stage, 0) * self.stage_fraction
+        return min(1.0, (self._finished_weight + current) / total)
+
+    def poll(self):
+        """Drains the progress queue (GUI thread): updates stage, detail, fractions and the log
+        and returns the new log lines."""
+        lines = []
+        while True:
+            try:
+                event = self.events.get_nowait()
+            except queue.Empty:
+                break
+            if event[0] != "progress":
+                continue
+            _, stage, seconds, fraction, detail = event
+            self.stage = stage
+            self.stage_fraction = fraction
+            if seconds is not None:
+                self._finished_weight += _STAGE_WEIGHTS.get(stage, 0)
+                self.stage_fraction = 0.0
+                lines.append("%s: %.2f s" % (stage, seconds))
+            elif detail:
+                self.detail = detail
+                lines.append("  " + detail)
+            else:
+                self.detail = ""
+                lines.append("%s ..." % stage)
+        self.log.extend(lines)
+        return lines
+
+    def wait(self, timeout=None):
+        """Blocks until the worker ends (headless use)."""
+        if self._thread is not None:
+            self._thread.join(timeout)
+        return self.done
+
+
+def run_with_progress_dialog(job, title):
+    """Runs ``job`` while a cancellable progress dialog keeps the GUI alive (FreeCAD's
+    recompute of a mesh object when the GUI is up). Returns the mesh or raises the job's
+    error. Escape or the dialog's Cancel cancels the job."""
+    from PySide2 import QtCore, QtWidgets
+    dialog = QtWidgets.QProgressDialog(title, "Cancel", 0, 1000, _main_window())
+    dialog.setWindowTitle("HOMesh")
+    dialog.setWindowModality(QtCore.Qt.WindowModal)  # no second recompute while this runs
+    dialog.setMinimumDuration(300)
+    dialog.canceled.connect(job.cancel)
+    loop = QtCore.QEventLoop()
+    timer = QtCore.QTimer()
+
+    def tick():
+        job.poll()
+        dialog.setValue(int(1000 * job.fraction))
+        dialog.setLabelText("%s\n%s %s (%.0f s)"
+                            % (title, job.stage, job.detail, job.elapsed))
+        if job.done:
+            loop.quit()
+
+    timer.timeout.connect(tick)
+    job.start()
+    timer.start(100)
+    loop.exec_()
+    timer.stop()
+    job.poll()
+    dialog.reset()
+    dialog.deleteLater()
+    if job.error is not None:
+        raise job.error
+    return job.result
+
+
+def _main_window():
+    try:
+        import FreeCADGui
+        return FreeCADGui.getMainWindow()
+    except Exception:  # noqa: BLE001 - no GUI: a dialog without parent
+        return None
