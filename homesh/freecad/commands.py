@@ -25,9 +25,15 @@ def _selected_shape_object():
     return obj
 
 
+def active_panel():
+    """The HOMesh task panel being shown, if any."""
+    from .taskpanels import last_panel
+    return last_panel() if FreeCADGui.Control.activeDialog() else None
+
+
 class CommandHighOrderMesh:
     """Creates a HighOrderMesh of the selected shape (or of the selected Sizing object's shape,
-    sized by it) and recomputes it."""
+    sized by it) and opens its task panel, which meshes it."""
 
     def GetResources(self):
         return {
@@ -58,10 +64,15 @@ class CommandHighOrderMesh:
             FreeCADGui.doCommand(
                 "_mesh = homesh.freecad.make_high_order_mesh("
                 "App.ActiveDocument, App.ActiveDocument.getObject(%r)%s)" % (part.Name, sizing_arg))
-            FreeCADGui.doCommand("Gui.ActiveDocument.getObject(%r).Visibility = False" % part.Name)
-            FreeCADGui.doCommand("App.ActiveDocument.recompute()")
         finally:
             doc.commitTransaction()
+        # The task panel meshes on a worker thread, with progress, Stop and the log; the
+        # object is applied (one undoable step) when the job ends.
+        mesh = doc.ActiveObject
+        FreeCADGui.ActiveDocument.setEdit(mesh.Name)
+        panel = active_panel()
+        if panel is not None:
+            panel.mesh()
 
 
 class CommandSizing:

@@ -8,7 +8,10 @@ token, which the core reads between stages, Gmsh's dimensions and the optimiser'
 groups. Nothing here changes the document: whoever started the job applies the result.
 """
 
+import os
 import queue
+import shutil
+import tempfile
 import threading
 import time
 
@@ -33,6 +36,8 @@ class MeshJob:
         self.token = homesh.CancelToken()
         self.events = queue.Queue()
         self.result = None
+        self.npz_path = None  # the result written as .npz (by the worker), for the document
+        self.folder = None
         self.error = None
         self.stage = ""
         self.detail = ""
@@ -54,8 +59,13 @@ class MeshJob:
         try:
             self.result = homesh.mesh(self.brep_text, name=self.name, progress=self._progress,
                                       cancel=self.token, **self.arguments)
+            # The document's copy of the mesh, compressed here rather than on the GUI thread.
+            self.folder = tempfile.mkdtemp(prefix="homesh-")
+            self.npz_path = os.path.join(self.folder, "mesh.npz")
+            self.result.write(self.npz_path)
         except BaseException as e:  # noqa: B902 - handed to the GUI thread, never lost
             self.error = e
+            self.result = None
         finally:
             self._end = time.monotonic()
             self.events.put(("done",))
@@ -120,6 +130,12 @@ class MeshJob:
                 lines.append("%s ..." % stage)
         self.log.extend(lines)
         return lines
+
+    def discard_files(self):
+        """Removes the worker's .npz copy (after the document has taken its own)."""
+        if self.folder is not None:
+            shutil.rmtree(self.folder, ignore_errors=True)
+            self.folder = self.npz_path = None
 
     def wait(self, timeout=None):
         """Blocks until the worker ends (headless use)."""

@@ -184,7 +184,10 @@ class HighOrderMeshProxy(_Proxy, ParameterGuard):
         except homesh.HOMeshError as e:
             _fail(obj, e)
             raise
-        apply_result(obj, mesh, predicted, touch=False)
+        try:
+            apply_result(obj, mesh, predicted, touch=False, npz_path=job.npz_path)
+        finally:
+            job.discard_files()
 
     def __setstate__(self, state):
         self.mesh = None
@@ -265,22 +268,20 @@ def job_for(obj, values=None):
 
 
 def predicted_elements(obj, job):
-    """The linear element count the job will make, predicted: the sizing octree's own
-    prediction, or for a uniform size the volume (area) over that of a regular tetrahedron
-    (triangle) of that edge."""
+    """The linear element count the job will make, predicted by the sizing octree (for a
+    uniform size, an octree whose sizes are all that size)."""
     import homesh
+    del obj
     arguments = job.arguments
     size = arguments.get("size")
     if size is None:
         sizing = {k: arguments[k] for k in ("min_delta", "max_delta", "eps", "sources")
                   if k in arguments}
-        report = homesh.predict(job.brep_text, name=job.name, threads=arguments["threads"],
-                                **sizing)
-        return int(report["predicted_elements"])
-    shape = part_shape(obj)
-    if shape.Solids:
-        return int(shape.Volume / (size ** 3 / (6.0 * 2.0 ** 0.5)))
-    return int(shape.Area / (size ** 2 * 3.0 ** 0.5 / 4.0))
+    else:
+        sizing = {"min_delta": size, "max_delta": size}
+    report = homesh.predict(job.brep_text, name=job.name, threads=arguments["threads"],
+                            **sizing)
+    return int(report["predicted_elements"])
 
 
 def check_element_limit(obj, job):
@@ -294,7 +295,7 @@ def check_element_limit(obj, job):
     return predicted
 
 
-def apply_result(obj, mesh, predicted=None, touch=True, values=None):
+def apply_result(obj, mesh, predicted=None, touch=True, values=None, npz_path=None):
     """Stores a finished job's mesh in a HighOrderMesh object: the task panel's ``values`` (its
     parameters, so the object says what made the mesh), the mesh (MeshData, kept in the .FCStd)
     and the result properties; a warning when elements are invalid or undecided. With ``touch``
@@ -303,13 +304,16 @@ def apply_result(obj, mesh, predicted=None, touch=True, values=None):
     for prop, value in (values or {}).items():
         if prop != "Sizing":
             setattr(obj, prop, value)
-    folder = tempfile.mkdtemp(prefix="homesh-")
-    try:
-        path = os.path.join(folder, "mesh.npz")
-        mesh.write(path)
-        obj.MeshData = path  # FreeCAD copies the file into the document
-    finally:
-        shutil.rmtree(folder, ignore_errors=True)
+    if npz_path is not None:  # written by the job's worker thread
+        obj.MeshData = npz_path  # FreeCAD copies the file into the document
+    else:
+        folder = tempfile.mkdtemp(prefix="homesh-")
+        try:
+            path = os.path.join(folder, "mesh.npz")
+            mesh.write(path)
+            obj.MeshData = path
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
     obj.Proxy.mesh = mesh
     quality = mesh.quality()
     obj.NumNodes = mesh.num_nodes

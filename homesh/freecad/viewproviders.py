@@ -1,10 +1,24 @@
-"""View providers. HighOrderMesh: the curved boundary surface coloured by element quality, with
-the curved element edges drawn on top (Coin3D scene built from tessellation.surface_and_edges).
-Sizing: nothing in the 3D view, only its icon."""
+"""View providers.
+
+HighOrderMesh: curved elements coloured by a quality measure (scaled Jacobian or distortion),
+with the curved element edges on top and a colour legend in the view's corner (Coin3D scene
+built from homesh.tessellation). ``Show`` picks what is drawn: the boundary, the elements below
+``Threshold`` (whole, so the inside of the mesh can be seen) or only the invalid ones. The tree
+icon carries a warning sign while the mesh has elements not proven valid. Selection draws a
+bounding box instead of painting the mesh over, so the colours stay readable. Double-clicking
+opens the task panel.
+
+Sizing: nothing in the 3D view; its task panel predicts the element count.
+"""
 
 from . import resources
 
 DISPLAY_MODES = ["Surface with edges", "Surface", "Wireframe"]
+SHOW = ["Boundary", "Elements below threshold", "Invalid elements"]
+MEASURES = ["Scaled Jacobian", "Distortion"]
+LEGEND_STEPS = 10
+# The legend's bar in normalised view coordinates (x0, x1, y0, y1; -1..1 across the view).
+LEGEND_BOX = (-0.95, -0.89, -0.8, 0.6)
 
 
 class _Stateless:
@@ -24,18 +38,62 @@ class _Stateless:
         return None
 
 
-class ViewProviderHighOrderMesh(_Stateless):
+class _EditsWithTaskPanel:
+    """Double-click or Edit opens the object's task panel (FreeCAD FEM's convention)."""
+
+    def doubleClicked(self, vobj):
+        import FreeCADGui
+        FreeCADGui.ActiveDocument.setEdit(vobj.Object.Name)
+        return True
+
+    def setEdit(self, vobj, mode=0):
+        if mode != 0:
+            return None  # transform and the like: FreeCAD's own
+        import FreeCADGui
+        from .taskpanels import panel_for
+        FreeCADGui.Control.showDialog(panel_for(vobj.Object))
+        return True
+
+    def unsetEdit(self, vobj, mode=0):
+        import FreeCADGui
+        FreeCADGui.Control.closeDialog()
+        return True
+
+
+class ViewProviderHighOrderMesh(_Stateless, _EditsWithTaskPanel):
     def __init__(self, vobj):
         vobj.Proxy = self
         self.add_properties(vobj)
 
     @staticmethod
     def add_properties(vobj):
-        if "Subdivision" not in vobj.PropertiesList:
+        have = vobj.PropertiesList
+        if "Subdivision" not in have:
             vobj.addProperty("App::PropertyIntegerConstraint", "Subdivision", "Display",
                              "Segments per element edge when drawing curved elements "
                              "(0: twice the order)")
             vobj.Subdivision = (0, 0, 32, 1)
+        if "Measure" not in have:
+            vobj.addProperty("App::PropertyEnumeration", "Measure", "Display",
+                             "Quality measure the colours show: the certified scaled Jacobian "
+                             "(min J / max J) or the distortion against the straight element")
+            vobj.Measure = MEASURES
+        if "Show" not in have:
+            vobj.addProperty("App::PropertyEnumeration", "Show", "Display",
+                             "What is drawn: the boundary, the whole elements whose measure "
+                             "is below Threshold (to see inside), or the invalid elements only")
+            vobj.Show = SHOW
+        if "Threshold" not in have:
+            vobj.addProperty("App::PropertyFloatConstraint", "Threshold", "Display",
+                             "With Show 'Elements below threshold': the measure below which an "
+                             "element is drawn")
+            vobj.Threshold = (0.3, -1.0, 1.0, 0.05)
+        if "Legend" not in have:
+            vobj.addProperty("App::PropertyBool", "Legend", "Display",
+                             "Draw the colour legend of the measure in the view's corner")
+            vobj.Legend = True
+        if "SelectionStyle" in have:
+            vobj.SelectionStyle = "BoundBox"  # selection must not paint over the colours
 
     def attach(self, vobj):
         from pivy import coin
@@ -66,41 +124,132 @@ class ViewProviderHighOrderMesh(_Stateless):
         for node in (light, color, style, self.edge_coords, self.lines):
             edges.addChild(node)
 
+        self.legend_switch = coin.SoSwitch()
+        self.legend_text = []
+        self.legend_switch.addChild(self._legend(coin))
+
         modes = []
         for children in ((surface, edges), (surface,), (edges,)):
             group = coin.SoGroup()
             for child in children:
                 group.addChild(child)
+            group.addChild(self.legend_switch)
             modes.append(group)
         for mode, group in zip(DISPLAY_MODES, modes):
             vobj.addDisplayMode(group, mode)
         self.rebuild()
 
+    def _legend(self, coin):
+        """A colour bar with labels, drawn in normalised screen coordinates by its own
+        orthographic camera, and left out of the view's bounding box (fit all ignores it)."""
+        from ..tessellation import quality_colors
+        skip = coin.SoType.fromName("SoSkipBoundingGroup")
+        root = skip.createInstance() if not skip.isBad() else coin.SoSeparator()
+        if not skip.isBad():
+            root.getField("mode").set("EXCLUDE_BBOX")
+        inner = coin.SoSeparator()
+        root.addChild(inner)
+        camera = coin.SoOrthographicCamera()
+        camera.viewportMapping = coin.SoCamera.LEAVE_ALONE
+        camera.position = (0.0, 0.0, 5.0)
+        camera.height = 2.0
+        camera.nearDistance = 0.5
+        camera.farDistance = 10.0
+        light = coin.SoLightModel()
+        light.model = coin.SoLightModel.BASE_COLOR
+        for node in (camera, light):
+            inner.addChild(node)
+        # Bar: LEGEND_STEPS bands from 0 (bottom) to 1 (top), plus the invalid colour below; on
+        # the left, clear of FreeCAD's navigation cube and axis cross on the right.
+        x0, x1, y0, y1 = LEGEND_BOX
+        values = [(i + 0.5) / LEGEND_STEPS for i in range(LEGEND_STEPS)]
+        colors = [tuple(map(float, c)) for c in quality_colors([-1.0] + values)]
+        points, faces = [], []
+        bands = [(y0 - 0.15, y0 - 0.05)] + [
+            (y0 + i * (y1 - y0) / LEGEND_STEPS, y0 + (i + 1) * (y1 - y0) / LEGEND_STEPS)
+            for i in range(LEGEND_STEPS)]
+        for k, (lo, hi) in enumerate(bands):
+            points += [(x0, lo, 0.0), (x1, lo, 0.0), (x1, hi, 0.0), (x0, hi, 0.0)]
+            faces += [4 * k, 4 * k + 1, 4 * k + 2, 4 * k + 3, -1]
+        coords = coin.SoCoordinate3()
+        coords.point.setValues(0, len(points), points)
+        material = coin.SoMaterial()
+        material.diffuseColor.setValues(0, len(colors), colors)
+        binding = coin.SoMaterialBinding()
+        binding.value = coin.SoMaterialBinding.PER_FACE
+        bar = coin.SoIndexedFaceSet()
+        bar.coordIndex.setValues(0, len(faces), faces)
+        for node in (coords, binding, material, bar):
+            inner.addChild(node)
+        text_color = coin.SoBaseColor()
+        text_color.rgb = (0.0, 0.0, 0.0)
+        font = coin.SoFont()
+        font.size = 13.0
+        inner.addChild(text_color)
+        inner.addChild(font)
+        labels = [(y0 - 0.12, "<= 0 invalid"), (y0, "0"), (0.5 * (y0 + y1), "0.5"), (y1, "1")]
+        for y, text in labels:
+            sep = coin.SoSeparator()
+            move = coin.SoTranslation()
+            move.translation = (x1 + 0.01, y - 0.01, 0.0)
+            label = coin.SoText2()
+            label.string = text
+            sep.addChild(move)
+            sep.addChild(label)
+            inner.addChild(sep)
+        title_sep = coin.SoSeparator()
+        move = coin.SoTranslation()
+        move.translation = (x0 - 0.02, y1 + 0.06, 0.0)
+        self.legend_title = coin.SoText2()
+        title_sep.addChild(move)
+        title_sep.addChild(self.legend_title)
+        inner.addChild(title_sep)
+        return root
+
     def rebuild(self):
-        """Rebuilds the scene from the object's mesh (after a recompute or a reload)."""
+        """Rebuilds the scene from the object's mesh (after a recompute or a reload) and the
+        display properties."""
         from .objects import get_mesh
-        from ..tessellation import surface_and_edges
+        from .. import tessellation
         obj = self.Object
+        vobj = obj.ViewObject
         mesh = get_mesh(obj)
+        self.legend_switch.whichChild = -1
         if mesh is None:
             for field in (self.coords.point, self.faces.coordIndex, self.edge_coords.point,
                           self.lines.coordIndex, self.material.diffuseColor):
                 field.setNum(0)
             return
-        level = obj.ViewObject.Subdivision if obj.ViewObject else 0
-        geometry = surface_and_edges(mesh, level or None)
+        level = vobj.Subdivision if vobj else 0
+        measure = str(vobj.Measure) if vobj else MEASURES[0]
+        show = str(vobj.Show) if vobj else SHOW[0]
+        if show == SHOW[0]:
+            geometry = tessellation.surface_and_edges(mesh, level or None, measure)
+        else:
+            if show == SHOW[2]:  # invalid or undecided (certified), whatever the measure
+                below = mesh.quality()["validity"] <= 0
+            else:
+                below = tessellation.element_values(mesh, measure) < vobj.Threshold
+            geometry = tessellation.element_surfaces(mesh, below.nonzero()[0], level or None,
+                                                     measure)
         _set_points(self.coords.point, geometry["points"])
         _set_index(self.faces.coordIndex, geometry["triangles"])
         _set_points(self.material.diffuseColor, geometry["colors"])
         _set_points(self.edge_coords.point, geometry["edge_points"])
         _set_index(self.lines.coordIndex, geometry["edge_polylines"])
+        self.legend_title.string = measure
+        self.legend_switch.whichChild = -3 if (vobj is None or vobj.Legend) else -1  # all
 
     def updateData(self, obj, prop):
-        if prop == "MeshData" and hasattr(self, "coords"):
-            self.rebuild()
+        if prop in ("MeshData", "InvalidElements", "UndecidedElements"):
+            if hasattr(self, "coords") and prop == "MeshData":
+                self.rebuild()
+            if obj.ViewObject is not None:
+                obj.ViewObject.signalChangeIcon()
 
     def onChanged(self, vobj, prop):
-        if prop == "Subdivision" and hasattr(self, "coords"):
+        if prop in ("Subdivision", "Measure", "Show", "Threshold", "Legend") and \
+                hasattr(self, "coords"):
             self.rebuild()
 
     def getDisplayModes(self, vobj):
@@ -113,16 +262,21 @@ class ViewProviderHighOrderMesh(_Stateless):
         return mode
 
     def getIcon(self):
+        from .objects import not_valid
+        obj = getattr(self, "Object", None)
+        if obj is not None and "InvalidElements" in obj.PropertiesList and not_valid(obj):
+            return resources.icon("homesh_mesh_invalid.svg")
         return resources.icon("homesh_mesh.svg")
 
     def claimChildren(self):
         return [child for child in (getattr(self.Object, "Part", None),
-                                    getattr(self.Object, "Sizing", None))
+                                    getattr(self.Object, "Sizing", None),
+                                    getattr(self.Object, "BoundaryLayer", None))
                 if child is not None]
 
 
-class ViewProviderSizing(_Stateless):
-    """A Sizing object draws nothing; the view provider gives its tree icon."""
+class ViewProviderSizing(_Stateless, _EditsWithTaskPanel):
+    """A Sizing object draws nothing; the view provider gives its tree icon and task panel."""
 
     def __init__(self, vobj):
         vobj.Proxy = self
@@ -135,17 +289,17 @@ class ViewProviderSizing(_Stateless):
 
 
 def _set_points(field, array):
-    values = [tuple(map(float, row)) for row in array]
+    import numpy as np
+    values = np.ascontiguousarray(array, dtype=np.float32).reshape(-1, 3)
     field.setNum(0)
-    if values:
+    if len(values):
         field.setValues(0, len(values), values)
 
 
 def _set_index(field, rows):
     import numpy as np
-    rows = np.asarray(rows, dtype=np.int64)
-    flat = np.hstack([rows, -np.ones((len(rows), 1), dtype=np.int64)]).ravel().tolist()
+    rows = np.asarray(rows, dtype=np.int32)
+    flat = np.hstack([rows, -np.ones((len(rows), 1), dtype=np.int32)]).ravel()
     field.setNum(0)
-    if flat:
-        field.setValues(0, len(flat), flat)
-
+    if len(flat):
+        field.setValues(0, len(flat), np.ascontiguousarray(flat))

@@ -1,21 +1,30 @@
-"""GUI smoke test, run by FreeCAD itself under Xvfb (see tests/CMakeLists.txt):
+"""GUI test, run by FreeCAD itself under Xvfb (see tests/CMakeLists.txt). It checks, and saves
+screenshots of (to $HOMESH_SCREENSHOT_DIR):
 
-activates the HOMesh workbench, selects a box-minus-cylinder, runs the toolbar command
-"High-order mesh", and saves two screenshots to $HOMESH_SCREENSHOT_DIR: the 3D view rendered
-off-screen (view.png) and the whole main window (window.png). It checks that the command made a
-valid mesh object and that the rendered view shows it (pixels in the quality colour map).
+1. The toolbar command "High-order mesh" on a box with a hole opens the task panel, which
+   meshes on a worker thread: a QTimer on the GUI thread keeps firing at least every 0.2 s
+   while the job runs, the progress bar rises at least 5 times during the optimiser, and the
+   job ends with a valid mesh applied to the object (panel.png during the run, histogram.png).
+2. The mesh is drawn in the quality colours with its legend (view.png, window.png).
+3. Stop during an order-6 job ends it within 1 s and leaves the object exactly as it was.
+4. A mesh with invalid elements carries the warning icon and Status, and Show "Invalid
+   elements" draws them alone (invalid.png, invalid_window.png).
+5. A boundary layer picked on the hole's face, recomputed behind the progress dialog
+   (layer.png).
+
 FreeCAD's GUI never exits by itself, so the script ends with os._exit(status).
 """
 
 import os
 import sys
+import time
 import traceback
 
 status = 1
 try:
     import FreeCAD
     import FreeCADGui
-    from PySide2 import QtGui, QtWidgets
+    from PySide2 import QtCore, QtGui, QtWidgets
 
     out = os.environ.get("HOMESH_SCREENSHOT_DIR", os.getcwd())
     os.makedirs(out, exist_ok=True)
@@ -25,52 +34,191 @@ try:
 
     sys.path.insert(0, os.path.join(os.environ["HOMESH_TESTS_DIR"], "freecad"))
     from fixtures import box_with_hole
+    import homesh.freecad
+    from homesh.freecad import commands, objects
+
+    app = QtWidgets.QApplication.instance()
+    window = FreeCADGui.getMainWindow()
+
+    def settle(n=10):
+        for _ in range(n):
+            app.processEvents()
+
+    def grab_window(name):
+        settle()
+        QtWidgets.QApplication.primaryScreen().grabWindow(window.winId()).save(
+            os.path.join(out, name))
+
+    def run_until(condition, limit, during=None, running=None):
+        """Runs the GUI's event loop until condition() holds (or limit seconds pass); returns
+        the largest gap between the firings of a 50 ms QTimer while running() (default:
+        throughout) and the number of firings."""
+        stamps = []
+        timer = QtCore.QTimer()
+        timer.setInterval(50)
+        timer.timeout.connect(lambda: stamps.append(time.monotonic())
+                              if running is None or running() else None)
+        timer.start()
+        start = time.monotonic()
+        while not condition() and time.monotonic() - start < limit:
+            app.processEvents(QtCore.QEventLoop.AllEvents, 20)
+            if during is not None and during():
+                stamps.append(None)  # the test itself was busy (a screenshot): not a gap
+            time.sleep(0.005)
+        timer.stop()
+        assert condition(), "not done within %g s" % limit
+        gaps = [b - a for a, b in zip(stamps, stamps[1:]) if a is not None and b is not None]
+        return max(gaps) if gaps else 0.0, sum(1 for t in stamps if t is not None)
 
     doc = FreeCAD.newDocument("Smoke")
     cut = box_with_hole(doc)
+    view = FreeCADGui.ActiveDocument.ActiveView
+    view.viewIsometric()
 
+    # 1. The command opens the panel, which meshes on a worker thread. -------------------------
     FreeCADGui.Selection.clearSelection()
     FreeCADGui.Selection.addSelection(cut)
     FreeCADGui.runCommand("HOMesh_HighOrderMesh")
+    panel = commands.active_panel()
+    assert panel is not None, "the command opened no task panel"
+    job = panel.job
+    assert job is not None and job.running, "the panel did not start meshing"
     meshes = [o for o in doc.Objects if getattr(o, "Proxy", None) is not None
               and getattr(o.Proxy, "Type", "") == "HOMesh::HighOrderMesh"]
     assert len(meshes) == 1, "the command made %d mesh objects" % len(meshes)
     mesh = meshes[0]
-    assert mesh.isValid(), "the mesh object failed to recompute"
-    assert mesh.NumElements > 0 and mesh.Order == 4
-    assert not cut.ViewObject.Visibility, "the meshed shape should be hidden"
-    print("HOMesh GUI smoke: %d nodes, %d elements, worst scaled Jacobian %.3f"
-          % (mesh.NumNodes, mesh.NumElements, mesh.MinScaledJacobian))
+    shot = {"taken": False}
 
-    view = FreeCADGui.ActiveDocument.ActiveView
+    def panel_shot():
+        if not shot["taken"] and job.stage == "optimise" and job.stage_fraction > 0.2:
+            shot["taken"] = True
+            grab_window("panel.png")
+            return True
+        return False
+
+    gap, ticks = run_until(lambda: job.done, 120, panel_shot, lambda: job.running)
+    t0 = time.monotonic()
+    run_until(lambda: not panel.timer.isActive(), 60)
+    print("HOMesh GUI: applying the result to the document took %.3f s"
+          % (time.monotonic() - t0))
+    print("HOMesh GUI: job of %.1f s; GUI timer fired %d times, largest gap %.3f s"
+          % (job.elapsed, ticks, gap))
+    assert job.elapsed > 1.0, "the job was too short to test responsiveness"
+    assert gap <= 0.2, "the GUI stalled for %.3f s while meshing" % gap
+    assert job.error is None, "the job failed: %s" % job.error
+    rises = [v for stage, v in panel.progress_values if stage.startswith("optimise")]
+    rises = sum(1 for a, b in zip(rises, rises[1:]) if b > a)
+    print("HOMesh GUI: the progress bar rose %d times during the optimiser (%d sweeps)"
+          % (rises, panel.log.toPlainText().count("optimise sweep")))
+    assert rises >= 5, "the progress bar rose only %d times during the optimiser" % rises
+    assert mesh.isValid() and mesh.NumElements > 0 and mesh.Order == 4
+    assert mesh.InvalidElements == 0 and "Touched" not in mesh.State, mesh.State
+    assert not cut.ViewObject.Visibility, "the meshed shape should be hidden"
+    assert "all elements proven valid" in panel.summary.text()
+    assert panel.log.toPlainText().count("sweep") >= 5, "the log misses the optimiser's sweeps"
+    panel.canvas.grab().save(os.path.join(out, "histogram.png"))
+    print("HOMesh GUI: %d nodes, %d elements, worst scaled Jacobian %.3f"
+          % (mesh.NumNodes, mesh.NumElements, mesh.MinScaledJacobian))
+    FreeCADGui.Control.closeDialog()
+    settle()
+
+    # 2. The coloured mesh and its legend. --------------------------------------------------------
     view.viewIsometric()
     view.fitAll()
-    for _ in range(10):
-        QtWidgets.QApplication.processEvents()
+    settle()
     view_png = os.path.join(out, "view.png")
     view.saveImage(view_png, 800, 600, "White")
-    window = FreeCADGui.getMainWindow()
-    QtWidgets.QApplication.primaryScreen().grabWindow(window.winId()).save(
-        os.path.join(out, "window.png"))
-
-    # The rendered view must show the mesh: many pixels of the colour map (green to yellow,
-    # little blue), none of which a white background or black edges have.
+    grab_window("window.png")
     image = QtGui.QImage(view_png)
-    coloured = total = 0
-    for y in range(0, image.height(), 4):
-        for x in range(0, image.width(), 4):
-            c = QtGui.QColor(image.pixel(x, y))
-            total += 1
-            if c.green() > 60 and c.green() > c.blue() + 40:
-                coloured += 1
-    fraction = coloured / float(total)
-    print("HOMesh GUI smoke: %.0f %% of the view shows the mesh" % (100 * fraction))
-    # The fitted isometric view of the 4 x 4 x 2 part fills about a third of the image; a view
-    # without the mesh has no such pixels at all. 0.15 does not depend on rounding.
-    assert fraction > 0.15, "the mesh is not visible in the 3D view"
 
-    # A boundary layer on the hole: the face picked in the selection, the toolbar command,
-    # the mesh recomputed with prisms and drawn again (layer.png).
+    def coloured(x_range, y_range, test):
+        hits = total = 0
+        for y in range(y_range[0], y_range[1], 2):
+            for x in range(x_range[0], x_range[1], 2):
+                c = QtGui.QColor(image.pixel(x, y))
+                total += 1
+                hits += bool(test(c))
+        return hits / float(max(total, 1))
+
+    def greenish(c):
+        return c.green() > 60 and c.green() > c.blue() + 40
+
+    mesh_part = coloured((80, 800), (0, 600), greenish)
+    print("HOMesh GUI: %.0f %% of the view (beside the legend) shows the mesh"
+          % (100 * mesh_part))
+    # The fitted isometric view of the 4 x 4 x 2 part fills about a third of the image; a view
+    # without the mesh has no such pixels at all.
+    assert mesh_part > 0.15, "the mesh is not visible in the 3D view"
+    # The legend's bar (viewproviders.LEGEND_BOX, in -1..1 view coordinates) in the 800 x 600
+    # image: its top band (1, green) and its bottom band (0, red), a few pixels inside each.
+    from homesh.freecad.viewproviders import LEGEND_BOX, LEGEND_STEPS
+    x0, x1, y0, y1 = LEGEND_BOX
+    band = (y1 - y0) / LEGEND_STEPS
+
+    def pixels(lo, hi, size):
+        return int((lo + 1) / 2 * size) + 3, int((hi + 1) / 2 * size) - 3
+
+    columns = pixels(x0, x1, 800)
+    top = coloured(columns, pixels(-y1, -(y1 - band), 600), greenish)
+    bottom = coloured(columns, pixels(-(y0 + band), -y0, 600),
+                      lambda c: c.red() > 150 and c.green() < 90)
+    print("HOMesh GUI: legend: %.0f %% green at its top, %.0f %% red at its bottom"
+          % (100 * top, 100 * bottom))
+    assert top > 0.8 and bottom > 0.8, "no colour legend in the view"
+
+    # 3. Stop during a longer job: the document stays as it was. ----------------------------------
+    def state(obj):
+        return {p: str(getattr(obj, p)) for p in obj.PropertiesList if p != "Proxy"}
+
+    before = state(mesh)
+    nodes_before = homesh.freecad.get_mesh(mesh).nodes.copy()
+    FreeCADGui.ActiveDocument.setEdit(mesh.Name)
+    panel = commands.active_panel()
+    panel.widgets["Order"].setValue(6)
+    job = panel.mesh()
+    assert job is not None
+    run_until(lambda: job.stage.startswith("optimise"), 120)
+    time.sleep(0.3)
+    t0 = time.monotonic()
+    panel.stop_button.click()
+    run_until(lambda: job.done, 30)
+    stop_seconds = time.monotonic() - t0
+    run_until(lambda: not panel.timer.isActive(), 10)
+    print("HOMesh GUI: Stop ended the job in %.3f s (%s)" % (stop_seconds, job.error))
+    assert isinstance(job.error, homesh.CancelledError), job.error
+    assert stop_seconds <= 1.0, "Stop took %.3f s" % stop_seconds
+    assert state(mesh) == before, "cancelling changed the object"
+    assert (homesh.freecad.get_mesh(mesh).nodes == nodes_before).all()
+    assert "Touched" not in mesh.State and mesh.Order == 4
+    assert "the document is unchanged" in panel.log.toPlainText()
+    FreeCADGui.Control.closeDialog()
+    settle()
+
+    # 4. Invalid elements: a warning in the tree and the report, drawn alone. ---------------------
+    bad = homesh.freecad.make_high_order_mesh(doc, cut, order=4, size=3.0, name="Coarse")
+    bad.OptimiserIterations = 0
+    bad.RepairRounds = 0
+    doc.recompute()  # behind the cancellable progress dialog
+    settle()
+    print("HOMesh GUI: coarse mesh: %s" % bad.Status)
+    assert bad.InvalidElements > 0 and "NOT VALID" in bad.Status
+    assert bad.ViewObject.Proxy.getIcon().endswith("homesh_mesh_invalid.svg")
+    mesh.ViewObject.Visibility = False
+    bad.ViewObject.Show = "Invalid elements"
+    drawn = len(bad.ViewObject.Proxy.faces.coordIndex) // 4
+    print("HOMesh GUI: invalid elements drawn alone: %d sub-triangles" % drawn)
+    assert drawn > 0
+    view.fitAll()
+    settle()
+    view.saveImage(os.path.join(out, "invalid.png"), 800, 600, "White")
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(bad)
+    grab_window("invalid_window.png")
+    FreeCADGui.Selection.clearSelection()
+    doc.removeObject(bad.Name)  # the layer command links to the shape's only mesh
+    mesh.ViewObject.Visibility = True
+
+    # 5. A boundary layer on the hole, picked in the selection. ----------------------------------
     (hole,) = [i + 1 for i, f in enumerate(cut.Shape.Faces)
                if f.Surface.__class__.__name__ == "Cylinder"]
     FreeCADGui.Selection.clearSelection()
@@ -78,15 +226,13 @@ try:
     FreeCADGui.runCommand("HOMesh_BoundaryLayer")
     assert mesh.BoundaryLayer is not None, "the command did not link the layer to the mesh"
     assert mesh.isValid() and mesh.InvalidElements == 0, "the mesh with a layer is not valid"
-    import homesh.freecad
     prisms = homesh.freecad.get_mesh(mesh).report()["elements"]["prism"]
     assert prisms > 0, "no prisms in the mesh"
-    print("HOMesh GUI smoke: with a boundary layer: %d elements (%d prisms), worst %.3f"
+    print("HOMesh GUI: with a boundary layer: %d elements (%d prisms), worst %.3f"
           % (mesh.NumElements, prisms, mesh.MinScaledJacobian))
     view.viewTop()
     view.fitAll()
-    for _ in range(10):
-        QtWidgets.QApplication.processEvents()
+    settle()
     view.saveImage(os.path.join(out, "layer.png"), 800, 600, "White")
     status = 0
 except Exception:
