@@ -25,7 +25,7 @@ from ._core import (  # noqa: F401  (re-exported)
     __version__,
 )
 from .api import (  # noqa: F401
-    BoundaryBlock, HighOrderMesh, load, mesh, parameters, predict, read)
+    BoundaryBlock, HighOrderMesh, curve, load, mesh, parameters, predict, read)
 
 __all__ = [
     "BoundaryBlock",
@@ -35,6 +35,7 @@ __all__ = [
     "FileError",
     "HOMeshError",
     "HighOrderMesh",
+    "curve",
     "MeshingError",
     "ParameterError",
     "load",

@@ -426,6 +426,48 @@ def _four_argument_progress(progress):
     return stages_only
 
 
+def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=None, name=None,
+          optimise=0, cancel=None):
+    """Curves a linear tetrahedral mesh made by another tool (FreeCAD FEM's Gmsh or Netgen
+    mesher) on the CAD it was made from.
+
+    shape       as for :func:`mesh` (one solid).
+    nodes       (N, 3) coordinates; the boundary nodes must lie on the CAD (within 1e-5 of its
+                bounding diagonal).
+    tetrahedra  (E, 4) 0-based node indices (either orientation; corner nodes only).
+
+    Each boundary node is put on the CAD vertex, edge or face it lies on, the mesh is raised to
+    ``order`` with its boundary nodes on the CAD and, with ``optimise`` > 0, optimised with them
+    sliding on it (stages "classify", "high_order", "optimise", ...). progress, cancel, threads
+    and name as for :func:`mesh`. Raises ParameterError, CadError or MeshingError (naming the
+    boundary node that lies on no CAD face).
+    """
+    order = _check_int("order", order)
+    threads = _check_int("threads", threads)
+    verbosity = _check_int("verbosity", verbosity)
+    optimise = _check_int("optimise", optimise)
+    if progress is not None and not callable(progress):
+        raise ParameterError("progress must be callable")
+    if cancel is not None and not isinstance(cancel, _core.CancelToken):
+        raise ParameterError("cancel must be a homesh.CancelToken, got %r" % (cancel,))
+    nodes = np.ascontiguousarray(nodes, dtype=np.float64)
+    tetrahedra = np.ascontiguousarray(tetrahedra, dtype=np.int64)
+    if nodes.ndim != 2 or nodes.shape[1] != 3:
+        raise ParameterError("nodes must be an (N, 3) array, got shape %s" % (nodes.shape,))
+    if tetrahedra.ndim != 2 or tetrahedra.shape[1] != 4:
+        raise ParameterError("tetrahedra must be an (E, 4) array of corner nodes, got shape %s"
+                             % (tetrahedra.shape,))
+    progress = _four_argument_progress(progress)
+    kind, value, label = _cad_source(shape, name)
+    if kind == "brep":
+        core = _core.curve_brep(value, label, nodes, tetrahedra, order, threads, verbosity,
+                                progress, optimise, cancel)
+    else:
+        core = _core.curve_file(value, nodes, tetrahedra, order, threads, verbosity, progress,
+                                optimise, cancel)
+    return HighOrderMesh(core)
+
+
 _BOUNDARY_LAYER_KEYS = ("faces", "thickness", "layers", "progression")
 
 

@@ -14,6 +14,7 @@
 #include "core/format.hpp"
 #include "core/parameters.hpp"
 #include "curving/order_elevation.hpp"
+#include "linear/cad_classification.hpp"
 #include "linear/linear_mesher.hpp"
 #include "pipeline/curved_reuse.hpp"
 #include "pipeline/repair.hpp"
@@ -532,6 +533,34 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     split.done();
   }
 
+  StageClock geometry("geometry", result.timings, observer);
+  result.geometry = measureGeometryAccuracy(result.mesh, *result.cad, options.threads);
+  geometry.done();
+  return result;
+}
+
+MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOptions options,
+                          PipelineObserver* observer) {
+  options.validate();
+  if (options.boundaryLayer)
+    throw ParameterError("a boundary layer needs HOMesh's own linear mesh, not a given one");
+  options.repairRounds = 0;  // repair regenerates the linear mesh: not this one
+  options.size.reset();
+  options.sizing.reset();
+  MeshResult result;
+  StageClock cad("cad", result.timings, observer);
+  result.cad = std::make_shared<const CadModel>(source.load());
+  cad.done();
+  result.options = options;
+  StageClock classify("classify", result.timings, observer);
+  Mesh onCad = classifyOnCad(linear, *result.cad);
+  classify.done();
+  CurvedState state =
+      curve(std::move(onCad), options, *result.cad, result.timings, observer, true);
+  result.mesh = std::move(state.mesh);
+  result.quality = std::move(state.quality);
+  result.optimiser = std::move(state.optimiser);
+  result.lowOrderOptimiser = std::move(state.lowOrderOptimiser);
   StageClock geometry("geometry", result.timings, observer);
   result.geometry = measureGeometryAccuracy(result.mesh, *result.cad, options.threads);
   geometry.done();

@@ -183,6 +183,14 @@ struct MeshResult {
 MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
                            PipelineObserver* observer = nullptr);
 
+// Curves a linear tetrahedral mesh made elsewhere (FreeCAD FEM's Gmsh or Netgen mesher) on the
+// CAD it was made from: the mesh is put on the CAD (linear/cad_classification.hpp, stage
+// "classify"), then elevated, optimised and evaluated as runMeshPipeline does ("high_order",
+// "optimise", "quality", "geometry"). The mesh is the user's: no sizing, no linear meshing, no
+// repair rounds and no boundary layer (ParameterError when one is asked for).
+MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOptions options,
+                          PipelineObserver* observer = nullptr);
+
 // The per-cell quality fields written beside the mesh: scaled Jacobian and distortion (for
 // boundary cells, their own measures: see quality/mesh_quality.hpp).
 std::vector<CellField> qualityFields(const QualitySummary& quality);

@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -486,6 +487,58 @@ PyMesh meshBrep(const std::string& text, const std::string& name, int order, con
       std::move(progress), cancel);
 }
 
+// Curves a linear tetrahedral mesh made elsewhere (nodes (N, 3), tetrahedra (E, 4), 0-based) on
+// the CAD of `source` (BRep text or a CAD file): pipeline's curveMeshOnCad.
+PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::object& tets,
+                  int order, int threads, int verbosity, bp::object progress, int optimise,
+                  const bp::object& cancel) {
+  Mesh linear;
+  linear.dim = 3;
+  linear.order = 1;
+  linear.xyz = fromArray<double>(nodes, "nodes");
+  if (linear.xyz.size() % 3 != 0) throw ParameterError("nodes must be an (N, 3) array");
+  for (std::size_t k = 0; k < linear.xyz.size(); ++k)
+    if (!std::isfinite(linear.xyz[k]))
+      throw ParameterError("nodes: node " + std::to_string(k / 3) +
+                           " has a coordinate that is not finite");
+  ElementBlock block;
+  block.type = CellType::Tetrahedron;
+  block.nodes = fromArray<std::int64_t>(tets, "tetrahedra");
+  if (block.nodes.size() % 4 != 0) throw ParameterError("tetrahedra must be an (E, 4) array");
+  block.entity.assign(block.nodes.size() / 4, 1);
+  linear.blocks.push_back(std::move(block));
+  const std::size_t n = linear.numNodes();
+  linear.nodeCadDim.assign(n, 3);
+  linear.nodeCadIndex.assign(n, 0);
+  linear.nodeCadParam.assign(2 * n, std::numeric_limits<double>::quiet_NaN());
+  MeshingOptions options =
+      makeOptions(order, bp::object(), threads, verbosity, optimise, bp::object(), 0, bp::object());
+  PythonProgress observer(std::move(progress), cancelTokenOf(cancel));
+  std::unique_ptr<MeshResult> result;
+  try {
+    const ReleaseGil nogil;
+    result = std::make_unique<MeshResult>(curveMeshOnCad(source, linear, options, &observer));
+  } catch (const CancelledError&) {
+    if (!observer.failure().empty()) throw CancelledError(observer.failure());
+    throw;
+  }
+  return PyMesh(std::move(*result));
+}
+
+PyMesh curveBrep(const std::string& text, const std::string& name, const bp::object& nodes,
+                 const bp::object& tets, int order, int threads, int verbosity,
+                 bp::object progress, int optimise, const bp::object& cancel) {
+  return curveOnCad(CadSource::brepText(text, name), nodes, tets, order, threads, verbosity,
+                    std::move(progress), optimise, cancel);
+}
+
+PyMesh curveFile(const std::string& path, const bp::object& nodes, const bp::object& tets,
+                 int order, int threads, int verbosity, bp::object progress, int optimise,
+                 const bp::object& cancel) {
+  return curveOnCad(CadSource::file(path), nodes, tets, order, threads, verbosity,
+                    std::move(progress), optimise, cancel);
+}
+
 // Rebuilds a mesh (without CAD) from the arrays PyMesh exposes, and evaluates its quality.
 // blocks: [(type name, order, connectivity, entity), ...] as returned by PyMesh.blocks().
 PyMesh meshFromArrays(int dim, int order, const bp::object& nodes, const bp::object& cadDim,
@@ -647,6 +700,14 @@ BOOST_PYTHON_MODULE(_core) {
           (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
            bp::arg("octree_path") = "", bp::arg("threads") = 1));
   bp::def("parameters", &parameters);
+  bp::def("curve_brep", &curveBrep,
+          (bp::arg("text"), bp::arg("name"), bp::arg("nodes"), bp::arg("tetrahedra"),
+           bp::arg("order"), bp::arg("threads"), bp::arg("verbosity"), bp::arg("progress"),
+           bp::arg("optimise"), bp::arg("cancel") = bp::object()));
+  bp::def("curve_file", &curveFile,
+          (bp::arg("path"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("order"),
+           bp::arg("threads"), bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise"),
+           bp::arg("cancel") = bp::object()));
   bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("threads") = 1));
   bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
   bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));
