@@ -163,6 +163,102 @@ class CommandBoundaryLayer:
             doc.commitTransaction()
 
 
+def _selected_fem_mesh():
+    """The selected FEM mesh object whose shape is known, or None."""
+    from .fem import fem_shape_object, is_fem_mesh
+    selection = FreeCADGui.Selection.getSelection()
+    if len(selection) == 1 and is_fem_mesh(selection[0]) and \
+            fem_shape_object(selection[0]) is not None:
+        return selection[0]
+    return None
+
+
+def _selected_high_order_mesh():
+    selection = FreeCADGui.Selection.getSelection()
+    if len(selection) == 1 and getattr(getattr(selection[0], "Proxy", None), "Type", None) == \
+            TYPE_HIGH_ORDER_MESH:
+        return selection[0]
+    return None
+
+
+class CommandCurveFemMesh:
+    """Curves the selected FEM mesh (FEM's Gmsh or Netgen mesher) on its shape: a HighOrderMesh
+    whose FemMesh property links it, meshed from the task panel."""
+
+    def GetResources(self):
+        return {
+            "Pixmap": resources.icon("homesh_curve_fem.svg"),
+            "MenuText": "Curve FEM mesh",
+            "ToolTip": "Put the selected FEM mesh (Gmsh or Netgen, first or second order) on "
+                       "its shape and curve it: a high-order mesh whose boundary nodes lie on "
+                       "the CAD, optimised",
+        }
+
+    def IsActive(self):
+        return FreeCAD.ActiveDocument is not None and _selected_fem_mesh() is not None
+
+    def Activated(self):
+        from .fem import fem_shape_object
+        fem = _selected_fem_mesh()
+        if fem is None:
+            FreeCAD.Console.PrintError("HOMesh: select one FEM mesh object made from a shape\n")
+            return
+        part = fem_shape_object(fem)
+        doc = FreeCAD.ActiveDocument
+        doc.openTransaction("Curve FEM mesh")
+        try:
+            FreeCADGui.addModule("homesh.freecad")
+            FreeCADGui.doCommand(
+                "_mesh = homesh.freecad.make_high_order_mesh(App.ActiveDocument, "
+                "App.ActiveDocument.getObject(%r), name=%r, "
+                "fem_mesh=App.ActiveDocument.getObject(%r))"
+                % (part.Name, "Curved" + fem.Name, fem.Name))
+        finally:
+            doc.commitTransaction()
+        mesh = doc.ActiveObject
+        FreeCADGui.ActiveDocument.setEdit(mesh.Name)
+        panel = active_panel()
+        if panel is not None:
+            panel.mesh()
+
+
+class CommandToFemMesh:
+    """Makes a FEM mesh object (order 2 at most) of the selected high-order mesh."""
+
+    def GetResources(self):
+        return {
+            "Pixmap": resources.icon("homesh_to_fem.svg"),
+            "MenuText": "To FEM mesh",
+            "ToolTip": "Make a FEM mesh object of the selected high-order mesh (quadratic "
+                       "tetrahedra through the curved elements' midpoints, the highest order "
+                       "FEM holds) for FEM's solvers and post-processing",
+        }
+
+    def IsActive(self):
+        from .objects import get_mesh
+        obj = _selected_high_order_mesh()
+        return obj is not None and get_mesh(obj) is not None
+
+    def Activated(self):
+        obj = _selected_high_order_mesh()
+        if obj is None:
+            return
+        doc = FreeCAD.ActiveDocument
+        doc.openTransaction("To FEM mesh")
+        try:
+            FreeCADGui.addModule("homesh.freecad.fem")
+            FreeCADGui.doCommand(
+                "_fem = homesh.freecad.fem.make_fem_mesh_object(App.ActiveDocument, "
+                "App.ActiveDocument.getObject(%r))" % obj.Name)
+        except ValueError as e:
+            FreeCAD.Console.PrintError("HOMesh: %s\n" % e)
+        finally:
+            doc.commitTransaction()
+        doc.recompute()
+
+
 FreeCADGui.addCommand("HOMesh_HighOrderMesh", CommandHighOrderMesh())
+FreeCADGui.addCommand("HOMesh_CurveFemMesh", CommandCurveFemMesh())
+FreeCADGui.addCommand("HOMesh_ToFemMesh", CommandToFemMesh())
 FreeCADGui.addCommand("HOMesh_BoundaryLayer", CommandBoundaryLayer())
 FreeCADGui.addCommand("HOMesh_Sizing", CommandSizing())

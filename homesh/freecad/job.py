@@ -19,19 +19,21 @@ import homesh
 
 # Rough shares of the run per stage, for one overall percentage (the optimiser dominates when it
 # runs); stages not listed (repair rounds) take the remainder.
-_STAGE_WEIGHTS = {"cad": 2, "sizing": 3, "linear": 10, "boundary_layer": 5, "high_order": 10,
+_STAGE_WEIGHTS = {"cad": 2, "classify": 3, "sizing": 3, "linear": 10, "boundary_layer": 5, "high_order": 10,
                   "optimise_low_order": 20, "raise_order": 3, "optimise": 40, "quality": 4,
                   "split_layers": 2, "geometry": 2}
 
 
 class MeshJob:
-    """``MeshJob(brep_text, name, **mesh_arguments)``; ``start()``, then ``poll()`` from the GUI
+    """``MeshJob(brep_text, name, function, **arguments)`` (function: homesh.mesh by default, or
+    homesh.curve); ``start()``, then ``poll()`` from the GUI
     thread until ``done``; ``result`` (a :class:`homesh.HighOrderMesh`) or ``error`` (the
     exception, :class:`homesh.CancelledError` after :meth:`cancel`)."""
 
-    def __init__(self, brep_text, name, **arguments):
+    def __init__(self, brep_text, name, function=None, **arguments):
         self.brep_text = brep_text
         self.name = name
+        self.function = function or homesh.mesh  # homesh.curve for a FEM mesh
         self.arguments = arguments
         self.token = homesh.CancelToken()
         self.events = queue.Queue()
@@ -57,8 +59,9 @@ class MeshJob:
 
     def _run(self):
         try:
-            self.result = homesh.mesh(self.brep_text, name=self.name, progress=self._progress,
-                                      cancel=self.token, **self.arguments)
+            self.result = self.function(self.brep_text, name=self.name,
+                                        progress=self._progress, cancel=self.token,
+                                        **self.arguments)
             # The document's copy of the mesh, compressed here rather than on the GUI thread.
             self.folder = tempfile.mkdtemp(prefix="homesh-")
             self.npz_path = os.path.join(self.folder, "mesh.npz")

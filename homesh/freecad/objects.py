@@ -25,14 +25,15 @@ _RESULT_PROPERTIES = ("NumNodes", "NumElements", "MinScaledJacobian", "InvalidEl
 
 
 def make_high_order_mesh(doc, part, order=4, size=0.0, name="HighOrderMesh", sizing=None,
-                         boundary_layer=None):
+                         boundary_layer=None, fem_mesh=None):
     """Adds a HighOrderMesh object meshing ``part`` (a document object with a Shape).
 
     ``size`` 0 means automatic: the sizing octree of ``sizing`` (a Sizing object, see
     :func:`make_sizing`) if given, else the automatic sizing octree (MaxDelta a twentieth of the
     bounding-box diagonal, MinDelta a twentieth of that, EPS 0.05). ``boundary_layer``: a
-    BoundaryLayer object on faces of ``part`` (:func:`make_boundary_layer`). The caller
-    recomputes.
+    BoundaryLayer object on faces of ``part`` (:func:`make_boundary_layer`). ``fem_mesh``: a
+    FEM mesh object of ``part`` (FEM's Gmsh or Netgen mesher) to curve instead of meshing
+    ``part`` (size, sizing and boundary layer then do not apply). The caller recomputes.
     """
     obj = doc.addObject("App::FeaturePython", name)
     HighOrderMeshProxy(obj)
@@ -41,6 +42,7 @@ def make_high_order_mesh(doc, part, order=4, size=0.0, name="HighOrderMesh", siz
     obj.Size = size
     obj.Sizing = sizing
     obj.BoundaryLayer = boundary_layer
+    obj.FemMesh = fem_mesh
     if FreeCAD.GuiUp:
         from .viewproviders import ViewProviderHighOrderMesh
         ViewProviderHighOrderMesh(obj.ViewObject)
@@ -132,6 +134,12 @@ class HighOrderMeshProxy(_Proxy, ParameterGuard):
             obj.addProperty("App::PropertyLink", "BoundaryLayer", "Mesh",
                             "Optional HOMesh BoundaryLayer object: prisms grown from its faces "
                             "of Part, curved and optimised with the rest, then split")
+        if "FemMesh" not in have:
+            obj.addProperty("App::PropertyLink", "FemMesh", "Mesh",
+                            "Optional FEM mesh of Part (FEM's Gmsh or Netgen mesher, first or "
+                            "second order): its tetrahedra are put on the CAD and curved "
+                            "instead of meshing Part (Size, Sizing, RepairRounds and "
+                            "BoundaryLayer do not apply)")
         if "MeshData" not in have:
             obj.addProperty("App::PropertyFileIncluded", "MeshData", "Result",
                             "The curved mesh, stored in the document")
@@ -238,7 +246,7 @@ def mesh_arguments(obj, values=None):
             raise ValueError("%s: Sizing must link to a HOMesh Sizing object, not %s"
                              % (obj.Label, sizing.Label))
         arguments.update(sizing_arguments(sizing))
-    if obj.BoundaryLayer is not None:
+    if obj.BoundaryLayer is not None and getattr(obj, "FemMesh", None) is None:
         if not is_boundary_layer(obj.BoundaryLayer):
             raise ValueError("%s: BoundaryLayer must link to a HOMesh BoundaryLayer object, "
                              "not %s" % (obj.Label, obj.BoundaryLayer.Label))
@@ -258,11 +266,28 @@ def part_shape(obj):
 
 def job_for(obj, values=None):
     """A :class:`job.MeshJob` (not started) for a HighOrderMesh object, with ``values`` from a
-    task panel in place of its properties. The shape is exported here, on the GUI thread."""
+    task panel in place of its properties. The shape (and a FEM mesh's arrays) are read here,
+    on the GUI thread."""
+    import homesh
     from .job import MeshJob
     shape = part_shape(obj)
     arguments = mesh_arguments(obj, values)
-    job = MeshJob(shape.exportBrepToString(), obj.Part.Label, **arguments)
+    fem_object = getattr(obj, "FemMesh", None)
+    if fem_object is None:
+        job = MeshJob(shape.exportBrepToString(), obj.Part.Label, **arguments)
+    else:
+        from .fem import fem_mesh_arrays, is_fem_mesh
+        if not is_fem_mesh(fem_object):
+            raise ValueError("%s: FemMesh must link to a FEM mesh object, not %s"
+                             % (obj.Label, fem_object.Label))
+        try:
+            nodes, tets = fem_mesh_arrays(fem_object.FemMesh)
+        except ValueError as e:
+            raise ValueError("%s: %s: %s" % (obj.Label, fem_object.Label, e)) from None
+        job = MeshJob(shape.exportBrepToString(), obj.Part.Label, function=homesh.curve,
+                      nodes=nodes, tetrahedra=tets, order=arguments["order"],
+                      optimise=arguments["optimise"], threads=arguments["threads"])
+        job.fem_elements = len(tets)
     job.values = values or {}
     return job
 
@@ -272,6 +297,8 @@ def predicted_elements(obj, job):
     uniform size, an octree whose sizes are all that size)."""
     import homesh
     del obj
+    if hasattr(job, "fem_elements"):
+        return job.fem_elements  # the FEM mesh's own tetrahedra
     arguments = job.arguments
     size = arguments.get("size")
     if size is None:

@@ -11,6 +11,7 @@ screenshots of (to $HOMESH_SCREENSHOT_DIR):
    elements" draws them alone (invalid.png, invalid_window.png).
 5. A boundary layer picked on the hole's face, recomputed behind the progress dialog
    (layer.png).
+6. "Curve FEM mesh" on FEM's Gmsh mesh of a cylinder, then "To FEM mesh" of the result.
 
 FreeCAD's GUI never exits by itself, so the script ends with os._exit(status).
 """
@@ -234,6 +235,37 @@ try:
     view.fitAll()
     settle()
     view.saveImage(os.path.join(out, "layer.png"), 800, 600, "White")
+
+    # 6. FEM both ways through the commands: curve FEM's Gmsh mesh of a cylinder, then make a
+    # FEM mesh object of the result. -------------------------------------------------------------
+    import shutil
+    if shutil.which("gmsh"):
+        from test_fem import gmsh_fem_mesh
+        cyl = doc.addObject("Part::Cylinder", "Cylinder2")
+        cyl.Radius, cyl.Height = 1.0, 2.0
+        cyl.Placement.Base = FreeCAD.Vector(10, 0, 0)
+        doc.recompute()
+        femmesh = gmsh_fem_mesh(doc, cyl)
+        FreeCADGui.Selection.clearSelection()
+        FreeCADGui.Selection.addSelection(femmesh)
+        assert FreeCADGui.Command.get("HOMesh_CurveFemMesh").isActive()
+        FreeCADGui.runCommand("HOMesh_CurveFemMesh")
+        panel = commands.active_panel()
+        job = panel.job
+        run_until(lambda: job.done and not panel.timer.isActive(), 120)
+        curved = panel.obj
+        print("HOMesh GUI: curved FEM mesh: %s" % curved.Status)
+        assert job.error is None and curved.InvalidElements == 0 and curved.UndecidedElements == 0
+        assert curved.NumElements == femmesh.FemMesh.VolumeCount
+        FreeCADGui.Control.closeDialog()
+        settle()
+        FreeCADGui.Selection.clearSelection()
+        FreeCADGui.Selection.addSelection(curved)
+        FreeCADGui.runCommand("HOMesh_ToFemMesh")
+        made = [o for o in doc.Objects if o.Name.endswith("_FEM") or o.Label.endswith("_FEM")]
+        assert made and made[-1].FemMesh.VolumeCount == curved.NumElements, made
+        print("HOMesh GUI: To FEM mesh: %d nodes, %d quadratic tetrahedra"
+              % (made[-1].FemMesh.NodeCount, made[-1].FemMesh.VolumeCount))
     status = 0
 except Exception:
     traceback.print_exc()

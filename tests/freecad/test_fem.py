@@ -1,0 +1,122 @@
+"""FEM both ways, headless: a FemMeshGmsh of a cylinder (made by FEM's own Gmsh tools) curved
+into a certified valid order-4 mesh whose boundary nodes lie on the cylinder, and a HOMesh mesh
+turned into a Fem::FemMeshObject of order 2 with the node and element counts of the order-2
+mesh, SMESH's node order and FEM's orientation."""
+
+import math
+import shutil
+import unittest
+
+import FreeCAD
+import numpy as np
+
+import homesh
+import homesh.freecad
+from homesh.freecad import fem
+
+GMSH = shutil.which("gmsh")
+
+
+def gmsh_fem_mesh(doc, part, order="2nd", size=0.5):
+    import ObjectsFem
+    from femmesh.gmshtools import GmshTools
+    mesh = ObjectsFem.makeMeshGmsh(doc, "FEMMeshGmsh")
+    mesh.Part = part
+    mesh.CharacteristicLengthMax = size
+    mesh.ElementOrder = order
+    doc.recompute()
+    error = GmshTools(mesh).create_mesh()
+    assert not error, error
+    return mesh
+
+
+def corner_sign(fm, element):
+    p = [fm.getNodeById(i) for i in fm.getElementNodes(element)[:4]]
+    return math.copysign(1.0, (p[1] - p[0]).cross(p[2] - p[0]).dot(p[3] - p[0]))
+
+
+@unittest.skipIf(GMSH is None, "FEM's Gmsh mesher needs the gmsh command")
+class FemBothWays(unittest.TestCase):
+    def setUp(self):
+        self.doc = FreeCAD.newDocument("HOMeshFem")
+        self.cyl = self.doc.addObject("Part::Cylinder", "Cylinder")
+        self.cyl.Radius, self.cyl.Height = 1.0, 2.0
+        self.doc.recompute()
+
+    def tearDown(self):
+        FreeCAD.closeDocument(self.doc.Name)
+
+    def test_curve_a_gmsh_fem_mesh_of_a_cylinder(self):
+        femmesh = gmsh_fem_mesh(self.doc, self.cyl)
+        tets = femmesh.FemMesh.VolumeCount
+        obj = homesh.freecad.make_high_order_mesh(self.doc, self.cyl, order=4,
+                                                  fem_mesh=femmesh)
+        obj.OptimiserIterations = 20
+        self.doc.recompute()
+        self.assertTrue(obj.isValid(), obj.Status)
+        mesh = homesh.freecad.get_mesh(obj)
+        quality = mesh.quality()
+        self.assertEqual(mesh.order, 4)
+        self.assertEqual(mesh.num_elements, tets)  # FEM's tetrahedra, curved, none added
+        self.assertEqual(quality["invalid_elements"], 0)
+        self.assertEqual(quality["undecided_elements"], 0)
+        self.assertGreater(quality["min"], 0.0)
+        # Every node on the lateral face (Face1 of Part's cylinder) at radius 1, every node on
+        # the caps at z = 0 or 2; CAD evaluation rounds at |x| <= 2: 1e-12 is slack, a
+        # straight-sided (uncurved) boundary is off by up to 0.03 at this size.
+        lateral = [i + 1 for i, f in enumerate(self.cyl.Shape.Faces)
+                   if f.Surface.__class__.__name__ == "Cylinder"]
+        on_face = mesh.node_cad_dim == 2
+        nodes = mesh.nodes
+        radius = np.hypot(nodes[:, 0], nodes[:, 1])
+        side = on_face & np.isin(mesh.node_cad_index, lateral)
+        self.assertGreater(side.sum(), 100)
+        self.assertLess(np.abs(radius[side] - 1.0).max(), 1e-12)
+        caps = on_face & ~side
+        self.assertLess(np.minimum(np.abs(nodes[caps, 2]), np.abs(nodes[caps, 2] - 2.0)).max(),
+                        1e-12)
+        # The linear mesh's nodes are FEM's corner nodes.
+        corners = fem.fem_mesh_arrays(femmesh.FemMesh)[0]
+        self.assertEqual(len(corners), len(set(map(tuple, corners))))
+        self.assertIn("classify", mesh.timings())
+
+    def test_to_fem_mesh_has_the_counts_of_the_order_two_mesh(self):
+        own = gmsh_fem_mesh(self.doc, self.cyl).FemMesh
+        signs = {corner_sign(own, element) for element in own.Volumes}
+        self.assertEqual(len(signs), 1)
+        self.fem_sign = signs.pop()
+        order4 = homesh.freecad.make_high_order_mesh(self.doc, self.cyl, order=4, size=0.5)
+        order2 = homesh.freecad.make_high_order_mesh(self.doc, self.cyl, order=2, size=0.5)
+        order4.OptimiserIterations = order2.OptimiserIterations = 0
+        order4.RepairRounds = order2.RepairRounds = 0
+        self.doc.recompute()
+        m2 = homesh.freecad.get_mesh(order2)
+        for source in (order4, order2):
+            target = fem.make_fem_mesh_object(self.doc, source)
+            self.doc.recompute()
+            fm = target.FemMesh
+            self.assertEqual(fm.NodeCount, m2.num_nodes)
+            self.assertEqual(fm.VolumeCount, m2.num_elements)
+            self.assertEqual(fm.TetraCount, m2.num_elements)
+            # SMESH's node order: every mid-edge node between its edge's corners (a wrong
+            # order puts it between other corners, an edge length away).
+            first = fm.Volumes[0]
+            ids = fm.getElementNodes(first)
+            p = [fm.getNodeById(i) for i in ids]
+            for k, (a, b) in enumerate(((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))):
+                self.assertLess((p[4 + k] - (p[a] + p[b]) * 0.5).Length, 0.05, (k, a, b))
+            # Oriented as FEM's own meshes are: the corners' signed volume has the sign it has
+            # in every element of FEM's Gmsh mesh of the same shape (SMESH turns the other
+            # way from Gmsh).
+            for element in fm.Volumes:
+                self.assertEqual(corner_sign(fm, element), self.fem_sign, element)
+
+    def test_a_surface_fem_mesh_is_refused_with_its_name(self):
+        class Surface:
+            Volumes = ()
+        with self.assertRaisesRegex(ValueError, "no volume elements"):
+            fem.fem_mesh_arrays(Surface())
+
+
+if __name__ == "__main__":
+    unittest.main()
