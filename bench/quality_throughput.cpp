@@ -117,7 +117,7 @@ int run(const Options& o) {
     path = (std::filesystem::temp_directory_path() /
             ("homesh_bench_quality_" + std::to_string(getpid()) + ".msh"))
                .string();
-    homesh::writeMesh(mesh, path, {}, {true, false});
+    homesh::writeMesh(mesh, path, {}, {true, false, {}});
     generated = path;
   } else {
     mesh = homesh::readMesh(path);

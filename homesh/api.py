@@ -153,15 +153,24 @@ class HighOrderMesh:
         """Seconds spent in each pipeline stage."""
         return dict(self._core.timings())
 
-    def write(self, path, binary=False, compressed=False):
+    def write(self, path, binary=False, compressed=False, groups=None):
         """Writes .msh (Gmsh 4.1), .vtu (VTK Lagrange cells), .xml (Nektar++) or .npz (this
         object's arrays). ``binary``: binary MSH, raw appended VTU data; ``compressed``:
-        compressed Nektar++ XML (B64Z-LittleEndian)."""
+        compressed Nektar++ XML (B64Z-LittleEndian). ``groups``: named boundary groups, a dict
+        such as ``{"wall": [1, 2], "inlet": [3]}`` (boundary faces, FaceN; 2D: curves, EdgeN)
+        written as one physical group (MSH) or composite (Nektar++) each, named so, in place of
+        "FaceN"; VTU has no boundary cells, hence no groups."""
         path = os.fspath(path)
         if path.lower().endswith(".npz"):
             self._save_npz(path)
-        else:
-            self._core.write(path, bool(binary), bool(compressed))
+            return
+        pairs = []
+        for name, entities in (groups or {}).items():
+            if isinstance(entities, numbers.Integral):
+                entities = [entities]
+            pairs.append((str(name), [_check_int("group %s entity" % name, e)
+                                      for e in entities]))
+        self._core.write(path, bool(binary), bool(compressed), pairs)
 
     def _save_npz(self, path):
         arrays = {

@@ -91,6 +91,22 @@ void addCommon(OptionTable& table, CommonOptions& c, bool outputs, bool report) 
                 [&c](const std::string&, const std::string& v) { c.outputs.push_back(v); });
     table.flag({"--binary"}, [&c] { c.binary = true; });
     table.flag({"--compressed"}, [&c] { c.compressed = true; });
+    table.value({"--group"}, [&c](const std::string& o, const std::string& v) {
+      const std::size_t eq = v.find('=');
+      if (eq == std::string::npos || eq == 0 || eq + 1 == v.size())
+        throw UsageError{o + " expects NAME=ENTITY[,ENTITY...] (boundary face numbers; 2D: "
+                         "curve numbers), got '" + v + "'"};
+      std::vector<int> entities;
+      std::size_t start = eq + 1;
+      while (start <= v.size()) {
+        const std::size_t comma = std::min(v.find(',', start), v.size());
+        entities.push_back(parseInteger(o, v.substr(start, comma - start)));
+        if (entities.back() < 1)
+          throw UsageError{o + ": entity numbers start at 1, got " + std::to_string(entities.back())};
+        start = comma + 1;
+      }
+      c.groups.emplace_back(v.substr(0, eq), std::move(entities));
+    });
   }
   if (report)
     table.value({"--report"}, [&c](const std::string&, const std::string& v) { c.report = v; });
@@ -372,6 +388,8 @@ options:
   -o, --output FILE   write the mesh: .msh (Gmsh 4.1), .vtu (VTK), .xml (Nektar++); repeatable
       --binary        binary MSH, raw appended VTU data
       --compressed    compressed Nektar++ XML (B64Z-LittleEndian)
+      --group NAME=F1,F2  a named boundary group (faces; 2D: curves) written as one physical
+                      group (MSH) / composite (Nektar++ XML) called NAME; repeatable
       --report FILE   write the JSON report ("-" for standard output)
   -j, --threads N     threads (default 1)
   -v, --verbose       show Gmsh's warnings (-vv: and its information)
@@ -420,6 +438,8 @@ options:
   -o, --output FILE   .msh, .vtu or .xml; repeatable
       --binary        binary MSH, raw appended VTU data
       --compressed    compressed Nektar++ XML (B64Z-LittleEndian)
+      --group NAME=F1,F2  a named boundary group (faces; 2D: curves) written as one physical
+                      group (MSH) / composite (Nektar++ XML) called NAME; repeatable
   -j, --threads N     threads (default 1)
   -q, --quiet         print nothing but errors
 )";
@@ -446,6 +466,8 @@ options:
   -o, --output FILE   write the mesh: .msh, .vtu, .xml; repeatable
       --binary        binary MSH, raw appended VTU data
       --compressed    compressed Nektar++ XML (B64Z-LittleEndian)
+      --group NAME=F1,F2  a named boundary group (faces; 2D: curves) written as one physical
+                      group (MSH) / composite (Nektar++ XML) called NAME; repeatable
       --report FILE   write the JSON report with "optimiser" ("-" for standard output)
   -j, --threads N     threads (default 1)
   -q, --quiet         print nothing but errors

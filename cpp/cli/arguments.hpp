@@ -22,6 +22,8 @@ struct CommonOptions {
   std::vector<std::string> outputs;   // -o, repeatable
   bool binary = false;                // MSH binary, VTU appended raw data
   bool compressed = false;            // Nektar++ XML compressed sections
+  // --group NAME=F1,F2,...: named boundary groups (physical groups, Nektar++ composites).
+  std::vector<std::pair<std::string, std::vector<int>>> groups;
 };
 
 // Sizing flags shared by `mesh` and `predict`: they override a .mcf's values.

@@ -58,6 +58,7 @@ homesh::WriteOptions writeOptions(const homesh::CommonOptions& c) {
   homesh::WriteOptions w;
   w.binary = c.binary;
   w.compressed = c.compressed;
+  for (const auto& [name, entities] : c.groups) w.groups.push_back({name, entities});
   return w;
 }
 

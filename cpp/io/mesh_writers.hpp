@@ -24,10 +24,24 @@ struct CellField {
   std::vector<double> values;
 };
 
+// A named boundary group (wall, inlet, farfield ...): CAD entities of dimension mesh.dim - 1
+// (faces in 3D, curves in 2D) written as one physical group (MSH) or composite (Nektar++)
+// called `name`, instead of one per entity ("FaceN"). VTU holds the elements only: no groups.
+struct NamedGroup {
+  std::string name;
+  std::vector<int> entities;  // 1-based, FreeCAD's FaceN / EdgeN
+};
+
 struct WriteOptions {
   bool binary = false;      // MSH: binary; VTU: raw appended data (else base64 inline)
   bool compressed = false;  // Nektar++ XML: B64Z-LittleEndian sections
+  std::vector<NamedGroup> groups;
 };
+
+// Throws ParameterError for an empty name or one with a quote, '<', '>' or '&' (it goes into
+// MSH and XML text), a name used twice, an entity in two groups, or an entity no boundary cell
+// of `mesh` lies on (naming the group and the entity).
+void checkGroups(const Mesh& mesh, const std::vector<NamedGroup>& groups);
 
 // Throws IoError unless `path` has a supported extension (.msh, .vtu, .xml) and its folder
 // exists: lets callers reject a bad output path before spending time on meshing.

@@ -70,7 +70,7 @@ struct Box {
 using EntityKey = std::pair<int, int>;  // (dim, tag)
 
 void writeEntities(MshSink& out, const std::map<EntityKey, Box>& entities,
-                   const std::set<EntityKey>& physical) {
+                   const std::map<EntityKey, int>& physical) {
   std::array<std::size_t, 4> counts{0, 0, 0, 0};
   for (const auto& [key, box] : entities) ++counts[key.first];
   out.text() << "$Entities\n";
@@ -82,9 +82,9 @@ void writeEntities(MshSink& out, const std::map<EntityKey, Box>& entities,
     for (const double lo : box.lo) out.real(lo);
     if (dim > 0)
       for (const double hi : box.hi) out.real(hi);
-    if (physical.count(key) > 0) {
+    if (const auto it = physical.find(key); it != physical.end()) {
       out.size(1);
-      out.integer(tag);
+      out.integer(it->second);
     } else {
       out.size(0);
     }
@@ -98,7 +98,7 @@ void writeEntities(MshSink& out, const std::map<EntityKey, Box>& entities,
 }  // namespace
 
 void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields,
-                bool binary) {
+                bool binary, const std::vector<NamedGroup>& named) {
   mesh.checkConsistency();
   checkCellFields(mesh, fields);
   const std::size_t n = mesh.numNodes();
@@ -111,15 +111,34 @@ void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<Cel
     entities[key].add(&mesh.xyz[3 * i]);
     nodesOf[key].push_back(i);
   }
-  std::set<EntityKey> physical;
+  // Physical group of each entity with cells: its own ("FaceN"), or its named group's.
+  std::map<EntityKey, int> physical;
+  std::map<EntityKey, std::string> physicalNames;
   for (const ElementBlock& block : mesh.blocks) {
     const int dim = cellDimension(block.type);
     for (std::size_t e = 0; e < block.count(); ++e) {
       const EntityKey key{dim, entityTag(block.entity[e])};
-      physical.insert(key);
+      if (physical.emplace(key, key.second).second)
+        physicalNames[key] = cadEntityName(dim, key.second);
       Box& box = entities[key];
       const std::int64_t* nodes = block.element(e);
       for (int k = 0; k < cellNumVertices(block.type); ++k) box.add(&mesh.xyz[3 * nodes[k]]);
+    }
+  }
+
+  if (!named.empty()) {
+    const int dim = mesh.dim - 1;
+    int next = 0;
+    for (const auto& [key, box] : entities)
+      if (key.first == dim) next = std::max(next, key.second);
+    for (const NamedGroup& g : named) {
+      ++next;
+      for (const int entity : g.entities) {
+        const EntityKey key{dim, entityTag(entity)};
+        physicalNames.erase(key);
+        physical[key] = next;
+      }
+      physicalNames[{dim, next}] = g.name;
     }
   }
 
@@ -133,9 +152,9 @@ void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<Cel
     os << '\n';
   }
   os << "$EndMeshFormat\n";
-  os << "$PhysicalNames\n" << physical.size() << "\n";
-  for (const auto& [dim, tag] : physical)
-    os << dim << " " << tag << " \"" << cadEntityName(dim, tag) << "\"\n";
+  os << "$PhysicalNames\n" << physicalNames.size() << "\n";
+  for (const auto& [key, name] : physicalNames)
+    os << key.first << " " << key.second << " \"" << name << "\"\n";
   os << "$EndPhysicalNames\n";
   writeEntities(out, entities, physical);
 

@@ -10,7 +10,9 @@
 
 namespace homesh {
 
+// `named` (checked by checkGroups): their entities form one physical group each, named after
+// the group, with tags after the largest entity tag of that dimension.
 void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields,
-                bool binary);
+                bool binary, const std::vector<NamedGroup>& named = {});
 
 }  // namespace homesh

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <set>
 #include <cstdio>
 #include <map>
 #include <sstream>
@@ -354,7 +355,8 @@ void writeEntities(std::ostream& os, char tag,
 
 }  // namespace
 
-void writeNektarXml(const Mesh& mesh, const std::string& path, bool compressed) {
+void writeNektarXml(const Mesh& mesh, const std::string& path, bool compressed,
+                    const std::vector<NamedGroup>& groups) {
   mesh.checkConsistency();
   const Builder b(mesh);
   AtomicFile file(path, false);
@@ -474,9 +476,26 @@ void writeNektarXml(const Mesh& mesh, const std::string& path, bool compressed) 
     os << "      <C ID=\"" << composite++ << "\" NAME=\"" << cadEntityName(mesh.dim, key.second)
        << "\"> " << key.first << '[' << idList(ids) << "] </C>\n";
   }
-  for (const auto& [entity, ids] : b.boundaryGroups)
+  // Boundary composites: one per named group (its entities' faces together), then one per
+  // entity in no group.
+  const char boundaryLetter = mesh.dim == 3 ? 'F' : 'E';
+  std::set<int> grouped;
+  for (const NamedGroup& g : groups) {
+    std::vector<int> ids;
+    for (const int entity : g.entities) {
+      grouped.insert(entity);
+      const auto it = b.boundaryGroups.find(entity);
+      if (it != b.boundaryGroups.end()) ids.insert(ids.end(), it->second.begin(), it->second.end());
+    }
+    std::sort(ids.begin(), ids.end());
+    os << "      <C ID=\"" << composite++ << "\" NAME=\"" << g.name << "\"> " << boundaryLetter
+       << '[' << idList(ids) << "] </C>\n";
+  }
+  for (const auto& [entity, ids] : b.boundaryGroups) {
+    if (grouped.count(entity) > 0) continue;
     os << "      <C ID=\"" << composite++ << "\" NAME=\"" << cadEntityName(mesh.dim - 1, entity)
-       << "\"> " << (mesh.dim == 3 ? 'F' : 'E') << '[' << idList(ids) << "] </C>\n";
+       << "\"> " << boundaryLetter << '[' << idList(ids) << "] </C>\n";
+  }
   os << "    </COMPOSITE>\n";
   os << "    <DOMAIN> C[" << idList(domain) << "] </DOMAIN>\n";
   os << "  </GEOMETRY>\n";

@@ -12,12 +12,18 @@
 #pragma once
 
 #include <string>
+#include <vector>
+
+#include "io/mesh_writers.hpp"
 
 #include "core/mesh.hpp"
 
 namespace homesh {
 
 // Throws ParameterError for element types Nektar++ has no counterpart for, IoError on write.
-void writeNektarXml(const Mesh& mesh, const std::string& path, bool compressed);
+// `groups` (checked by checkGroups): one boundary composite per group, named after it, holding
+// the faces (2D: edges) of all its entities, in place of their own "FaceN" composites.
+void writeNektarXml(const Mesh& mesh, const std::string& path, bool compressed,
+                    const std::vector<NamedGroup>& groups = {});
 
 }  // namespace homesh

@@ -264,10 +264,20 @@ class PyMesh {
     return d;
   }
 
-  void write(const std::string& path, bool binary, bool compressed) {
+  // groups: a list of (name, [entity, ...]) pairs (named boundary groups).
+  void write(const std::string& path, bool binary, bool compressed, const bp::list& groups) {
     WriteOptions options;
     options.binary = binary;
     options.compressed = compressed;
+    for (bp::ssize_t i = 0; i < bp::len(groups); ++i) {
+      const bp::tuple g = bp::extract<bp::tuple>(groups[i]);
+      NamedGroup group;
+      group.name = bp::extract<std::string>(g[0]);
+      const bp::list entities = bp::extract<bp::list>(g[1]);
+      for (bp::ssize_t k = 0; k < bp::len(entities); ++k)
+        group.entities.push_back(bp::extract<int>(entities[k]));
+      options.groups.push_back(std::move(group));
+    }
     const ReleaseGil nogil;
     writeMeshFiles(*result_, {path}, options);
   }
@@ -677,7 +687,8 @@ BOOST_PYTHON_MODULE(_core) {
       .def("quality_summary", &PyMesh::qualitySummary)
       .def("timings", &PyMesh::timings)
       .def("write", &PyMesh::write,
-           (bp::arg("path"), bp::arg("binary") = false, bp::arg("compressed") = false))
+           (bp::arg("path"), bp::arg("binary") = false, bp::arg("compressed") = false,
+            bp::arg("groups") = bp::list()))
       .def("element_volumes", &PyMesh::elementVolumes)
       .def("report_json", &PyMesh::reportJson)
       .def("optimise", &PyMesh::optimise);

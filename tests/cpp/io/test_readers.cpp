@@ -69,7 +69,7 @@ TEST(MshReader, RoundTripsOurFilesExactly) {
        {curvedBoxWithHole(1), curvedBoxWithHole(3), curvedBoxWithHole(6), curvedPlate(4)})
     for (const bool binary : {false, true}) {
       const std::string path = (dir / (binary ? "b.msh" : "a.msh")).string();
-      writeMesh(mesh, path, {}, {binary, false});
+      writeMesh(mesh, path, {}, {binary, false, {}});
       // Binary: bit-exact. ASCII: 17 significant digits round-trip every double exactly.
       expectSameMesh(mesh, readMsh(path), 0.0);
     }
@@ -278,14 +278,14 @@ TEST(MshWriter, GmshOpensOurFilesAtEveryOrder) {
   const CadModel cad = test::toModel(test::sphere(1.0));
   const Mesh linear = generateLinearMesh(cad, LinearMeshOptions::uniform(0.8));
   for (int order = 1; order <= 10; ++order) {  // tetrahedra, triangles, lines
-    writeMesh(elevateOrder(linear, order, &cad), path, {}, {order % 2 == 0, false});
+    writeMesh(elevateOrder(linear, order, &cad), path, {}, {order % 2 == 0, false, {}});
     const Mesh mesh = readMsh(path);
     EXPECT_EQ(gmshCounts(path), ourCounts(mesh)) << "order " << order;
   }
   for (const bool prisms : {false, true})  // hexahedra or prisms, with quadrilaterals
     for (int order = 1; order <= 9; ++order) {
       const Mesh mesh = gmshStructuredMesh(prisms, order, (dir / "g.msh").string());
-      writeMesh(mesh, path, {}, {order % 2 == 1, false});
+      writeMesh(mesh, path, {}, {order % 2 == 1, false, {}});
       EXPECT_EQ(gmshCounts(path), ourCounts(mesh))
           << (prisms ? "prisms" : "hexahedra") << " order " << order;
     }
@@ -297,7 +297,7 @@ TEST(NektarXml, RoundTripsPlainAndCompressed) {
                            curvedBoxWithHole(5), curvedPlate(4)})
     for (const bool compressed : {false, true}) {
       const std::string path = (dir / (compressed ? "c.xml" : "p.xml")).string();
-      writeMesh(mesh, path, {}, {false, compressed});
+      writeMesh(mesh, path, {}, {false, compressed, {}});
       const Mesh back = readMesh(path);
       ASSERT_EQ(back.order, mesh.order);
       ASSERT_EQ(back.numElements(), mesh.numElements());
