@@ -18,7 +18,8 @@ class HOMeshWorkbench(FreeCADGui.Workbench):
     def Initialize(self):
         import homesh.freecad.commands  # noqa: F401  (registers the commands)
         commands = ["HOMesh_HighOrderMesh", "HOMesh_Sizing", "HOMesh_BoundaryLayer",
-                    "HOMesh_CurveFemMesh", "HOMesh_ToFemMesh"]
+                    "HOMesh_MeshRegion", "HOMesh_BoundaryGroup", "HOMesh_CurveFemMesh",
+                    "HOMesh_ToFemMesh"]
         self.appendToolbar("HOMesh", commands)
         self.appendMenu("&HOMesh", commands)
 

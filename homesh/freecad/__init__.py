@@ -17,6 +17,7 @@ from .objects import (
     make_high_order_mesh,
     make_sizing,
 )
+from .regions import make_boundary_group, make_mesh_region
 
 __all__ = [
     "TYPE_BOUNDARY_LAYER",
@@ -27,6 +28,8 @@ __all__ = [
     "is_boundary_layer",
     "is_sizing",
     "make_boundary_layer",
+    "make_boundary_group",
     "make_high_order_mesh",
+    "make_mesh_region",
     "make_sizing",
 ]

@@ -257,6 +257,82 @@ class CommandToFemMesh:
         doc.recompute()
 
 
+def _selected_subshapes(kinds):
+    """(object, [names]) when sub-shapes of the given kinds of one object are selected."""
+    selection = FreeCADGui.Selection.getSelectionEx()
+    if len(selection) != 1:
+        return None
+    names = list(selection[0].SubElementNames)
+    if not names or not all(n.startswith(kinds) for n in names):
+        return None
+    return selection[0].Object, names
+
+
+def _mesh_of(part):
+    meshes = [o for o in part.Document.Objects
+              if getattr(getattr(o, "Proxy", None), "Type", None) == TYPE_HIGH_ORDER_MESH
+              and o.Part == part]
+    return meshes[0] if len(meshes) == 1 else None
+
+
+class CommandMeshRegion:
+    """A MeshRegion on the selected faces, edges or vertices, child of their shape's mesh."""
+
+    def GetResources(self):
+        return {"Pixmap": resources.icon("homesh_region.svg"), "MenuText": "Mesh region",
+                "ToolTip": "Refine the mesh near the selected faces, edges or vertices (a "
+                           "child of the shape's high-order mesh; set its Size)"}
+
+    def IsActive(self):
+        picked = _selected_subshapes(("Face", "Edge", "Vertex"))
+        return picked is not None and _mesh_of(picked[0]) is not None
+
+    def Activated(self):
+        part, names = _selected_subshapes(("Face", "Edge", "Vertex"))
+        mesh = _mesh_of(part)
+        size = part.Shape.BoundBox.DiagonalLength / 100.0
+        doc = FreeCAD.ActiveDocument
+        doc.openTransaction("Mesh region")
+        try:
+            FreeCADGui.addModule("homesh.freecad")
+            FreeCADGui.doCommand(
+                "_region = homesh.freecad.make_mesh_region(App.ActiveDocument, "
+                "App.ActiveDocument.getObject(%r), [(App.ActiveDocument.getObject(%r), %r)], "
+                "%r)" % (mesh.Name, part.Name, names, size))
+        finally:
+            doc.commitTransaction()
+
+
+class CommandBoundaryGroup:
+    """A named BoundaryGroup on the selected faces (2D: edges), child of their shape's mesh."""
+
+    def GetResources(self):
+        return {"Pixmap": resources.icon("homesh_group.svg"), "MenuText": "Boundary group",
+                "ToolTip": "Name the selected faces (wall, inlet, outlet ...): every export "
+                           "writes them as one Gmsh physical group / Nektar++ composite"}
+
+    def IsActive(self):
+        picked = _selected_subshapes(("Face", "Edge"))
+        return picked is not None and _mesh_of(picked[0]) is not None
+
+    def Activated(self):
+        part, names = _selected_subshapes(("Face", "Edge"))
+        mesh = _mesh_of(part)
+        existing = len(getattr(mesh, "Groups", []) or [])
+        doc = FreeCAD.ActiveDocument
+        doc.openTransaction("Boundary group")
+        try:
+            FreeCADGui.addModule("homesh.freecad")
+            FreeCADGui.doCommand(
+                "_group = homesh.freecad.make_boundary_group(App.ActiveDocument, "
+                "App.ActiveDocument.getObject(%r), [(App.ActiveDocument.getObject(%r), %r)], "
+                "%r)" % (mesh.Name, part.Name, names, "group%d" % (existing + 1)))
+        finally:
+            doc.commitTransaction()
+
+
+FreeCADGui.addCommand("HOMesh_MeshRegion", CommandMeshRegion())
+FreeCADGui.addCommand("HOMesh_BoundaryGroup", CommandBoundaryGroup())
 FreeCADGui.addCommand("HOMesh_HighOrderMesh", CommandHighOrderMesh())
 FreeCADGui.addCommand("HOMesh_CurveFemMesh", CommandCurveFemMesh())
 FreeCADGui.addCommand("HOMesh_ToFemMesh", CommandToFemMesh())

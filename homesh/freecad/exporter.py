@@ -1,5 +1,6 @@
 """File > Export of HighOrderMesh objects (registered in Init.py): .msh (Gmsh), .vtu (ParaView)
-and .xml (Nektar++)."""
+and .xml (Nektar++), with the mesh's BoundaryGroup children as named physical groups /
+composites."""
 
 import FreeCAD
 
@@ -17,5 +18,13 @@ def export(objects, filename):
             "HOMesh: %s has no valid mesh (never computed, or its last recompute failed): "
             "nothing exported\n" % meshes[0].Label)
         return
-    mesh.write(filename)
-    FreeCAD.Console.PrintMessage("HOMesh: wrote %s\n" % filename)
+    from .regions import mesh_groups
+    import homesh
+    try:
+        groups = mesh_groups(meshes[0])
+        mesh.write(filename, groups=groups)
+    except (ValueError, homesh.HOMeshError) as e:
+        FreeCAD.Console.PrintError("HOMesh: %s: nothing exported: %s\n" % (meshes[0].Label, e))
+        return
+    FreeCAD.Console.PrintMessage("HOMesh: wrote %s%s\n" % (
+        filename, " with groups %s" % ", ".join(groups) if groups else ""))

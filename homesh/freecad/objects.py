@@ -134,6 +134,14 @@ class HighOrderMeshProxy(_Proxy, ParameterGuard):
             obj.addProperty("App::PropertyLink", "BoundaryLayer", "Mesh",
                             "Optional HOMesh BoundaryLayer object: prisms grown from its faces "
                             "of Part, curved and optimised with the rest, then split")
+        if "Regions" not in have:
+            obj.addProperty("App::PropertyLinkList", "Regions", "Mesh",
+                            "HOMesh MeshRegion children: smaller sizes near faces, edges and "
+                            "vertices (sources of the sizing octree; Size must be 0)")
+        if "Groups" not in have:
+            obj.addProperty("App::PropertyLinkList", "Groups", "Mesh",
+                            "HOMesh BoundaryGroup children: named boundary groups (wall, "
+                            "inlet ...) written as physical groups / composites by every export")
         if "FemMesh" not in have:
             obj.addProperty("App::PropertyLink", "FemMesh", "Mesh",
                             "Optional FEM mesh of Part (FEM's Gmsh or Netgen mesher, first or "
@@ -246,6 +254,12 @@ def mesh_arguments(obj, values=None):
             raise ValueError("%s: Sizing must link to a HOMesh Sizing object, not %s"
                              % (obj.Label, sizing.Label))
         arguments.update(sizing_arguments(sizing))
+    if getattr(obj, "Regions", None) and getattr(obj, "FemMesh", None) is None:
+        from .regions import mesh_sources
+        if arguments["size"] is not None:
+            raise ValueError("%s: mesh regions refine the sizing octree: set Size to 0 "
+                             "(automatic) to use them" % obj.Label)
+        arguments["sources"] = list(arguments.get("sources", ())) + mesh_sources(obj)
     if obj.BoundaryLayer is not None and getattr(obj, "FemMesh", None) is None:
         if not is_boundary_layer(obj.BoundaryLayer):
             raise ValueError("%s: BoundaryLayer must link to a HOMesh BoundaryLayer object, "

@@ -269,10 +269,13 @@ class ViewProviderHighOrderMesh(_Stateless, _EditsWithTaskPanel):
         return resources.icon("homesh_mesh.svg")
 
     def claimChildren(self):
-        return [child for child in (getattr(self.Object, "Part", None),
-                                    getattr(self.Object, "Sizing", None),
-                                    getattr(self.Object, "BoundaryLayer", None))
-                if child is not None]
+        children = [child for child in (getattr(self.Object, "Part", None),
+                                        getattr(self.Object, "Sizing", None),
+                                        getattr(self.Object, "BoundaryLayer", None))
+                    if child is not None]
+        for prop in ("Regions", "Groups"):
+            children += list(getattr(self.Object, prop, None) or [])
+        return children
 
 
 class ViewProviderSizing(_Stateless, _EditsWithTaskPanel):
@@ -286,6 +289,22 @@ class ViewProviderSizing(_Stateless, _EditsWithTaskPanel):
 
     def getIcon(self):
         return resources.icon("homesh_sizing.svg")
+
+
+class ViewProviderIconOnly(_Stateless):
+    """Mesh regions and boundary groups draw nothing themselves; their tree icon."""
+
+    def __init__(self, vobj):
+        vobj.Proxy = self
+
+    def attach(self, vobj):
+        self.Object = vobj.Object
+
+    def getIcon(self):
+        from .regions import TYPE_BOUNDARY_GROUP
+        kind = getattr(getattr(getattr(self, "Object", None), "Proxy", None), "Type", "")
+        return resources.icon("homesh_group.svg" if kind == TYPE_BOUNDARY_GROUP
+                              else "homesh_region.svg")
 
 
 def _set_points(field, array):
