@@ -39,7 +39,9 @@ double parseParameter(const std::string& key, const std::string& option, const s
   const ParameterDefinition& p = parameterDefinition(key);
   const double value = p.kind == ParameterKind::Integer ? parseInteger(option, text)
                                                          : parseNumber(option, text);
-  if (!inRange(p, value)) throw UsageError{option + " must be " + rangeText(p) + ", got " + text};
+  // Named by its long form whatever alias was typed (-j: --threads).
+  const std::string name = *p.option != '\0' ? std::string(p.option) : option;
+  if (!inRange(p, value)) throw UsageError{name + " must be " + rangeText(p) + ", got " + text};
   return value;
 }
 

@@ -27,7 +27,7 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        0, 20, false, 3, false, "mesh",
        "Most repair rounds while elements are not proven valid (split or refine around them, "
        "curve, optimise and check again)"},
-      {"threads", "Threads", "-j", "threads", ParameterKind::Integer, 1, 1024, false, 1, false, "mesh",
+      {"threads", "Threads", "--threads", "threads", ParameterKind::Integer, 1, 1024, false, 1, false, "mesh",
        "Threads the sizing octree and the optimiser use"},
       {"min_delta", "MinDelta", "--min-delta", "MinDelta", ParameterKind::Length, 0, kNoLimit, true,
        0, true, "sizing", "Smallest element size, at high curvature"},
