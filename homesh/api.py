@@ -355,7 +355,7 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     progress  optional ``callable(stage, seconds)``: called with ``seconds=None`` when a stage
               starts and with its duration when it ends. A callable of four parameters,
               ``(stage, seconds, fraction, detail)``, is also called within stages (the linear
-              mesher per dimension, the optimiser per sweep) with ``seconds=None``, the
+              mesher when Gmsh is done, the optimiser per sweep) with ``seconds=None``, the
               estimated ``fraction`` of the stage done and ``detail`` in words. Raising inside
               it cancels the job (:class:`CancelledError`). It is called on the thread that
               runs :func:`mesh`.

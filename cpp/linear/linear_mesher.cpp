@@ -209,12 +209,10 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
       return sizeAt(Eigen::Vector3d(x, y, z));
     });
     try {
-      // One dimension at a time (what generate(dim) does), so progress and cancellation can
-      // come between them.
-      for (int d = 1; d <= dim; ++d) {
-        gmsh::model::mesh::generate(d);
-        if (options.dimensionDone) options.dimensionDone(d, dim);
-      }
+      // One call: generating dimension by dimension (1, 2, then 3) gives Gmsh 4.8 a different
+      // mesh than generate(dim), and every figure recorded so far is of generate(dim)'s.
+      gmsh::model::mesh::generate(dim);
+      if (options.dimensionDone) options.dimensionDone(dim, dim);
     } catch (const std::string& message) {
       throw MeshingError(
           "Gmsh could not mesh " + cad.sourceName() +

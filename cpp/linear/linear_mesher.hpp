@@ -26,8 +26,8 @@ struct LinearMeshOptions {
   int verbosity = 0;    // 0 silent, 1 Gmsh's warnings, 2 Gmsh's information
   SizeField sizeField;  // when set: sizes from it (Gmsh's curve meshing integrates 1/size)
   double minSize = 0.0, maxSize = 0.0;  // with sizeField: the bounds it keeps to (> 0)
-  // Called after the curves (1), the surfaces (2) and, in 3D, the volumes (3) are meshed; it
-  // may throw (CancelledError) to stop between them. Gmsh itself cannot be interrupted.
+  // Called once Gmsh has meshed every dimension up to the model's (dim == of); it may throw
+  // (CancelledError). Gmsh itself cannot be interrupted.
   std::function<void(int dim, int of)> dimensionDone;
 
   static LinearMeshOptions uniform(double size) {

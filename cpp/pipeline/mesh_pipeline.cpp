@@ -197,13 +197,13 @@ class OptimiserProgress : public OptimiserObserver {
   int maxIterations_;
 };
 
-// Reports each dimension the linear mesher finishes and stops between them when asked.
+// Reports the linear mesher's Gmsh run done (before the mesh is read back and oriented) and
+// stops there when asked.
 std::function<void(int, int)> linearProgress(PipelineObserver* observer) {
   if (observer == nullptr) return {};
   return [observer](int dim, int of) {
-    static const char* const kWhat[] = {"", "curves", "surfaces", "volumes"};
     observer->stageProgress("linear", static_cast<double>(dim) / of,
-                            std::string(kWhat[dim]) + " meshed");
+                            dim == 3 ? "volumes meshed by Gmsh" : "surfaces meshed by Gmsh");
     if (observer->cancelRequested()) throw CancelledError("cancelled during the linear mesh");
   };
 }

@@ -23,6 +23,8 @@ _STAGE_WEIGHTS = {"cad": 2, "classify": 3, "sizing": 3, "linear": 10, "boundary_
                   "optimise_low_order": 20, "raise_order": 3, "optimise": 40, "quality": 4,
                   "split_layers": 2, "geometry": 2}
 
+_WORKER_NICENESS = 10
+
 
 class MeshJob:
     """``MeshJob(brep_text, name, function, **arguments)`` (function: homesh.mesh by default, or
@@ -58,6 +60,13 @@ class MeshJob:
         return self
 
     def _run(self):
+        # Below the GUI's priority: the core keeps every core busy, and the GUI thread must
+        # still get the processor at once when it has events to handle. Threads the core
+        # starts from here (OpenMP's) inherit it. Linux applies niceness per thread.
+        try:
+            os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), _WORKER_NICENESS)
+        except (AttributeError, OSError):
+            pass
         try:
             self.result = self.function(self.brep_text, name=self.name,
                                         progress=self._progress, cancel=self.token,

@@ -50,6 +50,9 @@ try:
         QtWidgets.QApplication.primaryScreen().grabWindow(window.winId()).save(
             os.path.join(out, name))
 
+    def stage():
+        return getattr(getattr(commands.active_panel(), "job", None), "stage", "")
+
     def run_until(condition, limit, during=None, running=None):
         """Runs the GUI's event loop until condition() holds (or limit seconds pass); returns
         the largest gap between the firings of a 50 ms QTimer while running() (default:
@@ -57,7 +60,7 @@ try:
         stamps = []
         timer = QtCore.QTimer()
         timer.setInterval(50)
-        timer.timeout.connect(lambda: stamps.append(time.monotonic())
+        timer.timeout.connect(lambda: stamps.append((time.monotonic(), stage()))
                               if running is None or running() else None)
         timer.start()
         start = time.monotonic()
@@ -68,8 +71,12 @@ try:
             time.sleep(0.005)
         timer.stop()
         assert condition(), "not done within %g s" % limit
-        gaps = [b - a for a, b in zip(stamps, stamps[1:]) if a is not None and b is not None]
-        return max(gaps) if gaps else 0.0, sum(1 for t in stamps if t is not None)
+        gaps = [(b[0] - a[0], b[1]) for a, b in zip(stamps, stamps[1:])
+                if a is not None and b is not None]
+        worst = max(gaps) if gaps else (0.0, "")
+        if worst[0] > 0.1:
+            print("HOMesh GUI: largest gap %.3f s, during %s" % worst)
+        return worst[0], sum(1 for t in stamps if t is not None)
 
     doc = FreeCAD.newDocument("Smoke")
     cut = box_with_hole(doc)

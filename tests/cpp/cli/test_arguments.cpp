@@ -131,8 +131,8 @@ TEST(Arguments, BadCommandLinesNameTheProblem) {
   EXPECT_NE(usageError({"mesh", "a.step", "--order", "0"}).find("--order"), std::string::npos);
   EXPECT_NE(usageError({"mesh", "a.step", "--order", "11"}).find("--order"), std::string::npos);
   EXPECT_NE(usageError({"mesh", "a.step", "--order", "two"}).find("integer"), std::string::npos);
-  EXPECT_NE(usageError({"mesh", "a.step", "--size", "-1"}).find("positive"), std::string::npos);
-  EXPECT_NE(usageError({"mesh", "a.step", "--size", "0"}).find("positive"), std::string::npos);
+  EXPECT_NE(usageError({"mesh", "a.step", "--size", "-1"}).find("a length > 0"), std::string::npos);
+  EXPECT_NE(usageError({"mesh", "a.step", "--size", "0"}).find("a length > 0"), std::string::npos);
   EXPECT_NE(usageError({"mesh", "a.step", "--size", "1x"}).find("number"), std::string::npos);
   EXPECT_NE(usageError({"mesh", "a.step", "--size"}).find("needs a value"), std::string::npos);
   EXPECT_NE(usageError({"mesh", "a.step", "--bogus"}).find("--bogus"), std::string::npos);
