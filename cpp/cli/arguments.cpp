@@ -37,8 +37,8 @@ int parseInteger(const std::string& option, const std::string& text) {
 // `text` parsed as the parameter `key` of core/parameters.hpp and checked against its range.
 double parseParameter(const std::string& key, const std::string& option, const std::string& text) {
   const ParameterDefinition& p = parameterDefinition(key);
-  const double value = p.kind == ParameterKind::Integer ? parseInteger(option, text)
-                                                         : parseNumber(option, text);
+  const double value =
+      p.kind == ParameterKind::Integer ? parseInteger(option, text) : parseNumber(option, text);
   // Named by its long form whatever alias was typed (-j: --threads).
   const std::string name = *p.option != '\0' ? std::string(p.option) : option;
   if (!inRange(p, value)) throw UsageError{name + " must be " + rangeText(p) + ", got " + text};
@@ -96,15 +96,18 @@ void addCommon(OptionTable& table, CommonOptions& c, bool outputs, bool report) 
     table.value({"--group"}, [&c](const std::string& o, const std::string& v) {
       const std::size_t eq = v.find('=');
       if (eq == std::string::npos || eq == 0 || eq + 1 == v.size())
-        throw UsageError{o + " expects NAME=ENTITY[,ENTITY...] (boundary face numbers; 2D: "
-                         "curve numbers), got '" + v + "'"};
+        throw UsageError{o +
+                         " expects NAME=ENTITY[,ENTITY...] (boundary face numbers; 2D: "
+                         "curve numbers), got '" +
+                         v + "'"};
       std::vector<int> entities;
       std::size_t start = eq + 1;
       while (start <= v.size()) {
         const std::size_t comma = std::min(v.find(',', start), v.size());
         entities.push_back(parseInteger(o, v.substr(start, comma - start)));
         if (entities.back() < 1)
-          throw UsageError{o + ": entity numbers start at 1, got " + std::to_string(entities.back())};
+          throw UsageError{o + ": entity numbers start at 1, got " +
+                           std::to_string(entities.back())};
         start = comma + 1;
       }
       c.groups.emplace_back(v.substr(0, eq), std::move(entities));

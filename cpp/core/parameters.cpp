@@ -27,12 +27,12 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        0, 20, false, 3, false, "mesh",
        "Most repair rounds while elements are not proven valid (split or refine around them, "
        "curve, optimise and check again)"},
-      {"threads", "Threads", "--threads", "threads", ParameterKind::Integer, 1, 1024, false, 1, false, "mesh",
-       "Threads the sizing octree and the optimiser use"},
+      {"threads", "Threads", "--threads", "threads", ParameterKind::Integer, 1, 1024, false, 1,
+       false, "mesh", "Threads the sizing octree and the optimiser use"},
       {"min_delta", "MinDelta", "--min-delta", "MinDelta", ParameterKind::Length, 0, kNoLimit, true,
        0, true, "sizing", "Smallest element size, at high curvature"},
-      {"max_delta", "MaxDelta", "--max-delta", "MaxDelta", ParameterKind::Length, 0, kNoLimit,
-       true, 0, true, "sizing", "Largest element size"},
+      {"max_delta", "MaxDelta", "--max-delta", "MaxDelta", ParameterKind::Length, 0, kNoLimit, true,
+       0, true, "sizing", "Largest element size"},
       {"eps", "Eps", "--eps", "EPS", ParameterKind::Real, 0, 1, true, 0.05, false, "sizing",
        "Sagitta ratio: on a surface of curvature radius R the size is 2 R sqrt(eps (2 - eps))"},
       {"layers", "Layers", "--bl-layers", "boundary-layer layers", ParameterKind::Integer, 1, 100,
@@ -55,8 +55,7 @@ std::string rangeText(const ParameterDefinition& p) {
   const std::string what = integer                           ? "an integer"
                            : p.kind == ParameterKind::Length ? "a length"
                                                              : "a number";
-  if (std::isinf(p.max))
-    return what + (p.minExclusive ? " > " : " >= ") + formatNumber(p.min);
+  if (std::isinf(p.max)) return what + (p.minExclusive ? " > " : " >= ") + formatNumber(p.min);
   if (integer || !p.minExclusive)
     return what + " from " + formatNumber(p.min) + " to " + formatNumber(p.max);
   return what + " in (" + formatNumber(p.min) + ", " + formatNumber(p.max) + "]";

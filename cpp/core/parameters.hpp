@@ -25,7 +25,7 @@ struct ParameterDefinition {
   bool minExclusive;  // (min, max] instead of [min, max]
   double defaultValue;
   bool zeroIsAutomatic;  // 0 stands for "choose automatically" (a size from the model)
-  const char* group;  // "mesh", "sizing", "boundary_layer"
+  const char* group;     // "mesh", "sizing", "boundary_layer"
   const char* doc;
 };
 

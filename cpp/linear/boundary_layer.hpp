@@ -27,12 +27,11 @@
 
 namespace homesh {
 
-
 struct BoundaryLayerParameters {
   std::vector<int> faces;  // 1-based CAD faces (FaceN) that carry the layer
   std::string thickness;   // total thickness: a number or an expression of x, y, z
   // Defaults as NekMesh's: 2 layers, progression 2.
-  int layers = 2;            // thin layers each macro prism is split into, range in core/parameters.hpp
+  int layers = 2;  // thin layers each macro prism is split into, range in core/parameters.hpp
   double progression = 2.0;  // height ratio of consecutive layers (wall outwards), > 0
 
   // Throws ParameterError naming the parameter (no faces, a thickness that does not parse,

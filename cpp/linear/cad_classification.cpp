@@ -63,8 +63,8 @@ class Classifier {
       if (cad.isDegenerated(e)) continue;
       const ParameterRange r = cad.edgeRange(e);
       for (int k = 0; k <= 2 * kSamples; ++k)
-        edgeBoxes_[e].add(cad.evaluateCurve(e, r.first + (r.last - r.first) * k / (2 * kSamples))
-                              .point);
+        edgeBoxes_[e].add(
+            cad.evaluateCurve(e, r.first + (r.last - r.first) * k / (2 * kSamples)).point);
       edgeBoxes_[e].grow(0.25, tol_);
     }
     for (int f = 1; f <= cad.numFaces(); ++f) {
@@ -167,8 +167,8 @@ Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
   if (tets == nullptr || tets->count() == 0)
     throw ParameterError("the mesh has no tetrahedra to put on the CAD");
   if (cad.numSolids() != 1)
-    throw ParameterError("the CAD must be one solid to put a mesh on it, " +
-                         cad.sourceName() + " has " + std::to_string(cad.numSolids()));
+    throw ParameterError("the CAD must be one solid to put a mesh on it, " + cad.sourceName() +
+                         " has " + std::to_string(cad.numSolids()));
   if (!(tolerance > 0.0)) tolerance = 1e-5 * cad.boundingDiagonal();
 
   Mesh mesh;
@@ -230,10 +230,10 @@ Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
     if (place.dim < 0)
       throw MeshingError("boundary node " + std::to_string(i + 1) + " at " + describe(p) +
                          " lies on no face of " + cad.sourceName() +
-                         (nearest.first > 0 ? " (nearest: " + cadEntityName(2, nearest.first) +
-                                                  " at distance " +
-                                                  formatNumber(nearest.second) + ")"
-                                            : "") +
+                         (nearest.first > 0
+                              ? " (nearest: " + cadEntityName(2, nearest.first) + " at distance " +
+                                    formatNumber(nearest.second) + ")"
+                              : "") +
                          ": is the mesh of this shape?");
     mesh.nodeCadDim[i] = static_cast<std::uint8_t>(place.dim);
     mesh.nodeCadIndex[i] = place.index;
@@ -265,8 +265,8 @@ Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
     if (common.empty())
       throw MeshingError("the boundary triangle of nodes " + std::to_string(f[0] + 1) + ", " +
                          std::to_string(f[1] + 1) + ", " + std::to_string(f[2] + 1) + " near " +
-                         describe(centroid) + " spans more than one face of " +
-                         cad.sourceName() + ": the mesh does not follow the CAD's faces");
+                         describe(centroid) + " spans more than one face of " + cad.sourceName() +
+                         ": the mesh does not follow the CAD's faces");
     int face = *common.begin();
     if (common.size() > 1) {
       double nearest = std::numeric_limits<double>::infinity();
@@ -283,8 +283,7 @@ Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
       const std::set<int> ea = classifier.edgesOf(mesh.nodeCadDim[a], mesh.nodeCadIndex[a]);
       const std::set<int> eb = classifier.edgesOf(mesh.nodeCadDim[b], mesh.nodeCadIndex[b]);
       std::vector<int> shared;
-      std::set_intersection(ea.begin(), ea.end(), eb.begin(), eb.end(),
-                            std::back_inserter(shared));
+      std::set_intersection(ea.begin(), ea.end(), eb.begin(), eb.end(), std::back_inserter(shared));
       if (shared.empty()) continue;
       // A chord of its edge bulges from it by at most 0.29 of its length for arcs up to 120
       // degrees; a segment across a face between two vertices of one edge (a cap of two

@@ -555,8 +555,7 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
   StageClock classify("classify", result.timings, observer);
   Mesh onCad = classifyOnCad(linear, *result.cad);
   classify.done();
-  CurvedState state =
-      curve(std::move(onCad), options, *result.cad, result.timings, observer, true);
+  CurvedState state = curve(std::move(onCad), options, *result.cad, result.timings, observer, true);
   result.mesh = std::move(state.mesh);
   result.quality = std::move(state.quality);
   result.optimiser = std::move(state.optimiser);

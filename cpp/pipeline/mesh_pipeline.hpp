@@ -43,16 +43,16 @@ struct MeshingOptions {
   std::optional<SizingParameters> sizing;  // 0 deltas: automatic (completeSizing)
   std::optional<int> expectedDimension;    // 2 or 3 (a .mcf's MeshType): checked on the CAD
   std::string octreeOutput;                // when set: the octree's leaves, written after sizing
-  int threads = 1;                         // threads the stages may use, range in core/parameters.hpp
-  int verbosity = 0;                       // 0 silent; 1 Gmsh's warnings; 2 Gmsh's information
+  int threads = 1;    // threads the stages may use, range in core/parameters.hpp
+  int verbosity = 0;  // 0 silent; 1 Gmsh's warnings; 2 Gmsh's information
   // > 0: after elevation, at most this many sweeps of the variational optimiser (hyperelastic,
   // boundary nodes sliding on the CAD; optimise/optimiser.hpp), stopping earlier once the mesh
   // is proven valid and no longer improving (OptimiserOptions: "energy", or "stalled" with
   // stall 0.001).
   int optimiseIterations = 0;
-  // Repair rounds (pipeline/repair.hpp) while elements are not proven valid, range in core/parameters.hpp:
-  // each splits the offending linear cells' edges on curved faces (or refines around them),
-  // then curves, optimises and checks again. 0: none.
+  // Repair rounds (pipeline/repair.hpp) while elements are not proven valid, range in
+  // core/parameters.hpp: each splits the offending linear cells' edges on curved faces (or refines
+  // around them), then curves, optimises and checks again. 0: none.
   int repairRounds = 3;
   // A macro boundary layer on these CAD faces (linear/boundary_layer.hpp), curved and optimised
   // with the rest and split into its thin layers last (curving/layer_split.hpp).

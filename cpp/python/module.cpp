@@ -6,10 +6,10 @@
 // the GIL; the progress callback re-acquires it.
 #include <Python.h>
 
-#include <boost/python.hpp>
-#include <boost/python/numpy.hpp>
 #include <algorithm>
 #include <atomic>
+#include <boost/python.hpp>
+#include <boost/python/numpy.hpp>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -435,7 +435,7 @@ bp::list parameters() {
     d["property"] = p.property;
     d["option"] = p.option;
     d["label"] = p.label;
-    d["kind"] = p.kind == ParameterKind::Integer ? "integer"
+    d["kind"] = p.kind == ParameterKind::Integer  ? "integer"
                 : p.kind == ParameterKind::Length ? "length"
                                                   : "real";
     d["min"] = p.min;
@@ -536,8 +536,8 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::ob
 }
 
 PyMesh curveBrep(const std::string& text, const std::string& name, const bp::object& nodes,
-                 const bp::object& tets, int order, int threads, int verbosity,
-                 bp::object progress, int optimise, const bp::object& cancel) {
+                 const bp::object& tets, int order, int threads, int verbosity, bp::object progress,
+                 int optimise, const bp::object& cancel) {
   return curveOnCad(CadSource::brepText(text, name), nodes, tets, order, threads, verbosity,
                     std::move(progress), optimise, cancel);
 }
@@ -693,12 +693,11 @@ BOOST_PYTHON_MODULE(_core) {
       .def("report_json", &PyMesh::reportJson)
       .def("optimise", &PyMesh::optimise);
 
-  bp::def(
-      "mesh_file", &meshFile,
-      (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"), bp::arg("verbosity"),
-       bp::arg("progress"), bp::arg("optimise") = 0, bp::arg("sizing") = bp::object(),
-       bp::arg("repair_rounds") = 3, bp::arg("boundary_layer") = bp::object(),
-       bp::arg("cancel") = bp::object()));
+  bp::def("mesh_file", &meshFile,
+          (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
+           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
+           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = 3,
+           bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object()));
   bp::def("mesh_brep", &meshBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
            bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,

@@ -99,7 +99,8 @@ TEST(CadClassification, AMeshOfTheShapeGetsBackTheRecordsItsMesherGaveIt) {
     for (std::size_t e = 0; e < tets.count(); ++e) {
       const std::int64_t* t = tets.element(e);
       const Eigen::Vector3d a = nodePoint(again, t[0]);
-      EXPECT_GT((nodePoint(again, t[1]) - a).cross(nodePoint(again, t[2]) - a)
+      EXPECT_GT((nodePoint(again, t[1]) - a)
+                    .cross(nodePoint(again, t[2]) - a)
                     .dot(nodePoint(again, t[3]) - a),
                 0.0);
     }
