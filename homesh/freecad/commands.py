@@ -25,6 +25,27 @@ def _selected_shape_object():
     return obj
 
 
+def _do_commands(title, commands, module="homesh.freecad"):
+    """Runs ``commands`` through FreeCADGui.doCommand (so they show in the Python console and
+    macros) as one undoable step called ``title``."""
+    doc = FreeCAD.ActiveDocument
+    doc.openTransaction(title)
+    try:
+        FreeCADGui.addModule(module)
+        for command in commands:
+            FreeCADGui.doCommand(command)
+    finally:
+        doc.commitTransaction()
+
+
+def _edit_and_mesh(obj):
+    """Opens the task panel of a new HighOrderMesh and starts meshing it there."""
+    FreeCADGui.ActiveDocument.setEdit(obj.Name)
+    panel = active_panel()
+    if panel is not None:
+        panel.mesh()
+
+
 def active_panel():
     """The HOMesh task panel being shown, if any."""
     from .taskpanels import last_panel
@@ -55,24 +76,14 @@ class CommandHighOrderMesh:
             FreeCAD.Console.PrintError(
                 "HOMesh: select one object with a shape (or a Mesh sizing object) first\n")
             return
-        doc = FreeCAD.ActiveDocument
-        doc.openTransaction("High-order mesh")
-        try:
-            FreeCADGui.addModule("homesh.freecad")
-            sizing_arg = ("" if sizing is None else
-                          ", sizing=App.ActiveDocument.getObject(%r)" % sizing.Name)
-            FreeCADGui.doCommand(
-                "_mesh = homesh.freecad.make_high_order_mesh("
-                "App.ActiveDocument, App.ActiveDocument.getObject(%r)%s)" % (part.Name, sizing_arg))
-        finally:
-            doc.commitTransaction()
+        sizing_arg = ("" if sizing is None else
+                      ", sizing=App.ActiveDocument.getObject(%r)" % sizing.Name)
+        _do_commands("High-order mesh", [
+            "_mesh = homesh.freecad.make_high_order_mesh("
+            "App.ActiveDocument, App.ActiveDocument.getObject(%r)%s)" % (part.Name, sizing_arg)])
         # The task panel meshes on a worker thread, with progress, Stop and the log; the
         # object is applied (one undoable step) when the job ends.
-        mesh = doc.ActiveObject
-        FreeCADGui.ActiveDocument.setEdit(mesh.Name)
-        panel = active_panel()
-        if panel is not None:
-            panel.mesh()
+        _edit_and_mesh(FreeCAD.ActiveDocument.ActiveObject)
 
 
 class CommandSizing:
@@ -96,16 +107,10 @@ class CommandSizing:
         if part is None:
             FreeCAD.Console.PrintError("HOMesh: select one object with a shape first\n")
             return
-        doc = FreeCAD.ActiveDocument
-        doc.openTransaction("Mesh sizing")
-        try:
-            FreeCADGui.addModule("homesh.freecad")
-            FreeCADGui.doCommand(
-                "_sizing = homesh.freecad.make_sizing("
-                "App.ActiveDocument, App.ActiveDocument.getObject(%r))" % part.Name)
-            FreeCADGui.doCommand("App.ActiveDocument.recompute()")
-        finally:
-            doc.commitTransaction()
+        _do_commands("Mesh sizing", [
+            "_sizing = homesh.freecad.make_sizing("
+            "App.ActiveDocument, App.ActiveDocument.getObject(%r))" % part.Name,
+            "App.ActiveDocument.recompute()"])
 
 
 def _selected_faces():
@@ -148,19 +153,12 @@ class CommandBoundaryLayer:
         meshes = [o for o in part.Document.Objects
                   if getattr(getattr(o, "Proxy", None), "Type", None) == TYPE_HIGH_ORDER_MESH
                   and o.Part == part]
-        doc = FreeCAD.ActiveDocument
-        doc.openTransaction("Boundary layer")
-        try:
-            FreeCADGui.addModule("homesh.freecad")
-            FreeCADGui.doCommand(
-                "_layer = homesh.freecad.make_boundary_layer(App.ActiveDocument, "
-                "App.ActiveDocument.getObject(%r), %r, %r)" % (part.Name, faces, thickness))
-            if len(meshes) == 1:
-                FreeCADGui.doCommand("App.ActiveDocument.getObject(%r).BoundaryLayer = _layer"
-                                     % meshes[0].Name)
-            FreeCADGui.doCommand("App.ActiveDocument.recompute()")
-        finally:
-            doc.commitTransaction()
+        link = (["App.ActiveDocument.getObject(%r).BoundaryLayer = _layer" % meshes[0].Name]
+                if len(meshes) == 1 else [])
+        _do_commands("Boundary layer", [
+            "_layer = homesh.freecad.make_boundary_layer(App.ActiveDocument, "
+            "App.ActiveDocument.getObject(%r), %r, %r)" % (part.Name, faces, thickness)]
+            + link + ["App.ActiveDocument.recompute()"])
 
 
 def _selected_fem_mesh():
@@ -204,22 +202,12 @@ class CommandCurveFemMesh:
             FreeCAD.Console.PrintError("HOMesh: select one FEM mesh object made from a shape\n")
             return
         part = fem_shape_object(fem)
-        doc = FreeCAD.ActiveDocument
-        doc.openTransaction("Curve FEM mesh")
-        try:
-            FreeCADGui.addModule("homesh.freecad")
-            FreeCADGui.doCommand(
-                "_mesh = homesh.freecad.make_high_order_mesh(App.ActiveDocument, "
-                "App.ActiveDocument.getObject(%r), name=%r, "
-                "fem_mesh=App.ActiveDocument.getObject(%r))"
-                % (part.Name, "Curved" + fem.Name, fem.Name))
-        finally:
-            doc.commitTransaction()
-        mesh = doc.ActiveObject
-        FreeCADGui.ActiveDocument.setEdit(mesh.Name)
-        panel = active_panel()
-        if panel is not None:
-            panel.mesh()
+        _do_commands("Curve FEM mesh", [
+            "_mesh = homesh.freecad.make_high_order_mesh(App.ActiveDocument, "
+            "App.ActiveDocument.getObject(%r), name=%r, "
+            "fem_mesh=App.ActiveDocument.getObject(%r))"
+            % (part.Name, "Curved" + fem.Name, fem.Name)])
+        _edit_and_mesh(FreeCAD.ActiveDocument.ActiveObject)
 
 
 class CommandToFemMesh:
@@ -243,18 +231,13 @@ class CommandToFemMesh:
         obj = _selected_high_order_mesh()
         if obj is None:
             return
-        doc = FreeCAD.ActiveDocument
-        doc.openTransaction("To FEM mesh")
         try:
-            FreeCADGui.addModule("homesh.freecad.fem")
-            FreeCADGui.doCommand(
+            _do_commands("To FEM mesh", [
                 "_fem = homesh.freecad.fem.make_fem_mesh_object(App.ActiveDocument, "
-                "App.ActiveDocument.getObject(%r))" % obj.Name)
+                "App.ActiveDocument.getObject(%r))" % obj.Name], module="homesh.freecad.fem")
         except ValueError as e:
             FreeCAD.Console.PrintError("HOMesh: %s\n" % e)
-        finally:
-            doc.commitTransaction()
-        doc.recompute()
+        FreeCAD.ActiveDocument.recompute()
 
 
 def _selected_subshapes(kinds):
@@ -291,16 +274,10 @@ class CommandMeshRegion:
         part, names = _selected_subshapes(("Face", "Edge", "Vertex"))
         mesh = _mesh_of(part)
         size = part.Shape.BoundBox.DiagonalLength / 100.0
-        doc = FreeCAD.ActiveDocument
-        doc.openTransaction("Mesh region")
-        try:
-            FreeCADGui.addModule("homesh.freecad")
-            FreeCADGui.doCommand(
-                "_region = homesh.freecad.make_mesh_region(App.ActiveDocument, "
-                "App.ActiveDocument.getObject(%r), [(App.ActiveDocument.getObject(%r), %r)], "
-                "%r)" % (mesh.Name, part.Name, names, size))
-        finally:
-            doc.commitTransaction()
+        _do_commands("Mesh region", [
+            "_region = homesh.freecad.make_mesh_region(App.ActiveDocument, "
+            "App.ActiveDocument.getObject(%r), [(App.ActiveDocument.getObject(%r), %r)], "
+            "%r)" % (mesh.Name, part.Name, names, size)])
 
 
 class CommandBoundaryGroup:
@@ -319,16 +296,10 @@ class CommandBoundaryGroup:
         part, names = _selected_subshapes(("Face", "Edge"))
         mesh = _mesh_of(part)
         existing = len(getattr(mesh, "Groups", []) or [])
-        doc = FreeCAD.ActiveDocument
-        doc.openTransaction("Boundary group")
-        try:
-            FreeCADGui.addModule("homesh.freecad")
-            FreeCADGui.doCommand(
-                "_group = homesh.freecad.make_boundary_group(App.ActiveDocument, "
-                "App.ActiveDocument.getObject(%r), [(App.ActiveDocument.getObject(%r), %r)], "
-                "%r)" % (mesh.Name, part.Name, names, "group%d" % (existing + 1)))
-        finally:
-            doc.commitTransaction()
+        _do_commands("Boundary group", [
+            "_group = homesh.freecad.make_boundary_group(App.ActiveDocument, "
+            "App.ActiveDocument.getObject(%r), [(App.ActiveDocument.getObject(%r), %r)], "
+            "%r)" % (mesh.Name, part.Name, names, "group%d" % (existing + 1))])
 
 
 FreeCADGui.addCommand("HOMesh_MeshRegion", CommandMeshRegion())
