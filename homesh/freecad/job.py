@@ -48,6 +48,7 @@ class MeshJob:
         self.stage_fraction = 0.0
         self.log = []
         self._finished_weight = 0.0
+        self._complete = False
         self._thread = None
         self._start = None
         self._end = None
@@ -111,7 +112,10 @@ class MeshJob:
 
     @property
     def fraction(self):
-        """Estimated share of the whole job done, 0..1."""
+        """Estimated share of the whole job done, 0..1 (1 once poll() has seen it succeed: the
+        stages a run skips, sizing or repair rounds, would otherwise leave it short)."""
+        if self._complete:
+            return 1.0
         total = sum(_STAGE_WEIGHTS.values())
         current = _STAGE_WEIGHTS.get(self.stage, 0) * self.stage_fraction
         return min(1.0, (self._finished_weight + current) / total)
@@ -125,7 +129,8 @@ class MeshJob:
                 event = self.events.get_nowait()
             except queue.Empty:
                 break
-            if event[0] != "progress":
+            if event[0] != "progress":  # "done"
+                self._complete = self.error is None
                 continue
             _, stage, seconds, fraction, detail = event
             self.stage = stage

@@ -1,0 +1,69 @@
+"""The meshing job on a worker thread, headless: the calling thread stays free while it runs,
+its progress arrives through poll() in order (stages, then the optimiser's sweeps), cancel()
+ends it with CancelledError within a second, and a finished job's mesh is the one homesh.mesh
+makes with the same arguments."""
+
+import threading
+import time
+import unittest
+
+import FreeCAD
+
+import homesh
+import homesh.freecad
+from homesh.freecad import objects
+
+from fixtures import box_with_hole
+
+
+class MeshJobs(unittest.TestCase):
+    def setUp(self):
+        self.doc = FreeCAD.newDocument("HOMeshJob")
+        self.part = box_with_hole(self.doc)
+        self.obj = homesh.freecad.make_high_order_mesh(self.doc, self.part, order=4, size=0.8)
+        self.obj.Threads = 2
+
+    def tearDown(self):
+        FreeCAD.closeDocument(self.doc.Name)
+
+    def test_a_job_runs_beside_the_calling_thread_and_reports_its_sweeps(self):
+        job = objects.job_for(self.obj).start()
+        self.assertIsNot(job._thread, threading.current_thread())
+        polls = 0
+        while not job.done:
+            job.poll()
+            polls += 1
+            time.sleep(0.01)
+        job.poll()
+        self.assertIsNone(job.error)
+        self.assertGreater(polls, 1)  # the caller ran while the job did
+        stages = [line.split(" ...")[0] for line in job.log if line.endswith(" ...")]
+        self.assertEqual(stages[:3], ["cad", "linear", "high_order"])
+        self.assertIn("optimise", stages)
+        sweeps = [line for line in job.log if "optimise sweep" in line]
+        self.assertGreaterEqual(len(sweeps), 1)
+        self.assertTrue(sweeps[0].strip().startswith("optimise sweep 1:"))
+        self.assertEqual(job.fraction, 1.0)
+        same = homesh.mesh(self.part.Shape, **job.arguments)
+        self.assertEqual(same.num_elements, job.result.num_elements)
+        self.assertEqual(same.quality()["min"], job.result.quality()["min"])
+        job.discard_files()
+
+    def test_cancel_ends_the_job_within_a_second(self):
+        self.obj.Order = 6  # long enough to be caught in the optimiser
+        job = objects.job_for(self.obj).start()
+        while not job.stage.startswith("optimise") and not job.done:
+            job.poll()
+            time.sleep(0.01)
+        self.assertFalse(job.done, "the job ended before the optimiser")
+        start = time.monotonic()
+        job.cancel()
+        job.wait(10.0)
+        self.assertLess(time.monotonic() - start, 1.0)
+        self.assertIsInstance(job.error, homesh.CancelledError)
+        self.assertIsNone(job.result)
+        self.assertIsNone(job.npz_path)
+
+
+if __name__ == "__main__":
+    unittest.main()
