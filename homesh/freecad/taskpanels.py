@@ -151,9 +151,12 @@ class TaskPanelHighOrderMesh:
         self.escape = QtWidgets.QShortcut(QtGui.QKeySequence(QtCore.Qt.Key_Escape), self.form)
         self.escape.setContext(QtCore.Qt.WidgetWithChildrenShortcut)
         self.escape.activated.connect(self.cancel)
-        self.timer = QtCore.QTimer()
+        # The timer lives and dies with the form: FreeCAD may delete the panel's widgets (its
+        # own Escape handling closes the task dialog); a job still running is then cancelled.
+        self.timer = QtCore.QTimer(self.form)
         self.timer.setInterval(50)
         self.timer.timeout.connect(self._tick)
+        self.form.destroyed.connect(self._abandon)
         self._show_summary()
 
     # FreeCAD's task dialog protocol -----------------------------------------------------------
@@ -170,16 +173,20 @@ class TaskPanelHighOrderMesh:
 
     def close(self):
         """Stops a running job (waiting for it to end) and leaves edit mode."""
-        if self.job is not None:
-            if self.job.running:
-                self.job.cancel()
-                self.job.wait(5.0)
-            self.job.discard_files()
         self.timer.stop()
-        self.job = None
+        self._abandon()
         doc = FreeCADGui.ActiveDocument
         if doc is not None:
             doc.resetEdit()
+
+    def _abandon(self, *_):
+        """The form is gone: nothing may touch its widgets; a running job is cancelled and its
+        files removed (the document was never changed by it)."""
+        job, self.job = self.job, None
+        if job is not None:
+            job.cancel()
+            job.wait(5.0)
+            job.discard_files()
 
     # Actions ------------------------------------------------------------------------------------
     def values(self):

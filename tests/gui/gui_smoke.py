@@ -6,7 +6,8 @@ screenshots of (to $HOMESH_SCREENSHOT_DIR):
    while the job runs, the progress bar rises at least 5 times during the optimiser, and the
    job ends with a valid mesh applied to the object (panel.png during the run, histogram.png).
 2. The mesh is drawn in the quality colours with its legend (view.png, window.png).
-3. Stop during an order-6 job ends it within 1 s and leaves the object exactly as it was.
+3. Stop (and Escape) during an order-6 job ends it within 1 s and leaves the object exactly as
+   it was; the sizing panel predicts for typed values before applying them.
 4. A mesh with invalid elements carries the warning icon and Status, and Show "Invalid
    elements" draws them alone (invalid.png, invalid_window.png).
 5. A boundary layer picked on the hole's face, recomputed behind the progress dialog
@@ -199,7 +200,36 @@ try:
     assert (homesh.freecad.get_mesh(mesh).nodes == nodes_before).all()
     assert "Touched" not in mesh.State and mesh.Order == 4
     assert "the document is unchanged" in panel.log.toPlainText()
+    # Escape does the same as Stop.
+    job = panel.mesh()
+    run_until(lambda: job.stage.startswith("optimise"), 120)
+    t0 = time.monotonic()
+    field = panel.widgets["Order"]
+    field.setFocus()
+    for kind in (QtCore.QEvent.KeyPress, QtCore.QEvent.KeyRelease):
+        app.sendEvent(field, QtGui.QKeyEvent(kind, QtCore.Qt.Key_Escape, QtCore.Qt.NoModifier))
+    run_until(lambda: job.done, 30)
+    print("HOMesh GUI: Escape ended the job in %.3f s" % (time.monotonic() - t0))
+    assert isinstance(job.error, homesh.CancelledError), job.error
+    assert state(mesh) == before, "cancelling with Escape changed the object"
     FreeCADGui.Control.closeDialog()
+    settle()
+
+    # The sizing panel predicts for the values typed, without touching the object.
+    sizing = homesh.freecad.make_sizing(doc, cut)
+    doc.recompute()
+    FreeCADGui.ActiveDocument.setEdit(sizing.Name)
+    sizing_panel = commands.active_panel()
+    default_count = sizing.PredictedElements
+    sizing_panel.widgets["MaxDelta"].setValue(0.2)
+    finer = sizing_panel.predict()
+    print("HOMesh GUI: sizing panel: %d predicted with MaxDelta 0.2 (object: %d)"
+          % (finer, default_count))
+    assert finer > 2 * default_count and sizing.PredictedElements == default_count
+    sizing_panel.apply()
+    assert sizing.MaxDelta.Value == 0.2 and sizing.PredictedElements == finer
+    FreeCADGui.Control.closeDialog()
+    doc.removeObject(sizing.Name)
     settle()
 
     # 4. Invalid elements: a warning in the tree and the report, drawn alone. ---------------------
