@@ -25,7 +25,7 @@ from ._core import (  # noqa: F401  (re-exported)
     __version__,
 )
 from .api import (  # noqa: F401
-    BoundaryBlock, HighOrderMesh, curve, load, mesh, parameters, predict, read)
+    BoundaryBlock, HighOrderMesh, curve, load, mesh, parameters, predict, read, size_field)
 
 __all__ = [
     "BoundaryBlock",
@@ -43,4 +43,5 @@ __all__ = [
     "parameters",
     "predict",
     "read",
+    "size_field",
 ]

@@ -339,6 +339,20 @@ def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_o
     return json.loads(text)
 
 
+def size_field(shape, min_delta=None, max_delta=None, eps=None, sources=(), name=None,
+               threads=1):
+    """The sizing octree's leaves inside the model or on its boundary, for drawing the size
+    field: a dict of numpy arrays ``centre`` (L, 3), ``half_width`` (L,), ``delta`` (L,), the
+    size there, and ``boundary`` (L,) 1 where the model's boundary passes through the leaf,
+    with ``predicted_elements``. Arguments as for :func:`predict` (a shape, or BRep text)."""
+    sizing = _sizing(min_delta, max_delta, eps, sources)
+    threads = _check_int("threads", threads)
+    kind, value, label = _cad_source(shape, name)
+    if kind != "brep":
+        raise ParameterError("size_field takes a shape or BRep text, not a file path")
+    return dict(_core.size_field(value, label, sizing, threads))
+
+
 def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
          optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=3,
          boundary_layer=None, cancel=None):

@@ -27,6 +27,7 @@
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
 #include "quality/element_measure.hpp"
+#include "sizing/sizing_octree.hpp"
 
 namespace bp = boost::python;
 namespace np = boost::python::numpy;
@@ -410,6 +411,41 @@ std::string predict(CaseSetup setup, const bp::object& sizing, const std::string
   return predictReportJson(runSizingStage(setup.source, setup.options), input);
 }
 
+// The sizing octree's leaves that are not outside the model, as arrays: "centre" (L, 3),
+// "half_width" (L,), "delta" (L,) and "boundary" (L,) uint8 (1: the boundary passes through the
+// leaf), with "predicted_elements". For drawing the size field.
+bp::dict sizeField(const std::string& text, const std::string& name, const bp::object& sizing,
+                   int threads) {
+  CaseSetup setup;
+  setup.source = CadSource::brepText(text, name);
+  if (!sizing.is_none()) setup.options.sizing = sizingFrom(bp::extract<bp::dict>(sizing));
+  setup.options.threads = threads;
+  std::vector<double> centre, half, delta;
+  std::vector<std::uint8_t> boundary;
+  double predicted = 0.0;
+  {
+    const ReleaseGil nogil;
+    const SizingResult r = runSizingStage(setup.source, setup.options);
+    predicted = r.prediction.elements;
+    const SizingOctree& octree = *r.octree;
+    for (std::size_t i = 0; i < octree.numLeaves(); ++i) {
+      const SizingOctree::Leaf leaf = octree.leaf(i);
+      if (leaf.location == SizingOctree::Location::Outside) continue;
+      centre.insert(centre.end(), leaf.centre.data(), leaf.centre.data() + 3);
+      half.push_back(leaf.halfWidth);
+      delta.push_back(leaf.delta);
+      boundary.push_back(leaf.location == SizingOctree::Location::Boundary ? 1 : 0);
+    }
+  }
+  bp::dict out;
+  out["centre"] = toArray(centre, half.size(), 3);
+  out["half_width"] = toArray(half, half.size(), 0);
+  out["delta"] = toArray(delta, delta.size(), 0);
+  out["boundary"] = toArray(boundary, boundary.size(), 0);
+  out["predicted_elements"] = predicted;
+  return out;
+}
+
 // A CAD file or a NekMesh .mcf case (pipeline/case_setup.hpp).
 std::string predictFile(const std::string& path, const bp::object& sizing,
                         const std::string& octreePath, int threads) {
@@ -718,6 +754,9 @@ BOOST_PYTHON_MODULE(_core) {
           (bp::arg("path"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("order"),
            bp::arg("threads"), bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise"),
            bp::arg("cancel") = bp::object()));
+  bp::def("size_field", &sizeField,
+          (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
+           bp::arg("threads") = 1));
   bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("threads") = 1));
   bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
   bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));

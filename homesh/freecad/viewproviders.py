@@ -8,7 +8,8 @@ icon carries a warning sign while the mesh has elements not proven valid. Select
 bounding box instead of painting the mesh over, so the colours stay readable. Double-clicking
 opens the task panel.
 
-Sizing: nothing in the 3D view; its task panel predicts the element count.
+Sizing: its size field, the octree's leaves as points coloured by size; its task panel predicts
+the element count.
 """
 
 from . import resources
@@ -279,16 +280,86 @@ class ViewProviderHighOrderMesh(_Stateless, _EditsWithTaskPanel):
 
 
 class ViewProviderSizing(_Stateless, _EditsWithTaskPanel):
-    """A Sizing object draws nothing; the view provider gives its tree icon and task panel."""
+    """A Sizing object draws its size field: a point at the centre of every octree leaf inside
+    the shape or on its boundary, coloured by the size there on a log scale from the smallest
+    (blue) to the largest (red) (`ShowSizeField`)."""
 
     def __init__(self, vobj):
         vobj.Proxy = self
+        self.add_properties(vobj)
+
+    @staticmethod
+    def add_properties(vobj):
+        if "ShowSizeField" not in vobj.PropertiesList:
+            vobj.addProperty("App::PropertyBool", "ShowSizeField", "Display",
+                             "Draw the sizing octree's leaves as points coloured by size "
+                             "(blue smallest, red largest, log scale)")
+            vobj.ShowSizeField = True
 
     def attach(self, vobj):
+        from pivy import coin
         self.Object = vobj.Object
+        self.add_properties(vobj)
+        self.coords = coin.SoCoordinate3()
+        self.material = coin.SoMaterial()
+        binding = coin.SoMaterialBinding()
+        binding.value = coin.SoMaterialBinding.PER_VERTEX
+        style = coin.SoDrawStyle()
+        style.pointSize = 4.0
+        light = coin.SoLightModel()
+        light.model = coin.SoLightModel.BASE_COLOR
+        self.points = coin.SoPointSet()
+        group = coin.SoSeparator()
+        for node in (light, style, self.coords, binding, self.material, self.points):
+            group.addChild(node)
+        vobj.addDisplayMode(group, "Size field")
+        self.rebuild()
+
+    def rebuild(self):
+        """Samples the object's octree again (the parameters changed) and draws it."""
+        obj = self.Object
+        for field in (self.coords.point, self.material.diffuseColor):
+            field.setNum(0)
+        vobj = obj.ViewObject
+        if vobj is None or not vobj.ShowSizeField or obj.PredictedElements <= 0:
+            return
+        import homesh
+        from .objects import sizing_arguments
+        try:
+            field = homesh.size_field(obj.Part.Shape, name=obj.Part.Label,
+                                      **sizing_arguments(obj))
+        except (ValueError, homesh.HOMeshError):
+            return  # the object's recompute reports it
+        _set_points(self.coords.point, field["centre"])
+        _set_points(self.material.diffuseColor, size_colors(field["delta"]))
+
+    def updateData(self, obj, prop):
+        if prop == "PredictedElements" and hasattr(self, "coords"):
+            self.rebuild()
+
+    def onChanged(self, vobj, prop):
+        if prop == "ShowSizeField" and hasattr(self, "coords"):
+            self.rebuild()
+
+    def getDisplayModes(self, vobj):
+        return ["Size field"]
+
+    def getDefaultDisplayMode(self):
+        return "Size field"
+
+    def setDisplayMode(self, mode):
+        return mode
 
     def getIcon(self):
         return resources.icon("homesh_sizing.svg")
+
+
+def size_colors(delta):
+    """RGB per size on a log scale between the smallest (blue) and the largest (red)."""
+    import numpy as np
+    d = np.log(np.asarray(delta, dtype=float))
+    t = (d - d.min()) / (d.max() - d.min()) if d.max() > d.min() else np.zeros_like(d)
+    return np.stack([t, 0.2 + 0.6 * (1.0 - np.abs(2.0 * t - 1.0)), 1.0 - t], axis=1)
 
 
 class ViewProviderIconOnly(_Stateless):

@@ -7,7 +7,8 @@ screenshots of (to $HOMESH_SCREENSHOT_DIR):
    job ends with a valid mesh applied to the object (panel.png during the run, histogram.png).
 2. The mesh is drawn in the quality colours with its legend (view.png, window.png).
 3. Stop (and Escape) during an order-6 job ends it within 1 s and leaves the object exactly as
-   it was; the sizing panel predicts for typed values before applying them.
+   it was; the sizing panel predicts for typed values before applying them, and the size
+   field is drawn (sizing.png).
 4. A mesh with invalid elements carries the warning icon and Status, and Show "Invalid
    elements" draws them alone (invalid.png, invalid_window.png).
 5. A boundary layer picked on the hole's face, recomputed behind the progress dialog
@@ -229,6 +230,15 @@ try:
     sizing_panel.apply()
     assert sizing.MaxDelta.Value == 0.2 and sizing.PredictedElements == finer
     FreeCADGui.Control.closeDialog()
+    # The size field is drawn: a point per octree leaf inside or on the shape.
+    drawn = sizing.ViewObject.Proxy.coords.point.getNum()
+    print("HOMesh GUI: size field: %d leaves drawn" % drawn)
+    assert drawn > 100
+    mesh.ViewObject.Visibility = False
+    view.fitAll()
+    settle()
+    view.saveImage(os.path.join(out, "sizing.png"), 800, 600, "White")
+    mesh.ViewObject.Visibility = True
     doc.removeObject(sizing.Name)
     settle()
 

@@ -271,3 +271,24 @@ def test_boundary_layer_argument_and_mcf_keys():
 def test_bad_boundary_layers_are_named(spec, message):
     with pytest.raises(homesh.ParameterError, match=message):
         homesh.mesh(str(CYLINDER / "3d_bl_cyl.stp"), order=2, boundary_layer=spec)
+
+
+def test_size_field_is_the_octree_that_predict_integrates(data):
+    """size_field's leaves: sizes within [MinDelta, MaxDelta], smaller on the sphere's surface
+    (curvature) than inside, and the same predicted count as predict()."""
+    text = (data / "sphere.brep").read_text()
+    field = homesh.size_field(text, min_delta=0.05, max_delta=0.5, eps=0.01)
+    n = len(field["delta"])
+    assert field["centre"].shape == (n, 3) and field["half_width"].shape == (n,)
+    assert n > 100 and 0 < field["boundary"].sum() < n
+    assert field["delta"].min() >= 0.05 and field["delta"].max() <= 0.5
+    # Curvature radius 1 with eps 0.01: 2 sqrt(0.01 * 1.99) = 0.28 on the surface, graded
+    # inward by 0.2 per unit length up to 0.5: boundary leaves are the finer ones.
+    boundary = field["boundary"] == 1
+    assert field["delta"][boundary].mean() < field["delta"][~boundary].mean()
+    report = homesh.predict(text, min_delta=0.05, max_delta=0.5, eps=0.01)
+    # The report gives the count as a whole number.
+    assert abs(field["predicted_elements"] - report["predicted_elements"]) < 1.0
+    # Every leaf centre lies within its half width (times sqrt 3) of the unit ball.
+    radius = np.linalg.norm(field["centre"], axis=1)
+    assert (radius <= 1.0 + np.sqrt(3.0) * field["half_width"] + 1e-12).all()
