@@ -355,7 +355,7 @@ def size_field(shape, min_delta=None, max_delta=None, eps=None, sources=(), name
 
 def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
          optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=3,
-         boundary_layer=None, cancel=None):
+         boundary_layer=None, cancel=None, optimise_seconds=0.0):
     """Meshes a CAD shape with curved elements of the given order.
 
     shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
@@ -380,6 +380,9 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
               the FreeCAD object's label); default "the shape".
     optimise  > 0: after curving, at most this many sweeps of the variational optimiser
               (hyperelastic; boundary nodes slide on the CAD), stage "optimise".
+    optimise_seconds
+              > 0: each optimiser run stops after this many seconds with its best state so
+              far (``report()["optimiser"]["stopped"] == "time budget"``); 0: no limit.
     repair_rounds
               at most this many repair rounds (0..20) while elements are not proven valid:
               each splits the offending linear elements' edges on curved CAD faces (or refines
@@ -418,12 +421,13 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     layer = _boundary_layer(boundary_layer)
 
     kind, value, label = _cad_source(shape, name)
+    optimise_seconds = _check_seconds(optimise_seconds)
     if kind == "brep":
         core = _core.mesh_brep(value, label, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds, layer, cancel)
+                               sizing, repair_rounds, layer, cancel, optimise_seconds)
     else:
         core = _core.mesh_file(value, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds, layer, cancel)
+                               sizing, repair_rounds, layer, cancel, optimise_seconds)
     return HighOrderMesh(core)
 
 
@@ -450,7 +454,7 @@ def _four_argument_progress(progress):
 
 
 def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=None, name=None,
-          optimise=0, cancel=None):
+          optimise=0, cancel=None, optimise_seconds=0.0):
     """Curves a linear tetrahedral mesh made by another tool (FreeCAD FEM's Gmsh or Netgen
     mesher) on the CAD it was made from.
 
@@ -461,8 +465,8 @@ def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=No
 
     Each boundary node is put on the CAD vertex, edge or face it lies on, the mesh is raised to
     ``order`` with its boundary nodes on the CAD and, with ``optimise`` > 0, optimised with them
-    sliding on it (stages "classify", "high_order", "optimise", ...). progress, cancel, threads
-    and name as for :func:`mesh`. Raises ParameterError, CadError or MeshingError (naming the
+    sliding on it (stages "classify", "high_order", "optimise", ...). progress, cancel,
+    optimise_seconds, threads and name as for :func:`mesh`. Raises ParameterError, CadError or MeshingError (naming the
     boundary node that lies on no CAD face).
     """
     order = _check_int("order", order)
@@ -482,12 +486,13 @@ def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=No
                              % (tetrahedra.shape,))
     progress = _four_argument_progress(progress)
     kind, value, label = _cad_source(shape, name)
+    optimise_seconds = _check_seconds(optimise_seconds)
     if kind == "brep":
         core = _core.curve_brep(value, label, nodes, tetrahedra, order, threads, verbosity,
-                                progress, optimise, cancel)
+                                progress, optimise, cancel, optimise_seconds)
     else:
         core = _core.curve_file(value, nodes, tetrahedra, order, threads, verbosity, progress,
-                                optimise, cancel)
+                                optimise, cancel, optimise_seconds)
     return HighOrderMesh(core)
 
 
@@ -526,6 +531,13 @@ def _boundary_layer(spec):
             raise ParameterError("boundary_layer progression must be a number, got %r" % (r,))
         out["progression"] = float(r)
     return out
+
+
+def _check_seconds(value):
+    """A time limit in seconds: a number (the core checks its range)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ParameterError("optimise_seconds must be a number of seconds, got %r" % (value,))
+    return float(value)
 
 
 _INT32_MAX = 2**31 - 1

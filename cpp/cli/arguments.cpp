@@ -215,6 +215,9 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   table.value({"--repair-rounds"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.repairRounds = static_cast<int>(parseParameter("repair_rounds", o, v));
   });
+  table.value({"--time-limit"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.timeLimit = parseParameter("optimise_seconds", o, v);
+  });
   table.value({"--bl-faces"},
               [&cmd](const std::string&, const std::string& v) { cmd.blFaces = v; });
   table.value({"--bl-thickness"},
@@ -385,6 +388,8 @@ options:
       --repair-rounds N  at most N repair rounds while elements are not proven valid
                       (split their edges on curved faces, or refine around them; then curve,
                       optimise and check again); default 3, 0 for none
+      --time-limit S  each optimiser run stops after S seconds with its best state
+                      (report: "stopped": "time budget"); default 0, no limit
       --bl-faces LIST     boundary layer on these CAD faces (FaceN numbers: 1,8 or 11-12)
       --bl-thickness T    its total thickness: a number or an expression of x, y, z
       --bl-layers N       thin layers it is split into (default 2; 1..100)

@@ -112,6 +112,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
   options.verbosity = cmd.verbosity;
   options.optimiseIterations = cmd.optimiseIterations;
   options.repairRounds = cmd.repairRounds;
+  options.optimiseSeconds = cmd.timeLimit;
   if (cmd.blFaces || cmd.blThickness || cmd.blLayers || cmd.blProgression) {
     homesh::BoundaryLayerParameters bl =
         options.boundaryLayer.value_or(homesh::BoundaryLayerParameters{});

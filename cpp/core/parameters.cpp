@@ -23,6 +23,10 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        ParameterKind::Integer, 0, 10000, false, 20, false, "mesh",
        "Most sweeps of the variational optimiser after curving (0: none); it stops earlier "
        "once the mesh is valid and no longer improving"},
+      {"optimise_seconds", "OptimiserTimeLimit", "--time-limit", "optimiser time limit",
+       ParameterKind::Real, 0, kNoLimit, false, 0, false, "mesh",
+       "Seconds one optimiser run may take (each of a job's runs); it then stops with the best "
+       "state so far and the report says \"stopped\": \"time budget\"; 0: no limit"},
       {"repair_rounds", "RepairRounds", "--repair-rounds", "repair rounds", ParameterKind::Integer,
        0, 20, false, 3, false, "mesh",
        "Most repair rounds while elements are not proven valid (split or refine around them, "

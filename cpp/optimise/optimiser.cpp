@@ -31,6 +31,8 @@ void OptimiserOptions::validate() const {
     throw ParameterError("tolerance must be a finite number >= 0");
   if (!(energyTolerance >= 0.0) || !std::isfinite(energyTolerance))
     throw ParameterError("energy tolerance must be a finite number >= 0");
+  if (!(timeLimit >= 0.0) || !std::isfinite(timeLimit))
+    throw ParameterError("the optimiser's time limit must be a finite number of seconds >= 0");
   if (!(stall >= 0.0) || !std::isfinite(stall))
     throw ParameterError("stall must be a finite number >= 0");
   if (!(stallEnergy >= 0.0) || !std::isfinite(stallEnergy))
@@ -144,6 +146,7 @@ class Optimiser {
 
   OptimiserResult run() {
     const auto t0 = Clock::now();
+    runStart_ = t0;
     result_.functional = options_.functional;
     setFrame();
     buildBlocks();
@@ -183,13 +186,17 @@ class Optimiser {
           result_.stopReason = "cancelled";
           break;
         }
+        if (overBudget()) {
+          result_.stopReason = "time budget";
+          break;
+        }
         const auto s0 = Clock::now();
         Moves moved;
         try {
           moved = sweep();
         } catch (const CancelledError&) {  // asked between colour groups: the best is kept
-          result_.cancelled = true;
-          result_.stopReason = "cancelled";
+          result_.cancelled = !budgetSpent_;
+          result_.stopReason = budgetSpent_ ? "time budget" : "cancelled";
           break;
         }
         result_.sweepSeconds += since(s0);
@@ -292,6 +299,14 @@ class Optimiser {
   Mesh& mesh_;
   const OptimiserOptions& options_;
   OptimiserObserver* observer_;
+  Clock::time_point runStart_;
+  bool budgetSpent_ = false;  // set by overBudget(), read after the threads joined
+
+  // Whether the run has taken options_.timeLimit seconds (never, without a limit).
+  bool overBudget() {
+    if (options_.timeLimit > 0.0 && since(runStart_) >= options_.timeLimit) budgetSpent_ = true;
+    return budgetSpent_;
+  }
   const CadModel* cad_;  // null: boundary nodes stay fixed
   // Without CAD the optimiser moves the nodes of the well-conditioned set (kWorkingSet). With
   // CAD it moves the mesh's own (equispaced) nodes, the ones that lie on the CAD, and so it does
@@ -922,7 +937,7 @@ class Optimiser {
     std::size_t visits = 0;
     FirstFailure failure;
     const std::int64_t colours = static_cast<std::int64_t>(starts.size()) - 1;
-    const bool observed = observer_ != nullptr;
+    const bool observed = observer_ != nullptr || options_.timeLimit > 0.0;
     bool cancel = false;  // shared: one thread asks, the barrier after `single` publishes it
 #pragma omp parallel num_threads(options_.threads) reduction(max : moved, relative) \
     reduction(+ : visits)
@@ -933,7 +948,7 @@ class Optimiser {
           // A sweep of a large high-order mesh takes seconds: a cancel request is honoured
           // between colour groups, every thread leaving the loop together.
 #pragma omp single
-          cancel = observer_->cancelRequested();
+          cancel = (observer_ != nullptr && observer_->cancelRequested()) || overBudget();
           if (cancel) break;
         }
         const auto lo = static_cast<std::int64_t>(starts[c]);
@@ -955,7 +970,9 @@ class Optimiser {
     }
     failure.rethrow();
     // run() keeps its best state: a half-done sweep is never kept.
-    if (cancel) throw CancelledError("cancelled during an optimiser sweep");
+    if (cancel)
+      throw CancelledError(budgetSpent_ ? "time budget spent during an optimiser sweep"
+                                        : "cancelled during an optimiser sweep");
     return {moved, relative, visits};
   }
 

@@ -61,8 +61,12 @@ struct OptimiserOptions {
   //    `stuckWindow` sweeps their count did not fall, the worst scaled Jacobian rose by less
   //    than `stall` and the last sweep lowered the energy by less than `stallEnergy`: more
   //    sweeps will not make the mesh valid (the pipeline's repair rounds take over);
-  //  "iterations": maxIterations sweeps done.
+  //  "iterations": maxIterations sweeps done;
+  //  "time budget" (only with `timeLimit` > 0): the run has taken `timeLimit` seconds, set-up
+  //    included; checked after every sweep and between a sweep's colour groups (a half-done
+  //    sweep is dropped); the best state so far is kept, as for every rule.
   double tolerance = 1e-6;
+  double timeLimit = 0.0;  // seconds, 0: none
   double energyTolerance = 1e-5;
   double stall = 0.0;
   double stallEnergy = 0.05;
@@ -124,7 +128,7 @@ struct OptimiserResult {
   int iterations = 0;      // sweeps done
   bool converged = false;  // stopped by "displacement", "energy" or "stalled"
   // Which rule ended the run: "displacement", "energy", "stalled", "stuck", "iterations",
-  // "cancelled",
+  // "time budget", "cancelled",
   // or "no free nodes" (see OptimiserOptions).
   std::string stopReason;
   double energyBefore = 0.0, energyAfter = 0.0;  // of the input and of the state kept

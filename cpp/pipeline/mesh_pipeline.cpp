@@ -27,6 +27,7 @@ void MeshingOptions::validate() const {
   if (size) checkParameter("size", *size);
   checkParameter("threads", threads);
   checkParameter("optimise", optimiseIterations);
+  checkParameter("optimise_seconds", optimiseSeconds);
   checkParameter("repair_rounds", repairRounds);
   if (boundaryLayer) boundaryLayer->validate();
   if (size && !octreeOutput.empty())
@@ -269,6 +270,7 @@ OptimiserOptions pipelineOptimiserOptions(const MeshingOptions& options) {
   o.stall = 1e-3;                        // valid and no longer improving: stop early
   o.stuckWindow = kPipelineStuckWindow;  // not valid and not improving: repair rounds take over
   o.threads = options.threads;
+  o.timeLimit = options.optimiseSeconds;
   return o;
 }
 

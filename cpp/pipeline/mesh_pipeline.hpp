@@ -50,6 +50,7 @@ struct MeshingOptions {
   // is proven valid and no longer improving (OptimiserOptions: "energy", or "stalled" with
   // stall 0.001).
   int optimiseIterations = 0;
+  double optimiseSeconds = 0.0;  // time limit of each optimiser run (0: none)
   // Repair rounds (pipeline/repair.hpp) while elements are not proven valid, range in
   // core/parameters.hpp: each splits the offending linear cells' edges on curved faces (or refines
   // around them), then curves, optimises and checks again. 0: none.

@@ -386,8 +386,9 @@ BoundaryLayerParameters boundaryLayerFrom(const bp::dict& d) {
 
 MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity,
                            int optimise, const bp::object& sizing, int repairRounds,
-                           const bp::object& boundaryLayer) {
+                           const bp::object& boundaryLayer, double optimiseSeconds = 0.0) {
   MeshingOptions options;
+  options.optimiseSeconds = optimiseSeconds;
   if (!boundaryLayer.is_none())
     options.boundaryLayer = boundaryLayerFrom(bp::extract<bp::dict>(boundaryLayer));
   options.optimiseIterations = optimise;
@@ -513,10 +514,11 @@ PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::o
 // A CAD file or a NekMesh .mcf case: a case's CAD and sizes (unless given here) are used.
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
                 int verbosity, bp::object progress, int optimise, const bp::object& sizing,
-                int repairRounds, const bp::object& boundaryLayer, const bp::object& cancel) {
+                int repairRounds, const bp::object& boundaryLayer, const bp::object& cancel,
+                double optimiseSeconds) {
   const CaseSetup setup = setupCase(path);
-  MeshingOptions options =
-      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds, boundaryLayer);
+  MeshingOptions options = makeOptions(order, size, threads, verbosity, optimise, sizing,
+                                       repairRounds, boundaryLayer, optimiseSeconds);
   if (!options.size && !options.sizing) options.sizing = setup.options.sizing;
   if (!options.boundaryLayer) options.boundaryLayer = setup.options.boundaryLayer;
   options.expectedDimension = setup.options.expectedDimension;
@@ -526,18 +528,18 @@ PyMesh meshFile(const std::string& path, int order, const bp::object& size, int 
 PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
                 int threads, int verbosity, bp::object progress, int optimise,
                 const bp::object& sizing, int repairRounds, const bp::object& boundaryLayer,
-                const bp::object& cancel) {
-  return runPipeline(
-      CadSource::brepText(text, name),
-      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds, boundaryLayer),
-      std::move(progress), cancel);
+                const bp::object& cancel, double optimiseSeconds) {
+  return runPipeline(CadSource::brepText(text, name),
+                     makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds,
+                                 boundaryLayer, optimiseSeconds),
+                     std::move(progress), cancel);
 }
 
 // Curves a linear tetrahedral mesh made elsewhere (nodes (N, 3), tetrahedra (E, 4), 0-based) on
 // the CAD of `source` (BRep text or a CAD file): pipeline's curveMeshOnCad.
 PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::object& tets,
                   int order, int threads, int verbosity, bp::object progress, int optimise,
-                  const bp::object& cancel) {
+                  const bp::object& cancel, double optimiseSeconds) {
   Mesh linear;
   linear.dim = 3;
   linear.order = 1;
@@ -557,8 +559,8 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::ob
   linear.nodeCadDim.assign(n, 3);
   linear.nodeCadIndex.assign(n, 0);
   linear.nodeCadParam.assign(2 * n, std::numeric_limits<double>::quiet_NaN());
-  MeshingOptions options =
-      makeOptions(order, bp::object(), threads, verbosity, optimise, bp::object(), 0, bp::object());
+  MeshingOptions options = makeOptions(order, bp::object(), threads, verbosity, optimise,
+                                       bp::object(), 0, bp::object(), optimiseSeconds);
   PythonProgress observer(std::move(progress), cancelTokenOf(cancel));
   std::unique_ptr<MeshResult> result;
   try {
@@ -573,16 +575,16 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::ob
 
 PyMesh curveBrep(const std::string& text, const std::string& name, const bp::object& nodes,
                  const bp::object& tets, int order, int threads, int verbosity, bp::object progress,
-                 int optimise, const bp::object& cancel) {
+                 int optimise, const bp::object& cancel, double optimiseSeconds) {
   return curveOnCad(CadSource::brepText(text, name), nodes, tets, order, threads, verbosity,
-                    std::move(progress), optimise, cancel);
+                    std::move(progress), optimise, cancel, optimiseSeconds);
 }
 
 PyMesh curveFile(const std::string& path, const bp::object& nodes, const bp::object& tets,
                  int order, int threads, int verbosity, bp::object progress, int optimise,
-                 const bp::object& cancel) {
+                 const bp::object& cancel, double optimiseSeconds) {
   return curveOnCad(CadSource::file(path), nodes, tets, order, threads, verbosity,
-                    std::move(progress), optimise, cancel);
+                    std::move(progress), optimise, cancel, optimiseSeconds);
 }
 
 // Rebuilds a mesh (without CAD) from the arrays PyMesh exposes, and evaluates its quality.
@@ -729,16 +731,18 @@ BOOST_PYTHON_MODULE(_core) {
       .def("report_json", &PyMesh::reportJson)
       .def("optimise", &PyMesh::optimise);
 
-  bp::def("mesh_file", &meshFile,
-          (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
-           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
-           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = 3,
-           bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object()));
+  bp::def(
+      "mesh_file", &meshFile,
+      (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"), bp::arg("verbosity"),
+       bp::arg("progress"), bp::arg("optimise") = 0, bp::arg("sizing") = bp::object(),
+       bp::arg("repair_rounds") = 3, bp::arg("boundary_layer") = bp::object(),
+       bp::arg("cancel") = bp::object(), bp::arg("optimise_seconds") = 0.0));
   bp::def("mesh_brep", &meshBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
            bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
            bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = 3,
-           bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object()));
+           bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object(),
+           bp::arg("optimise_seconds") = 0.0));
   bp::def("predict_file", &predictFile,
           (bp::arg("path"), bp::arg("sizing") = bp::object(), bp::arg("octree_path") = "",
            bp::arg("threads") = 1));
@@ -746,17 +750,18 @@ BOOST_PYTHON_MODULE(_core) {
           (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
            bp::arg("octree_path") = "", bp::arg("threads") = 1));
   bp::def("parameters", &parameters);
-  bp::def("curve_brep", &curveBrep,
-          (bp::arg("text"), bp::arg("name"), bp::arg("nodes"), bp::arg("tetrahedra"),
-           bp::arg("order"), bp::arg("threads"), bp::arg("verbosity"), bp::arg("progress"),
-           bp::arg("optimise"), bp::arg("cancel") = bp::object()));
+  bp::def(
+      "curve_brep", &curveBrep,
+      (bp::arg("text"), bp::arg("name"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("order"),
+       bp::arg("threads"), bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise"),
+       bp::arg("cancel") = bp::object(), bp::arg("optimise_seconds") = 0.0));
   bp::def("curve_file", &curveFile,
           (bp::arg("path"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("order"),
            bp::arg("threads"), bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise"),
-           bp::arg("cancel") = bp::object()));
-  bp::def("size_field", &sizeField,
-          (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
-           bp::arg("threads") = 1));
+           bp::arg("cancel") = bp::object(), bp::arg("optimise_seconds") = 0.0));
+  bp::def(
+      "size_field", &sizeField,
+      (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(), bp::arg("threads") = 1));
   bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("threads") = 1));
   bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
   bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));

@@ -122,6 +122,7 @@ class HighOrderMeshProxy(_Proxy, ParameterGuard):
                             "Optional HOMesh Sizing object whose octree (MinDelta, MaxDelta, "
                             "Eps, refinement spheres) sizes the elements when Size is 0")
         add_parameter_property(obj, "optimise", "Mesh", " Boundary nodes slide on the CAD.")
+        add_parameter_property(obj, "optimise_seconds", "Mesh")
         add_parameter_property(obj, "repair_rounds", "Mesh")
         add_parameter_property(obj, "threads", "Mesh", " Default: all cores.",
                                default=os.cpu_count() or 1)
@@ -247,6 +248,7 @@ def mesh_arguments(obj, values=None):
     size = get("Size")
     arguments = {"order": int(get("Order")), "size": size if size > 0 else None,
                  "optimise": int(get("OptimiserIterations")),
+                 "optimise_seconds": get("OptimiserTimeLimit"),
                  "repair_rounds": int(get("RepairRounds")), "threads": int(get("Threads"))}
     sizing = values.get("Sizing", getattr(obj, "Sizing", None))
     if arguments["size"] is None and sizing is not None:
@@ -300,7 +302,8 @@ def job_for(obj, values=None):
             raise ValueError("%s: %s: %s" % (obj.Label, fem_object.Label, e)) from None
         job = MeshJob(shape.exportBrepToString(), obj.Part.Label, function=homesh.curve,
                       nodes=nodes, tetrahedra=tets, order=arguments["order"],
-                      optimise=arguments["optimise"], threads=arguments["threads"])
+                      optimise=arguments["optimise"], threads=arguments["threads"],
+                      optimise_seconds=arguments["optimise_seconds"])
         job.fem_elements = len(tets)
     job.values = values or {}
     return job

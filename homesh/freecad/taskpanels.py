@@ -20,7 +20,8 @@ import homesh
 from . import objects
 from .properties import definition, value_of
 
-_MESH_PARAMETERS = ("Order", "Size", "OptimiserIterations", "RepairRounds", "Threads")
+_MESH_PARAMETERS = ("Order", "Size", "OptimiserIterations", "OptimiserTimeLimit", "RepairRounds",
+                    "Threads")
 _SIZING_PARAMETERS = ("MinDelta", "MaxDelta", "Eps")
 
 
@@ -316,7 +317,8 @@ class TaskPanelHighOrderMesh:
         return answer == QtWidgets.QMessageBox.Yes
 
 
-_LABELS = {"OptimiserIterations": "Optimiser sweeps", "RepairRounds": "Repair rounds"}
+_LABELS = {"OptimiserIterations": "Optimiser sweeps", "OptimiserTimeLimit": "Time limit (s)",
+           "RepairRounds": "Repair rounds"}
 
 
 def _row_label(prop):

@@ -292,3 +292,26 @@ def test_size_field_is_the_octree_that_predict_integrates(data):
     # Every leaf centre lies within its half width (times sqrt 3) of the unit ball.
     radius = np.linalg.norm(field["centre"], axis=1)
     assert (radius <= 1.0 + np.sqrt(3.0) * field["half_width"] + 1e-12).all()
+
+
+def test_an_optimiser_time_limit_stops_it_with_the_best_state(data):
+    text = (data / "sphere.brep").read_text()
+    m = homesh.mesh(text, order=4, size=0.5, optimise=50, optimise_seconds=1e-6,
+                    repair_rounds=0)
+    record = m.report()["optimiser"]
+    assert record["stopped"] == "time budget"
+    assert record["iterations"] == 0 and record["kept_iteration"] == 0
+    with pytest.raises(homesh.ParameterError, match="optimiser time limit must be a number >= 0"):
+        homesh.mesh(text, order=2, size=0.5, optimise=5, optimise_seconds=-1.0)
+
+
+def test_the_command_line_takes_a_time_limit(homesh_bin, data, tmp_path):
+    from conftest import run
+    report = tmp_path / "r.json"
+    ok = run([homesh_bin, "mesh", data / "sphere.brep", "--order", "4", "--size", "0.5",
+              "--optimise", "--time-limit", "0.000001", "--repair-rounds", "0",
+              "--report", report, "-q"])
+    assert ok.returncode in (0, 4), ok.stderr
+    assert json.loads(report.read_text())["optimiser"]["stopped"] == "time budget"
+    bad = run([homesh_bin, "mesh", data / "sphere.brep", "--time-limit", "-2"])
+    assert bad.returncode == 2 and "--time-limit must be a number >= 0" in bad.stderr
