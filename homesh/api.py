@@ -398,10 +398,8 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
 
     Raises ParameterError, FileError, CadError, MeshingError or CancelledError.
     """
-    order = _check_int("order", order)
-    threads = _check_int("threads", threads)
-    verbosity = _check_int("verbosity", verbosity)
-    optimise = _check_int("optimise", optimise)
+    order, threads, verbosity, optimise, progress, optimise_seconds = _job_arguments(
+        order, threads, verbosity, optimise, progress, cancel, optimise_seconds)
     repair_rounds = _check_int("repair_rounds", repair_rounds)
     if size is not None:
         if isinstance(size, bool) or not isinstance(size, numbers.Real):
@@ -409,11 +407,6 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
         size = float(size)
         if not size > 0.0:
             raise ParameterError("size must be a positive length, got %g" % size)
-    if progress is not None and not callable(progress):
-        raise ParameterError("progress must be callable")
-    if cancel is not None and not isinstance(cancel, _core.CancelToken):
-        raise ParameterError("cancel must be a homesh.CancelToken, got %r" % (cancel,))
-    progress = _four_argument_progress(progress)
     sizing = _sizing(min_delta, max_delta, eps, sources)
     if size is not None and sizing is not None:
         raise ParameterError("give either size (uniform) or the sizing octree parameters")
@@ -421,7 +414,6 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     layer = _boundary_layer(boundary_layer)
 
     kind, value, label = _cad_source(shape, name)
-    optimise_seconds = _check_seconds(optimise_seconds)
     if kind == "brep":
         core = _core.mesh_brep(value, label, order, size, threads, verbosity, progress, optimise,
                                sizing, repair_rounds, layer, cancel, optimise_seconds)
@@ -429,6 +421,19 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
         core = _core.mesh_file(value, order, size, threads, verbosity, progress, optimise,
                                sizing, repair_rounds, layer, cancel, optimise_seconds)
     return HighOrderMesh(core)
+
+
+def _job_arguments(order, threads, verbosity, optimise, progress, cancel, optimise_seconds):
+    """The arguments :func:`mesh` and :func:`curve` share, checked (types here, ranges by the
+    core): order, threads, verbosity, optimise, the progress callable in the core's
+    four-argument form and optimise_seconds."""
+    if progress is not None and not callable(progress):
+        raise ParameterError("progress must be callable")
+    if cancel is not None and not isinstance(cancel, _core.CancelToken):
+        raise ParameterError("cancel must be a homesh.CancelToken, got %r" % (cancel,))
+    return (_check_int("order", order), _check_int("threads", threads),
+            _check_int("verbosity", verbosity), _check_int("optimise", optimise),
+            _four_argument_progress(progress), _check_seconds(optimise_seconds))
 
 
 def _four_argument_progress(progress):
@@ -469,14 +474,8 @@ def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=No
     optimise_seconds, threads and name as for :func:`mesh`. Raises ParameterError, CadError or MeshingError (naming the
     boundary node that lies on no CAD face).
     """
-    order = _check_int("order", order)
-    threads = _check_int("threads", threads)
-    verbosity = _check_int("verbosity", verbosity)
-    optimise = _check_int("optimise", optimise)
-    if progress is not None and not callable(progress):
-        raise ParameterError("progress must be callable")
-    if cancel is not None and not isinstance(cancel, _core.CancelToken):
-        raise ParameterError("cancel must be a homesh.CancelToken, got %r" % (cancel,))
+    order, threads, verbosity, optimise, progress, optimise_seconds = _job_arguments(
+        order, threads, verbosity, optimise, progress, cancel, optimise_seconds)
     nodes = np.ascontiguousarray(nodes, dtype=np.float64)
     tetrahedra = np.ascontiguousarray(tetrahedra, dtype=np.int64)
     if nodes.ndim != 2 or nodes.shape[1] != 3:
@@ -484,9 +483,7 @@ def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=No
     if tetrahedra.ndim != 2 or tetrahedra.shape[1] != 4:
         raise ParameterError("tetrahedra must be an (E, 4) array of corner nodes, got shape %s"
                              % (tetrahedra.shape,))
-    progress = _four_argument_progress(progress)
     kind, value, label = _cad_source(shape, name)
-    optimise_seconds = _check_seconds(optimise_seconds)
     if kind == "brep":
         core = _core.curve_brep(value, label, nodes, tetrahedra, order, threads, verbosity,
                                 progress, optimise, cancel, optimise_seconds)

@@ -12,16 +12,13 @@
 
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "linear/edge_split.hpp"
 
 namespace homesh {
 
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-Eigen::Vector3d nodePoint(const Mesh& mesh, std::int64_t i) {
-  return Eigen::Vector3d::Map(&mesh.xyz[3 * static_cast<std::size_t>(i)]);
-}
 
 // A box around sampled points of an entity, grown by `margin`: points farther out cannot lie on
 // the entity (the margin covers the bulge between samples).

@@ -14,6 +14,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -488,6 +489,15 @@ bp::list parameters() {
   return out;
 }
 
+// Whether `value` is in the range of parameter `key` (core/parameters.hpp's inRange).
+bool parameterInRange(const std::string& key, double value) {
+  try {
+    return inRange(parameterDefinition(key), value);
+  } catch (const std::out_of_range&) {
+    throw ParameterError("no parameter '" + key + "'");
+  }
+}
+
 // The token behind a `cancel` argument (None or a CancelToken); the caller's argument keeps it
 // alive for the call.
 const CancelToken* cancelTokenOf(const bp::object& cancel) {
@@ -497,18 +507,38 @@ const CancelToken* cancelTokenOf(const bp::object& cancel) {
   return &token();
 }
 
-PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::object progress,
-                   const bp::object& cancel) {
+// Runs `run(observer)` (a pipeline returning a MeshResult) with the GIL released, reporting to
+// the Python progress callback and honouring the cancel token; a cancel caused by the callback
+// raising says so.
+template <class Run>
+PyMesh runObserved(bp::object progress, const bp::object& cancel, Run run) {
   PythonProgress observer(std::move(progress), cancelTokenOf(cancel));
   std::unique_ptr<MeshResult> result;
   try {
     const ReleaseGil nogil;
-    result = std::make_unique<MeshResult>(runMeshPipeline(source, options, &observer));
+    result = std::make_unique<MeshResult>(run(&observer));
   } catch (const CancelledError&) {
     if (!observer.failure().empty()) throw CancelledError(observer.failure());
     throw;
   }
   return PyMesh(std::move(*result));
+}
+
+PyMesh runPipeline(const CadSource& source, const MeshingOptions& options, bp::object progress,
+                   const bp::object& cancel) {
+  return runObserved(std::move(progress), cancel, [&](PipelineObserver* observer) {
+    return runMeshPipeline(source, options, observer);
+  });
+}
+
+// Node coordinates from an (N, 3) array, every one finite.
+std::vector<double> finiteNodes(const bp::object& nodes) {
+  std::vector<double> xyz = fromArray<double>(nodes, "nodes");
+  for (std::size_t k = 0; k < xyz.size(); ++k)
+    if (!std::isfinite(xyz[k]))
+      throw ParameterError("nodes: node " + std::to_string(k / 3) +
+                           " has a coordinate that is not finite");
+  return xyz;
 }
 
 // A CAD file or a NekMesh .mcf case: a case's CAD and sizes (unless given here) are used.
@@ -543,12 +573,8 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::ob
   Mesh linear;
   linear.dim = 3;
   linear.order = 1;
-  linear.xyz = fromArray<double>(nodes, "nodes");
+  linear.xyz = finiteNodes(nodes);
   if (linear.xyz.size() % 3 != 0) throw ParameterError("nodes must be an (N, 3) array");
-  for (std::size_t k = 0; k < linear.xyz.size(); ++k)
-    if (!std::isfinite(linear.xyz[k]))
-      throw ParameterError("nodes: node " + std::to_string(k / 3) +
-                           " has a coordinate that is not finite");
   ElementBlock block;
   block.type = CellType::Tetrahedron;
   block.nodes = fromArray<std::int64_t>(tets, "tetrahedra");
@@ -559,18 +585,11 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::ob
   linear.nodeCadDim.assign(n, 3);
   linear.nodeCadIndex.assign(n, 0);
   linear.nodeCadParam.assign(2 * n, std::numeric_limits<double>::quiet_NaN());
-  MeshingOptions options = makeOptions(order, bp::object(), threads, verbosity, optimise,
-                                       bp::object(), 0, bp::object(), optimiseSeconds);
-  PythonProgress observer(std::move(progress), cancelTokenOf(cancel));
-  std::unique_ptr<MeshResult> result;
-  try {
-    const ReleaseGil nogil;
-    result = std::make_unique<MeshResult>(curveMeshOnCad(source, linear, options, &observer));
-  } catch (const CancelledError&) {
-    if (!observer.failure().empty()) throw CancelledError(observer.failure());
-    throw;
-  }
-  return PyMesh(std::move(*result));
+  const MeshingOptions options = makeOptions(order, bp::object(), threads, verbosity, optimise,
+                                             bp::object(), 0, bp::object(), optimiseSeconds);
+  return runObserved(std::move(progress), cancel, [&](PipelineObserver* observer) {
+    return curveMeshOnCad(source, linear, options, observer);
+  });
 }
 
 PyMesh curveBrep(const std::string& text, const std::string& name, const bp::object& nodes,
@@ -599,11 +618,7 @@ PyMesh meshFromArrays(int dim, int order, const bp::object& nodes, const bp::obj
   if (dim != 2 && dim != 3) throw ParameterError("dim must be 2 or 3");
   if (bp::len(normal) != 3) throw ParameterError("plane normal needs 3 components");
   for (int k = 0; k < 3; ++k) mesh.planeNormal[k] = bp::extract<double>(normal[k]);
-  mesh.xyz = fromArray<double>(nodes, "nodes");
-  for (std::size_t k = 0; k < mesh.xyz.size(); ++k)
-    if (!std::isfinite(mesh.xyz[k]))
-      throw ParameterError("nodes: node " + std::to_string(k / 3) +
-                           " has a coordinate that is not finite");
+  mesh.xyz = finiteNodes(nodes);
   mesh.nodeCadDim = fromArray<std::uint8_t>(cadDim, "node_cad_dim");
   mesh.nodeCadIndex = fromArray<std::int32_t>(cadIndex, "node_cad_index");
   mesh.nodeCadParam = fromArray<double>(cadParams, "node_cad_params");
@@ -750,6 +765,7 @@ BOOST_PYTHON_MODULE(_core) {
           (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
            bp::arg("octree_path") = "", bp::arg("threads") = 1));
   bp::def("parameters", &parameters);
+  bp::def("parameter_in_range", &parameterInRange, (bp::arg("key"), bp::arg("value")));
   bp::def(
       "curve_brep", &curveBrep,
       (bp::arg("text"), bp::arg("name"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("order"),

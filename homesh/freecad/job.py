@@ -195,6 +195,15 @@ def run_with_progress_dialog(job, title):
     return job.result
 
 
+def confirm_large_mesh(message):
+    """Asks (GUI) whether to mesh although the predicted size exceeds the object's limit."""
+    from PySide2 import QtWidgets
+    answer = QtWidgets.QMessageBox.question(
+        _main_window(), "HOMesh: large mesh", message + "\n\nMesh it anyway?",
+        QtWidgets.QMessageBox.Yes | QtWidgets.QMessageBox.No, QtWidgets.QMessageBox.No)
+    return answer == QtWidgets.QMessageBox.Yes
+
+
 def _main_window():
     try:
         import FreeCADGui

@@ -182,7 +182,8 @@ class HighOrderMeshProxy(_Proxy, ParameterGuard):
             job = job_for(obj)
             predicted = check_element_limit(obj, job)
         except LargeMeshError as e:
-            if not (FreeCAD.GuiUp and _confirm_large(obj, e)):
+            from .job import confirm_large_mesh
+            if not (FreeCAD.GuiUp and confirm_large_mesh(str(e))):
                 _fail(obj, e)
                 raise
             predicted = None
@@ -216,16 +217,6 @@ DEFAULT_ELEMENT_LIMIT = 2000000
 def _fail(obj, error):
     obj.Status = "Failed: %s" % error
     FreeCAD.Console.PrintError("HOMesh: %s: %s\n" % (obj.Label, error))
-
-
-def _confirm_large(obj, error):
-    from PySide2 import QtWidgets
-    import FreeCADGui
-    answer = QtWidgets.QMessageBox.question(
-        FreeCADGui.getMainWindow(), "HOMesh: large mesh",
-        "%s\n\nMesh it anyway?" % error,
-        QtWidgets.QMessageBox.Yes | QtWidgets.QMessageBox.No, QtWidgets.QMessageBox.No)
-    return answer == QtWidgets.QMessageBox.Yes
 
 
 def mesh_arguments(obj, values=None):

@@ -50,17 +50,12 @@ def value_of(obj, prop):
 
 
 def allowed(p, value):
-    """Whether ``value`` is allowed for the table entry ``p`` (0 too where it means automatic).
-    The same rule as the core's inRange."""
-    if value != value:  # NaN
-        return False
+    """Whether ``value`` is allowed for the table entry ``p``: the core's own range check, or
+    0 where 0 means automatic."""
+    from .. import _core
     if p["zero_is_automatic"] and value == 0:
         return True
-    if p["kind"] == "integer" and value != int(value):
-        return False
-    if value < p["min"] or (p["min_exclusive"] and value == p["min"]):
-        return False
-    return value <= p["max"]
+    return _core.parameter_in_range(p["key"], float(value))
 
 
 class ParameterGuard:

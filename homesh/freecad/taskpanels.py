@@ -18,6 +18,7 @@ from PySide2 import QtCore, QtGui, QtWidgets
 import homesh
 
 from . import objects
+from .job import confirm_large_mesh
 from .properties import definition, value_of
 
 _MESH_PARAMETERS = ("Order", "Size", "OptimiserIterations", "OptimiserTimeLimit", "RepairRounds",
@@ -75,8 +76,20 @@ def parameter_widget(obj, prop):
     return widget
 
 
-def _widget_value(widget):
-    return widget.value()
+def parameter_box(obj, title, props):
+    """A group box with a spin box (parameter_widget) per table property of ``obj`` among
+    ``props``, and those widgets by property name."""
+    box = QtWidgets.QGroupBox(title)
+    form = QtWidgets.QFormLayout(box)
+    widgets = {}
+    for prop in props:
+        if prop in obj.PropertiesList:  # an older document may lack one
+            widgets[prop] = parameter_widget(obj, prop)
+            form.addRow(_row_label(prop), widgets[prop])
+    # Fields take the width that is left; long rows wrap under their label (panels are narrow).
+    form.setRowWrapPolicy(QtWidgets.QFormLayout.WrapLongRows)
+    form.setFieldGrowthPolicy(QtWidgets.QFormLayout.AllNonFixedFieldsGrow)
+    return box, widgets
 
 
 class TaskPanelHighOrderMesh:
@@ -89,19 +102,12 @@ class TaskPanelHighOrderMesh:
         self.job = None
         self.predicted = None
         self.progress_values = []
-        self.confirm_large = confirm_large or self._ask_large
+        self.confirm_large = confirm_large or confirm_large_mesh
         self.form = QtWidgets.QWidget()
         self.form.setWindowTitle("HOMesh: %s" % obj.Label)
         layout = QtWidgets.QVBoxLayout(self.form)
 
-        box = QtWidgets.QGroupBox("Parameters")
-        form = QtWidgets.QFormLayout(box)
-        self.widgets = {}
-        for prop in _MESH_PARAMETERS:
-            if prop in obj.PropertiesList:
-                self.widgets[prop] = parameter_widget(obj, prop)
-                form.addRow(_row_label(prop), self.widgets[prop])
-        _compact(form)
+        box, self.widgets = parameter_box(obj, "Parameters", _MESH_PARAMETERS)
         layout.addWidget(box)
 
         buttons = QtWidgets.QGridLayout()
@@ -191,7 +197,7 @@ class TaskPanelHighOrderMesh:
 
     # Actions ------------------------------------------------------------------------------------
     def values(self):
-        return {prop: _widget_value(w) for prop, w in self.widgets.items()}
+        return {prop: w.value() for prop, w in self.widgets.items()}
 
     def apply(self):
         """Writes the panel's parameters to the object (one undoable step; the object is then
@@ -309,12 +315,6 @@ class TaskPanelHighOrderMesh:
     def _log(self, line):
         self.log.appendPlainText(line)
 
-    @staticmethod
-    def _ask_large(message):
-        answer = QtWidgets.QMessageBox.question(
-            FreeCADGui.getMainWindow(), "HOMesh: large mesh", message + "\n\nMesh it anyway?",
-            QtWidgets.QMessageBox.Yes | QtWidgets.QMessageBox.No, QtWidgets.QMessageBox.No)
-        return answer == QtWidgets.QMessageBox.Yes
 
 
 _LABELS = {"OptimiserIterations": "Optimiser sweeps", "OptimiserTimeLimit": "Time limit (s)",
@@ -325,12 +325,6 @@ def _row_label(prop):
     """A short row label (the range is in the field's limits and tooltip: task panels are
     narrow)."""
     return _LABELS.get(prop, prop)
-
-
-def _compact(form):
-    """Fields take the width that is left; long rows wrap under their label."""
-    form.setRowWrapPolicy(QtWidgets.QFormLayout.WrapLongRows)
-    form.setFieldGrowthPolicy(QtWidgets.QFormLayout.AllNonFixedFieldsGrow)
 
 
 def _histogram_canvas():
@@ -376,13 +370,7 @@ class TaskPanelSizing:
         self.form = QtWidgets.QWidget()
         self.form.setWindowTitle("HOMesh sizing: %s" % obj.Label)
         layout = QtWidgets.QVBoxLayout(self.form)
-        box = QtWidgets.QGroupBox("Sizing octree")
-        form = QtWidgets.QFormLayout(box)
-        self.widgets = {}
-        for prop in _SIZING_PARAMETERS:
-            self.widgets[prop] = parameter_widget(obj, prop)
-            form.addRow(_row_label(prop), self.widgets[prop])
-        _compact(form)
+        box, self.widgets = parameter_box(obj, "Sizing octree", _SIZING_PARAMETERS)
         layout.addWidget(box)
         buttons = QtWidgets.QHBoxLayout()
         self.predict_button = QtWidgets.QPushButton("Predict")
