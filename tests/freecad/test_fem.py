@@ -98,13 +98,18 @@ class FemBothWays(unittest.TestCase):
             self.assertEqual(fm.NodeCount, m2.num_nodes)
             self.assertEqual(fm.VolumeCount, m2.num_elements)
             self.assertEqual(fm.TetraCount, m2.num_elements)
-            # SMESH's node order: every mid-edge node between its edge's corners (a wrong
-            # order puts it between other corners, an edge length away).
-            first = fm.Volumes[0]
-            ids = fm.getElementNodes(first)
-            p = [fm.getNodeById(i) for i in ids]
-            for k, (a, b) in enumerate(((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))):
-                self.assertLess((p[4 + k] - (p[a] + p[b]) * 0.5).Length, 0.05, (k, a, b))
+            # SMESH's node order: in every element each mid-edge node is nearer the midpoint
+            # of its own edge's corners (SMESH's edges (0,1) (1,2) (2,0) (0,3) (1,3) (2,3))
+            # than that of any other edge. The curved node is off its chord's midpoint by the
+            # edge's sagitta, far less than the distance between two edges' midpoints (half
+            # an edge length at least); a wrong order swaps nodes between edges.
+            edges = ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))
+            for element in fm.Volumes:
+                p = [fm.getNodeById(i) for i in fm.getElementNodes(element)]
+                mids = [(p[a] + p[b]) * 0.5 for a, b in edges]
+                for k in range(6):
+                    nearest = min(range(6), key=lambda j: (p[4 + k] - mids[j]).Length)
+                    self.assertEqual(nearest, k, (element, k))
             # Oriented as FEM's own meshes are: the corners' signed volume has the sign it has
             # in every element of FEM's Gmsh mesh of the same shape (SMESH turns the other
             # way from Gmsh).
