@@ -355,7 +355,8 @@ def size_field(shape, min_delta=None, max_delta=None, eps=None, sources=(), name
 
 def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
          optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=3,
-         boundary_layer=None, cancel=None, optimise_seconds=0.0):
+         boundary_layer=None, cancel=None, optimise_seconds=0.0, linear_seconds=600.0,
+         heal=True):
     """Meshes a CAD shape with curved elements of the given order.
 
     shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
@@ -383,6 +384,15 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     optimise_seconds
               > 0: each optimiser run stops after this many seconds with its best state so
               far (``report()["optimiser"]["stopped"] == "time budget"``); 0: no limit.
+    linear_seconds
+              Gmsh's linear meshing runs in a child process (a crash inside Gmsh becomes a
+              :class:`MeshingError`); it is stopped after this many seconds and the job fails
+              naming this limit; 0: no limit. ``report()["notes"]`` says when Gmsh crashed and
+              was run again another way.
+    heal      check the CAD after loading and, where the check finds a problem (faces not
+              sewn into a solid, OCCT-invalid shapes, edges or faces far smaller than the model),
+              repair it with OpenCASCADE's shape healing; ``report()["healing"]`` says what was
+              found and done (a healed model's faces are numbered afresh). False: check only.
     repair_rounds
               at most this many repair rounds (0..20) while elements are not proven valid:
               each splits the offending linear elements' edges on curved CAD faces (or refines
@@ -401,6 +411,7 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     order, threads, verbosity, optimise, progress, optimise_seconds = _job_arguments(
         order, threads, verbosity, optimise, progress, cancel, optimise_seconds)
     repair_rounds = _check_int("repair_rounds", repair_rounds)
+    linear_seconds = _check_seconds(linear_seconds, "linear_seconds")
     if size is not None:
         if isinstance(size, bool) or not isinstance(size, numbers.Real):
             raise ParameterError("size must be a positive number, got %r" % (size,))
@@ -416,10 +427,12 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
         core = _core.mesh_brep(value, label, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds, layer, cancel, optimise_seconds)
+                               sizing, repair_rounds, layer, cancel, optimise_seconds,
+                               linear_seconds, bool(heal))
     else:
         core = _core.mesh_file(value, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds, layer, cancel, optimise_seconds)
+                               sizing, repair_rounds, layer, cancel, optimise_seconds,
+                               linear_seconds, bool(heal))
     return HighOrderMesh(core)
 
 
@@ -530,10 +543,10 @@ def _boundary_layer(spec):
     return out
 
 
-def _check_seconds(value):
+def _check_seconds(value, name="optimise_seconds"):
     """A time limit in seconds: a number (the core checks its range)."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ParameterError("optimise_seconds must be a number of seconds, got %r" % (value,))
+        raise ParameterError("%s must be a number of seconds, got %r" % (name, value))
     return float(value)
 
 

@@ -217,6 +217,13 @@ CadModel CadModel::fromBrepText(const std::string& text, const std::string& name
   return CadModel(std::move(impl));
 }
 
+CadModel cadModelFromShape(const TopoDS_Shape& shape, const std::string& source) {
+  auto impl = std::make_unique<CadModel::Impl>();
+  impl->shape = shape;
+  impl->source = source;
+  return CadModel(std::move(impl));
+}
+
 CadModel CadModel::clone() const {
   auto impl = std::make_unique<Impl>();
   impl->shape = impl_->shape;

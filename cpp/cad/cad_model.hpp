@@ -16,6 +16,8 @@
 #include <utility>
 #include <vector>
 
+class TopoDS_Shape;
+
 namespace homesh {
 
 struct CurveDerivatives {
@@ -137,6 +139,7 @@ class CadModel {
   const Impl& impl() const { return *impl_; }
 
  private:
+  friend CadModel cadModelFromShape(const TopoDS_Shape& shape, const std::string& source);
   explicit CadModel(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

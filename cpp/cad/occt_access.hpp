@@ -19,6 +19,10 @@ TopoDS_Edge occtEdge(const CadModel& cad, int index);
 TopoDS_Face occtFace(const CadModel& cad, int index);
 TopoDS_Solid occtSolid(const CadModel& cad, int index);
 
+// A model of `shape` (numbered afresh), named `source` in messages; throws CadError as the
+// loaders do (no face).
+CadModel cadModelFromShape(const TopoDS_Shape& shape, const std::string& source);
+
 // Runs f() and converts OCCT's Standard_Failure into CadError("<what>: <OCCT message>").
 template <class F>
 auto withOcctErrors(const std::string& what, F&& f) -> decltype(f());

@@ -208,6 +208,7 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   bool optimise = false;
   std::optional<int> maxiter;
   table.flag({"--optimise", "--optimize"}, [&optimise] { optimise = true; });
+  table.flag({"--no-heal"}, [&cmd] { cmd.heal = false; });
   table.value({"--maxiter", "-n"}, [&maxiter](const std::string& o, const std::string& v) {
     maxiter = parseInteger(o, v);
     if (*maxiter < 1) throw UsageError{"--maxiter must be >= 1, got " + v};
@@ -217,6 +218,9 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   });
   table.value({"--time-limit"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.timeLimit = parseParameter("optimise_seconds", o, v);
+  });
+  table.value({"--linear-time-limit"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.linearTimeLimit = parseParameter("linear_seconds", o, v);
   });
   table.value({"--bl-faces"},
               [&cmd](const std::string&, const std::string& v) { cmd.blFaces = v; });
@@ -390,6 +394,11 @@ options:
                       optimise and check again); default 3, 0 for none
       --time-limit S  each optimiser run stops after S seconds with its best state
                       (report: "stopped": "time budget"); default 0, no limit
+      --no-heal       check the CAD only; do not sew, fix or merge small edges and faces
+                      (healing runs only when the check finds a problem, and the report's
+                      "healing" says what it found and did)
+      --linear-time-limit S  Gmsh's linear meshing (in a process of its own) is stopped after
+                      S seconds and the run fails (default 600; 0: no limit)
       --bl-faces LIST     boundary layer on these CAD faces (FaceN numbers: 1,8 or 11-12)
       --bl-thickness T    its total thickness: a number or an expression of x, y, z
       --bl-layers N       thin layers it is split into (default 2; 1..100)

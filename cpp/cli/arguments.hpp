@@ -39,10 +39,12 @@ struct MeshCommand {
   std::optional<int> order;  // unset: the .mcf's Order, else 4
   std::optional<double> size;
   SizingFlags sizing;
-  int verbosity = 0;           // -v: 1, -vv: 2
-  int optimiseIterations = 0;  // --optimise: 100, --maxiter N
-  int repairRounds = 3;        // --repair-rounds N, range in core/parameters.hpp
-  double timeLimit = 0.0;      // --time-limit S: seconds per optimiser run (0: none)
+  int verbosity = 0;               // -v: 1, -vv: 2
+  int optimiseIterations = 0;      // --optimise: 100, --maxiter N
+  int repairRounds = 3;            // --repair-rounds N, range in core/parameters.hpp
+  double timeLimit = 0.0;          // --time-limit S: seconds per optimiser run (0: none)
+  bool heal = true;                // --no-heal: the CAD is only checked
+  double linearTimeLimit = 600.0;  // --linear-time-limit S: seconds per Gmsh run (0: none)
   // --bl-faces, --bl-thickness, --bl-layers, --bl-progression: a boundary layer (each
   // overrides the .mcf's BndLayer* key).
   std::optional<std::string> blFaces, blThickness;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -49,9 +50,23 @@ void writeReport(const std::string& path, const std::string& text) {
 }
 
 // Refuses bad output and report paths before any time is spent.
-void checkOutputs(const homesh::CommonOptions& c) {
-  for (const std::string& path : c.outputs) homesh::checkMeshOutputPath(path);
-  if (c.report && *c.report != "-") homesh::checkParentFolder(*c.report);
+// Refuses, before any work, outputs that cannot be written and any output (mesh or report)
+// that is the input itself: the input would be replaced by what was made from it.
+void checkOutputs(const homesh::CommonOptions& c, const std::string& input) {
+  const auto isInput = [&input](const std::string& path) {
+    std::error_code error;
+    return std::filesystem::equivalent(path, input, error) && !error;
+  };
+  for (const std::string& path : c.outputs) {
+    if (isInput(path))
+      throw homesh::IoError("output '" + path + "' is the input file; write to another file");
+    homesh::checkMeshOutputPath(path);
+  }
+  if (c.report && *c.report != "-") {
+    if (isInput(*c.report))
+      throw homesh::IoError("report '" + *c.report + "' is the input file; write to another file");
+    homesh::checkParentFolder(*c.report);
+  }
 }
 
 homesh::WriteOptions writeOptions(const homesh::CommonOptions& c) {
@@ -104,7 +119,7 @@ void printPrediction(const homesh::SizingResult& s, int dim) {
 
 int runMesh(const homesh::MeshCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
-  checkOutputs(c);
+  checkOutputs(c, cmd.input);
   homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.sizing, cmd.size, c.quiet);
   homesh::MeshingOptions& options = setup.options;
   if (cmd.order) options.order = *cmd.order;
@@ -113,6 +128,8 @@ int runMesh(const homesh::MeshCommand& cmd) {
   options.optimiseIterations = cmd.optimiseIterations;
   options.repairRounds = cmd.repairRounds;
   options.optimiseSeconds = cmd.timeLimit;
+  options.linearSeconds = cmd.linearTimeLimit;
+  options.heal = cmd.heal;
   if (cmd.blFaces || cmd.blThickness || cmd.blLayers || cmd.blProgression) {
     homesh::BoundaryLayerParameters bl =
         options.boundaryLayer.value_or(homesh::BoundaryLayerParameters{});
@@ -127,6 +144,14 @@ int runMesh(const homesh::MeshCommand& cmd) {
   homesh::MeshResult result = homesh::runMeshPipeline(setup.source, options, observer);
   if (!c.outputs.empty()) homesh::writeMeshOutputs(result, c.outputs, writeOptions(c), observer);
   if (!c.quiet) {
+    for (const std::string& action : result.healing.actions)
+      std::fprintf(stderr, "homesh: healed the CAD: %s\n", action.c_str());
+    if (result.healing.changed())
+      std::fprintf(stderr,
+                   "homesh: note: face numbers are the healed model's (%d faces, were %d)\n",
+                   result.healing.facesAfter, result.healing.facesBefore);
+    for (const std::string& note : result.notes)
+      std::fprintf(stderr, "homesh: note: %s\n", note.c_str());
     if (result.sizing) printPrediction(*result.sizing, result.mesh.dim);
     std::fprintf(stderr,
                  "homesh: %zu nodes, %zu elements of order %d; scaled Jacobian min %.4f mean "
@@ -177,7 +202,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
 
 int runPredict(const homesh::PredictCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
-  checkOutputs(c);
+  checkOutputs(c, cmd.input);
   homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.sizing, std::nullopt, c.quiet);
   setup.options.threads = c.threads;
   const homesh::SizingResult s = homesh::runSizingStage(setup.source, setup.options);
@@ -227,7 +252,7 @@ void printQuality(std::FILE* out, const std::string& input, const homesh::Mesh& 
 }
 
 int runQuality(const homesh::QualityCommand& cmd) {
-  checkOutputs(cmd.common);
+  checkOutputs(cmd.common, cmd.input);
   const homesh::Mesh mesh = homesh::readMesh(cmd.input);
   const homesh::QualitySummary q = homesh::evaluateQuality(mesh, cmd.common.threads);
   if (!cmd.common.quiet)
@@ -239,7 +264,7 @@ int runQuality(const homesh::QualityCommand& cmd) {
 }
 
 int runConvert(const homesh::ConvertCommand& cmd) {
-  checkOutputs(cmd.common);
+  checkOutputs(cmd.common, cmd.input);
   const homesh::Mesh mesh = homesh::readMesh(cmd.input);
   const homesh::QualitySummary q = homesh::evaluateQuality(mesh, cmd.common.threads);
   for (const std::string& path : cmd.common.outputs) {
@@ -263,7 +288,7 @@ class SweepLog : public homesh::OptimiserObserver {
 
 int runOptimise(const homesh::OptimiseCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
-  checkOutputs(c);
+  checkOutputs(c, cmd.input);
   homesh::OptimiserOptions options;
   options.functional = homesh::parseFunctional(cmd.functional);
   options.maxIterations = cmd.maxIterations;

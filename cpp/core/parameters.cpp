@@ -27,6 +27,10 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        ParameterKind::Real, 0, kNoLimit, false, 0, false, "mesh",
        "Seconds one optimiser run may take (each of a job's runs); it then stops with the best "
        "state so far and the report says \"stopped\": \"time budget\"; 0: no limit"},
+      {"linear_seconds", "LinearTimeLimit", "--linear-time-limit", "linear meshing time limit",
+       ParameterKind::Real, 0, kNoLimit, false, 600, false, "mesh",
+       "Seconds Gmsh's linear meshing may take (each run, in its own process); it is then "
+       "stopped and the job fails naming this limit; 0: no limit"},
       {"repair_rounds", "RepairRounds", "--repair-rounds", "repair rounds", ParameterKind::Integer,
        0, 20, false, 3, false, "mesh",
        "Most repair rounds while elements are not proven valid (split or refine around them, "

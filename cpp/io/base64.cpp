@@ -73,7 +73,7 @@ std::string zlibCompress(const std::string& bytes) {
   return out;
 }
 
-std::string zlibDecompress(const std::string& stream) {
+std::string zlibDecompress(const std::string& stream, std::size_t maxBytes) {
   z_stream z{};
   if (inflateInit(&z) != Z_OK) throw IoError("zlib initialisation failed");
   z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(stream.data()));
@@ -85,6 +85,11 @@ std::string zlibDecompress(const std::string& stream) {
     z.next_out = reinterpret_cast<Bytef*>(chunk.data());
     z.avail_out = static_cast<uInt>(chunk.size());
     status = inflate(&z, Z_NO_FLUSH);
+    if (out.size() + (chunk.size() - z.avail_out) > maxBytes) {
+      inflateEnd(&z);
+      throw IoError("compressed data inflates to more than " + std::to_string(maxBytes >> 20) +
+                    " MiB (refused)");
+    }
     out.append(chunk.data(), chunk.size() - z.avail_out);
     if (status == Z_BUF_ERROR && z.avail_in == 0) break;
   }

@@ -269,7 +269,12 @@ std::vector<Record> Reader::records(const XmlElement& e, bool tagged) const {
     fail("<" + e.name + "> is not compressed like the rest of the file");
   if (tagged && e.attribute("COMPRESSED") != nektar::kCompressed)
     fail("unsupported compression '" + excerpt(e.attribute("COMPRESSED")) + "'");
-  const std::string bytes = nektar::decode(e.text);
+  std::string bytes;
+  try {
+    bytes = nektar::decode(e.text);
+  } catch (const IoError& error) {
+    fail("<" + e.name + ">: " + error.what());
+  }
   std::vector<Record> out(bytes.size() / sizeof(Record));
   if (!out.empty()) std::memcpy(out.data(), bytes.data(), out.size() * sizeof(Record));
   return out;

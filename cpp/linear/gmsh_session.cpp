@@ -3,6 +3,7 @@
 #include <gmsh.h>
 
 #include <cstdio>
+#include <utility>
 #include <vector>
 
 namespace homesh {
@@ -13,7 +14,15 @@ std::mutex& gmshMutex() {
 }
 }  // namespace
 
-GmshSession::GmshSession(int verbosity, int threads) : lock_(gmshMutex()), verbosity_(verbosity) {
+std::unique_lock<std::mutex> holdGmsh() {
+  return std::unique_lock<std::mutex>(gmshMutex());
+}
+
+GmshSession::GmshSession(int verbosity, int threads)
+    : GmshSession(holdGmsh(), verbosity, threads) {}
+
+GmshSession::GmshSession(std::unique_lock<std::mutex> held, int verbosity, int threads)
+    : lock_(std::move(held)), verbosity_(verbosity) {
   withGmshErrors("starting Gmsh", [&] {
     gmsh::initialize(0, nullptr, false);
     gmsh::option::setNumber("General.Terminal", 0);

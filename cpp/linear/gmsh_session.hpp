@@ -21,6 +21,9 @@ class GmshSession {
   // terminal output (stdout) stays off: its messages are collected and written to stderr when
   // the session ends, so that stdout stays clean for a report.
   explicit GmshSession(int verbosity = 0, int threads = 1);
+  // The same with the exclusive right to Gmsh already held (holdGmsh), as in a child process
+  // forked while its parent held it.
+  GmshSession(std::unique_lock<std::mutex> held, int verbosity, int threads);
   ~GmshSession();
   GmshSession(const GmshSession&) = delete;
   GmshSession& operator=(const GmshSession&) = delete;
@@ -29,6 +32,9 @@ class GmshSession {
   std::unique_lock<std::mutex> lock_;
   int verbosity_;
 };
+
+// The exclusive right to use Gmsh in this process, without starting it.
+std::unique_lock<std::mutex> holdGmsh();
 
 // The last error Gmsh logged, or "" (to explain a failure that produced no exception).
 std::string gmshLastError();

@@ -16,6 +16,8 @@
 #include "cad/occt_access.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "core/isolated_call.hpp"
+#include "core/mesh_bytes.hpp"
 #include "linear/gmsh_entity_map.hpp"
 #include "linear/gmsh_session.hpp"
 
@@ -28,7 +30,9 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Gmsh element type codes of the linear cells we request.
 constexpr int kGmshLine = 1, kGmshTriangle = 2, kGmshTetrahedron = 4, kGmshPoint = 15;
 
-void checkSize(const CadModel& cad, double size, int dim) {
+}  // namespace
+
+void checkUniformSize(const CadModel& cad, double size, int dim) {
   if (!(size > 0.0) || !std::isfinite(size))
     throw ParameterError("mesh size must be a positive number, got " + formatNumber(size));
   // The bounding box bounds the domain; an absurd element count means a typo in the size.
@@ -37,8 +41,7 @@ void checkSize(const CadModel& cad, double size, int dim) {
     throw ParameterError("mesh size " + formatNumber(size) + " is not smaller than " +
                          cad.sourceName() + " itself (bounding-box diagonal " + formatNumber(d) +
                          ")");
-  const double estimate = dim == 3 ? 8.5 * std::pow(d / std::sqrt(3.0) / size, 3)
-                                   : 2.3 * std::pow(d / std::sqrt(2.0) / size, 2);
+  const double estimate = estimatedElementCount(cad, size, dim);
   if (estimate > kMaxEstimatedElements) {
     std::ostringstream msg;
     msg << "mesh size " << size << " is too small for " << cad.sourceName()
@@ -47,6 +50,8 @@ void checkSize(const CadModel& cad, double size, int dim) {
     throw ParameterError(msg.str());
   }
 }
+
+namespace {
 
 struct NodeTable {
   std::vector<std::int64_t> byTag;  // gmsh tag -> mesh node id, -1 if none
@@ -165,33 +170,29 @@ void orientPlanarMesh(Mesh& mesh, ElementBlock& tris) {
 
 }  // namespace
 
-Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
-  Eigen::Vector3d normal(0.0, 0.0, 1.0);
-  const int dim = modelMeshDimension(cad, normal);
-  // A uniform size is the constant field (no lower bound, as before fields existed).
-  const bool field = static_cast<bool>(options.sizeField);
-  if (field) {
-    if (!(options.minSize > 0.0) || !(options.maxSize >= options.minSize))
-      throw ParameterError("a size field needs bounds 0 < minSize <= maxSize");
-  } else {
-    checkSize(cad, options.size, dim);
-  }
-  const double size = options.size;
-  const SizeField sizeAt =
-      field ? options.sizeField : [size](const Eigen::Vector3d&) { return size; };
-  const double minSize = field ? options.minSize : 0.0;
-  const double maxSize = field ? options.maxSize : size;
+namespace {
 
+// Gmsh's Mesh.Algorithm for surfaces: its default (Frontal-Delaunay), and MeshAdapt, slower but
+// the one Gmsh's documentation calls the most robust for complex curved surfaces.
+constexpr int kDefaultSurfaceAlgorithm = 6, kMeshAdapt = 1;
+
+// What one Gmsh run needs: the model's dimension and plane, and the sizes.
+struct GmshRun {
+  int dim = 3;
+  Eigen::Vector3d normal{0.0, 0.0, 1.0};
+  SizeField sizeAt;
+  double minSize = 0.0, maxSize = 0.0;
+  std::string sizes;  // "with the sizing field" or "with size 0.1", for messages
+  int surfaceAlgorithm = kDefaultSurfaceAlgorithm;
+};
+
+// Meshes `cad` with Gmsh in this process (session held) and reads the mesh back.
+Mesh meshWithGmsh(const CadModel& cad, const GmshRun& run) {
   Mesh mesh;
-  mesh.dim = dim;
+  mesh.dim = run.dim;
   mesh.order = 1;
-  mesh.planeNormal = {normal.x(), normal.y(), normal.z()};
-
-  // Gmsh meshes on one thread: its threaded meshing gave a
-  // different mesh from run to run (box_hole.step at size 1: 256, 257 or 258 tetrahedra at 2
-  // threads), and a mesh must be reproducible; the coarse meshes made here take a fraction of a
-  // second (0.18 s for NekMesh's 3d_sphere case), the threads pay off in the later stages.
-  GmshSession session(options.verbosity, 1);
+  mesh.planeNormal = {run.normal.x(), run.normal.y(), run.normal.z()};
+  const int dim = run.dim;
   withGmshErrors("meshing " + cad.sourceName(), [&] {
     gmsh::model::add("homesh");
     gmsh::vectorpair imported;
@@ -202,9 +203,11 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
     gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
     gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
     gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeMax", maxSize);
-    gmsh::option::setNumber("Mesh.MeshSizeMin", minSize);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", run.maxSize);
+    gmsh::option::setNumber("Mesh.MeshSizeMin", run.minSize);
     gmsh::option::setNumber("Mesh.ElementOrder", 1);
+    gmsh::option::setNumber("Mesh.Algorithm", run.surfaceAlgorithm);
+    const SizeField& sizeAt = run.sizeAt;
     gmsh::model::mesh::setSizeCallback([&sizeAt](int, int, double x, double y, double z) {
       return sizeAt(Eigen::Vector3d(x, y, z));
     });
@@ -212,15 +215,12 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
       // One call: generating dimension by dimension (1, 2, then 3) gives Gmsh 4.8 a different
       // mesh than generate(dim), and every figure recorded so far is of generate(dim)'s.
       gmsh::model::mesh::generate(dim);
-      if (options.dimensionDone) options.dimensionDone(dim, dim);
     } catch (const std::string& message) {
-      throw MeshingError(
-          "Gmsh could not mesh " + cad.sourceName() +
-          (field ? std::string(" with the sizing field") : " with size " + formatNumber(size)) +
-          ": " + message +
-          (message.find("No elements") != std::string::npos
-               ? " (the size may be too large for a thin part)"
-               : ""));
+      throw MeshingError("Gmsh could not mesh " + cad.sourceName() + " " + run.sizes + ": " +
+                         message +
+                         (message.find("No elements") != std::string::npos
+                              ? " (the size may be too large for a thin part)"
+                              : ""));
     }
 
     NodeTable table;
@@ -251,6 +251,95 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
     }
     gmsh::model::mesh::removeSizeCallback();
   });
+  return mesh;
+}
+
+IsolationLimits isolationLimits(const LinearMeshOptions& options) {
+  IsolationLimits limits;
+  limits.seconds = options.timeLimit;
+  limits.budgetName = options.timeLimitName;
+  limits.cancelled = options.cancelRequested;
+  return limits;
+}
+
+// `work` (which uses Gmsh, holding the session it is given) in a child process when
+// options.isolate, else here; `work` returns its result as bytes either way.
+std::string withGmsh(const LinearMeshOptions& options, const std::string& what,
+                     const std::function<std::string(GmshSession&)>& work) {
+  if (!options.isolate) {
+    GmshSession session(options.verbosity, 1);
+    return work(session);
+  }
+  // Held across the fork: no other thread of this process is inside Gmsh while the child
+  // starts (its copy of a held lock would never be released), and the child's session uses it.
+  std::unique_lock<std::mutex> held = holdGmsh();
+  return runIsolated(what, isolationLimits(options), [&] {
+    GmshSession session(std::move(held), options.verbosity, 1);
+    return work(session);
+  });
+}
+
+}  // namespace
+
+double estimatedElementCount(const CadModel& cad, double size, int dim) {
+  const double d = cad.boundingDiagonal();
+  return dim == 3 ? 8.5 * std::pow(d / std::sqrt(3.0) / size, 3)
+                  : 2.3 * std::pow(d / std::sqrt(2.0) / size, 2);
+}
+
+Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
+  GmshRun run;
+  run.dim = modelMeshDimension(cad, run.normal);
+  // A uniform size is the constant field (no lower bound, as before fields existed).
+  const bool field = static_cast<bool>(options.sizeField);
+  if (field) {
+    if (!(options.minSize > 0.0) || !(options.maxSize >= options.minSize))
+      throw ParameterError("a size field needs bounds 0 < minSize <= maxSize");
+  } else {
+    checkUniformSize(cad, options.size, run.dim);
+  }
+  const double size = options.size;
+  run.sizeAt = field ? options.sizeField : [size](const Eigen::Vector3d&) { return size; };
+  run.minSize = field ? options.minSize : 0.0;
+  run.maxSize = field ? options.maxSize : size;
+  run.sizes = field ? "with the sizing field" : "with size " + formatNumber(size);
+
+  // Gmsh meshes on one thread: its threaded meshing gave a
+  // different mesh from run to run (box_hole.step at size 1: 256, 257 or 258 tetrahedra at 2
+  // threads), and a mesh must be reproducible; the coarse meshes made here take a fraction of a
+  // second (0.18 s for NekMesh's 3d_sphere case), the threads pay off in the later stages.
+  const auto attempt = [&](const GmshRun& r) {
+    const std::string bytes =
+        withGmsh(options, "Gmsh's meshing of " + cad.sourceName(), [&](GmshSession&) {
+          std::string out;
+          appendMeshBytes(out, meshWithGmsh(cad, r));
+          return out;
+        });
+    std::size_t offset = 0;
+    return readMeshBytes(bytes, offset);
+  };
+  Mesh mesh;
+  try {
+    mesh = attempt(run);
+  } catch (const ChildCrashed& crash) {
+    // Gmsh 4.8 crashes on some surfaces its default algorithm cannot mesh (a needle-thin cone
+    // aborted it from inside a parallel region); MeshAdapt often can.
+    GmshRun again = run;
+    again.surfaceAlgorithm = kMeshAdapt;
+    try {
+      mesh = attempt(again);
+    } catch (const ChildCrashed& second) {
+      throw MeshingError(std::string(second.what()) + " " + run.sizes +
+                         ", with its default surface algorithm and with MeshAdapt: the model may "
+                         "have a degenerate face (a needle or sliver; healing or another size "
+                         "may help)");
+    }
+    if (options.note)
+      options.note(std::string(crash.what()) +
+                   " with its default surface algorithm; meshed "
+                   "with MeshAdapt instead");
+  }
+  if (options.dimensionDone) options.dimensionDone(run.dim, run.dim);
   mesh.checkConsistency();
   return mesh;
 }
@@ -314,6 +403,20 @@ void readFill(Mesh& mesh, const std::map<std::array<double, 3>, std::int64_t>& k
   }
 }
 
+// A fill's result (the mesh with the fill's nodes appended, and its cells) as bytes, and back.
+std::string meshAndBlockBytes(const Mesh& mesh, const ElementBlock& cells) {
+  std::string out;
+  appendMeshBytes(out, mesh);
+  appendBlockBytes(out, cells);
+  return out;
+}
+
+void readMeshAndBlock(const std::string& bytes, Mesh& mesh, ElementBlock& cells) {
+  std::size_t offset = 0;
+  mesh = readMeshBytes(bytes, offset);
+  cells = readBlockBytes(bytes, offset);
+}
+
 }  // namespace
 
 ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_t, 3>>& boundary,
@@ -339,26 +442,30 @@ ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_
   ElementBlock tets;
   tets.type = CellType::Tetrahedron;
   const double maxSize = options.sizeField ? options.maxSize : options.size;
-  GmshSession session(options.verbosity, 1);
-  withGmshErrors("filling the volume inside the boundary layer", [&] {
-    gmsh::model::add("homesh-fill");
-    gmsh::model::addDiscreteEntity(2, 1);
-    gmsh::model::mesh::addNodes(2, 1, tags, coords);
-    gmsh::model::mesh::addElementsByType(1, kGmshTriangle, {}, triangles);
-    // A volume bounded by a discrete surface without parametrisation: Gmsh meshes the volume
-    // and leaves the surface mesh alone.
-    const int loop = gmsh::model::geo::addSurfaceLoop({1});
-    const int volume = gmsh::model::geo::addVolume({loop});
-    gmsh::model::geo::synchronize();
-    generateFill(3, maxSize, "the volume inside the boundary layer");
-    std::map<std::array<double, 3>, std::int64_t> known;
-    for (std::size_t i = 0; i < used.size(); ++i)
-      if (used[i] != 0)
-        known.emplace(
-            std::array<double, 3>{mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]},
-            static_cast<std::int64_t>(i));
-    readFill(mesh, known, {1}, 3, volume, kGmshTetrahedron, solid, tets);
-  });
+  const std::string bytes =
+      withGmsh(options, "Gmsh's filling of the boundary layer's inside", [&](GmshSession&) {
+        withGmshErrors("filling the volume inside the boundary layer", [&] {
+          gmsh::model::add("homesh-fill");
+          gmsh::model::addDiscreteEntity(2, 1);
+          gmsh::model::mesh::addNodes(2, 1, tags, coords);
+          gmsh::model::mesh::addElementsByType(1, kGmshTriangle, {}, triangles);
+          // A volume bounded by a discrete surface without parametrisation: Gmsh meshes the volume
+          // and leaves the surface mesh alone.
+          const int loop = gmsh::model::geo::addSurfaceLoop({1});
+          const int volume = gmsh::model::geo::addVolume({loop});
+          gmsh::model::geo::synchronize();
+          generateFill(3, maxSize, "the volume inside the boundary layer");
+          std::map<std::array<double, 3>, std::int64_t> known;
+          for (std::size_t i = 0; i < used.size(); ++i)
+            if (used[i] != 0)
+              known.emplace(
+                  std::array<double, 3>{mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]},
+                  static_cast<std::int64_t>(i));
+          readFill(mesh, known, {1}, 3, volume, kGmshTetrahedron, solid, tets);
+        });
+        return meshAndBlockBytes(mesh, tets);
+      });
+  readMeshAndBlock(bytes, mesh, tets);
   if (tets.count() == 0) throw MeshingError("Gmsh made no tetrahedra inside the boundary layer");
   orientTetrahedra(mesh, tets);
   return tets;
@@ -410,39 +517,43 @@ ElementBlock fillTriangles(Mesh& mesh, const std::vector<std::array<std::int64_t
   ElementBlock tris;
   tris.type = CellType::Triangle;
   const double maxSize = options.sizeField ? options.maxSize : options.size;
-  GmshSession session(options.verbosity, 1);
-  withGmshErrors("filling the region inside the boundary layer", [&] {
-    gmsh::model::add("homesh-fill-2d");
-    std::map<std::array<double, 3>, std::int64_t> byPoint;
-    std::vector<int> curveLoops;
-    std::size_t tag = 1;
-    for (std::size_t l = 0; l < loops.size(); ++l) {
-      const int curve = static_cast<int>(l) + 1;
-      gmsh::model::addDiscreteEntity(1, curve);
-      std::vector<std::size_t> tags, lines;
-      std::vector<double> coords;
-      for (const std::int64_t v : loops[l]) {
-        tags.push_back(tag++);
-        const Eigen::Vector3d x = point(mesh, v);
-        coords.insert(coords.end(), {x.x(), x.y(), x.z()});
-        byPoint.emplace(std::array<double, 3>{x.x(), x.y(), x.z()}, v);
-      }
-      for (std::size_t k = 0; k < tags.size(); ++k)
-        lines.insert(lines.end(), {tags[k], tags[(k + 1) % tags.size()]});
-      gmsh::model::mesh::addNodes(1, curve, tags, coords);
-      gmsh::model::mesh::addElementsByType(curve, kGmshLine, {}, lines);
-      curveLoops.push_back(gmsh::model::geo::addCurveLoop({curve}));
-    }
-    std::vector<int> surfaceLoops{curveLoops[outer]};
-    for (std::size_t l = 0; l < curveLoops.size(); ++l)
-      if (l != outer) surfaceLoops.push_back(curveLoops[l]);
-    const int surface = gmsh::model::geo::addPlaneSurface(surfaceLoops);
-    gmsh::model::geo::synchronize();
-    generateFill(2, maxSize, "the region inside the boundary layer");
-    std::vector<int> curves;
-    for (std::size_t l = 0; l < loops.size(); ++l) curves.push_back(static_cast<int>(l) + 1);
-    readFill(mesh, byPoint, curves, 2, surface, kGmshTriangle, face, tris);
-  });
+  const std::string bytes =
+      withGmsh(options, "Gmsh's filling of the boundary layer's inside", [&](GmshSession&) {
+        withGmshErrors("filling the region inside the boundary layer", [&] {
+          gmsh::model::add("homesh-fill-2d");
+          std::map<std::array<double, 3>, std::int64_t> byPoint;
+          std::vector<int> curveLoops;
+          std::size_t tag = 1;
+          for (std::size_t l = 0; l < loops.size(); ++l) {
+            const int curve = static_cast<int>(l) + 1;
+            gmsh::model::addDiscreteEntity(1, curve);
+            std::vector<std::size_t> tags, lines;
+            std::vector<double> coords;
+            for (const std::int64_t v : loops[l]) {
+              tags.push_back(tag++);
+              const Eigen::Vector3d x = point(mesh, v);
+              coords.insert(coords.end(), {x.x(), x.y(), x.z()});
+              byPoint.emplace(std::array<double, 3>{x.x(), x.y(), x.z()}, v);
+            }
+            for (std::size_t k = 0; k < tags.size(); ++k)
+              lines.insert(lines.end(), {tags[k], tags[(k + 1) % tags.size()]});
+            gmsh::model::mesh::addNodes(1, curve, tags, coords);
+            gmsh::model::mesh::addElementsByType(curve, kGmshLine, {}, lines);
+            curveLoops.push_back(gmsh::model::geo::addCurveLoop({curve}));
+          }
+          std::vector<int> surfaceLoops{curveLoops[outer]};
+          for (std::size_t l = 0; l < curveLoops.size(); ++l)
+            if (l != outer) surfaceLoops.push_back(curveLoops[l]);
+          const int surface = gmsh::model::geo::addPlaneSurface(surfaceLoops);
+          gmsh::model::geo::synchronize();
+          generateFill(2, maxSize, "the region inside the boundary layer");
+          std::vector<int> curves;
+          for (std::size_t l = 0; l < loops.size(); ++l) curves.push_back(static_cast<int>(l) + 1);
+          readFill(mesh, byPoint, curves, 2, surface, kGmshTriangle, face, tris);
+        });
+        return meshAndBlockBytes(mesh, tris);
+      });
+  readMeshAndBlock(bytes, mesh, tris);
   if (tris.count() == 0) throw MeshingError("Gmsh made no triangles inside the boundary layer");
   orientPlanarMesh(mesh, tris);
   return tris;

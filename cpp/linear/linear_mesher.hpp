@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "cad/cad_model.hpp"
@@ -27,8 +28,18 @@ struct LinearMeshOptions {
   SizeField sizeField;  // when set: sizes from it (Gmsh's curve meshing integrates 1/size)
   double minSize = 0.0, maxSize = 0.0;  // with sizeField: the bounds it keeps to (> 0)
   // Called once Gmsh has meshed every dimension up to the model's (dim == of); it may throw
-  // (CancelledError). Gmsh itself cannot be interrupted.
+  // (CancelledError).
   std::function<void(int dim, int of)> dimensionDone;
+  // Gmsh runs in a child process (core/isolated_call.hpp), so that a crash inside Gmsh is a
+  // MeshingError and a run can be stopped: after timeLimit seconds (0: none; MeshingError
+  // naming timeLimitName) or when cancelRequested says so (asked every 50 ms; CancelledError).
+  // When Gmsh crashes on a model's surfaces, generateLinearMesh tries once more with Gmsh's
+  // MeshAdapt surface algorithm and tells `note` so. false: Gmsh runs in this process.
+  bool isolate = true;
+  double timeLimit = 0.0;
+  std::string timeLimitName;
+  std::function<bool()> cancelRequested;
+  std::function<void(const std::string&)> note;
 
   static LinearMeshOptions uniform(double size) {
     LinearMeshOptions o;
@@ -36,6 +47,14 @@ struct LinearMeshOptions {
     return o;
   }
 };
+
+// An upper estimate of the elements a uniform `size` makes in the model's bounding box (a
+// cube's worth of regular tetrahedra, or a square's of triangles for dim 2).
+double estimatedElementCount(const CadModel& cad, double size, int dim);
+
+// Throws ParameterError when a uniform `size` is not a positive number, not smaller than the
+// model, or would make more than 5e7 elements by that estimate (a typo in the size).
+void checkUniformSize(const CadModel& cad, double size, int dim);
 
 // Gmsh meshes on one thread (see linear_mesher.cpp): the same CAD and options give the same
 // mesh every time. Throws ParameterError (bad size), CadError (nothing meshable) or

@@ -7,12 +7,11 @@
 #include <map>
 #include <sstream>
 
-#include <unistd.h>
-
 #include "cad/model_dimension.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "core/parameters.hpp"
+#include "core/system_memory.hpp"
 #include "curving/order_elevation.hpp"
 #include "linear/cad_classification.hpp"
 #include "linear/linear_mesher.hpp"
@@ -28,6 +27,7 @@ void MeshingOptions::validate() const {
   checkParameter("threads", threads);
   checkParameter("optimise", optimiseIterations);
   checkParameter("optimise_seconds", optimiseSeconds);
+  checkParameter("linear_seconds", linearSeconds);
   checkParameter("repair_rounds", repairRounds);
   if (boundaryLayer) boundaryLayer->validate();
   if (size && !octreeOutput.empty())
@@ -81,7 +81,8 @@ SizingParameters resolveSizing(const std::optional<SizingParameters>& requested,
 }
 
 SizingResult runSizingStage(const CadSource& source, const MeshingOptions& options) {
-  const CadModel cad = source.load();
+  HealingRecord healing;
+  const CadModel cad = healModel(source.load(), options.heal, healing);
   checkMeshDimension(cad, options.expectedDimension);
   SizingResult result = runSizing(cad, resolveSizing(options.sizing, cad), options.threads);
   if (!options.octreeOutput.empty()) writeOctree(*result.octree, options.octreeOutput);
@@ -114,6 +115,26 @@ SizingResult runSizing(const CadModel& cad, const SizingParameters& params, int 
     throw ParameterError(msg.str());
   }
   return r;
+}
+
+double predictedMemoryBytes(double elements, int order, int dim) {
+  const double p = order;
+  const double nodesPerElement =
+      dim == 3 ? (p + 1) * (p + 2) * (p + 3) / 6.0 : (p + 1) * (p + 2) / 2.0;
+  return 50e6 + elements * nodesPerElement * 160.0;
+}
+
+void checkPredictedMemory(double elements, int order, int dim, const std::string& what) {
+  const double need = predictedMemoryBytes(elements, order, dim);
+  const auto have = static_cast<double>(availableMemoryBytes());
+  if (have > 0.0 && need > have) {
+    std::ostringstream msg;
+    msg.precision(3);
+    msg << what << " at order " << order << " (about " << elements
+        << " elements) is predicted to need " << need / 1e9 << " GB of memory; the machine has "
+        << have / 1e9 << " GB available: use larger sizes or a lower order";
+    throw ParameterError(msg.str());
+  }
 }
 
 void StageTimings::add(const std::string& stage, double s) {
@@ -155,24 +176,11 @@ class StageClock {
   std::chrono::steady_clock::time_point start_;
 };
 
-// Refuses an order that would make the high-order mesh need more than half the machine's memory
-// (connectivity plus nodes, whose count is about a fifth of the element-node slots for
-// tetrahedra), before elevation starts allocating it.
+// The prediction again on the linear mesh made (its real element count), before elevation
+// allocates the high-order nodes.
 void checkHighOrderMemory(const Mesh& linear, int order) {
-  double slots = 0.0;
-  for (const ElementBlock& b : linear.blocks)
-    slots += static_cast<double>(b.count()) * cellNumNodes(b.type, order);
-  const double bytes = slots * sizeof(std::int64_t) + 0.2 * slots * 48.0;
-  const double physical =
-      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
-  if (physical > 0.0 && bytes > 0.5 * physical) {
-    std::ostringstream msg;
-    msg.precision(3);
-    msg << "order " << order << " on " << linear.numElements() << " elements would need about "
-        << bytes / 1e9 << " GB of memory (this machine has " << physical / 1e9
-        << " GB): use a larger size or a lower order";
-    throw ParameterError(msg.str());
-  }
+  checkPredictedMemory(static_cast<double>(linear.numElements()), order, linear.dim,
+                       "curving the linear mesh");
 }
 
 // Forwards the pipeline's cancel request to the optimiser (checked between colour groups) and
@@ -383,20 +391,30 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
 
   MeshResult result;
   StageClock cad("cad", result.timings, observer);
-  result.cad = std::make_shared<const CadModel>(source.load());
+  result.cad =
+      std::make_shared<const CadModel>(healModel(source.load(), options.heal, result.healing));
   cad.done();
   checkMeshDimension(*result.cad, options.expectedDimension);
   if (!options.size) options.sizing = resolveSizing(options.sizing, *result.cad);
   result.options = options;
 
+  Eigen::Vector3d normal;  // (the plane of a 2D model)
   LinearMeshOptions linearOptions;
   linearOptions.verbosity = options.verbosity;
   linearOptions.dimensionDone = linearProgress(observer);
+  linearOptions.timeLimit = options.linearSeconds;
+  linearOptions.timeLimitName = parameterDefinition("linear_seconds").label;
+  if (observer != nullptr)
+    linearOptions.cancelRequested = [observer] { return observer->cancelRequested(); };
+  linearOptions.note = [&result](const std::string& note) { result.notes.push_back(note); };
   if (options.sizing) {
     StageClock sizing("sizing", result.timings, observer);
     result.sizing = runSizing(*result.cad, *options.sizing, options.threads);
     if (!options.octreeOutput.empty()) writeOctree(*result.sizing->octree, options.octreeOutput);
     sizing.done();
+    checkPredictedMemory(result.sizing->prediction.elements, options.order,
+                         modelMeshDimension(*result.cad, normal),
+                         "meshing " + result.cad->sourceName());
     const SizingOctree& octree = *result.sizing->octree;
     linearOptions.sizeField = [&octree](const Eigen::Vector3d& x) { return octree.delta(x); };
     linearOptions.maxSize = options.sizing->maxDelta;
@@ -405,6 +423,11 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       linearOptions.minSize = std::min(linearOptions.minSize, src.delta);
   } else {
     linearOptions.size = *options.size;
+    const int dim = modelMeshDimension(*result.cad, normal);
+    checkUniformSize(*result.cad, *options.size, dim);
+    checkPredictedMemory(
+        estimatedElementCount(*result.cad, *options.size, dim), options.order, dim,
+        "meshing " + result.cad->sourceName() + " with size " + formatNumber(*options.size));
   }
   // The linear mesh, with its macro boundary layer when one is asked for (timed as its own
   // stage the first time; within the round in repair rounds).

@@ -5,6 +5,7 @@
 #include <map>
 #include <vector>
 
+#include "cad/cad_model.hpp"
 #include "quality/bezier_jacobian.hpp"
 
 namespace homesh {
@@ -226,6 +227,33 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
   JsonWriter json;
   json.beginObject();
   json.value("input", input);
+  if (result.cad) {
+    json.beginObject("cad");
+    json.value("solids", result.cad->numSolids());
+    json.value("faces", result.cad->numFaces());
+    json.value("edges", result.cad->numEdges());
+    json.value("vertices", result.cad->numVertices());
+    json.value("diagonal", result.cad->boundingDiagonal());
+    json.endObject();
+    const HealingRecord& h = result.healing;
+    json.beginObject("healing");
+    json.value("enabled", h.enabled);
+    json.value("tolerance", h.tolerance);
+    json.beginArray("problems");
+    for (const std::string& p : h.problems) json.value("", p);
+    json.endArray();
+    json.beginArray("actions");
+    for (const std::string& a : h.actions) json.value("", a);
+    json.endArray();
+    // Face numbers (boundary layers, groups) refer to the healed model when it changed.
+    json.value("renumbered", h.changed());
+    json.value("faces_before", h.facesBefore);
+    json.value("faces_after", h.facesAfter);
+    json.value("solids_before", h.solidsBefore);
+    json.value("solids_after", h.solidsAfter);
+    json.value("seconds", h.seconds);
+    json.endObject();
+  }
   json.value("dimension", result.mesh.dim);
   json.value("order", result.mesh.order);
   json.value("size", result.options.size.value_or(0.0));
@@ -244,6 +272,9 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
                     "optimiser_order_" + std::to_string(kContinuationOrder));
   appendRepairRounds(json, result.rounds);
   if (result.boundaryLayer) appendBoundaryLayer(json, result);
+  json.beginArray("notes");
+  for (const std::string& note : result.notes) json.value("", note);
+  json.endArray();
   json.beginObject("timings_s");
   for (const auto& [stage, s] : result.timings.seconds) json.value(stage, s);
   json.endObject();

@@ -387,9 +387,12 @@ BoundaryLayerParameters boundaryLayerFrom(const bp::dict& d) {
 
 MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity,
                            int optimise, const bp::object& sizing, int repairRounds,
-                           const bp::object& boundaryLayer, double optimiseSeconds = 0.0) {
+                           const bp::object& boundaryLayer, double optimiseSeconds = 0.0,
+                           double linearSeconds = 600.0, bool heal = true) {
   MeshingOptions options;
+  options.heal = heal;
   options.optimiseSeconds = optimiseSeconds;
+  options.linearSeconds = linearSeconds;
   if (!boundaryLayer.is_none())
     options.boundaryLayer = boundaryLayerFrom(bp::extract<bp::dict>(boundaryLayer));
   options.optimiseIterations = optimise;
@@ -545,10 +548,11 @@ std::vector<double> finiteNodes(const bp::object& nodes) {
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
                 int verbosity, bp::object progress, int optimise, const bp::object& sizing,
                 int repairRounds, const bp::object& boundaryLayer, const bp::object& cancel,
-                double optimiseSeconds) {
+                double optimiseSeconds, double linearSeconds, bool heal) {
   const CaseSetup setup = setupCase(path);
-  MeshingOptions options = makeOptions(order, size, threads, verbosity, optimise, sizing,
-                                       repairRounds, boundaryLayer, optimiseSeconds);
+  MeshingOptions options =
+      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds, boundaryLayer,
+                  optimiseSeconds, linearSeconds, heal);
   if (!options.size && !options.sizing) options.sizing = setup.options.sizing;
   if (!options.boundaryLayer) options.boundaryLayer = setup.options.boundaryLayer;
   options.expectedDimension = setup.options.expectedDimension;
@@ -558,10 +562,10 @@ PyMesh meshFile(const std::string& path, int order, const bp::object& size, int 
 PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
                 int threads, int verbosity, bp::object progress, int optimise,
                 const bp::object& sizing, int repairRounds, const bp::object& boundaryLayer,
-                const bp::object& cancel, double optimiseSeconds) {
+                const bp::object& cancel, double optimiseSeconds, double linearSeconds, bool heal) {
   return runPipeline(CadSource::brepText(text, name),
                      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds,
-                                 boundaryLayer, optimiseSeconds),
+                                 boundaryLayer, optimiseSeconds, linearSeconds, heal),
                      std::move(progress), cancel);
 }
 
@@ -751,13 +755,15 @@ BOOST_PYTHON_MODULE(_core) {
       (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"), bp::arg("verbosity"),
        bp::arg("progress"), bp::arg("optimise") = 0, bp::arg("sizing") = bp::object(),
        bp::arg("repair_rounds") = 3, bp::arg("boundary_layer") = bp::object(),
-       bp::arg("cancel") = bp::object(), bp::arg("optimise_seconds") = 0.0));
+       bp::arg("cancel") = bp::object(), bp::arg("optimise_seconds") = 0.0,
+       bp::arg("linear_seconds") = 600.0, bp::arg("heal") = true));
   bp::def("mesh_brep", &meshBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
            bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
            bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = 3,
            bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object(),
-           bp::arg("optimise_seconds") = 0.0));
+           bp::arg("optimise_seconds") = 0.0, bp::arg("linear_seconds") = 600.0,
+           bp::arg("heal") = true));
   bp::def("predict_file", &predictFile,
           (bp::arg("path"), bp::arg("sizing") = bp::object(), bp::arg("octree_path") = "",
            bp::arg("threads") = 1));

@@ -123,6 +123,14 @@ class HighOrderMeshProxy(_Proxy, ParameterGuard):
                             "Eps, refinement spheres) sizes the elements when Size is 0")
         add_parameter_property(obj, "optimise", "Mesh", " Boundary nodes slide on the CAD.")
         add_parameter_property(obj, "optimise_seconds", "Mesh")
+        add_parameter_property(obj, "linear_seconds", "Mesh")
+        if "Heal" not in have:
+            obj.addProperty("App::PropertyBool", "Heal", "Mesh",
+                            "Check the shape and, where the check finds a problem (faces not "
+                            "sewn into a solid, invalid geometry, tiny edges or sliver faces), "
+                            "repair it with OpenCASCADE's shape healing before meshing; a "
+                            "healed shape's faces are numbered afresh (see the report)")
+            obj.Heal = True
         add_parameter_property(obj, "repair_rounds", "Mesh")
         add_parameter_property(obj, "threads", "Mesh", " Default: all cores.",
                                default=os.cpu_count() or 1)
@@ -240,6 +248,8 @@ def mesh_arguments(obj, values=None):
     arguments = {"order": int(get("Order")), "size": size if size > 0 else None,
                  "optimise": int(get("OptimiserIterations")),
                  "optimise_seconds": get("OptimiserTimeLimit"),
+                 "linear_seconds": get("LinearTimeLimit"),
+                 "heal": bool(values.get("Heal", getattr(obj, "Heal", True))),
                  "repair_rounds": int(get("RepairRounds")), "threads": int(get("Threads"))}
     sizing = values.get("Sizing", getattr(obj, "Sizing", None))
     if arguments["size"] is None and sizing is not None:

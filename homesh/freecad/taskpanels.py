@@ -21,8 +21,8 @@ from . import objects
 from .job import confirm_large_mesh
 from .properties import definition, value_of
 
-_MESH_PARAMETERS = ("Order", "Size", "OptimiserIterations", "OptimiserTimeLimit", "RepairRounds",
-                    "Threads")
+_MESH_PARAMETERS = ("Order", "Size", "OptimiserIterations", "OptimiserTimeLimit",
+                    "LinearTimeLimit", "RepairRounds", "Threads")
 _SIZING_PARAMETERS = ("MinDelta", "MaxDelta", "Eps")
 
 
@@ -318,6 +318,7 @@ class TaskPanelHighOrderMesh:
 
 
 _LABELS = {"OptimiserIterations": "Optimiser sweeps", "OptimiserTimeLimit": "Time limit (s)",
+           "LinearTimeLimit": "Gmsh time limit (s)",
            "RepairRounds": "Repair rounds"}
 
 

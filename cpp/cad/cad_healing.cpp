@@ -1,0 +1,277 @@
+#include "cad/cad_healing.hpp"
+
+#include <BRepAdaptor_Curve.hxx>
+#include <BRepBuilderAPI_Sewing.hxx>
+#include <BRepCheck_Analyzer.hxx>
+#include <BRepGProp.hxx>
+#include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
+#include <GCPnts_AbscissaPoint.hxx>
+#include <GProp_GProps.hxx>
+#include <ShapeAnalysis_CheckSmallFace.hxx>
+#include <ShapeFix_FixSmallFace.hxx>
+#include <ShapeFix_Shape.hxx>
+#include <ShapeFix_Solid.hxx>
+#include <ShapeFix_Wireframe.hxx>
+#include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopTools_IndexedDataMapOfShapeListOfShape.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Compound.hxx>
+#include <TopoDS_Shell.hxx>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "cad/model_dimension.hpp"
+#include "cad/occt_access.hpp"
+#include "core/error.hpp"
+#include "core/format.hpp"
+
+namespace homesh {
+namespace {
+
+// Relative to the bounding-box diagonal: the sewing and fixing tolerance (gaps a STEP exporter
+// leaves between faces are of this order), edges shorter than kSmallEdge are merged away (a
+// mesher would need elements that small there), and a fix may widen a tolerance to kMaxWiden.
+constexpr double kTolerance = 1e-6, kSmallEdge = 1e-5, kMaxWiden = 1e-3;
+
+int count(const TopoDS_Shape& shape, TopAbs_ShapeEnum type) {
+  TopTools_IndexedMapOfShape map;
+  TopExp::MapShapes(shape, type, map);
+  return map.Extent();
+}
+
+// The first free edge of `solid` (an edge bounding only one of its faces, not a seam or a
+// degenerated edge), as its index in `edges`; 0 when its boundary is closed.
+int firstFreeEdge(const TopoDS_Shape& solid, const TopTools_IndexedMapOfShape& edges) {
+  TopTools_IndexedDataMapOfShapeListOfShape faces;
+  TopExp::MapShapesAndUniqueAncestors(solid, TopAbs_EDGE, TopAbs_FACE, faces);
+  for (int i = 1; i <= faces.Extent(); ++i) {
+    const TopoDS_Edge& edge = TopoDS::Edge(faces.FindKey(i));
+    if (BRep_Tool::Degenerated(edge) || faces(i).Extent() != 1) continue;
+    if (BRep_Tool::IsClosed(edge, TopoDS::Face(faces(i).First()))) continue;  // a seam
+    return edges.FindIndex(edge);
+  }
+  return 0;
+}
+
+double volumeOf(const TopoDS_Shape& solid) {
+  GProp_GProps props;
+  BRepGProp::VolumeProperties(solid, props);
+  return std::abs(props.Mass());
+}
+
+// Whether a solid has no volume to mesh: its mean thickness (volume / boundary area) is below
+// the healing tolerance. (Relative to the area, not to the bounding box: a needle is thin, not
+// empty.)
+bool hasNoVolume(const TopoDS_Shape& solid, double diagonal, double& volume) {
+  GProp_GProps props;
+  BRepGProp::SurfaceProperties(solid, props);
+  volume = volumeOf(solid);
+  return volume < std::abs(props.Mass()) * kTolerance * diagonal;
+}
+
+struct Findings {
+  bool invalid = false, unsewn = false, openSolid = false;
+  int smallEdges = 0, smallFaces = 0;
+  bool any() const { return invalid || unsewn || openSolid || smallEdges > 0 || smallFaces > 0; }
+};
+
+// `planar`: a model of planar faces in one plane (a 2D case), whose faces are not meant to be
+// sewn into a solid.
+Findings inspect(const TopoDS_Shape& shape, double diagonal, bool planar,
+                 std::vector<std::string>& problems) {
+  Findings f;
+  TopTools_IndexedMapOfShape edges, faces, solids;
+  TopExp::MapShapes(shape, TopAbs_EDGE, edges);
+  TopExp::MapShapes(shape, TopAbs_FACE, faces);
+  TopExp::MapShapes(shape, TopAbs_SOLID, solids);
+  if (!BRepCheck_Analyzer(shape).IsValid()) {
+    f.invalid = true;
+    problems.emplace_back("OpenCASCADE's check finds the shape invalid");
+  }
+  if (solids.Extent() == 0 && faces.Extent() > 1 && !planar) {
+    f.unsewn = true;
+    problems.push_back("no solid: " + std::to_string(faces.Extent()) + " loose faces");
+  }
+  for (int s = 1; s <= solids.Extent(); ++s) {
+    const int edge = firstFreeEdge(solids(s), edges);
+    if (edge == 0) continue;
+    f.openSolid = true;
+    problems.push_back(cadEntityName(3, s) + " is open (" + cadEntityName(1, edge) +
+                       " bounds only one of its faces)");
+  }
+  const double shortest = kSmallEdge * diagonal;
+  int firstSmall = 0;
+  for (int e = 1; e <= edges.Extent(); ++e) {
+    const TopoDS_Edge& edge = TopoDS::Edge(edges(e));
+    if (BRep_Tool::Degenerated(edge)) continue;
+    if (GCPnts_AbscissaPoint::Length(BRepAdaptor_Curve(edge)) < shortest) {
+      ++f.smallEdges;
+      if (firstSmall == 0) firstSmall = e;
+    }
+  }
+  if (f.smallEdges > 0)
+    problems.push_back(std::to_string(f.smallEdges) + " edges shorter than " +
+                       formatNumber(shortest) + " (first " + cadEntityName(1, firstSmall) + ")");
+  ShapeAnalysis_CheckSmallFace check;
+  int firstFace = 0;
+  for (int i = 1; i <= faces.Extent(); ++i) {
+    const TopoDS_Face& face = TopoDS::Face(faces(i));
+    TopoDS_Edge e1, e2;
+    if (check.CheckSpotFace(face, shortest) || check.CheckStripFace(face, e1, e2, shortest)) {
+      ++f.smallFaces;
+      if (firstFace == 0) firstFace = i;
+    }
+  }
+  if (f.smallFaces > 0)
+    problems.push_back(std::to_string(f.smallFaces) + " tiny or sliver faces (first " +
+                       cadEntityName(2, firstFace) + ")");
+  return f;
+}
+
+// Sews the faces and makes a solid of every closed shell; nullopt when no closed shell results.
+std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tolerance,
+                                          double diagonal, std::vector<std::string>& actions) {
+  BRepBuilderAPI_Sewing sewing(tolerance);
+  sewing.Add(shape);
+  sewing.Perform();
+  const TopoDS_Shape sewn = sewing.SewedShape();
+  TopoDS_Compound solids;
+  BRep_Builder builder;
+  builder.MakeCompound(solids);
+  int made = 0;
+  for (TopExp_Explorer shells(sewn, TopAbs_SHELL); shells.More(); shells.Next()) {
+    const TopoDS_Shell& shell = TopoDS::Shell(shells.Current());
+    if (!BRep_Tool::IsClosed(shell)) continue;
+    ShapeFix_Solid fix;
+    const TopoDS_Solid solid = fix.SolidFromShell(shell);
+    // Two faces on one boundary loop also close: a solid of no volume is no solid.
+    double volume = 0.0;
+    if (hasNoVolume(solid, diagonal, volume)) continue;
+    builder.Add(solids, solid);
+    ++made;
+  }
+  if (made == 0) return std::nullopt;
+  actions.push_back("sewed the faces (tolerance " + formatNumber(tolerance) + ") into " +
+                    std::to_string(made) + (made == 1 ? " closed shell" : " closed shells") +
+                    " and made " + (made == 1 ? "a solid of it" : "solids of them"));
+  return made == 1 ? TopoDS_Shape(TopExp_Explorer(solids, TopAbs_SOLID).Current())
+                   : TopoDS_Shape(solids);
+}
+
+TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal,
+                  HealingRecord& record) {
+  const double tolerance = kTolerance * diagonal;
+  bool sewn = false;
+  if (found.unsewn || found.openSolid) {
+    if (auto solids = sewIntoSolids(shape, 10.0 * tolerance, diagonal, record.actions)) {
+      shape = *solids;
+      sewn = true;
+    }
+  }
+  if (found.invalid || sewn) {
+    ShapeFix_Shape fix(shape);
+    fix.SetPrecision(tolerance);
+    fix.SetMaxTolerance(kMaxWiden * diagonal);
+    if (fix.Perform()) {
+      shape = fix.Shape();
+      record.actions.emplace_back(
+          "fixed wires, edges, tolerances and orientation (ShapeFix_Shape)");
+    }
+  }
+  if (found.smallEdges > 0) {
+    ShapeFix_Wireframe wires(shape);
+    wires.SetPrecision(kSmallEdge * diagonal);
+    wires.SetMaxTolerance(kMaxWiden * diagonal);
+    const bool gaps = wires.FixWireGaps();
+    const bool small = wires.FixSmallEdges();
+    if (gaps || small) {
+      shape = wires.Shape();
+      record.actions.push_back("merged edges shorter than " + formatNumber(kSmallEdge * diagonal) +
+                               " and closed wire gaps");
+    }
+  }
+  if (found.smallFaces > 0) {
+    ShapeFix_FixSmallFace faces;
+    faces.Init(shape);
+    faces.SetPrecision(kSmallEdge * diagonal);
+    faces.SetMaxTolerance(kMaxWiden * diagonal);
+    faces.Perform();
+    const TopoDS_Shape fixed = faces.FixShape();
+    if (!fixed.IsNull() && count(fixed, TopAbs_FACE) < count(shape, TopAbs_FACE)) {
+      record.actions.push_back(
+          "removed " + std::to_string(count(shape, TopAbs_FACE) - count(fixed, TopAbs_FACE)) +
+          " tiny or sliver faces");
+      shape = fixed;
+    }
+  }
+  return shape;
+}
+
+}  // namespace
+
+CadModel healModel(CadModel cad, bool enabled, HealingRecord& record) {
+  const auto start = std::chrono::steady_clock::now();
+  record = HealingRecord{};
+  record.enabled = enabled;
+  const double diagonal = cad.boundingDiagonal();
+  record.tolerance = kTolerance * diagonal;
+  record.facesBefore = record.facesAfter = cad.numFaces();
+  record.solidsBefore = record.solidsAfter = cad.numSolids();
+  bool planar = false;
+  if (cad.numSolids() == 0) {
+    try {
+      Eigen::Vector3d normal;
+      planar = modelMeshDimension(cad, normal) == 2;
+    } catch (const CadError&) {  // neither a solid nor planar: reported below
+    }
+  }
+  const Findings found = withOcctErrors("checking " + cad.sourceName(), [&] {
+    return inspect(occtShape(cad), diagonal, planar, record.problems);
+  });
+  if (enabled && found.any()) {
+    const TopoDS_Shape healed = withOcctErrors("healing " + cad.sourceName(), [&] {
+      return heal(occtShape(cad), found, diagonal, record);
+    });
+    if (record.changed()) {
+      cad = cadModelFromShape(healed, cad.sourceName());
+      record.facesAfter = cad.numFaces();
+      record.solidsAfter = cad.numSolids();
+    }
+  }
+  record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // A solid that is still open cannot be meshed: say where.
+  const TopoDS_Shape& shape = occtShape(cad);
+  TopTools_IndexedMapOfShape edges, solids;
+  TopExp::MapShapes(shape, TopAbs_EDGE, edges);
+  TopExp::MapShapes(shape, TopAbs_SOLID, solids);
+  const std::string healed =
+      enabled ? "; healing could not close it" : "; healing is off (it may close it)";
+  for (int s = 1; s <= solids.Extent(); ++s) {
+    const int edge = firstFreeEdge(solids(s), edges);
+    if (edge != 0)
+      throw CadError(cad.sourceName() + ": " + cadEntityName(3, s) + " is not closed (" +
+                     cadEntityName(1, edge) + " bounds only one of its faces)" + healed);
+    double volume = 0.0;
+    if (hasNoVolume(solids(s), diagonal, volume))
+      throw CadError(cad.sourceName() + ": " + cadEntityName(3, s) + " has no volume (" +
+                     formatNumber(volume) + " for a bounding-box diagonal of " +
+                     formatNumber(diagonal) + "): a zero-thickness solid cannot be meshed");
+  }
+  if (solids.Extent() == 0 && !planar) {
+    const int edge = firstFreeEdge(shape, edges);
+    throw CadError(cad.sourceName() + " is not a closed solid: it has no solid, and its " +
+                   std::to_string(cad.numFaces()) + " faces do not close" +
+                   (edge != 0 ? " (" + cadEntityName(1, edge) + " bounds only one face)" : "") +
+                   healed + "; HOMesh meshes solids, or planar faces in one plane (2D)");
+  }
+  return cad;
+}
+
+}  // namespace homesh

@@ -1,0 +1,39 @@
+// CAD healing before meshing: checks a model for what defeats a mesher and, where it finds
+// something and healing is on, repairs it with OpenCASCADE's shape-healing tools.
+//
+// Checked: OCCT's validity analysis (BRepCheck), faces not joined into a closed solid (no solid,
+// or a solid whose shell has free edges), edges shorter than the healing tolerance, and tiny
+// or sliver faces. Repaired, in that order: sewing faces within the tolerance and making solids
+// of the closed shells (BRepBuilderAPI_Sewing, ShapeFix_Solid), general fixes of wires, edges
+// and orientation (ShapeFix_Shape), small edges and wire gaps (ShapeFix_Wireframe), small faces
+// (ShapeFix_FixSmallFace). Tolerances follow the model's size: 1e-6 of its bounding-box
+// diagonal for sewing and fixing, at most 1e-3 of it for what a fix may widen a tolerance to.
+//
+// A model with nothing to heal is returned as it is: its FaceN numbering, which boundary layers
+// and boundary groups refer to, is unchanged. A healed model is renumbered; the record says so.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cad/cad_model.hpp"
+
+namespace homesh {
+
+struct HealingRecord {
+  bool enabled = true;
+  double tolerance = 0.0;             // of the fixes (model units)
+  std::vector<std::string> problems;  // what the check found, in words, entities named
+  std::vector<std::string> actions;   // what healing did (empty: the model is unchanged)
+  int facesBefore = 0, facesAfter = 0;
+  int solidsBefore = 0, solidsAfter = 0;
+  double seconds = 0.0;
+  bool changed() const { return !actions.empty(); }
+};
+
+// The model to mesh: `cad` itself when the check finds nothing (or healing is off), else the
+// healed model (same source name). Fills `record`. Throws CadError when the model (healed or
+// not) has a solid whose boundary is open, naming the solid and a free edge.
+CadModel healModel(CadModel cad, bool enabled, HealingRecord& record);
+
+}  // namespace homesh

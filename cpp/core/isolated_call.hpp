@@ -1,0 +1,48 @@
+// Runs a piece of work in a child process, so that a crash, a hang or a runaway allocation in
+// third-party code (Gmsh) ends that child and not the caller: a FreeCAD session survives what
+// would otherwise take it down.
+//
+// The child is a fork() of the caller: the work sees the caller's memory as it was (a copy),
+// runs on the child's single thread and hands back its result as bytes through a pipe. What it
+// changes in memory is lost; only the returned bytes come back. Stdout and stderr are shared.
+//
+// The work must not need other threads of the caller (their locks may be held forever in the
+// child) and must not start an OpenMP team of more than one thread.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <string>
+
+#include "core/error.hpp"
+
+namespace homesh {
+
+struct IsolationLimits {
+  double seconds = 0.0;             // wall-time budget; 0: none
+  std::string budgetName;           // how a message names the setting: "--linear-time-limit"
+  std::function<bool()> cancelled;  // asked about every 50 ms while the child runs
+  // Address space the child may add to the caller's (its allocations beyond fail with
+  // std::bad_alloc); 0: the memory available on the machine when the child starts.
+  std::size_t extraBytes = 0;
+};
+
+// Runs `work` in a child process and returns the bytes it returned.
+// - work throws a homesh::Error: the same kind of error (ParameterError, IoError, CadError,
+//   MeshingError, CancelledError) is thrown here with its message;
+// - the child runs out of memory, dies of a signal or exits otherwise: MeshingError
+//   "<what> ran out of memory (...)", or ChildCrashed "<what> crashed (Segmentation fault)";
+// - the budget runs out: the child is killed, MeshingError "<what> stopped at its time budget
+//   of S s (<budgetName>)";
+// - cancelled: the child is killed, CancelledError.
+// If the child cannot be started: Error.
+std::string runIsolated(const std::string& what, const IsolationLimits& limits,
+                        const std::function<std::string()>& work);
+
+// The child died (a signal, or an exit without a result): the work may be retried another way.
+class ChildCrashed : public MeshingError {
+ public:
+  using MeshingError::MeshingError;
+};
+
+}  // namespace homesh

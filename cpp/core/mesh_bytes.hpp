@@ -1,0 +1,20 @@
+// A Mesh (and a lone ElementBlock) as a flat byte string and back: how a mesh made in a child
+// process (core/isolated_call.hpp) reaches its parent. Same machine, same build: the numbers
+// are copied as they are in memory, so the round trip is exact.
+#pragma once
+
+#include <string>
+
+#include "core/mesh.hpp"
+
+namespace homesh {
+
+void appendMeshBytes(std::string& out, const Mesh& mesh);
+void appendBlockBytes(std::string& out, const ElementBlock& block);
+
+// Read from `bytes` at `offset`, which moves past what was read. Throw Error when the bytes are
+// short or inconsistent (checkConsistency for the mesh).
+Mesh readMeshBytes(const std::string& bytes, std::size_t& offset);
+ElementBlock readBlockBytes(const std::string& bytes, std::size_t& offset);
+
+}  // namespace homesh

@@ -1,0 +1,156 @@
+// Work run in a child process: its result comes back exactly, its errors keep their kind, and
+// a crash, a hang, a runaway allocation or a cancel ends the child, never this process.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/isolated_call.hpp"
+#include "core/mesh_bytes.hpp"
+
+namespace homesh {
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+TEST(IsolatedCall, ReturnsTheChildsBytesAndLeavesThisProcessUnchanged) {
+  int touched = 0;
+  std::string big(3'000'000, '\0');  // larger than a pipe's buffer: read while written
+  for (std::size_t i = 0; i < big.size(); ++i) big[i] = static_cast<char>(i * 7);
+  const std::string bytes = runIsolated("a test", {}, [&] {
+    touched = 1;  // in the child's copy of memory only
+    return big;
+  });
+  EXPECT_EQ(bytes, big);
+  EXPECT_EQ(touched, 0);
+}
+
+TEST(IsolatedCall, ErrorsKeepTheirKindAndMessage) {
+  EXPECT_THROW(runIsolated("a test", {}, []() -> std::string { throw CadError("Face3 is bad"); }),
+               CadError);
+  try {
+    runIsolated("a test", {}, []() -> std::string { throw ParameterError("order is 0"); });
+    FAIL();
+  } catch (const ParameterError& e) {
+    EXPECT_STREQ(e.what(), "order is 0");
+  }
+  EXPECT_THROW(runIsolated("a test", {}, []() -> std::string { throw MeshingError("m"); }),
+               MeshingError);
+  EXPECT_THROW(runIsolated("a test", {}, []() -> std::string { throw IoError("i"); }), IoError);
+  EXPECT_THROW(runIsolated("a test", {}, []() -> std::string { throw CancelledError("c"); }),
+               CancelledError);
+  EXPECT_THROW(runIsolated("a test", {}, []() -> std::string { throw 42; }), Error);
+}
+
+TEST(IsolatedCall, ACrashInTheChildIsAnErrorHere) {
+  try {
+    runIsolated("the crashing work", {}, []() -> std::string {
+      std::raise(SIGSEGV);
+      return "unreachable";
+    });
+    FAIL();
+  } catch (const ChildCrashed& e) {
+    EXPECT_NE(std::string(e.what()).find("the crashing work crashed (Segmentation fault)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(runIsolated("an aborting work", {}, []() -> std::string { std::abort(); }),
+               ChildCrashed);
+  EXPECT_THROW(runIsolated("an exiting work", {}, []() -> std::string { std::_Exit(0); }),
+               ChildCrashed);
+}
+
+TEST(IsolatedCall, TheTimeBudgetEndsAHangingChild) {
+  IsolationLimits limits;
+  limits.seconds = 0.3;
+  limits.budgetName = "the test's limit";
+  const auto start = std::chrono::steady_clock::now();
+  std::string message;
+  try {
+    runIsolated("the hanging work", limits, []() -> std::string {
+      std::this_thread::sleep_for(std::chrono::seconds(60));
+      return "";
+    });
+  } catch (const MeshingError& e) {
+    message = e.what();
+  }
+  const double elapsed = secondsSince(start);
+  EXPECT_NE(message.find("stopped at its time budget of 0.3 s (the test's limit)"),
+            std::string::npos)
+      << message;
+  // The budget plus one poll interval (50 ms) and process start-up, with margin for a loaded
+  // machine; far below the minute the child would sleep.
+  EXPECT_LT(elapsed, 5.0);
+}
+
+TEST(IsolatedCall, CancellingEndsTheChild) {
+  IsolationLimits limits;
+  const auto start = std::chrono::steady_clock::now();
+  limits.cancelled = [start] { return secondsSince(start) > 0.2; };
+  EXPECT_THROW(runIsolated("the long work", limits,
+                           []() -> std::string {
+                             std::this_thread::sleep_for(std::chrono::seconds(60));
+                             return "";
+                           }),
+               CancelledError);
+  EXPECT_LT(secondsSince(start), 5.0);
+}
+
+TEST(IsolatedCall, ARunawayAllocationFailsInTheChildOnly) {
+  IsolationLimits limits;
+  limits.extraBytes = std::size_t{256} << 20;  // 256 MiB more than this process
+  try {
+    runIsolated("the greedy work", limits, []() -> std::string {
+      std::vector<std::vector<char>> hoard;
+      for (;;) hoard.emplace_back(std::size_t{64} << 20, 'x');  // until bad_alloc
+    });
+    FAIL();
+  } catch (const MeshingError& e) {
+    EXPECT_NE(std::string(e.what()).find("the greedy work ran out of memory"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(MeshBytes, AMeshAndABlockRoundTripExactly) {
+  Mesh mesh;
+  mesh.dim = 3;
+  mesh.order = 1;
+  mesh.planeNormal = {0.0, 0.6, 0.8};
+  const double nodes[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.1, 0.2, 1.0 / 3.0}};
+  for (int i = 0; i < 4; ++i) mesh.addNode(nodes[i], i == 3 ? 3 : 2, i, 0.25 * i, -1e-300);
+  ElementBlock tets;
+  tets.type = CellType::Tetrahedron;
+  tets.nodes = {0, 1, 2, 3};
+  tets.entity = {7};
+  mesh.blocks.push_back(tets);
+  std::string bytes;
+  appendMeshBytes(bytes, mesh);
+  appendBlockBytes(bytes, tets);
+  std::size_t offset = 0;
+  const Mesh back = readMeshBytes(bytes, offset);
+  const ElementBlock block = readBlockBytes(bytes, offset);
+  EXPECT_EQ(offset, bytes.size());
+  EXPECT_EQ(back.xyz, mesh.xyz);
+  EXPECT_EQ(back.nodeCadDim, mesh.nodeCadDim);
+  EXPECT_EQ(back.nodeCadIndex, mesh.nodeCadIndex);
+  EXPECT_EQ(back.nodeCadParam, mesh.nodeCadParam);
+  EXPECT_EQ(back.planeNormal, mesh.planeNormal);
+  ASSERT_EQ(back.blocks.size(), 1U);
+  EXPECT_EQ(back.blocks[0].nodes, tets.nodes);
+  EXPECT_EQ(block.entity, tets.entity);
+  // Short bytes are refused, not read past their end.
+  for (const std::size_t cut : {std::size_t{0}, std::size_t{5}, bytes.size() / 2}) {
+    std::size_t at = 0;
+    EXPECT_THROW(readMeshBytes(bytes.substr(0, cut), at), Error) << cut;
+  }
+}
+
+}  // namespace
+}  // namespace homesh

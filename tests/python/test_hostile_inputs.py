@@ -1,0 +1,163 @@
+"""Hostile inputs (issue 15): each ends with one clear error line and exit status 1 or 2, or a
+mesh, within its limit; never a crash, a hang or a partial file. The CAD fixtures in
+tests/data/hostile were exported by FreeCAD (Part.makeCone(0.01, 0, 100) for the needle,
+five faces of a box for the open shell, two coincident opposite faces made a solid for the zero
+thickness, spheres of radius 1e-6 and 1e6)."""
+
+import json
+import os
+import signal
+import zlib
+import base64
+
+import pytest
+
+from conftest import run
+
+HOSTILE = os.path.join(os.path.dirname(__file__), "..", "data", "hostile")
+
+
+def cad(name):
+    return os.path.join(HOSTILE, name)
+
+
+def one_line_error(r, status, *phrases):
+    assert r.returncode == status, (r.returncode, r.stderr[-2000:])
+    errors = [l for l in r.stderr.splitlines() if l.startswith("homesh: error: ")]
+    assert len(errors) == 1, r.stderr
+    for phrase in phrases:
+        assert phrase in errors[0], errors[0]
+    return errors[0]
+
+
+def test_unreadable_step_files(homesh_bin, data, tmp_path):
+    box = open(data / "box_hole.step", "rb").read()
+    cases = {"empty.step": b"", "truncated.step": box[: len(box) // 3],
+             "random.step": os.urandom(5000)}
+    for name, content in cases.items():
+        (tmp_path / name).write_bytes(content)
+        out = tmp_path / (name + ".msh")
+        r = run([homesh_bin, "mesh", tmp_path / name, "-o", out], timeout=120)
+        one_line_error(r, 1, name, "not a readable STEP")
+        assert not out.exists()
+
+
+def test_open_shell_names_a_free_edge(homesh_bin, tmp_path):
+    r = run([homesh_bin, "mesh", cad("open_shell.step"), "-o", tmp_path / "m.msh"], timeout=120)
+    one_line_error(r, 1, "open_shell.step", "is not a closed solid", "Edge",
+                   "bounds only one face", "healing could not close it")
+    assert not (tmp_path / "m.msh").exists()
+
+
+def test_closed_shell_without_solid_is_healed_into_one(homesh_bin, tmp_path):
+    report = tmp_path / "r.json"
+    r = run([homesh_bin, "mesh", cad("closed_shell.step"), "--order", "2", "--size", "0.25",
+             "--report", report], timeout=300)
+    assert r.returncode == 0, r.stderr
+    healing = json.loads(report.read_text())["healing"]
+    assert healing["solids_before"] == 0 and healing["solids_after"] == 1, healing
+    assert healing["renumbered"] and any("sewed" in a for a in healing["actions"]), healing
+    assert "homesh: healed the CAD: sewed" in r.stderr
+    # With healing off the same file is refused, and the message says healing could help.
+    r = run([homesh_bin, "mesh", cad("closed_shell.step"), "--no-heal", "--size", "0.25"],
+            timeout=120)
+    one_line_error(r, 1, "is not a closed solid", "healing is off")
+
+
+def test_a_sound_model_is_left_as_it_is(homesh_bin, data, tmp_path):
+    report = tmp_path / "r.json"
+    r = run([homesh_bin, "mesh", data / "sphere.brep", "--order", "2", "--size", "0.5",
+             "--report", report], timeout=300)
+    assert r.returncode == 0, r.stderr
+    healing = json.loads(report.read_text())["healing"]
+    assert healing["problems"] == [] and healing["actions"] == [] and not healing["renumbered"]
+
+
+def test_zero_thickness_solid(homesh_bin):
+    r = run([homesh_bin, "mesh", cad("zero_thick.step")], timeout=120)
+    one_line_error(r, 1, "zero_thick.step", "Solid1 has no volume", "zero-thickness")
+
+
+def test_models_of_extreme_scale(homesh_bin, tmp_path):
+    # A sphere of radius 1e-6 meshes like the unit sphere; the one of radius 1e6 defeats Gmsh
+    # 4.8's surface mesher (its surface gets no triangles): a mesh or one clear error line.
+    report = tmp_path / "tiny.json"
+    r = run([homesh_bin, "mesh", cad("tiny.step"), "--order", "2", "--report", report],
+            timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(report.read_text())["quality"]["invalid_elements"] == 0
+    r = run([homesh_bin, "mesh", cad("huge.step"), "--order", "2", "-o", tmp_path / "h.msh"],
+            timeout=300)
+    if r.returncode != 0:
+        one_line_error(r, 1, "huge.step")
+        assert not (tmp_path / "h.msh").exists()
+
+
+@pytest.mark.parametrize("option,value,phrase", [
+    ("--size", "nan", "--size"), ("--size", "-3", "--size must be a length > 0"),
+    ("--order", "11", "--order must be an integer from 1 to 10"),
+    ("--eps", "-0.1", "--eps"), ("--threads", "0", "--threads"),
+    ("--linear-time-limit", "-1", "--linear-time-limit"),
+    ("--time-limit", "nan", "--time-limit")])
+def test_bad_parameters(homesh_bin, data, option, value, phrase):
+    one_line_error(run([homesh_bin, "mesh", data / "sphere.brep", option, value]), 2, phrase)
+
+
+def test_a_mesh_predicted_not_to_fit_in_memory_is_refused_before_meshing(homesh_bin, data,
+                                                                         tmp_path):
+    # Order 10 at a size giving millions of elements: hundreds of GB predicted. Refused in a
+    # second or two, before the linear mesh is made.
+    r = run([homesh_bin, "mesh", data / "box_hole.step", "--order", "10", "--size", "0.08",
+             "-o", tmp_path / "m.msh"], timeout=60)
+    one_line_error(r, 2, "is predicted to need", "GB of memory", "available")
+    assert "linear" not in r.stderr  # refused before the linear mesher ran
+    assert not (tmp_path / "m.msh").exists()
+
+
+def test_compressed_nektar_xml_that_inflates_without_bound(homesh_bin, tmp_path):
+    # 3 GiB of zeros compress to about 3 MB: the reader stops at its 2 GiB limit.
+    packer = zlib.compressobj(9)
+    chunk = bytes(1 << 24)
+    packed = b"".join(packer.compress(chunk) for _ in range(192)) + packer.flush()
+    text = base64.b64encode(packed).decode()
+    xml = ('<?xml version="1.0" encoding="utf-8" ?>\n<NEKTAR>\n<GEOMETRY DIM="3" SPACE="3">\n'
+           '<VERTEX COMPRESSED="B64Z-LittleEndian" BITSIZE="64">%s</VERTEX>\n'
+           '</GEOMETRY>\n</NEKTAR>\n' % text)
+    path = tmp_path / "bomb.xml"
+    path.write_text(xml)
+    r = run([homesh_bin, "quality", path], timeout=300)
+    one_line_error(r, 1, "bomb.xml", "<VERTEX>", "inflates to more than 2048 MiB")
+
+
+def test_an_output_that_is_the_input_is_refused(homesh_bin, data, tmp_path):
+    mesh = tmp_path / "m.msh"
+    assert run([homesh_bin, "mesh", data / "sphere.brep", "--order", "2", "--size", "0.5",
+                "-o", mesh, "-q"]).returncode == 0
+    before = mesh.read_bytes()
+    for command in (["convert", mesh, "-o", mesh], ["optimise", mesh, "-o", mesh],
+                    ["quality", mesh, "--report", mesh]):
+        r = run([homesh_bin] + command, timeout=120)
+        one_line_error(r, 1, "is the input file")
+        assert mesh.read_bytes() == before
+
+
+def test_needle_cone_time_budget(homesh_bin, tmp_path):
+    # Gmsh grinds on the needle for tens of seconds before it crashes; the linear stage's
+    # budget stops it.
+    r = run([homesh_bin, "mesh", cad("needle.step"), "--linear-time-limit", "3",
+             "-o", tmp_path / "n.msh"], timeout=120)
+    one_line_error(r, 1, "needle.step", "stopped at its time budget of 3 s",
+                   "linear meshing time limit")
+    assert not (tmp_path / "n.msh").exists()
+
+
+def test_needle_cone_crash_inside_gmsh_is_contained(homesh_bin, tmp_path):
+    # Gmsh 4.8 crashes (SIGSEGV, or an abort from inside an OpenMP region) on this cone with
+    # both its default surface algorithm and MeshAdapt: the crash ends Gmsh's child process and
+    # homesh reports it; a later Gmsh that meshes it may give a mesh instead.
+    r = run([homesh_bin, "mesh", cad("needle.step"), "--order", "2", "-o", tmp_path / "n.msh"],
+            timeout=400)
+    assert r.returncode >= 0, "homesh died of signal %s" % signal.Signals(-r.returncode).name
+    if r.returncode != 0:
+        one_line_error(r, 1, "needle.step", "Gmsh", "crashed")
+        assert not (tmp_path / "n.msh").exists()
