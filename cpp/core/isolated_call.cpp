@@ -151,8 +151,8 @@ std::string runIsolated(const std::string& what, const IsolationLimits& limits,
 
   if (cancelled) throw CancelledError("cancelled during " + what);
   if (overTime)
-    throw MeshingError(what + " stopped at its time budget of " + formatNumber(limits.seconds) +
-                       " s" + (limits.budgetName.empty() ? "" : " (" + limits.budgetName + ")"));
+    throw BudgetExceeded(what + " stopped at its time budget of " + formatNumber(limits.seconds) +
+                         " s" + (limits.budgetName.empty() ? "" : " (" + limits.budgetName + ")"));
   if (waited == pid && WIFSIGNALED(status)) {
     const int sig = WTERMSIG(status);
     if (sig == SIGKILL)

@@ -32,12 +32,18 @@ struct IsolationLimits {
 //   MeshingError, CancelledError) is thrown here with its message;
 // - the child runs out of memory, dies of a signal or exits otherwise: MeshingError
 //   "<what> ran out of memory (...)", or ChildCrashed "<what> crashed (Segmentation fault)";
-// - the budget runs out: the child is killed, MeshingError "<what> stopped at its time budget
+// - the budget runs out: the child is killed, BudgetExceeded "<what> stopped at its time budget
 //   of S s (<budgetName>)";
 // - cancelled: the child is killed, CancelledError.
 // If the child cannot be started: Error.
 std::string runIsolated(const std::string& what, const IsolationLimits& limits,
                         const std::function<std::string()>& work);
+
+// The child ran out of its time budget (and was killed).
+class BudgetExceeded : public MeshingError {
+ public:
+  using MeshingError::MeshingError;
+};
 
 // The child died (a signal, or an exit without a result): the work may be retried another way.
 class ChildCrashed : public MeshingError {

@@ -318,26 +318,39 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
     std::size_t offset = 0;
     return readMeshBytes(bytes, offset);
   };
+  // Gmsh 4.8's default surface algorithm crashes on some surfaces (a needle-thin cone aborted
+  // it from inside a parallel region) and leaves others empty (a sphere of radius 1e6: "Surface
+  // 1 consists of no elements"); MeshAdapt meshes both more often. A run stopped by its time
+  // budget or cancelled is not tried again.
+  const auto retry = [&](const std::string& first) {
+    GmshRun again = run;
+    again.surfaceAlgorithm = kMeshAdapt;
+    Mesh m = attempt(again);
+    if (options.note) options.note(first + "; with its MeshAdapt surface algorithm Gmsh meshed it");
+    return m;
+  };
   Mesh mesh;
   try {
     mesh = attempt(run);
+  } catch (const BudgetExceeded&) {
+    throw;
   } catch (const ChildCrashed& crash) {
-    // Gmsh 4.8 crashes on some surfaces its default algorithm cannot mesh (a needle-thin cone
-    // aborted it from inside a parallel region); MeshAdapt often can.
-    GmshRun again = run;
-    again.surfaceAlgorithm = kMeshAdapt;
     try {
-      mesh = attempt(again);
+      mesh = retry(crash.what());
     } catch (const ChildCrashed& second) {
       throw MeshingError(std::string(second.what()) + " " + run.sizes +
                          ", with its default surface algorithm and with MeshAdapt: the model may "
                          "have a degenerate face (a needle or sliver; healing or another size "
                          "may help)");
     }
-    if (options.note)
-      options.note(std::string(crash.what()) +
-                   " with its default surface algorithm; meshed "
-                   "with MeshAdapt instead");
+  } catch (const MeshingError& failure) {
+    try {
+      mesh = retry(failure.what());
+    } catch (const BudgetExceeded&) {
+      throw;
+    } catch (const Error&) {
+      throw failure;  // the first algorithm's message says more
+    }
   }
   if (options.dimensionDone) options.dimensionDone(run.dim, run.dim);
   mesh.checkConsistency();

@@ -80,9 +80,31 @@ SizingParameters resolveSizing(const std::optional<SizingParameters>& requested,
   return completeSizing(requested.value_or(defaultSizing(cad)), cad);
 }
 
+namespace {
+
+// Healing numbers a changed model's faces and edges afresh: a boundary layer's faces or a
+// refinement along a CAD curve, given in the original numbering, could land elsewhere.
+void checkRenumbering(const HealingRecord& healing, const MeshingOptions& options) {
+  if (!healing.changed()) return;
+  std::string what;
+  if (options.boundaryLayer) what = "the boundary layer";
+  if (options.sizing)
+    for (const RefinementSource& s : options.sizing->sources)
+      if (s.kind == RefinementSource::Kind::Curve)
+        what = "a refinement along CAD curve " + std::to_string(s.edge);
+  if (!what.empty())
+    throw ParameterError("healing changed the CAD (" + healing.actions.front() +
+                         "), which numbers its faces and edges afresh, and " + what +
+                         " is given in the original numbering: repair the CAD file, or mesh "
+                         "without healing (--no-heal, heal=False, Heal off)");
+}
+
+}  // namespace
+
 SizingResult runSizingStage(const CadSource& source, const MeshingOptions& options) {
   HealingRecord healing;
   const CadModel cad = healModel(source.load(), options.heal, healing);
+  checkRenumbering(healing, options);
   checkMeshDimension(cad, options.expectedDimension);
   SizingResult result = runSizing(cad, resolveSizing(options.sizing, cad), options.threads);
   if (!options.octreeOutput.empty()) writeOctree(*result.octree, options.octreeOutput);
@@ -394,6 +416,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   result.cad =
       std::make_shared<const CadModel>(healModel(source.load(), options.heal, result.healing));
   cad.done();
+  checkRenumbering(result.healing, options);
   checkMeshDimension(*result.cad, options.expectedDimension);
   if (!options.size) options.sizing = resolveSizing(options.sizing, *result.cad);
   result.options = options;

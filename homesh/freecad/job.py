@@ -89,7 +89,7 @@ class MeshJob:
 
     def cancel(self):
         """Asks the core to stop; the job ends with CancelledError within a fraction of a
-        second (Gmsh's own meshing of one dimension cannot be interrupted)."""
+        second (Gmsh's meshing runs in a child process, which is then killed)."""
         self.token.cancel()
 
     @property

@@ -49,6 +49,41 @@ class MeshJobs(unittest.TestCase):
         self.assertEqual(same.quality()["min"], job.result.quality()["min"])
         job.discard_files()
 
+    def test_gmsh_runs_in_a_child_that_a_time_limit_or_a_cancel_ends(self):
+        # Gmsh 4.8 grinds on a needle-thin cone for tens of seconds, then crashes: in its own
+        # process, a time limit or a Stop ends it and this process carries on.
+        import Part
+        needle = self.doc.addObject("Part::Feature", "Needle")
+        needle.Shape = Part.makeCone(0.01, 0.0, 100.0)
+        mesh = homesh.freecad.make_high_order_mesh(self.doc, needle, order=2)
+        mesh.LinearTimeLimit = 2
+        start = time.monotonic()
+        job = objects.job_for(mesh).start()
+        job.wait(60)
+        job.poll()
+        self.assertLess(time.monotonic() - start, 30)
+        self.assertIsInstance(job.error, homesh.MeshingError)
+        self.assertIn("stopped at its time budget of 2 s", str(job.error))
+        mesh.LinearTimeLimit = 600
+        job = objects.job_for(mesh).start()
+        while job.stage != "linear" and not job.done:
+            job.poll()
+            time.sleep(0.01)
+        time.sleep(0.5)  # inside Gmsh now
+        start = time.monotonic()
+        job.cancel()
+        job.wait(10)
+        job.poll()
+        self.assertLess(time.monotonic() - start, 1.0)
+        self.assertIsInstance(job.error, homesh.CancelledError)
+        # The process is intact: the next job meshes.
+        job = objects.job_for(self.obj).start()
+        job.wait(300)
+        job.poll()
+        self.assertIsNone(job.error)
+        self.assertGreater(job.result.num_elements, 0)
+        job.discard_files()
+
     def test_cancel_ends_the_job_within_a_second(self):
         self.obj.Order = 6  # long enough to be caught in the optimiser
         job = objects.job_for(self.obj).start()
