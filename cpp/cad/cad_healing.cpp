@@ -1,11 +1,13 @@
 #include "cad/cad_healing.hpp"
 
 #include <BRepAdaptor_Curve.hxx>
+#include <BRepBndLib.hxx>
 #include <BRepBuilderAPI_Sewing.hxx>
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepGProp.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
+#include <Bnd_Box.hxx>
 #include <GCPnts_AbscissaPoint.hxx>
 #include <GProp_GProps.hxx>
 #include <ShapeAnalysis_CheckSmallFace.hxx>
@@ -46,16 +48,26 @@ int count(const TopoDS_Shape& shape, TopAbs_ShapeEnum type) {
   return map.Extent();
 }
 
-// The first free edge of `solid` (an edge bounding only one of its faces, not a seam or a
-// degenerated edge), as its index in `edges`; 0 when its boundary is closed.
+bool bounding(TopAbs_Orientation o) {
+  return o == TopAbs_FORWARD || o == TopAbs_REVERSED;
+}
+
+// The first free edge of `solid` (an edge used once by its bounding faces: not a seam, which a
+// face uses twice, not degenerated, and not an internal or external edge imprinted on a face),
+// as its index in `edges`; 0 when its boundary is closed.
 int firstFreeEdge(const TopoDS_Shape& solid, const TopTools_IndexedMapOfShape& edges) {
-  TopTools_IndexedDataMapOfShapeListOfShape faces;
-  TopExp::MapShapesAndUniqueAncestors(solid, TopAbs_EDGE, TopAbs_FACE, faces);
-  for (int i = 1; i <= faces.Extent(); ++i) {
-    const TopoDS_Edge& edge = TopoDS::Edge(faces.FindKey(i));
-    if (BRep_Tool::Degenerated(edge) || faces(i).Extent() != 1) continue;
-    if (BRep_Tool::IsClosed(edge, TopoDS::Face(faces(i).First()))) continue;  // a seam
-    return edges.FindIndex(edge);
+  TopTools_IndexedDataMapOfShapeListOfShape uses;  // edge -> the faces using it (repeats kept)
+  for (TopExp_Explorer f(solid, TopAbs_FACE); f.More(); f.Next()) {
+    if (!bounding(f.Current().Orientation())) continue;
+    for (TopExp_Explorer e(f.Current(), TopAbs_EDGE); e.More(); e.Next()) {
+      if (!bounding(e.Current().Orientation())) continue;
+      if (!uses.Contains(e.Current())) uses.Add(e.Current(), TopTools_ListOfShape());
+      uses.ChangeFromKey(e.Current()).Append(f.Current());
+    }
+  }
+  for (int i = 1; i <= uses.Extent(); ++i) {
+    const TopoDS_Edge& edge = TopoDS::Edge(uses.FindKey(i));
+    if (uses(i).Extent() == 1 && !BRep_Tool::Degenerated(edge)) return edges.FindIndex(edge);
   }
   return 0;
 }
@@ -74,6 +86,29 @@ bool hasNoVolume(const TopoDS_Shape& solid, double diagonal, double& volume) {
   BRepGProp::SurfaceProperties(solid, props);
   volume = volumeOf(solid);
   return volume < std::abs(props.Mass()) * kTolerance * diagonal;
+}
+
+// Whether `after` numbers its faces and edges as `before` does: the same counts, and the i-th
+// face (edge) of each has the same centre of mass within `tolerance`.
+bool sameNumbering(const TopoDS_Shape& before, const TopoDS_Shape& after, double tolerance) {
+  for (const TopAbs_ShapeEnum type : {TopAbs_FACE, TopAbs_EDGE}) {
+    TopTools_IndexedMapOfShape a, b;
+    TopExp::MapShapes(before, type, a);
+    TopExp::MapShapes(after, type, b);
+    if (a.Extent() != b.Extent()) return false;
+    for (int i = 1; i <= a.Extent(); ++i) {
+      GProp_GProps pa, pb;
+      if (type == TopAbs_FACE) {
+        BRepGProp::SurfaceProperties(a(i), pa);
+        BRepGProp::SurfaceProperties(b(i), pb);
+      } else {
+        BRepGProp::LinearProperties(a(i), pa);
+        BRepGProp::LinearProperties(b(i), pb);
+      }
+      if (pa.CentreOfMass().Distance(pb.CentreOfMass()) > tolerance) return false;
+    }
+  }
+  return true;
 }
 
 struct Findings {
@@ -157,7 +192,20 @@ std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tole
     builder.Add(solids, solid);
     ++made;
   }
-  if (made == 0) return std::nullopt;
+  // Only when every face ends up in a solid, and no solid lies inside another (an inner shell
+  // is a void, not material): else the model is refused as it is, naming a free edge.
+  if (made == 0 || count(solids, TopAbs_FACE) < count(shape, TopAbs_FACE)) return std::nullopt;
+  std::vector<Bnd_Box> boxes;
+  for (TopExp_Explorer s(solids, TopAbs_SOLID); s.More(); s.Next()) {
+    Bnd_Box box;
+    BRepBndLib::Add(s.Current(), box);
+    for (const Bnd_Box& other : boxes)
+      if (!box.IsOut(other.CornerMin()) && !box.IsOut(other.CornerMax()))
+        return std::nullopt;
+      else if (!other.IsOut(box.CornerMin()) && !other.IsOut(box.CornerMax()))
+        return std::nullopt;
+    boxes.push_back(box);
+  }
   actions.push_back("sewed the faces (tolerance " + formatNumber(tolerance) + ") into " +
                     std::to_string(made) + (made == 1 ? " closed shell" : " closed shells") +
                     " and made " + (made == 1 ? "a solid of it" : "solids of them"));
@@ -203,7 +251,7 @@ TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal,
     faces.SetPrecision(kSmallEdge * diagonal);
     faces.SetMaxTolerance(kMaxWiden * diagonal);
     faces.Perform();
-    const TopoDS_Shape fixed = faces.FixShape();
+    const TopoDS_Shape fixed = faces.Shape();
     if (!fixed.IsNull() && count(fixed, TopAbs_FACE) < count(shape, TopAbs_FACE)) {
       record.actions.push_back(
           "removed " + std::to_string(count(shape, TopAbs_FACE) - count(fixed, TopAbs_FACE)) +
@@ -232,14 +280,22 @@ CadModel healModel(CadModel cad, bool enabled, HealingRecord& record) {
     } catch (const CadError&) {  // neither a solid nor planar: reported below
     }
   }
-  const Findings found = withOcctErrors("checking " + cad.sourceName(), [&] {
-    return inspect(occtShape(cad), diagonal, planar, record.problems);
-  });
+  // A check that fails (OCCT cannot measure an edge, say) is recorded, not fatal: the model is
+  // then meshed as it is, and a stage that cannot handle it says so.
+  Findings found;
+  try {
+    found = withOcctErrors("checking " + cad.sourceName(), [&] {
+      return inspect(occtShape(cad), diagonal, planar, record.problems);
+    });
+  } catch (const CadError& e) {
+    record.problems.push_back(std::string("the check failed: ") + e.what());
+  }
   if (enabled && found.any()) {
     const TopoDS_Shape healed = withOcctErrors("healing " + cad.sourceName(), [&] {
       return heal(occtShape(cad), found, diagonal, record);
     });
     if (record.changed()) {
+      record.renumbered = !sameNumbering(occtShape(cad), healed, 10.0 * record.tolerance);
       cad = cadModelFromShape(healed, cad.sourceName());
       record.facesAfter = cad.numFaces();
       record.solidsAfter = cad.numSolids();

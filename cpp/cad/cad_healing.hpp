@@ -10,7 +10,8 @@
 // diagonal for sewing and fixing, at most 1e-3 of it for what a fix may widen a tolerance to.
 //
 // A model with nothing to heal is returned as it is: its FaceN numbering, which boundary layers
-// and boundary groups refer to, is unchanged. A healed model is renumbered; the record says so.
+// and boundary groups refer to, is unchanged. Whether a healed model's numbering changed is
+// measured and recorded (HealingRecord::renumbered).
 #pragma once
 
 #include <string>
@@ -28,6 +29,9 @@ struct HealingRecord {
   int facesBefore = 0, facesAfter = 0;
   int solidsBefore = 0, solidsAfter = 0;
   double seconds = 0.0;
+  // The healed model's FaceN and EdgeN differ from the original's (counts, or a face or edge
+  // whose centre of mass moved); a fix of tolerances alone keeps the numbering.
+  bool renumbered = false;
   bool changed() const { return !actions.empty(); }
 };
 

@@ -146,7 +146,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
   if (!c.quiet) {
     for (const std::string& action : result.healing.actions)
       std::fprintf(stderr, "homesh: healed the CAD: %s\n", action.c_str());
-    if (result.healing.changed())
+    if (result.healing.renumbered)
       std::fprintf(stderr,
                    "homesh: note: face numbers are the healed model's (%d faces, were %d)\n",
                    result.healing.facesAfter, result.healing.facesBefore);

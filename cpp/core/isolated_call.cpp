@@ -40,13 +40,21 @@ bool writeAll(int fd, const char* data, std::size_t n) {
   return true;
 }
 
-[[noreturn]] void runChild(int fd, const IsolationLimits& limits,
+[[noreturn]] void runChild(int fd, pid_t parent, const IsolationLimits& limits,
                            const std::function<std::string()>& work) {
   // A crash must end the child with its signal, whatever handlers the caller (FreeCAD) set, and
-  // the child must not outlive the thread that waits for it.
+  // the child must not outlive the thread that waits for it (nor start after it died).
   for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGPIPE, SIGTERM, SIGINT})
     std::signal(sig, SIG_DFL);
   prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (getppid() != parent) _exit(3);
+  // Only stdin, stdout, stderr and the result pipe stay open: the caller's other files, pipes
+  // and sockets (FreeCAD's) must not be held open by a child that may run for minutes.
+  if (fd != 3) {
+    if (dup2(fd, 3) < 0) _exit(3);
+    fd = 3;
+  }
+  close_range(4, ~0U, 0);
   const std::size_t extra = limits.extraBytes > 0 ? limits.extraBytes : availableMemoryBytes();
   if (extra > 0) {
     rlimit limit{};
@@ -89,8 +97,24 @@ bool writeAll(int fd, const char* data, std::size_t n) {
 }
 
 std::string signalName(int sig) {
-  const char* name = strsignal(sig);
-  return name != nullptr ? std::string(name) : "signal " + std::to_string(sig);
+  // sigabbrev_np is thread-safe, unlike strsignal.
+  const char* name = sigabbrev_np(sig);
+  switch (sig) {
+    case SIGSEGV:
+      return "Segmentation fault";
+    case SIGABRT:
+      return "Aborted";
+    case SIGBUS:
+      return "Bus error";
+    case SIGFPE:
+      return "Floating point exception";
+    case SIGILL:
+      return "Illegal instruction";
+    case SIGKILL:
+      return "Killed";
+    default:
+      return name != nullptr ? "SIG" + std::string(name) : "signal " + std::to_string(sig);
+  }
 }
 
 }  // namespace
@@ -101,6 +125,7 @@ std::string runIsolated(const std::string& what, const IsolationLimits& limits,
   if (pipe2(fds.data(), O_CLOEXEC) != 0)
     throw Error("cannot start a process for " + what + ": " + std::strerror(errno));
   std::fflush(nullptr);
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid < 0) {
     const int error = errno;
@@ -110,9 +135,26 @@ std::string runIsolated(const std::string& what, const IsolationLimits& limits,
   }
   if (pid == 0) {
     ::close(fds[0]);
-    runChild(fds[1], limits, work);
+    runChild(fds[1], parent, limits, work);
   }
   ::close(fds[1]);
+  // Whatever happens below (an allocation failing, a cancel callback throwing), the child is
+  // killed and reaped and the pipe closed; `reaped` once waitpid has run.
+  bool reaped = false;
+  int status = 0;
+  pid_t waited = 0;
+  const auto reap = [&](bool kill) {
+    if (reaped) return;
+    ::close(fds[0]);
+    if (kill) ::kill(pid, SIGKILL);
+    while ((waited = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
+    }
+    reaped = true;
+  };
+  struct Guard {
+    std::function<void()> onExit;
+    ~Guard() { onExit(); }
+  } guard{[&] { reap(true); }};
 
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
@@ -126,11 +168,13 @@ std::string runIsolated(const std::string& what, const IsolationLimits& limits,
       const ssize_t n = ::read(fds[0], buffer.data(), buffer.size());
       if (n > 0) {
         bytes.append(buffer.data(), static_cast<std::size_t>(n));
-      } else if (n == 0 || errno != EINTR) {
+      } else if (n == 0) {
         break;  // the child closed its end (finished or died)
+      } else if (errno != EINTR) {
+        throw Error("cannot read the result of " + what + ": " + std::strerror(errno));
       }
     } else if (ready < 0 && errno != EINTR) {
-      break;
+      throw Error("cannot wait for " + what + ": " + std::strerror(errno));
     }
     if (limits.cancelled && limits.cancelled()) {
       cancelled = true;
@@ -142,12 +186,7 @@ std::string runIsolated(const std::string& what, const IsolationLimits& limits,
       break;
     }
   }
-  ::close(fds[0]);
-  if (cancelled || overTime) kill(pid, SIGKILL);
-  int status = 0;
-  pid_t waited = 0;
-  while ((waited = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
-  }
+  reap(cancelled || overTime);
 
   if (cancelled) throw CancelledError("cancelled during " + what);
   if (overTime)
@@ -156,8 +195,8 @@ std::string runIsolated(const std::string& what, const IsolationLimits& limits,
   if (waited == pid && WIFSIGNALED(status)) {
     const int sig = WTERMSIG(status);
     if (sig == SIGKILL)
-      throw MeshingError(what + " was killed (" + signalName(sig) +
-                         "), most likely by the system for lack of memory");
+      throw OutOfMemory(what + " was killed (" + signalName(sig) +
+                        "), most likely by the system for lack of memory");
     throw ChildCrashed(what + " crashed (" + signalName(sig) + ")");
   }
   if (bytes.empty() || (waited == pid && WIFEXITED(status) && WEXITSTATUS(status) != 0))
@@ -171,7 +210,7 @@ std::string runIsolated(const std::string& what, const IsolationLimits& limits,
     case kResult:
       return payload;
     case kMemory:
-      throw MeshingError(
+      throw OutOfMemory(
           what + " ran out of memory (the machine had " +
           formatNumber(std::round(static_cast<double>(availableMemoryBytes()) / 1e8) / 10) +
           " GB available)");

@@ -31,13 +31,20 @@ struct IsolationLimits {
 // - work throws a homesh::Error: the same kind of error (ParameterError, IoError, CadError,
 //   MeshingError, CancelledError) is thrown here with its message;
 // - the child runs out of memory, dies of a signal or exits otherwise: MeshingError
-//   "<what> ran out of memory (...)", or ChildCrashed "<what> crashed (Segmentation fault)";
+//   OutOfMemory "<what> ran out of memory (...)", or ChildCrashed "<what> crashed
+//   (Segmentation fault)";
 // - the budget runs out: the child is killed, BudgetExceeded "<what> stopped at its time budget
 //   of S s (<budgetName>)";
 // - cancelled: the child is killed, CancelledError.
 // If the child cannot be started: Error.
 std::string runIsolated(const std::string& what, const IsolationLimits& limits,
                         const std::function<std::string()>& work);
+
+// The child ran out of memory (an allocation failed at its limit, or the system killed it).
+class OutOfMemory : public MeshingError {
+ public:
+  using MeshingError::MeshingError;
+};
 
 // The child ran out of its time budget (and was killed).
 class BudgetExceeded : public MeshingError {

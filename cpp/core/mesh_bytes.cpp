@@ -18,13 +18,14 @@ void put(std::string& out, const T& value) {
 template <class T>
 void putVector(std::string& out, const std::vector<T>& values) {
   put(out, static_cast<std::uint64_t>(values.size()));
-  out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+  if (!values.empty())
+    out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
 }
 
 template <class T>
 T get(const std::string& bytes, std::size_t& offset) {
   if (offset > bytes.size() || bytes.size() - offset < sizeof(T))
-    throw Error("mesh bytes end early");
+    throw MeshingError("the mesh handed back by Gmsh's process ends early");
   T value;
   std::memcpy(&value, bytes.data() + offset, sizeof(T));
   offset += sizeof(T);
@@ -34,9 +35,10 @@ T get(const std::string& bytes, std::size_t& offset) {
 template <class T>
 std::vector<T> getVector(const std::string& bytes, std::size_t& offset) {
   const auto n = get<std::uint64_t>(bytes, offset);
-  if (n > (bytes.size() - offset) / sizeof(T)) throw Error("mesh bytes end early");
+  if (n > (bytes.size() - offset) / sizeof(T))
+    throw MeshingError("the mesh handed back by Gmsh's process ends early");
   std::vector<T> values(n);
-  std::memcpy(values.data(), bytes.data() + offset, n * sizeof(T));
+  if (n > 0) std::memcpy(values.data(), bytes.data() + offset, n * sizeof(T));
   offset += n * sizeof(T);
   return values;
 }

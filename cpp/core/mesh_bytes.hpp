@@ -12,8 +12,8 @@ namespace homesh {
 void appendMeshBytes(std::string& out, const Mesh& mesh);
 void appendBlockBytes(std::string& out, const ElementBlock& block);
 
-// Read from `bytes` at `offset`, which moves past what was read. Throw Error when the bytes are
-// short or inconsistent (checkConsistency for the mesh).
+// Read from `bytes` at `offset`, which moves past what was read. Throw MeshingError when the
+// bytes are short, Error when inconsistent (checkConsistency for the mesh).
 Mesh readMeshBytes(const std::string& bytes, std::size_t& offset);
 ElementBlock readBlockBytes(const std::string& bytes, std::size_t& offset);
 

@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -308,9 +309,17 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
   // different mesh from run to run (box_hole.step at size 1: 256, 257 or 258 tetrahedra at 2
   // threads), and a mesh must be reproducible; the coarse meshes made here take a fraction of a
   // second (0.18 s for NekMesh's 3d_sphere case), the threads pay off in the later stages.
+  // A retry gets what is left of the time budget, not a budget of its own.
+  const auto start = std::chrono::steady_clock::now();
   const auto attempt = [&](const GmshRun& r) {
+    LinearMeshOptions o = options;
+    if (o.timeLimit > 0.0) {
+      const double spent =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      o.timeLimit = std::max(o.timeLimit - spent, 1e-3);
+    }
     const std::string bytes =
-        withGmsh(options, "Gmsh's meshing of " + cad.sourceName(), [&](GmshSession&) {
+        withGmsh(o, "Gmsh's meshing of " + cad.sourceName(), [&](GmshSession&) {
           std::string out;
           appendMeshBytes(out, meshWithGmsh(cad, r));
           return out;
@@ -321,7 +330,7 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
   // Gmsh 4.8's default surface algorithm crashes on some surfaces (a needle-thin cone aborted
   // it from inside a parallel region) and leaves others empty (a sphere of radius 1e6: "Surface
   // 1 consists of no elements"); MeshAdapt meshes both more often. A run stopped by its time
-  // budget or cancelled is not tried again.
+  // budget, cancelled or out of memory is not tried again.
   const auto retry = [&](const std::string& first) {
     GmshRun again = run;
     again.surfaceAlgorithm = kMeshAdapt;
@@ -333,6 +342,8 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
   try {
     mesh = attempt(run);
   } catch (const BudgetExceeded&) {
+    throw;
+  } catch (const OutOfMemory&) {
     throw;
   } catch (const ChildCrashed& crash) {
     try {
@@ -347,6 +358,10 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
     try {
       mesh = retry(failure.what());
     } catch (const BudgetExceeded&) {
+      throw;
+    } catch (const OutOfMemory&) {
+      throw;
+    } catch (const CancelledError&) {
       throw;
     } catch (const Error&) {
       throw failure;  // the first algorithm's message says more

@@ -85,7 +85,7 @@ namespace {
 // Healing numbers a changed model's faces and edges afresh: a boundary layer's faces or a
 // refinement along a CAD curve, given in the original numbering, could land elsewhere.
 void checkRenumbering(const HealingRecord& healing, const MeshingOptions& options) {
-  if (!healing.changed()) return;
+  if (!healing.renumbered) return;
   std::string what;
   if (options.boundaryLayer) what = "the boundary layer";
   if (options.sizing)
@@ -94,7 +94,7 @@ void checkRenumbering(const HealingRecord& healing, const MeshingOptions& option
         what = "a refinement along CAD curve " + std::to_string(s.edge);
   if (!what.empty())
     throw ParameterError("healing changed the CAD (" + healing.actions.front() +
-                         "), which numbers its faces and edges afresh, and " + what +
+                         ") and the numbering of its faces and edges, and " + what +
                          " is given in the original numbering: repair the CAD file, or mesh "
                          "without healing (--no-heal, heal=False, Heal off)");
 }
@@ -426,7 +426,9 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   linearOptions.verbosity = options.verbosity;
   linearOptions.dimensionDone = linearProgress(observer);
   linearOptions.timeLimit = options.linearSeconds;
-  linearOptions.timeLimitName = parameterDefinition("linear_seconds").label;
+  const ParameterDefinition& linearLimit = parameterDefinition("linear_seconds");
+  linearOptions.timeLimitName = std::string(linearLimit.label) + ": " + linearLimit.option +
+                                ", Python " + linearLimit.key + ", FreeCAD " + linearLimit.property;
   if (observer != nullptr)
     linearOptions.cancelRequested = [observer] { return observer->cancelRequested(); };
   linearOptions.note = [&result](const std::string& note) { result.notes.push_back(note); };
@@ -446,11 +448,8 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       linearOptions.minSize = std::min(linearOptions.minSize, src.delta);
   } else {
     linearOptions.size = *options.size;
-    const int dim = modelMeshDimension(*result.cad, normal);
-    checkUniformSize(*result.cad, *options.size, dim);
-    checkPredictedMemory(
-        estimatedElementCount(*result.cad, *options.size, dim), options.order, dim,
-        "meshing " + result.cad->sourceName() + " with size " + formatNumber(*options.size));
+    // (No memory prediction here: the bounding-box estimate of a uniform size is no measure of
+    // it, a thin plate fills little of its box. The linear mesh made is checked instead.)
   }
   // The linear mesh, with its macro boundary layer when one is asked for (timed as its own
   // stage the first time; within the round in repair rounds).

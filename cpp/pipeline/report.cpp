@@ -246,7 +246,7 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
     for (const std::string& a : h.actions) json.value("", a);
     json.endArray();
     // Face numbers (boundary layers, groups) refer to the healed model when it changed.
-    json.value("renumbered", h.changed());
+    json.value("renumbered", h.renumbered);
     json.value("faces_before", h.facesBefore);
     json.value("faces_after", h.facesAfter);
     json.value("solids_before", h.solidsBefore);
