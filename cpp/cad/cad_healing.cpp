@@ -5,6 +5,7 @@
 #include <BRepBuilderAPI_Sewing.hxx>
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepGProp.hxx>
+#include <BRepTools_ReShape.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
@@ -114,7 +115,11 @@ bool sameNumbering(const TopoDS_Shape& before, const TopoDS_Shape& after, double
 struct Findings {
   bool invalid = false, unsewn = false, openSolid = false;
   int smallEdges = 0, smallFaces = 0;
-  bool any() const { return invalid || unsewn || openSolid || smallEdges > 0 || smallFaces > 0; }
+  std::vector<TopoDS_Shape> emptySolids;  // solids without a face (an exporter's leftovers)
+  bool any() const {
+    return invalid || unsewn || openSolid || smallEdges > 0 || smallFaces > 0 ||
+           !emptySolids.empty();
+  }
 };
 
 // `planar`: a model of planar faces in one plane (a 2D case), whose faces are not meant to be
@@ -129,6 +134,12 @@ Findings inspect(const TopoDS_Shape& shape, double diagonal, bool planar,
   if (!BRepCheck_Analyzer(shape).IsValid()) {
     f.invalid = true;
     problems.emplace_back("OpenCASCADE's check finds the shape invalid");
+  }
+  for (int s = 1; s <= solids.Extent(); ++s) {
+    if (count(solids(s), TopAbs_FACE) > 0) continue;
+    if (f.emptySolids.empty())
+      problems.push_back(cadEntityName(3, s) + " has no face (an empty solid)");
+    f.emptySolids.push_back(solids(s));
   }
   if (solids.Extent() == 0 && faces.Extent() > 1 && !planar) {
     f.unsewn = true;
@@ -199,11 +210,11 @@ std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tole
   for (TopExp_Explorer s(solids, TopAbs_SOLID); s.More(); s.Next()) {
     Bnd_Box box;
     BRepBndLib::Add(s.Current(), box);
+    const auto inside = [](const Bnd_Box& inner, const Bnd_Box& outer) {
+      return !outer.IsOut(inner.CornerMin()) && !outer.IsOut(inner.CornerMax());
+    };
     for (const Bnd_Box& other : boxes)
-      if (!box.IsOut(other.CornerMin()) && !box.IsOut(other.CornerMax()))
-        return std::nullopt;
-      else if (!other.IsOut(box.CornerMin()) && !other.IsOut(box.CornerMax()))
-        return std::nullopt;
+      if (inside(other, box) || inside(box, other)) return std::nullopt;
     boxes.push_back(box);
   }
   actions.push_back("sewed the faces (tolerance " + formatNumber(tolerance) + ") into " +
@@ -215,6 +226,13 @@ std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tole
 
 TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal,
                   HealingRecord& record) {
+  if (!found.emptySolids.empty()) {
+    const Handle(BRepTools_ReShape) reshape = new BRepTools_ReShape;
+    for (const TopoDS_Shape& solid : found.emptySolids) reshape->Remove(solid);
+    shape = reshape->Apply(shape);
+    record.actions.push_back("removed " + std::to_string(found.emptySolids.size()) +
+                             (found.emptySolids.size() == 1 ? " empty solid" : " empty solids"));
+  }
   const double tolerance = kTolerance * diagonal;
   bool sewn = false;
   if (found.unsewn || found.openSolid) {
