@@ -32,8 +32,13 @@ for t in $targets; do
             -exec cp {} "$seeds" \; 2>/dev/null ;;
   esac
   echo "fuzz_$t: ${seconds} s"
-  # -rss_limit_mb: the readers must refuse absurd sizes before allocating them.
+  # -rss_limit_mb: the readers must refuse absurd sizes before allocating them. Leaks are not
+  # checked in the STEP harness: OpenCASCADE's STEP reader keeps process-lifetime statics
+  # (XSControl sessions, IFSelect editors) that LeakSanitizer reports at every exit.
+  leaks=1
+  [ "$t" = step ] && leaks=0
   if ! "$build/fuzz/fuzz_$t" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=30 \
+      -detect_leaks=$leaks \
       -max_len=65536 -artifact_prefix="$build/findings/$t/" -print_final_stats=1 \
       "$build/corpus-$t" "$seeds" 2>"$build/findings/$t.log"; then
     echo "fuzz_$t: FINDING, see $build/findings/$t/ and $build/findings/$t.log" >&2
