@@ -223,6 +223,32 @@ void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
   json.endObject();
 }
 
+namespace {
+
+void appendStrings(JsonWriter& json, const std::string& key, const std::vector<std::string>& v) {
+  json.beginArray(key);
+  for (const std::string& text : v) json.value("", text);
+  json.endArray();
+}
+
+void appendHealing(JsonWriter& json, const HealingRecord& h) {
+  json.beginObject("healing");
+  json.value("enabled", h.enabled);
+  json.value("tolerance", h.tolerance);
+  appendStrings(json, "problems", h.problems);
+  appendStrings(json, "actions", h.actions);
+  // Face numbers (boundary layers, groups) are the healed model's when it was renumbered.
+  json.value("renumbered", h.renumbered);
+  json.value("faces_before", h.facesBefore);
+  json.value("faces_after", h.facesAfter);
+  json.value("solids_before", h.solidsBefore);
+  json.value("solids_after", h.solidsAfter);
+  json.value("seconds", h.seconds);
+  json.endObject();
+}
+
+}  // namespace
+
 std::string meshReportJson(const MeshResult& result, const std::string& input) {
   JsonWriter json;
   json.beginObject();
@@ -235,24 +261,7 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
     json.value("vertices", result.cad->numVertices());
     json.value("diagonal", result.cad->boundingDiagonal());
     json.endObject();
-    const HealingRecord& h = result.healing;
-    json.beginObject("healing");
-    json.value("enabled", h.enabled);
-    json.value("tolerance", h.tolerance);
-    json.beginArray("problems");
-    for (const std::string& p : h.problems) json.value("", p);
-    json.endArray();
-    json.beginArray("actions");
-    for (const std::string& a : h.actions) json.value("", a);
-    json.endArray();
-    // Face numbers (boundary layers, groups) refer to the healed model when it changed.
-    json.value("renumbered", h.renumbered);
-    json.value("faces_before", h.facesBefore);
-    json.value("faces_after", h.facesAfter);
-    json.value("solids_before", h.solidsBefore);
-    json.value("solids_after", h.solidsAfter);
-    json.value("seconds", h.seconds);
-    json.endObject();
+    appendHealing(json, result.healing);
   }
   json.value("dimension", result.mesh.dim);
   json.value("order", result.mesh.order);
@@ -272,9 +281,7 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
                     "optimiser_order_" + std::to_string(kContinuationOrder));
   appendRepairRounds(json, result.rounds);
   if (result.boundaryLayer) appendBoundaryLayer(json, result);
-  json.beginArray("notes");
-  for (const std::string& note : result.notes) json.value("", note);
-  json.endArray();
+  appendStrings(json, "notes", result.notes);
   json.beginObject("timings_s");
   for (const auto& [stage, s] : result.timings.seconds) json.value(stage, s);
   json.endObject();
