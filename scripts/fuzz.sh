@@ -37,7 +37,8 @@ for t in $targets; do
   # (XSControl sessions, IFSelect editors) that LeakSanitizer reports at every exit.
   leaks=1
   [ "$t" = step ] && leaks=0
-  if ! "$build/fuzz/fuzz_$t" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=30 \
+  if ! ASAN_OPTIONS="detect_leaks=$leaks" "$build/fuzz/fuzz_$t" -max_total_time="$seconds" \
+      -rss_limit_mb=2048 -timeout=30 \
       -detect_leaks=$leaks \
       -max_len=65536 -artifact_prefix="$build/findings/$t/" -print_final_stats=1 \
       "$build/corpus-$t" "$seeds" 2>"$build/findings/$t.log"; then
