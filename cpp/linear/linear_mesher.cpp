@@ -31,7 +31,13 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Gmsh element type codes of the linear cells we request.
 constexpr int kGmshLine = 1, kGmshTriangle = 2, kGmshTetrahedron = 4, kGmshPoint = 15;
 
-}  // namespace
+// An upper estimate of the elements a uniform `size` makes in the model's bounding box (a
+// cube's worth of regular tetrahedra, or a square's of triangles for dim 2).
+double estimatedElementCount(const CadModel& cad, double size, int dim) {
+  const double d = cad.boundingDiagonal();
+  return dim == 3 ? 8.5 * std::pow(d / std::sqrt(3.0) / size, 3)
+                  : 2.3 * std::pow(d / std::sqrt(2.0) / size, 2);
+}
 
 void checkUniformSize(const CadModel& cad, double size, int dim) {
   if (!(size > 0.0) || !std::isfinite(size))
@@ -51,8 +57,6 @@ void checkUniformSize(const CadModel& cad, double size, int dim) {
     throw ParameterError(msg.str());
   }
 }
-
-namespace {
 
 struct NodeTable {
   std::vector<std::int64_t> byTag;  // gmsh tag -> mesh node id, -1 if none
@@ -281,12 +285,6 @@ std::string withGmsh(const LinearMeshOptions& options, const std::string& what,
 }
 
 }  // namespace
-
-double estimatedElementCount(const CadModel& cad, double size, int dim) {
-  const double d = cad.boundingDiagonal();
-  return dim == 3 ? 8.5 * std::pow(d / std::sqrt(3.0) / size, 3)
-                  : 2.3 * std::pow(d / std::sqrt(2.0) / size, 2);
-}
 
 Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
   GmshRun run;

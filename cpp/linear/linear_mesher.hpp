@@ -48,14 +48,6 @@ struct LinearMeshOptions {
   }
 };
 
-// An upper estimate of the elements a uniform `size` makes in the model's bounding box (a
-// cube's worth of regular tetrahedra, or a square's of triangles for dim 2).
-double estimatedElementCount(const CadModel& cad, double size, int dim);
-
-// Throws ParameterError when a uniform `size` is not a positive number, not smaller than the
-// model, or would make more than 5e7 elements by that estimate (a typo in the size).
-void checkUniformSize(const CadModel& cad, double size, int dim);
-
 // Gmsh meshes on one thread (see linear_mesher.cpp): the same CAD and options give the same
 // mesh every time. Throws ParameterError (bad size), CadError (nothing meshable) or
 // MeshingError.
