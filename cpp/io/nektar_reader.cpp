@@ -18,6 +18,7 @@
 #include "core/format.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
+#include "io/nektar_expansion.hpp"
 #include "io/nektar_format.hpp"
 #include "io/xml_document.hpp"
 
@@ -140,10 +141,10 @@ class Reader {
       const std::map<std::vector<int>, std::vector<std::int64_t>>& faceByVertices);
   void fill(CellType type, const std::vector<std::int64_t>& nodes);
   void toEvenlySpaced();
-  void fillPrism(const ReferenceElement& ref, const std::map<Lattice, std::int64_t>& at,
-                 const std::vector<int>& unknown);
   void fillTransfinite(CellType type, const ReferenceElement& ref,
                        const std::map<Lattice, std::int64_t>& at, const std::vector<int>& unknown);
+  void fillExpansion(CellType type, const std::vector<std::int64_t>& nodes,
+                     const std::vector<int>& unknown);
 
   std::string path_;
   int dim_ = 3;
@@ -611,8 +612,9 @@ std::vector<std::int64_t> Reader::polygonNodes(const std::vector<int>& own,
   return nodes;
 }
 
-// Fills nodes of unknown position by a discrete harmonic extension on the element's lattice
-// (each unknown node the mean of its lattice neighbours), Gauss-Seidel to convergence.
+// Fills nodes of unknown position as Nektar++ builds them: quadrilaterals and hexahedra by
+// transfinite interpolation, triangles, tetrahedra and prisms by their modified basis with
+// interior modes zero.
 void Reader::fill(CellType type, const std::vector<std::int64_t>& nodes) {
   const ReferenceElement& ref = ReferenceElement::get(type, order_);
   std::map<Lattice, std::int64_t> at;
@@ -622,46 +624,10 @@ void Reader::fill(CellType type, const std::vector<std::int64_t>& nodes) {
     if (!known_[nodes[n]]) unknown.push_back(n);
   }
   if (unknown.empty()) return;
-  if (type == CellType::Prism) {
-    fillPrism(ref, at, unknown);
-    return;
-  }
-  if (type == CellType::Quadrilateral || type == CellType::Hexahedron) {
+  if (type == CellType::Quadrilateral || type == CellType::Hexahedron)
     fillTransfinite(type, ref, at, unknown);
-    return;
-  }
-  std::vector<Lattice> stencil{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  if (type == CellType::Triangle || type == CellType::Tetrahedron || type == CellType::Prism)
-    stencil.push_back({1, -1, 0});
-  if (type == CellType::Tetrahedron) {
-    stencil.push_back({1, 0, -1});
-    stencil.push_back({0, 1, -1});
-  }
-  double scale = 0.0;
-  for (const std::int64_t n : nodes)
-    if (known_[n]) scale = std::max(scale, Eigen::Map<const Point>(&mesh_.xyz[3 * n]).norm());
-  for (int sweep = 0; sweep < 10000; ++sweep) {
-    double change = 0.0;
-    for (const int u : unknown) {
-      const Lattice& l = ref.lattice()[u];
-      Point sum = Point::Zero();
-      int count = 0;
-      for (const Lattice& d : stencil)
-        for (const int sign : {-1, 1}) {
-          const Lattice m{l[0] + sign * d[0], l[1] + sign * d[1], l[2] + sign * d[2]};
-          const auto it = at.find(m);
-          if (it == at.end()) continue;
-          sum += Eigen::Map<const Point>(&mesh_.xyz[3 * it->second]);
-          ++count;
-        }
-      double* x = &mesh_.xyz[3 * nodes[u]];
-      const Point next = sum / count;
-      change = std::max(change, (next - Eigen::Map<const Point>(x)).norm());
-      for (int c = 0; c < 3; ++c) x[c] = next[c];
-    }
-    if (change <= 1e-15 * std::max(scale, 1.0)) break;
-  }
-  for (const int u : unknown) known_[nodes[u]] = true;
+  else
+    fillExpansion(type, nodes, unknown);
 }
 
 // A quadrilateral's (hexahedron's) unknown nodes by transfinite (Coons, Gordon-Hall)
@@ -704,58 +670,23 @@ void Reader::fillTransfinite(CellType type, const ReferenceElement& ref,
   for (const int u : unknown) known_[at.at(ref.lattice()[u])] = true;
 }
 
-// A prism's unknown nodes by transfinite (Gordon-Hall) interpolation: at level k of p, the
-// blend (1 - s) B + s T of the bottom and top triangles' nodes above and below (s = k / p),
-// corrected by how far the side faces at that level depart from the same blend, that
-// correction extended into the triangle harmonically (each interior value the mean of its six
-// lattice neighbours). A prism whose columns are straight (a boundary layer's) is rebuilt
-// exactly, as in Nektar++, whose expansion of such a map has no interior modes; averaging
-// across a thin curved prism instead (the plain harmonic extension) moves its interior by the
-// wall's sagitta and inverts it.
-void Reader::fillPrism(const ReferenceElement& ref, const std::map<Lattice, std::int64_t>& at,
-                       const std::vector<int>& unknown) {
-  const int p = order_;
-  const auto x = [&](int a, int b, int c) {
-    return Point(Eigen::Map<const Point>(&mesh_.xyz[3 * at.at({a, b, c})]));
-  };
-  std::vector<char> levelDone(static_cast<std::size_t>(p + 1), 0);
-  for (const int u : unknown) {
-    const int k = ref.lattice()[u][2];
-    if (k <= 0 || k >= p || levelDone[static_cast<std::size_t>(k)] != 0) continue;
-    levelDone[static_cast<std::size_t>(k)] = 1;
-    const double s = double(k) / p;
-    // The correction at this level: known on the triangle's ring, 0 inside to start.
-    std::map<std::pair<int, int>, Point> delta;
-    for (int a = 0; a <= p; ++a)
-      for (int b = 0; a + b <= p; ++b) {
-        const bool ring = a == 0 || b == 0 || a + b == p;
-        delta[{a, b}] =
-            ring ? Point(x(a, b, k) - (1 - s) * x(a, b, 0) - s * x(a, b, p)) : Point(Point::Zero());
-      }
-    double scale = 0.0;
-    for (const auto& [ab, d] : delta) scale = std::max(scale, d.norm());
-    const int steps[6][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, -1}, {-1, 1}};
-    for (int sweep = 0; sweep < 10000 && scale > 0.0; ++sweep) {
-      double change = 0.0;
-      for (auto& [ab, d] : delta) {
-        const auto [a, b] = ab;
-        if (a == 0 || b == 0 || a + b == p) continue;
-        Point sum = Point::Zero();
-        for (const auto& st : steps) sum += delta.at({a + st[0], b + st[1]});
-        const Point next = sum / 6.0;
-        change = std::max(change, (next - d).norm());
-        d = next;
-      }
-      if (change <= 1e-15 * scale) break;
-    }
-    for (int a = 1; a < p; ++a)
-      for (int b = 1; a + b < p; ++b) {
-        const Point v = (1 - s) * x(a, b, 0) + s * x(a, b, p) + delta.at({a, b});
-        double* out = &mesh_.xyz[3 * at.at({a, b, k})];
-        for (int c = 0; c < 3; ++c) out[c] = v[c];
-      }
+// A triangle's, tetrahedron's or prism's interior nodes as Nektar++ builds them: the modified
+// basis's map whose boundary modes come from the edges (faces) and whose interior modes are zero
+// (io/nektar_expansion).
+void Reader::fillExpansion(CellType type, const std::vector<std::int64_t>& nodes,
+                           const std::vector<int>& unknown) {
+  const nektar::ExpansionInteriorMap& map = nektar::interiorFromBoundary(type, order_);
+  if (unknown != map.interior) fail("an element's faces are incomplete");
+  Eigen::MatrixXd boundary(static_cast<Eigen::Index>(map.boundary.size()), 3);
+  for (std::size_t k = 0; k < map.boundary.size(); ++k)
+    boundary.row(static_cast<Eigen::Index>(k)) =
+        Eigen::Map<const Eigen::RowVector3d>(&mesh_.xyz[3 * nodes[map.boundary[k]]]);
+  const Eigen::MatrixXd interior = map.weights * boundary;
+  for (std::size_t k = 0; k < map.interior.size(); ++k) {
+    const std::int64_t node = nodes[map.interior[k]];
+    for (int c = 0; c < 3; ++c) mesh_.xyz[3 * node + c] = interior(static_cast<Eigen::Index>(k), c);
+    known_[node] = true;
   }
-  for (const int u : unknown) known_[at.at(ref.lattice()[u])] = true;
 }
 
 // The curves' points at our node positions (equispaced), from the points types Nektar++ and
@@ -806,6 +737,14 @@ void Reader::toEvenlySpaced() {
       }
       c.points = std::move(out);
       c.type = nektar::kEvenlySpaced;
+    } else if (!quad && c.type == "NodalTriElec" && nektar::hasTriElecPoints(order_)) {
+      const Eigen::MatrixXd& m = nektar::triElecToEvenlySpaced(order_);
+      std::vector<Point> out(c.points.size(), Point::Zero());
+      for (std::size_t r = 0; r < out.size(); ++r)
+        for (std::size_t k = 0; k < out.size(); ++k)
+          out[r] += m(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) * c.points[k];
+      c.points = std::move(out);
+      c.type = nektar::kTriEvenlySpaced;
     } else if (!quad && (c.type == "NodalTriElec" || c.type == "NodalTriFekete")) {
       dropped.push_back(id);
     } else {

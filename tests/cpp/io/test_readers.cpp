@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <gp_Pln.hxx>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -19,6 +20,7 @@
 #include "io/mesh_readers.hpp"
 #include "io/mesh_writers.hpp"
 #include "io/msh_reader.hpp"
+#include "io/nektar_expansion.hpp"
 #include "linear/linear_mesher.hpp"
 #include "peers/gmsh_quality.hpp"
 #include "quality/bezier_jacobian.hpp"
@@ -328,8 +330,8 @@ TEST(NektarXml, RoundTripsPlainAndCompressed) {
 // out tangled (its 3d_bl_cyl: every prism inverted; the sphere in a box at order 6: 294 invalid
 // where Nektar++ finds 10). A straight tetrahedron at order 4 whose edge 0-1 bulges along the
 // parabola x(t) = a + t (b - a) + 4 t (1 - t) h, given at the 5 GLL points: the equispaced
-// nodes read back are the same parabola's, to rounding; an electrostatic triangle's interior
-// points are not used (rebuilt from the edges), and an unknown points type is refused.
+// nodes read back are the same parabola's, to rounding; a triangle given at electrostatic
+// points reads back through its polynomial, and an unknown points type is refused.
 TEST(NektarXml, CurvesAtGaussLobattoPointsAreResampledExactly) {
   const std::vector<double> gll{0.0, 0.5 - std::sqrt(21.0) / 14.0, 0.5,
                                 0.5 + std::sqrt(21.0) / 14.0, 1.0};  // on [0, 1], 5 points
@@ -390,13 +392,37 @@ TEST(NektarXml, CurvesAtGaussLobattoPointsAreResampledExactly) {
   }
   EXPECT_GE(checked, 3U);
   EXPECT_EQ(evaluateQuality(m).invalid, 0U);
-  // A triangle at electrostatic points: its points are not used, the element still reads.
+  // Face 0 (vertices 0, 1, 2) curved at NodalTriElec points: the map
+  // F(x, y) = (x, y, 0) + 4 x (1 - x - y) h + 27 x y (1 - x - y) g, whose edge y = 0 is the
+  // parabola above and whose other edges are straight, given at the electrostatic points of
+  // order 4: the face's equispaced nodes read back are F's.
+  const Eigen::Vector3d g(0.02, -0.03, 0.08);
+  const auto faceMap = [&](double x, double y) {
+    return Eigen::Vector3d(Eigen::Vector3d(x, y, 0) + 4 * x * (1 - x - y) * h +
+                           27 * x * y * (1 - x - y) * g);
+  };
   std::ostringstream tri;
+  tri.precision(17);
   tri << R"(<F ID="1" FACEID="0" NUMPOINTS="15" TYPE="NodalTriElec">)";
-  for (int k = 0; k < 15; ++k) tri << "9 9 9 ";  // nonsense: must not be used
+  for (const auto& [x, y] : nektar::triElecPoints(4))
+    tri << faceMap(x, y).x() << ' ' << faceMap(x, y).y() << ' ' << faceMap(x, y).z() << ' ';
   tri << "</F>";
   const Mesh withTriangle = readMesh(file("GaussLobattoLegendre", tri.str()));
-  for (const double c : withTriangle.xyz) EXPECT_LT(c, 2.0);
+  const ElementBlock& tet = withTriangle.blocks[0];
+  // Resampling: row sums of the resampling matrix (its Lebesgue constant, about 1.4) times
+  // values of size <= 1.2, times the relative error of its solve (condition number 10).
+  const double bound = 1e3 * std::numeric_limits<double>::epsilon() *
+                       nektar::triElecToEvenlySpaced(4).cwiseAbs().rowwise().sum().maxCoeff();
+  int faceNodes = 0;
+  for (int n = 0; n < ref.numNodes(); ++n) {
+    const LatticePoint& l = ref.lattice()[static_cast<std::size_t>(n)];
+    if (l[2] != 0) continue;
+    const Eigen::Vector3d x(&withTriangle.xyz[3 * static_cast<std::size_t>(tet.element(0)[n])]);
+    EXPECT_LE((x - faceMap(l[0] / 4.0, l[1] / 4.0)).norm(), bound)
+        << "face node (" << l[0] << ", " << l[1] << ")";
+    ++faceNodes;
+  }
+  EXPECT_EQ(faceNodes, 15);
   EXPECT_THROW(readMesh(file("GaussRadauMLegendre", "")), IoError);
 }
 
