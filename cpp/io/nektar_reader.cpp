@@ -739,6 +739,10 @@ void Reader::toEvenlySpaced() {
       c.type = nektar::kEvenlySpaced;
     } else if (!quad && c.type == "NodalTriElec" && nektar::hasTriElecPoints(order_)) {
       const Eigen::MatrixXd& m = nektar::triElecToEvenlySpaced(order_);
+      if (c.points.size() != static_cast<std::size_t>(m.rows()))
+        fail("face " + std::to_string(id) + "'s curve has " + std::to_string(c.points.size()) +
+             " points; a triangle of order " + std::to_string(order_) + " needs " +
+             std::to_string(m.rows()));
       std::vector<Point> out(c.points.size(), Point::Zero());
       for (std::size_t r = 0; r < out.size(); ++r)
         for (std::size_t k = 0; k < out.size(); ++k)

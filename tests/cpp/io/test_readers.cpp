@@ -401,13 +401,20 @@ TEST(NektarXml, CurvesAtGaussLobattoPointsAreResampledExactly) {
     return Eigen::Vector3d(Eigen::Vector3d(x, y, 0) + 4 * x * (1 - x - y) * h +
                            27 * x * y * (1 - x - y) * g);
   };
-  std::ostringstream tri;
-  tri.precision(17);
-  tri << R"(<F ID="1" FACEID="0" NUMPOINTS="15" TYPE="NodalTriElec">)";
-  for (const auto& [x, y] : nektar::triElecPoints(4))
-    tri << faceMap(x, y).x() << ' ' << faceMap(x, y).y() << ' ' << faceMap(x, y).z() << ' ';
-  tri << "</F>";
-  const Mesh withTriangle = readMesh(file("GaussLobattoLegendre", tri.str()));
+  // The face's curve with its first `count` points.
+  const auto faceCurve = [&](std::size_t count) {
+    std::ostringstream tri;
+    tri.precision(17);
+    tri << R"(<F ID="1" FACEID="0" NUMPOINTS=")" << count << R"(" TYPE="NodalTriElec">)";
+    const auto points = nektar::triElecPoints(4);
+    for (std::size_t k = 0; k < count; ++k) {
+      const Eigen::Vector3d x = faceMap(points[k][0], points[k][1]);
+      tri << x.x() << ' ' << x.y() << ' ' << x.z() << ' ';
+    }
+    tri << "</F>";
+    return tri.str();
+  };
+  const Mesh withTriangle = readMesh(file("GaussLobattoLegendre", faceCurve(15)));
   const ElementBlock& tet = withTriangle.blocks[0];
   // Resampling: row sums of the resampling matrix (its Lebesgue constant, about 1.4) times
   // values of size <= 1.2, times the relative error of its solve (condition number 10).
@@ -423,6 +430,14 @@ TEST(NektarXml, CurvesAtGaussLobattoPointsAreResampledExactly) {
     ++faceNodes;
   }
   EXPECT_EQ(faceNodes, 15);
+  // The same face with a point missing is refused by name, not read past its end.
+  try {
+    readMesh(file("GaussLobattoLegendre", faceCurve(14)));
+    ADD_FAILURE() << "a face with 14 of its 15 points was read";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("face 0's curve has 14 points"), std::string::npos)
+        << e.what();
+  }
   EXPECT_THROW(readMesh(file("GaussRadauMLegendre", "")), IoError);
 }
 
