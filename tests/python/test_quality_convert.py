@@ -197,3 +197,25 @@ def test_convert_errors_name_the_problem(homesh_bin, tmp_path):
     r = run([homesh_bin, "quality", garbage])
     assert r.returncode != 0 and "garbage.msh" in r.stderr
     assert r.stderr.count("\n") == 1, r.stderr  # one line, no trace
+
+
+def test_nektar_output_is_checked_as_nektar_builds_it(homesh_bin, tmp_path):
+    """Nektar++ rebuilds element interiors from the faces, so a written .xml is read back and
+    checked as Nektar++ will build it: NekMesh's tangled sphere_box_o6 file, passed through, is
+    reported with its invalid elements; a valid mesh is reported with none."""
+    nektar = PEERS.parent / "nektar-xml" / "sphere_box_o6_varopti.xml"
+    r = run([homesh_bin, "convert", nektar, "-o", tmp_path / "t.xml"])
+    assert r.returncode == 0, r.stderr
+    line = [s for s in r.stderr.splitlines() if "as Nektar++ builds it" in s]
+    assert len(line) == 1, r.stderr
+    invalid = int(line[0].split("; ")[1].split()[0])
+    assert invalid > 0, line[0]
+    # Quiet, a bad geometry is still said; a good one is not.
+    r = run([homesh_bin, "convert", nektar, "-o", tmp_path / "t.xml", "-q"])
+    assert "as Nektar++ builds it" in r.stderr
+    r = run([homesh_bin, "convert", CUBE_SPHERE, "-o", tmp_path / "c.xml"])
+    assert r.returncode == 0, r.stderr
+    assert "as Nektar++ builds it (element interiors from the faces): scaled Jacobian min" in \
+        r.stderr and "; 0 invalid, 0 undecided" in r.stderr, r.stderr
+    r = run([homesh_bin, "convert", CUBE_SPHERE, "-o", tmp_path / "c.xml", "-q"])
+    assert r.returncode == 0 and r.stderr == "", r.stderr
