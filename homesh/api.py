@@ -3,6 +3,7 @@
 import json
 import numbers
 import os
+import warnings
 import zipfile
 from dataclasses import dataclass
 
@@ -171,6 +172,16 @@ class HighOrderMesh:
             pairs.append((str(name), [_check_int("group %s entity" % name, e)
                                       for e in entities]))
         self._core.write(path, bool(binary), bool(compressed), pairs)
+        if path.lower().endswith(".xml"):
+            # Nektar++ rebuilds 3D element interiors from the faces: the solver's geometry is the
+            # file read back, not this mesh. Say so when that geometry is not proven valid.
+            q = read(path).quality()
+            if q["invalid_elements"] + q["undecided_elements"] > 0:
+                warnings.warn(
+                    "%s as Nektar++ builds it (element interiors from the faces): scaled "
+                    "Jacobian min %.4f; %d invalid, %d undecided"
+                    % (path, q["min"], q["invalid_elements"], q["undecided_elements"]),
+                    stacklevel=2)
 
     def _save_npz(self, path):
         arrays = {

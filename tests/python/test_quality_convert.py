@@ -219,3 +219,15 @@ def test_nektar_output_is_checked_as_nektar_builds_it(homesh_bin, tmp_path):
         r.stderr and "; 0 invalid, 0 undecided" in r.stderr, r.stderr
     r = run([homesh_bin, "convert", CUBE_SPHERE, "-o", tmp_path / "c.xml", "-q"])
     assert r.returncode == 0 and r.stderr == "", r.stderr
+
+
+def test_python_write_warns_when_nektar_geometry_is_not_valid(tmp_path):
+    """HighOrderMesh.write to .xml says, as a warning, when the geometry Nektar++ builds from the
+    file (element interiors from the faces) is not proven valid, and is silent when it is."""
+    import warnings
+    nektar = read(PEERS.parent / "nektar-xml" / "sphere_box_o6_varopti.xml")
+    with pytest.warns(UserWarning, match="as Nektar..? builds it.*[1-9][0-9]* invalid"):
+        nektar.write(tmp_path / "t.xml")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        read(CUBE_SPHERE).write(tmp_path / "c.xml")
