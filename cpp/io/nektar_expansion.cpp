@@ -98,14 +98,14 @@ double modifiedTriMode(int p, int q, const std::array<double, 3>& lambda) {
 // A mode at a point of our (Gmsh's) reference element, in Nektar++'s local numbering of the
 // vertices (the reader's Gmsh local order of a tetrahedron is Nektar++'s; its prism's Gmsh
 // vertices 0, 1, 2, 3, 4, 5 are Nektar++'s 4, 1, 0, 5, 2, 3).
-double modeAt(CellType type, int order, const Mode& m, double x, double y, double z) {
+double modeAt(CellType type, const Mode& m, double x, double y, double z) {
   if (type == CellType::Triangle) return modifiedTriMode(m.p, m.q, {1.0 - x - y, x, y});
   if (type == CellType::Tetrahedron)
-    return modifiedTetMode(order, m.p, m.q, m.r, {1.0 - x - y - z, x, y, z});
+    return modifiedTetMode(m.p, m.q, m.r, {1.0 - x - y - z, x, y, z});
   // Nektar++'s prism: xi1 from its vertex 0 to 1 (our y = 0 .. x = 1), xi2 from 0 to 3 (our
   // z), xi3 from 0 to 4 (our x + y = 1 .. 0).
   const double xi1 = 2.0 * x - 1.0, xi2 = 2.0 * z - 1.0, xi3 = 1.0 - 2.0 * (x + y);
-  return modifiedPrismMode(order, m.p, m.q, m.r, {xi1, xi2, xi3});
+  return modifiedPrismMode(m.p, m.q, m.r, {xi1, xi2, xi3});
 }
 
 ExpansionInteriorMap buildMap(CellType type, int order) {
@@ -155,8 +155,8 @@ ExpansionInteriorMap buildMap(CellType type, int order) {
   Eigen::MatrixXd modeValues(n, static_cast<Eigen::Index>(modes.size()));
   for (Eigen::Index k = 0; k < n; ++k)
     for (std::size_t m = 0; m < modes.size(); ++m)
-      modeValues(k, static_cast<Eigen::Index>(m)) = modeAt(
-          type, order, modes[m], samples(k, 0), samples(k, 1), dim > 2 ? samples(k, 2) : 0.0);
+      modeValues(k, static_cast<Eigen::Index>(m)) =
+          modeAt(type, modes[m], samples(k, 0), samples(k, 1), dim > 2 ? samples(k, 2) : 0.0);
   const Eigen::MatrixXd atNodes =
       orthogonalAt(ref.nodes()) * orthogonalAt(samples).partialPivLu().solve(modeValues);
 
@@ -288,8 +288,7 @@ bool isInteriorPrismMode(int p, int q, int r) {
   return p >= 2 && q >= 2 && r >= 1;
 }
 
-double modifiedPrismMode(int order, int p, int q, int r, const std::array<double, 3>& xi) {
-  (void)order;
+double modifiedPrismMode(int p, int q, int r, const std::array<double, 3>& xi) {
   const double eta1 = 2.0 * (1.0 + xi[0]) / (1.0 - xi[2]) - 1.0;
   // Nektar++ completes the modes of the collapsed edge (vertices 4 to 5) so they do not
   // depend on eta1 there: the (0, q, 1) functions lose their (1 - eta1)/2 factor.
@@ -297,8 +296,7 @@ double modifiedPrismMode(int order, int p, int q, int r, const std::array<double
   return modA(p, eta1) * modA(q, xi[1]) * modB(p, r, xi[2]);
 }
 
-double modifiedTetMode(int order, int p, int q, int r, const std::array<double, 4>& lambda) {
-  (void)order;
+double modifiedTetMode(int p, int q, int r, const std::array<double, 4>& lambda) {
   const double s1 = lambda[0] + lambda[1], s2 = s1 + lambda[2];
   const double eta1 = (lambda[1] - lambda[0]) / s1;
   const double eta2 = (lambda[2] - s1) / s2;

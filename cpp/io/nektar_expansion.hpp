@@ -19,7 +19,7 @@
 
 namespace homesh::nektar {
 
-// Interior nodes of a tetrahedron or prism from its boundary nodes, on the equispaced
+// Interior nodes of a triangle, tetrahedron or prism from its boundary nodes, on the equispaced
 // Gmsh-ordered lattice of `order`: interior = weights * boundary (rows of the nodes'
 // coordinates). The element's local vertices are Nektar++'s as the reader orders them.
 struct ExpansionInteriorMap {
@@ -30,12 +30,12 @@ struct ExpansionInteriorMap {
 // Shared and built once per shape and order (thread-safe); order 1 to kMaxOrder.
 const ExpansionInteriorMap& interiorFromBoundary(CellType type, int order);
 
-// Value of the modified basis's mode (p, q, r) with order + 1 modes per direction, with
+// Value of the modified basis's mode (p, q, r) (its form does not depend on the order), with
 // Nektar++'s treatment of the collapsed vertex and edges. A tetrahedron's at barycentric point
 // `lambda` (Nektar++'s vertices 0..3; lambda0 + lambda1 > 0 and lambda3 < 1), a prism's at
 // reference point `xi` in [-1, 1]^3 (xi3 < 1). Exposed for tests.
-double modifiedTetMode(int order, int p, int q, int r, const std::array<double, 4>& lambda);
-double modifiedPrismMode(int order, int p, int q, int r, const std::array<double, 3>& xi);
+double modifiedTetMode(int p, int q, int r, const std::array<double, 4>& lambda);
+double modifiedPrismMode(int p, int q, int r, const std::array<double, 3>& xi);
 bool isInteriorTetMode(int p, int q, int r);
 bool isInteriorPrismMode(int p, int q, int r);
 
