@@ -20,7 +20,7 @@ namespace homesh {
 namespace {
 
 std::string writeFile(const std::string& name, const std::string& text) {
-  const std::string path = (test::tempDir() / name).string();
+  std::string path = (test::tempDir() / name).string();
   std::ofstream(path, std::ios::binary) << text;
   return path;
 }
