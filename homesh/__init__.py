@@ -8,7 +8,7 @@ Usable from FreeCAD's Python console, from ``freecadcmd`` and from plain Python 
     m.elements         # (E, nodes per element) int64, Gmsh node order
     m.quality()        # per-element scaled Jacobian and summary
     m.write("out.msh") # .msh (Gmsh 4.1), .vtu (VTK), .xml (Nektar++), .npz (arrays)
-    homesh.read("mesh.msh")  # a mesh file (.msh 2.2/4.1, Nektar++ .xml) with its quality
+    homesh.read("mesh.msh")  # a mesh file (.msh 2.2/4.1, Nektar++ .xml, FEM's .unv/.vtk/.vtu)
 
 Every failure raises a subclass of :class:`HOMeshError`; the meshing core never takes the host
 process down.

@@ -222,8 +222,11 @@ def parameters():
 
 
 def read(path, threads=1):
-    """Reads a mesh file: .msh (Gmsh 2.2 or 4.1, ASCII or binary) or .xml (Nektar++, plain or
-    compressed), and evaluates its quality."""
+    """Reads a mesh file: .msh (Gmsh 2.2 or 4.1, ASCII or binary), .xml (Nektar++, plain or
+    compressed), or FreeCAD FEM's .unv (I-DEAS), .vtk (legacy VTK) and .vtu (VTK XML), linear or
+    quadratic, and evaluates its quality. Solids a FEM file lists left-handed (FreeCAD's VTK
+    export) are read mirrored: ``report()["notes"]`` says so. Raises FileError naming the file,
+    the line or data array and the element."""
     return HighOrderMesh(_core.read_mesh(os.fspath(path), _check_int("threads", threads)))
 
 

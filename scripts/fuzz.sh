@@ -3,12 +3,13 @@
 # build-fuzz/ and runs each for SECONDS (default 600) on the seeds in tests/data and
 # ../shared/peer-cases. Findings land in build-fuzz/findings/TARGET/ (crash-*, leak-*, timeout-*);
 # a finding fails the script. Not part of CI's default run.
-#   scripts/fuzz.sh [SECONDS] [TARGET...]     TARGET: msh nektar mcf step (default: all)
+#   scripts/fuzz.sh [SECONDS] [TARGET...]     TARGET: msh nektar mcf step unv vtk vtu (default:
+#                                             all)
 set -eu
 cd "$(dirname "$0")/.."
 seconds=${1:-600}
 [ $# -gt 0 ] && shift
-targets=${*:-msh nektar mcf step}
+targets=${*:-msh nektar mcf step unv vtk vtu}
 build=build-fuzz
 if [ ! -f "$build/CMakeCache.txt" ]; then
   CXX=clang++ cmake -S . -B "$build" -DHOMESH_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -28,6 +29,7 @@ for t in $targets; do
     msh) find tests/data "$shared" -name '*.msh' -size -2M -exec cp {} "$seeds" \; 2>/dev/null ;;
     nektar) find tests/data "$shared" -name '*.xml' -size -2M -exec cp {} "$seeds" \; 2>/dev/null ;;
     mcf) find tests/data "$shared" -name '*.mcf' -exec cp {} "$seeds" \; 2>/dev/null ;;
+    unv | vtk | vtu) find tests/data -name "*.$t" -size -2M -exec cp {} "$seeds" \; 2>/dev/null ;;
     step) find tests/data "$shared" \( -name '*.step' -o -name '*.stp' \) -size -1M \
             -exec cp {} "$seeds" \; 2>/dev/null ;;
   esac

@@ -436,8 +436,8 @@ options:
   if (topic == "quality")
     return R"(usage: homesh quality INPUT [options]
 
-Prints the quality of a mesh (.msh 2.2 or 4.1, ASCII or binary; .xml Nektar++): per element
-type, the certified scaled Jacobian (Bezier bounds, as Gmsh's AnalyseMeshQuality) and the
+Prints the quality of a mesh (.msh 2.2 or 4.1, ASCII or binary; .xml Nektar++; FreeCAD FEM's
+.unv, .vtk and .vtu, linear or quadratic): per element type, the certified scaled Jacobian (Bezier bounds, as Gmsh's AnalyseMeshQuality) and the
 distortion against the straight-sided elements, worst, mean and histogram, and the number of
 invalid elements.
 
@@ -450,8 +450,8 @@ options:
   if (topic == "convert")
     return R"(usage: homesh convert INPUT -o OUTPUT [options]
 
-Converts a mesh between Gmsh MSH (2.2/4.1 in, 4.1 out), VTU (out) and Nektar++ XML, with
-the quality fields.
+Converts a mesh between Gmsh MSH (2.2/4.1 in, 4.1 out), VTU, Nektar++ XML, and from UNV and
+legacy VTK, with the quality fields.
 
 options:
   -o, --output FILE   .msh, .vtu or .xml; repeatable
@@ -465,8 +465,8 @@ options:
   if (topic == "optimise" || topic == "optimize")
     return R"(usage: homesh optimise INPUT [-o OUTPUT] [options]
 
-Curves the interior of a high-order mesh (.msh 2.2 or 4.1, .xml Nektar++) by minimising a
-variational energy node by node (Newton steps, parallel by node colours). Nodes on the
+Curves the interior of a high-order mesh (.msh 2.2 or 4.1, .xml Nektar++, .unv, .vtk, .vtu) by
+minimising a variational energy node by node (Newton steps, parallel by node colours). Nodes on the
 boundary, on interfaces between volumes and on the file's boundary cells stay fixed. Prints the worst certified scaled Jacobian and the invalid count after every sweep; the
 mesh returned is never worse than the input in either.
 

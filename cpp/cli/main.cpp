@@ -278,21 +278,31 @@ void printQuality(std::FILE* out, const std::string& input, const homesh::Mesh& 
                    double(k + 1) / homesh::Histogram::kBins, q.scaled.histogram.counts[k]);
 }
 
+// Reads a mesh file, printing on stderr (unless quiet) what reading changed.
+homesh::Mesh readMeshFile(const std::string& path, bool quiet, std::vector<std::string>& notes) {
+  homesh::Mesh mesh = homesh::readMesh(path, &notes);
+  if (!quiet)
+    for (const std::string& note : notes) std::fprintf(stderr, "homesh: note: %s\n", note.c_str());
+  return mesh;
+}
+
 int runQuality(const homesh::QualityCommand& cmd) {
   checkOutputs(cmd.common, cmd.input);
-  const homesh::Mesh mesh = homesh::readMesh(cmd.input);
+  std::vector<std::string> notes;
+  const homesh::Mesh mesh = readMeshFile(cmd.input, cmd.common.quiet, notes);
   const homesh::QualitySummary q = homesh::evaluateQuality(mesh, cmd.common.threads);
   if (!cmd.common.quiet)
     printQuality(cmd.common.report && *cmd.common.report == "-" ? stderr : stdout, cmd.input, mesh,
                  q);
   if (cmd.common.report)
-    writeReport(*cmd.common.report, homesh::qualityReportJson(mesh, q, cmd.input));
+    writeReport(*cmd.common.report, homesh::qualityReportJson(mesh, q, cmd.input, notes));
   return cmd.strict && (q.invalid > 0 || q.undecided > 0) ? 3 : 0;
 }
 
 int runConvert(const homesh::ConvertCommand& cmd) {
   checkOutputs(cmd.common, cmd.input);
-  const homesh::Mesh mesh = homesh::readMesh(cmd.input);
+  std::vector<std::string> notes;
+  const homesh::Mesh mesh = readMeshFile(cmd.input, cmd.common.quiet, notes);
   const homesh::QualitySummary q = homesh::evaluateQuality(mesh, cmd.common.threads);
   for (const std::string& path : cmd.common.outputs) {
     homesh::writeMesh(mesh, path, homesh::qualityFields(q), writeOptions(cmd.common));
@@ -326,7 +336,8 @@ int runOptimise(const homesh::OptimiseCommand& cmd) {
   options.regionLayers = cmd.regionLayers;
   options.focusPasses = cmd.focusPasses;
   options.freeInterfaces = cmd.freeInterfaces;
-  homesh::Mesh mesh = homesh::readMesh(cmd.input);
+  std::vector<std::string> notes;
+  homesh::Mesh mesh = readMeshFile(cmd.input, c.quiet, notes);
   if (cmd.order && *cmd.order != mesh.order) mesh = homesh::changeOrder(mesh, *cmd.order, nullptr);
   SweepLog log;
   const homesh::OptimiserResult r = homesh::optimiseMesh(mesh, options, c.quiet ? nullptr : &log);
@@ -353,7 +364,7 @@ int runOptimise(const homesh::OptimiseCommand& cmd) {
     homesh::writeMesh(mesh, path, homesh::qualityFields(q), writeOptions(c));
     if (!c.quiet) std::fprintf(stderr, "homesh: wrote %s\n", path.c_str());
   }
-  if (c.report) writeReport(*c.report, homesh::optimiseReportJson(mesh, q, r, cmd.input));
+  if (c.report) writeReport(*c.report, homesh::optimiseReportJson(mesh, q, r, cmd.input, notes));
   checkNektarOutputs(c.outputs, c.threads, c.quiet);
   return 0;
 }

@@ -302,6 +302,20 @@ std::vector<int> nodePermutationFromGmsh(CellType type, int order, NodeConventio
   return perm;
 }
 
+std::vector<int> mirrorPermutation(CellType type, int order) {
+  const std::vector<LatticePoint> gmsh = latticeOrder(type, order, NodeConvention::Gmsh);
+  std::map<LatticePoint, int> index;
+  for (int i = 0; i < static_cast<int>(gmsh.size()); ++i) index[gmsh[i]] = i;
+  std::vector<int> perm;
+  perm.reserve(gmsh.size());
+  for (const LatticePoint& c : gmsh) {
+    const LatticePoint m =
+        type == CellType::Line ? LatticePoint{order - c[0], 0, 0} : LatticePoint{c[1], c[0], c[2]};
+    perm.push_back(index.at(m));
+  }
+  return perm;
+}
+
 std::array<int, 4> simplexBarycentric(const LatticePoint& c, int dim, int order) {
   std::array<int, 4> a{0, 0, 0, 0};
   a[0] = order;

@@ -36,6 +36,13 @@ std::vector<LatticePoint> latticeOrder(CellType type, int order, NodeConvention 
 // perm[i] = index, in Gmsh order, of the i-th node in `convention` order.
 std::vector<int> nodePermutationFromGmsh(CellType type, int order, NodeConvention convention);
 
+// The nodes of the element's mirror image: perm[i] = index, in Gmsh order, of the node that
+// takes the place of node i when the first two reference axes are swapped (for a line, when
+// it is reversed). Listing an element's nodes as nodes[perm[i]] describes the same curved
+// element with the opposite orientation (its Jacobian changes sign everywhere); perm is its
+// own inverse. Readers use it for files written in the mirrored convention.
+std::vector<int> mirrorPermutation(CellType type, int order);
+
 // Integer barycentric coordinates (a0, a1, ..., ad) of a simplex lattice point: a_k = c_{k-1}
 // for k >= 1 and a0 = P - sum. For simplices only.
 std::array<int, 4> simplexBarycentric(const LatticePoint& c, int dim, int order);

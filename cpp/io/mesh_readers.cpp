@@ -8,17 +8,23 @@
 #include "core/input_file.hpp"
 #include "io/msh_reader.hpp"
 #include "io/nektar_reader.hpp"
+#include "io/unv_reader.hpp"
+#include "io/vtk_readers.hpp"
 
 namespace homesh {
 
-Mesh readMesh(const std::string& path) {
+Mesh readMesh(const std::string& path, std::vector<std::string>* notes) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   requireRegularFile(path, "mesh file");
   if (ext == ".msh") return readMsh(path);
   if (ext == ".xml") return readNektarXml(path);
-  throw IoError("cannot read '" + path + "': unknown mesh format '" + ext + "' (use .msh or .xml)");
+  if (ext == ".unv") return readUnv(path, notes);
+  if (ext == ".vtk") return readLegacyVtk(path, notes);
+  if (ext == ".vtu") return readVtu(path, notes);
+  throw IoError("cannot read '" + path + "': unknown mesh format '" + ext +
+                "' (use .msh, .xml, .unv, .vtk or .vtu)");
 }
 
 }  // namespace homesh

@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "core/error.hpp"
-#include "element/node_ordering.hpp"
 #include "io/atomic_file.hpp"
 #include "io/base64.hpp"
+#include "io/vtk_cells.hpp"
 
 namespace homesh {
 
@@ -62,39 +62,6 @@ class DataArrays {
   std::string appendix_;
 };
 
-std::uint8_t vtkLagrangeType(CellType type) {
-  switch (type) {
-    case CellType::Line:
-      return 68;
-    case CellType::Triangle:
-      return 69;
-    case CellType::Quadrilateral:
-      return 70;
-    case CellType::Tetrahedron:
-      return 71;
-    case CellType::Hexahedron:
-      return 72;
-    case CellType::Prism:
-      return 73;
-    case CellType::Pyramid:
-      return 74;
-    default:
-      throw ParameterError("no VTK Lagrange cell for " + cellShortName(type));
-  }
-}
-
-// VTK 9 renumbered the Lagrange hexahedron: files older than version 2.2 list the nodes of
-// edges 10 and 11 (the vertical edges through vertices 2-6 and 3-7) the other way round, and
-// VTK's reader swaps them back. We write version 1.0, which every reader (meshio included)
-// accepts, so the hexahedra carry the version-1 numbering.
-void swapToFileVersion1HexEdges(std::vector<int>& perm, int order) {
-  const auto perEdge = static_cast<std::size_t>(order - 1);
-  const std::size_t edge10 = 8 + 10 * perEdge;
-  std::swap_ranges(perm.begin() + static_cast<std::ptrdiff_t>(edge10),
-                   perm.begin() + static_cast<std::ptrdiff_t>(edge10 + perEdge),
-                   perm.begin() + static_cast<std::ptrdiff_t>(edge10 + perEdge));
-}
-
 }  // namespace
 
 void writeVtu(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields,
@@ -106,8 +73,9 @@ void writeVtu(const Mesh& mesh, const std::string& path, const std::vector<CellF
   std::vector<std::int32_t> entity;
   for (const ElementBlock& block : mesh.blocks) {
     if (cellDimension(block.type) != mesh.dim) continue;
-    std::vector<int> perm = nodePermutationFromGmsh(block.type, block.order, NodeConvention::Vtk);
-    if (block.type == CellType::Hexahedron) swapToFileVersion1HexEdges(perm, block.order);
+    // File version 1.0, which every reader (meshio included) accepts: hexahedra carry VTK's
+    // version-1 numbering, which VTK 9 renumbers on reading.
+    const std::vector<int> perm = vtkPermutationFromGmsh(block.type, block.order, true);
     for (std::size_t e = 0; e < block.count(); ++e) {
       const std::int64_t* nodes = block.element(e);
       for (const int k : perm) connectivity.push_back(nodes[k]);

@@ -294,7 +294,8 @@ namespace {
 // The report of a mesh file: input, dimension, order, counts, quality, and the optimiser's
 // record when there is one.
 std::string fileReportJson(const Mesh& mesh, const QualitySummary& quality,
-                           const OptimiserResult* optimiser, const std::string& input) {
+                           const OptimiserResult* optimiser, const std::string& input,
+                           const std::vector<std::string>& notes) {
   JsonWriter json;
   json.beginObject();
   json.value("input", input);
@@ -304,6 +305,7 @@ std::string fileReportJson(const Mesh& mesh, const QualitySummary& quality,
   appendCounts(json, mesh);
   appendQuality(json, mesh, quality);
   if (optimiser != nullptr) appendOptimiser(json, *optimiser);
+  appendStrings(json, "notes", notes);
   json.endObject();
   return json.str();
 }
@@ -311,8 +313,8 @@ std::string fileReportJson(const Mesh& mesh, const QualitySummary& quality,
 }  // namespace
 
 std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
-                              const std::string& input) {
-  return fileReportJson(mesh, quality, nullptr, input);
+                              const std::string& input, const std::vector<std::string>& notes) {
+  return fileReportJson(mesh, quality, nullptr, input, notes);
 }
 
 void appendOptimiser(JsonWriter& json, const OptimiserResult& r, const std::string& key) {
@@ -359,8 +361,9 @@ void appendOptimiser(JsonWriter& json, const OptimiserResult& r, const std::stri
 }
 
 std::string optimiseReportJson(const Mesh& mesh, const QualitySummary& quality,
-                               const OptimiserResult& result, const std::string& input) {
-  return fileReportJson(mesh, quality, &result, input);
+                               const OptimiserResult& result, const std::string& input,
+                               const std::vector<std::string>& notes) {
+  return fileReportJson(mesh, quality, &result, input, notes);
 }
 
 void appendRepairRounds(JsonWriter& json, const std::vector<RepairRound>& rounds) {

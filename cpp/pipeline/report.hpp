@@ -48,9 +48,10 @@ std::string meshReportJson(const MeshResult& result, const std::string& input);
 // Appends "rounds": one record per repair round (pipeline/repair.hpp), in order; [] when none ran.
 void appendRepairRounds(JsonWriter& json, const std::vector<RepairRound>& rounds);
 
-// The report of `homesh quality`: input, order, counts, quality.
+// The report of `homesh quality`: input, order, counts, quality, and "notes" (what reading the
+// file changed, from readMesh).
 std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
-                              const std::string& input);
+                              const std::string& input, const std::vector<std::string>& notes = {});
 
 // Appends "optimiser": {functional, iterations, worst_before, worst_after, invalid_before,
 // invalid_after, seconds, ...} with the per-sweep history.
@@ -59,6 +60,7 @@ void appendOptimiser(JsonWriter& json, const OptimiserResult& result,
 
 // The report of `homesh optimise`: the quality report of the result plus "optimiser".
 std::string optimiseReportJson(const Mesh& mesh, const QualitySummary& quality,
-                               const OptimiserResult& result, const std::string& input);
+                               const OptimiserResult& result, const std::string& input,
+                               const std::vector<std::string>& notes = {});
 
 }  // namespace homesh

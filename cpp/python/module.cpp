@@ -646,7 +646,7 @@ PyMesh readMeshFile(const std::string& path, int threads) {
   std::unique_ptr<MeshResult> result = std::make_unique<MeshResult>();
   {
     const ReleaseGil nogil;
-    result->mesh = readMesh(path);
+    result->mesh = readMesh(path, &result->notes);
     result->quality = evaluateQuality(result->mesh, threads);
   }
   result->options.order = result->mesh.order;

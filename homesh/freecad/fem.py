@@ -1,5 +1,8 @@
 """FreeCAD FEM both ways.
 
+Quality: :func:`read_fem_mesh` gives a ``Fem::FemMesh`` as it is (linear or quadratic, every
+cell) with the certified validity of its curved elements, read from FEM's own UNV writer.
+
 In: the nodes and tetrahedra of a ``Fem::FemMesh`` (FEM's Gmsh or Netgen mesher, first or
 second order: only the corner nodes are used), for :func:`homesh.curve` to put on the CAD and
 curve. Out: a ``Fem::FemMesh`` of order 2 at most (what FEM's solvers and post-processing hold)
@@ -10,6 +13,10 @@ Node orders: Gmsh's (ours) and SMESH's (FEM's) tetrahedra are oriented oppositel
 three corners turn clockwise seen from the fourth) and number the mid-edge nodes differently;
 ``_SMESH_FROM_GMSH`` maps one to the other. Triangles agree.
 """
+
+import os
+import shutil
+import tempfile
 
 import numpy as np
 
@@ -41,6 +48,22 @@ def fem_mesh_arrays(fem_mesh):
     nodes = np.array([[points[n].x, points[n].y, points[n].z] for n in used], dtype=float)
     tets = np.array([[index[n] for n in c] for c in corners], dtype=np.int64)
     return nodes, tets
+
+
+def read_fem_mesh(fem_mesh):
+    """A ``Fem::FemMesh`` as a :class:`homesh.HighOrderMesh` with its quality: every cell as FEM
+    holds it (tetrahedra and triangles of order 1 or 2, their mid-edge nodes where FEM put them,
+    on the CAD for its Gmsh and Netgen meshes), written by FEM itself to a temporary .unv (17
+    digits, right-handed) and read by :func:`homesh.read`. Raises homesh.FileError for cells
+    HOMesh does not hold (8-node quadrilaterals, 20-node hexahedra, ...), naming the element."""
+    from .. import api
+    folder = tempfile.mkdtemp(prefix="homesh-fem-")
+    try:
+        path = os.path.join(folder, "fem_mesh.unv")
+        fem_mesh.write(path)
+        return api.read(path)
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 def order_two_elements(mesh):

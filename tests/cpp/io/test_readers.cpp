@@ -77,6 +77,36 @@ TEST(MshReader, RoundTripsOurFilesExactly) {
     }
 }
 
+// Our VTU holds every node and the elements (no boundary cells), as VTK Lagrange cells: read
+// back, the nodes are bit-exact (Float64) and the elements the same cells in Gmsh's order.
+void expectSameElements(const Mesh& mesh, const Mesh& vtu) {
+  ASSERT_EQ(vtu.dim, mesh.dim);
+  ASSERT_EQ(vtu.order, mesh.order);
+  EXPECT_EQ(vtu.xyz, mesh.xyz);
+  std::size_t k = 0;
+  for (const ElementBlock& b : mesh.blocks) {
+    if (cellDimension(b.type) != mesh.dim) continue;
+    ASSERT_LT(k, vtu.blocks.size());
+    EXPECT_EQ(vtu.blocks[k].type, b.type);
+    EXPECT_EQ(vtu.blocks[k].nodes, b.nodes) << cellShortName(b.type) << " order " << b.order;
+    ++k;
+  }
+  EXPECT_EQ(vtu.blocks.size(), k);
+}
+
+TEST(VtuReader, ReadsOurLagrangeCellsBackExactly) {
+  const auto dir = test::tempDir();
+  for (const Mesh& mesh :
+       {curvedBoxWithHole(1), curvedBoxWithHole(2), curvedBoxWithHole(5), curvedPlate(3)})
+    for (const bool appended : {false, true}) {
+      const std::string path = (dir / (appended ? "b.vtu" : "a.vtu")).string();
+      writeMesh(mesh, path, {}, {appended, false, {}});
+      std::vector<std::string> notes;
+      expectSameElements(mesh, readMesh(path, &notes));
+      EXPECT_TRUE(notes.empty());  // right-handed: read as it is
+    }
+}
+
 // The node of `to` nearest each node of `from` (which must be within `tol`), by hashing
 // coordinates on a coarse grid and searching the neighbouring cells.
 std::vector<std::int64_t> matchNodes(const Mesh& from, const Mesh& to, double tol) {
@@ -260,6 +290,8 @@ TEST(Readers, HexahedraPrismsAndQuadrilateralsFromGmsh) {
       for (const char* name : {"o.msh", "o.vtu", "o.xml"})
         writeMesh(mesh, (dir / name).string(), {}, {});
       expectSameMesh(mesh, readMsh((dir / "o.msh").string()), 0.0);  // 17 digits: exact
+      // VTU: Lagrange hexahedra in VTK's file-version-1 numbering, wedges.
+      expectSameElements(mesh, readMesh((dir / "o.vtu").string()));
       // Nektar++ keeps every node but the elements' interiors, which it rebuilds itself.
       const Mesh nektar = readMesh((dir / "o.xml").string());
       EXPECT_EQ(nektar.numElements(), mesh.numElements());
