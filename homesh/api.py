@@ -370,7 +370,7 @@ def size_field(shape, min_delta=None, max_delta=None, eps=None, sources=(), name
 def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
          optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=3,
          boundary_layer=None, cancel=None, optimise_seconds=0.0, linear_seconds=600.0,
-         heal=True):
+         heal=True, job_seconds=0.0):
     """Meshes a CAD shape with curved elements of the given order.
 
     shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
@@ -403,6 +403,15 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
               :class:`MeshingError`); it is stopped after this many seconds and the job fails
               naming this limit; 0: no limit. ``report()["notes"]`` says when Gmsh crashed and
               was run again another way.
+    job_seconds
+              > 0: the whole job's wall-time budget, from loading the CAD. Gmsh and every
+              optimiser run get at most what is left of it, a repair round starts only if what
+              is left covers what the round before took, the geometry check is left out once it
+              is spent, and the best mesh so far is returned (not proven valid, perhaps:
+              check ``quality()``); ``report()["job"]`` has ``"stopped": "time budget"`` and
+              lists what it ``"cut"`` short or ``"skipped"``. Spent before there is a mesh (in
+              the CAD, sizing or linear stage): :class:`MeshingError` naming the stage. 0: no
+              budget.
     heal      check the CAD after loading and, where the check finds a problem (faces not
               sewn into a solid, OCCT-invalid shapes, edges or faces far smaller than the model),
               repair it with OpenCASCADE's shape healing; ``report()["healing"]`` says what was
@@ -425,7 +434,9 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     order, threads, verbosity, optimise, progress, optimise_seconds = _job_arguments(
         order, threads, verbosity, optimise, progress, cancel, optimise_seconds)
     repair_rounds = _check_int("repair_rounds", repair_rounds)
-    linear_seconds = _check_seconds(linear_seconds, "linear_seconds")
+    limits = {"optimise_seconds": optimise_seconds,
+              "linear_seconds": _check_seconds(linear_seconds, "linear_seconds"),
+              "job_seconds": _check_seconds(job_seconds, "job_seconds")}
     if size is not None:
         if isinstance(size, bool) or not isinstance(size, numbers.Real):
             raise ParameterError("size must be a positive number, got %r" % (size,))
@@ -441,12 +452,10 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
         core = _core.mesh_brep(value, label, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds, layer, cancel, optimise_seconds,
-                               linear_seconds, bool(heal))
+                               sizing, repair_rounds, layer, cancel, limits, bool(heal))
     else:
         core = _core.mesh_file(value, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds, layer, cancel, optimise_seconds,
-                               linear_seconds, bool(heal))
+                               sizing, repair_rounds, layer, cancel, limits, bool(heal))
     return HighOrderMesh(core)
 
 
@@ -486,7 +495,7 @@ def _four_argument_progress(progress):
 
 
 def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=None, name=None,
-          optimise=0, cancel=None, optimise_seconds=0.0):
+          optimise=0, cancel=None, optimise_seconds=0.0, job_seconds=0.0):
     """Curves a linear tetrahedral mesh made by another tool (FreeCAD FEM's Gmsh or Netgen
     mesher) on the CAD it was made from.
 
@@ -498,7 +507,7 @@ def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=No
     Each boundary node is put on the CAD vertex, edge or face it lies on, the mesh is raised to
     ``order`` with its boundary nodes on the CAD and, with ``optimise`` > 0, optimised with them
     sliding on it (stages "classify", "high_order", "optimise", ...). progress, cancel,
-    optimise_seconds, threads and name as for :func:`mesh`. Raises ParameterError, CadError or MeshingError (naming the
+    optimise_seconds, job_seconds, threads and name as for :func:`mesh`. Raises ParameterError, CadError or MeshingError (naming the
     boundary node that lies on no CAD face).
     """
     order, threads, verbosity, optimise, progress, optimise_seconds = _job_arguments(
@@ -510,13 +519,15 @@ def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=No
     if tetrahedra.ndim != 2 or tetrahedra.shape[1] != 4:
         raise ParameterError("tetrahedra must be an (E, 4) array of corner nodes, got shape %s"
                              % (tetrahedra.shape,))
+    limits = {"optimise_seconds": optimise_seconds,
+              "job_seconds": _check_seconds(job_seconds, "job_seconds")}
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
         core = _core.curve_brep(value, label, nodes, tetrahedra, order, threads, verbosity,
-                                progress, optimise, cancel, optimise_seconds)
+                                progress, optimise, cancel, limits)
     else:
         core = _core.curve_file(value, nodes, tetrahedra, order, threads, verbosity, progress,
-                                optimise, cancel, optimise_seconds)
+                                optimise, cancel, limits)
     return HighOrderMesh(core)
 
 

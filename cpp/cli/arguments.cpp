@@ -222,6 +222,9 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   table.value({"--linear-time-limit"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.linearTimeLimit = parseParameter("linear_seconds", o, v);
   });
+  table.value({"--job-time-limit"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.jobTimeLimit = parseParameter("job_seconds", o, v);
+  });
   table.value({"--bl-faces"},
               [&cmd](const std::string&, const std::string& v) { cmd.blFaces = v; });
   table.value({"--bl-thickness"},
@@ -399,6 +402,10 @@ options:
                       "healing" says what it found and did)
       --linear-time-limit S  Gmsh's linear meshing (in a process of its own) is stopped after
                       S seconds and the run fails (default 600; 0: no limit)
+      --job-time-limit S  the whole job's wall time: Gmsh and the optimiser get at most what
+                      is left, a repair round starts only if the last one would still fit, and
+                      the best mesh so far is written (report: "job": {"stopped": "time
+                      budget"}); with no mesh yet, one error naming the stage (default 0: none)
       --bl-faces LIST     boundary layer on these CAD faces (FaceN numbers: 1,8 or 11-12)
       --bl-thickness T    its total thickness: a number or an expression of x, y, z
       --bl-layers N       thin layers it is split into (default 2; 1..100)

@@ -45,6 +45,7 @@ struct MeshCommand {
   double timeLimit = 0.0;          // --time-limit S: seconds per optimiser run (0: none)
   bool heal = true;                // --no-heal: the CAD is only checked
   double linearTimeLimit = 600.0;  // --linear-time-limit S: seconds per Gmsh run (0: none)
+  double jobTimeLimit = 0.0;       // --job-time-limit S: seconds for the whole job (0: none)
   // --bl-faces, --bl-thickness, --bl-layers, --bl-progression: a boundary layer (each
   // overrides the .mcf's BndLayer* key).
   std::optional<std::string> blFaces, blThickness;

@@ -149,6 +149,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
   options.repairRounds = cmd.repairRounds;
   options.optimiseSeconds = cmd.timeLimit;
   options.linearSeconds = cmd.linearTimeLimit;
+  options.jobSeconds = cmd.jobTimeLimit;
   options.heal = cmd.heal;
   if (cmd.blFaces || cmd.blThickness || cmd.blLayers || cmd.blProgression) {
     homesh::BoundaryLayerParameters bl =
@@ -203,6 +204,18 @@ int runMesh(const homesh::MeshCommand& cmd) {
                    "invalid, %zu undecided (%zu elements, %zu reused)%s\n",
                    k + 1, r.invalid, r.undecided, r.action.c_str(), r.elements, r.invalidAfter,
                    r.undecidedAfter, r.meshElements, r.reused, r.kept ? "" : ", not kept");
+    }
+    if (result.job.stopped()) {
+      const auto list = [](const std::vector<std::string>& stages) {
+        std::string text;
+        for (const std::string& s : stages) text += (text.empty() ? "" : ", ") + s;
+        return text.empty() ? std::string("none") : text;
+      };
+      std::fprintf(stderr,
+                   "homesh: the job time limit of %g s stopped it (stopped: time budget): cut "
+                   "short: %s; left out: %s\n",
+                   result.job.timeLimit, list(result.job.cut).c_str(),
+                   list(result.job.skipped).c_str());
     }
     if (cmd.sizing.writeOctree)
       std::fprintf(stderr, "homesh: wrote %s\n", cmd.sizing.writeOctree->c_str());

@@ -31,6 +31,12 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        ParameterKind::Real, 0, kNoLimit, false, 600, false, "mesh",
        "Seconds Gmsh's linear meshing may take (each run, in its own process); it is then "
        "stopped and the job fails naming this limit; 0: no limit"},
+      {"job_seconds", "JobTimeLimit", "--job-time-limit", "job time limit", ParameterKind::Real, 0,
+       kNoLimit, false, 0, false, "mesh",
+       "Seconds the whole job may take, from loading the CAD: Gmsh and the optimiser get at most "
+       "what is left, a repair round starts only if the last one would still fit, and the best "
+       "mesh so far is kept (the report's \"job\" says \"stopped\": \"time budget\"); with no "
+       "mesh yet, the job fails naming its stage; 0: no limit"},
       {"repair_rounds", "RepairRounds", "--repair-rounds", "repair rounds", ParameterKind::Integer,
        0, 20, false, 3, false, "mesh",
        "Most repair rounds while elements are not proven valid (split or refine around them, "

@@ -63,8 +63,10 @@ struct OptimiserOptions {
   //    sweeps will not make the mesh valid (the pipeline's repair rounds take over);
   //  "iterations": maxIterations sweeps done;
   //  "time budget" (only with `timeLimit` > 0): the run has taken `timeLimit` seconds, set-up
-  //    included; checked after every sweep and between a sweep's colour groups (a half-done
-  //    sweep is dropped); the best state so far is kept, as for every rule.
+  //    included; checked once in the set-up (after the input's certified quality: the input is
+  //    then kept and its energy not computed, NaN), after every sweep and between a sweep's
+  //    colour groups (a half-done sweep is dropped); the best state so far is kept, as for
+  //    every rule.
   double tolerance = 1e-6;
   double timeLimit = 0.0;  // seconds, 0: none
   double energyTolerance = 1e-5;

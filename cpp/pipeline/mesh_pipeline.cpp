@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -10,6 +11,8 @@
 #include "cad/model_dimension.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "core/isolated_call.hpp"
+#include "core/job_budget.hpp"
 #include "core/parameters.hpp"
 #include "core/system_memory.hpp"
 #include "curving/order_elevation.hpp"
@@ -28,6 +31,7 @@ void MeshingOptions::validate() const {
   checkParameter("optimise", optimiseIterations);
   checkParameter("optimise_seconds", optimiseSeconds);
   checkParameter("linear_seconds", linearSeconds);
+  checkParameter("job_seconds", jobSeconds);
   checkParameter("repair_rounds", repairRounds);
   if (boundaryLayer) boundaryLayer->validate();
   if (size && !octreeOutput.empty())
@@ -294,6 +298,48 @@ constexpr int kPlainSplitAttempts = 3;
 // (the layer's included) a second optimiser run may move.
 constexpr int kLayerReleaseLayers = 4;
 
+// How messages name a time-limit parameter: "linear meshing time limit: --linear-time-limit,
+// Python linear_seconds, FreeCAD LinearTimeLimit".
+std::string limitName(const char* key) {
+  const ParameterDefinition& p = parameterDefinition(key);
+  return std::string(p.label) + ": " + p.option + ", Python " + p.key + ", FreeCAD " + p.property;
+}
+
+// Seconds in messages: three digits are enough ("3.19 s").
+std::string formatSeconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", s);
+  return buf;
+}
+
+// "job time limit of 120 s", then how to set it: "--job-time-limit, Python job_seconds, FreeCAD
+// JobTimeLimit".
+std::string jobLimitName(const JobBudget& budget) {
+  return std::string(parameterDefinition("job_seconds").label) + " of " +
+         formatNumber(budget.seconds()) + " s";
+}
+std::string jobLimitSettings() {
+  const ParameterDefinition& p = parameterDefinition("job_seconds");
+  return std::string(p.option) + ", Python " + p.key + ", FreeCAD " + p.property;
+}
+
+// "the job time limit of 120 s (--job-time-limit, Python job_seconds, FreeCAD JobTimeLimit)".
+std::string jobLimitText(const JobBudget& budget) {
+  return "the " + jobLimitName(budget) + " (" + jobLimitSettings() + ")";
+}
+
+// Before a stage that makes the first mesh: with the budget spent there is no mesh to keep, so
+// the job fails naming the stage it did not reach and where the time went.
+void checkBudgetLeft(const JobBudget& budget, const std::string& stage,
+                     const StageTimings& timings) {
+  if (!budget.spent()) return;
+  std::string spent;
+  for (const auto& [name, s] : timings.seconds)
+    spent += (spent.empty() ? "" : ", ") + name + " " + formatSeconds(s) + " s";
+  throw BudgetExceeded(jobLimitText(budget) + " was spent before the " + stage + " stage (" +
+                       spent + "): no mesh was made");
+}
+
 OptimiserOptions pipelineOptimiserOptions(const MeshingOptions& options) {
   OptimiserOptions o;
   o.maxIterations = options.optimiseIterations;
@@ -308,9 +354,12 @@ OptimiserOptions pipelineOptimiserOptions(const MeshingOptions& options) {
 // under its own name; a repair round times them all as one stage instead. With `previous` (a
 // repair round's starting state), the elements whose linear cell is unchanged take their
 // curved nodes from it and the optimiser works only on the new elements, the ones not proven
-// valid or poor, and kRepairRegionLayers layers around them.
+// valid or poor, and kRepairRegionLayers layers around them. Each optimiser run gets at most
+// what is left of `budget` and is left out once it is spent (named with `round`, "repair 2",
+// in the budget's record; "" before the rounds).
 CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& cad,
                   StageTimings& timings, PipelineObserver* observer, bool clocked,
+                  JobBudget& budget, const std::string& round,
                   const CurvedState* previous = nullptr) {
   CurvedState state;
   state.linear = std::move(linear);
@@ -326,9 +375,21 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
       if (reuse.reused > 0) fresh = std::move(reuse.fresh);
     }
     if (options.optimiseIterations <= 0) return std::optional<OptimiserResult>();
+    const std::string where = round.empty() ? std::string(stage) : round + " " + stage;
+    if (budget.spent()) {  // the mesh stays as curving left it
+      budget.skip(where);
+      return std::optional<OptimiserResult>();
+    }
     std::optional<StageClock> clock;
     if (clocked) clock.emplace(stage, timings, observer);
     OptimiserOptions o = pipelineOptimiserOptions(options);
+    // Each run under the smaller of its own limit and what is left of the job's budget.
+    bool cut = false;
+    const auto limit = [&](OptimiserOptions& run) {
+      run.timeLimit = budget.stageLimit(options.optimiseSeconds);
+      return budget.binds(options.optimiseSeconds);
+    };
+    const bool capped = limit(o);
     if (!fresh.empty()) {
       o.regionSeed = std::move(fresh);
       o.regionLayers = kRepairRegionLayers;
@@ -341,13 +402,19 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
     OptimiserProgress cancel(observer, stage, o.maxIterations);
     std::optional<OptimiserResult> r = optimiseMesh(mesh, o, &cancel, &cad);
     if (r->cancelled) throw CancelledError("cancelled during optimise");
+    cut = capped && r->stopReason == "time budget";
     // Released in steps, each only if elements are still not valid: the layer's top slides
     // parallel to the wall (its heights stay) with its nodes on the CAD (the layer's sides)
     // fixed, then with those sliding on their faces too, then the top moves freely.
     for (const LayerRelease step :
          {LayerRelease::Parallel, LayerRelease::Sides, LayerRelease::Free}) {
       if (o.fixedNodes.empty() || r->invalidAfter + r->undecidedAfter == 0) break;
+      if (budget.spent()) {
+        cut = true;  // the layer's release steps left out
+        break;
+      }
       OptimiserOptions around = o;
+      const bool aroundCapped = limit(around);
       around.fixedNodes.clear();
       if (step != LayerRelease::Free) around.normalLocked = layerTopNormals(mesh);
       if (step == LayerRelease::Parallel) {
@@ -360,6 +427,7 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
       around.regionLayers = kLayerReleaseLayers;        // ... and their neighbours
       const OptimiserResult second = optimiseMesh(mesh, around, &cancel, &cad);
       if (second.cancelled) throw CancelledError("cancelled during optimise");
+      cut = cut || (aroundCapped && second.stopReason == "time budget");
       blendLayerInteriors(mesh, &cad, false);
       r->iterations += second.iterations;
       r->history.insert(r->history.end(), second.history.begin(), second.history.end());
@@ -374,6 +442,7 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
       r->visits += second.visits;
       state.layerRelease = std::max(state.layerRelease, step);
     }
+    if (cut) budget.cut(where);
     if (clocked) clock->done();
     return r;
   };
@@ -405,6 +474,24 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
   return state;
 }
 
+// The geometry stage (left out once the job's budget is spent: it only measures), then the
+// job's record.
+void finishJob(MeshResult& result, JobBudget& budget, PipelineObserver* observer) {
+  if (budget.spent()) {
+    budget.skip("geometry");
+    result.notes.push_back("the boundary's distance to the CAD was not measured: " +
+                           jobLimitText(budget) + " was spent (stopped: time budget)");
+  } else {
+    StageClock geometry("geometry", result.timings, observer);
+    result.geometry = measureGeometryAccuracy(result.mesh, *result.cad, result.options.threads);
+    geometry.done();
+  }
+  result.job.timeLimit = budget.seconds();
+  result.job.seconds = budget.elapsed();
+  result.job.cut = budget.cutStages();
+  result.job.skipped = budget.skippedStages();
+}
+
 }  // namespace
 
 MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
@@ -412,6 +499,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   options.validate();  // before the (possibly slow) CAD import
 
   MeshResult result;
+  JobBudget budget(options.jobSeconds);  // its clock starts here
   StageClock cad("cad", result.timings, observer);
   result.cad =
       std::make_shared<const CadModel>(healModel(source.load(), options.heal, result.healing));
@@ -425,14 +513,11 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   LinearMeshOptions linearOptions;
   linearOptions.verbosity = options.verbosity;
   linearOptions.dimensionDone = linearProgress(observer);
-  linearOptions.timeLimit = options.linearSeconds;
-  const ParameterDefinition& linearLimit = parameterDefinition("linear_seconds");
-  linearOptions.timeLimitName = std::string(linearLimit.label) + ": " + linearLimit.option +
-                                ", Python " + linearLimit.key + ", FreeCAD " + linearLimit.property;
   if (observer != nullptr)
     linearOptions.cancelRequested = [observer] { return observer->cancelRequested(); };
   linearOptions.note = [&result](const std::string& note) { result.notes.push_back(note); };
   if (options.sizing) {
+    checkBudgetLeft(budget, "sizing", result.timings);
     StageClock sizing("sizing", result.timings, observer);
     result.sizing = runSizing(*result.cad, *options.sizing, options.threads);
     if (!options.octreeOutput.empty()) writeOctree(*result.sizing->octree, options.octreeOutput);
@@ -451,26 +536,43 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     // (No memory prediction here: the bounding-box estimate of a uniform size is no measure of
     // it, a thin plate fills little of its box. The linear mesh made is checked instead.)
   }
+  // Each Gmsh run (the linear mesh, the boundary layer's fill) under the smaller of
+  // --linear-time-limit and what is left of the job's budget, its message naming which.
+  bool gmshByBudget = false;  // the last Gmsh run's limit was the budget's rest
+  const auto limitGmsh = [&](LinearMeshOptions& o, const std::string& stage) {
+    o.timeLimit = budget.stageLimit(options.linearSeconds);
+    gmshByBudget = budget.binds(options.linearSeconds);
+    o.timeLimitName = gmshByBudget ? stage + " stage, what was left of the " +
+                                         jobLimitName(budget) + ": " + jobLimitSettings()
+                                   : limitName("linear_seconds");
+  };
   // The linear mesh, with its macro boundary layer when one is asked for (timed as its own
-  // stage the first time; within the round in repair rounds).
+  // stage the first time, `stage` "linear"; within the round in repair rounds, "repair K").
   std::optional<BoundaryLayerRecord> layer;
-  const auto makeLinear = [&](const LinearMeshOptions& o, bool clocked) {
+  const auto makeLinear = [&](LinearMeshOptions o, bool clocked, const std::string& stage) {
     std::optional<StageClock> clock;
     if (clocked) clock.emplace("linear", result.timings, observer);
+    limitGmsh(o, stage);
     Mesh mesh = generateLinearMesh(*result.cad, o);
     if (clocked) clock->done();
     if (!options.boundaryLayer) return mesh;
     if (clocked) clock.emplace("boundary_layer", result.timings, observer);
     layer.emplace();
+    limitGmsh(o, clocked ? std::string("boundary_layer") : stage);
     mesh = growBoundaryLayer(mesh, *result.cad, *options.boundaryLayer, o, *layer);
     if (clocked) clock->done();
     return mesh;
   };
-  Mesh linearMesh = makeLinear(linearOptions, true);
+  checkBudgetLeft(budget, "linear", result.timings);
+  const double firstStart = budget.elapsed();
+  Mesh linearMesh = makeLinear(linearOptions, true, "linear");
 
-  CurvedState best =
-      curve(std::move(linearMesh), options, *result.cad, result.timings, observer, true);
+  CurvedState best = curve(std::move(linearMesh), options, *result.cad, result.timings, observer,
+                           true, budget, "");
   best.layer = layer;
+  // What a round repeats (the linear mesh, curving, optimiser and quality), measured: a round
+  // starts only if what is left of the job's budget covers what the one before it took.
+  double lastSeconds = budget.elapsed() - firstStart;
   // Repair rounds: each works from the previous round's mesh; the best state is kept.
   std::vector<RefinementSource> sources;  // accumulated over the refine rounds
   std::optional<CurvedState> last;        // the last round's state when it was not kept
@@ -478,7 +580,20 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   for (int round = 1; round <= options.repairRounds; ++round) {
     const CurvedState& from = last && !splitFailed ? *last : best;
     if (from.notValid() == 0) break;
-    StageClock clock("repair " + std::to_string(round), result.timings, observer);
+    const std::string name = "repair " + std::to_string(round);
+    if (budget.limited() && budget.left() < lastSeconds) {
+      budget.skip(name);
+      result.notes.push_back(
+          "repair rounds ended by " + jobLimitText(budget) + ": " +
+          formatSeconds(std::max(budget.left(), 0.0)) + " s left before round " +
+          std::to_string(round) + ", less than the " + formatSeconds(lastSeconds) + " s " +
+          (round == 1 ? std::string("the first linear mesh, curving and optimiser took")
+                      : "round " + std::to_string(round - 1) + " took") +
+          " (stopped: time budget)");
+      break;
+    }
+    const std::size_t budgetEvents = budget.cutStages().size() + budget.skippedStages().size();
+    StageClock clock(name, result.timings, observer);
     const auto start = std::chrono::steady_clock::now();
     RepairRound record;
     record.invalid = from.quality.invalid;
@@ -513,10 +628,14 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       for (const RefinementSource& src : sources)
         refined.minSize = std::min(refined.minSize, src.delta);
       try {
-        next = makeLinear(refined, false);
+        next = makeLinear(refined, false, name);
       } catch (const MeshingError& e) {
         // The refined mesh (or its layer) could not be made: the rounds end, the best stays.
         record.failure = e.what();
+        if (dynamic_cast<const BudgetExceeded*>(&e) != nullptr && gmshByBudget) {
+          budget.cut(name);
+          record.budgetStopped = true;
+        }
         record.seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         result.rounds.push_back(record);
@@ -524,9 +643,11 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
         break;
       }
     }
-    CurvedState state =
-        curve(std::move(next), options, *result.cad, result.timings, observer, false, &from);
+    CurvedState state = curve(std::move(next), options, *result.cad, result.timings, observer,
+                              false, budget, name, &from);
     state.layer = layer;
+    record.budgetStopped =
+        budget.cutStages().size() + budget.skippedStages().size() != budgetEvents;
     record.reused = state.reused;
     record.invalidAfter = state.quality.invalid;
     record.undecidedAfter = state.quality.undecided;
@@ -541,6 +662,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     }
     record.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    lastSeconds = record.seconds;
     result.rounds.push_back(record);
     clock.done();
   }
@@ -580,9 +702,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     split.done();
   }
 
-  StageClock geometry("geometry", result.timings, observer);
-  result.geometry = measureGeometryAccuracy(result.mesh, *result.cad, options.threads);
-  geometry.done();
+  finishJob(result, budget, observer);
   return result;
 }
 
@@ -595,6 +715,7 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
   options.size.reset();
   options.sizing.reset();
   MeshResult result;
+  JobBudget budget(options.jobSeconds);
   StageClock cad("cad", result.timings, observer);
   result.cad = std::make_shared<const CadModel>(source.load());
   cad.done();
@@ -602,14 +723,13 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
   StageClock classify("classify", result.timings, observer);
   Mesh onCad = classifyOnCad(linear, *result.cad);
   classify.done();
-  CurvedState state = curve(std::move(onCad), options, *result.cad, result.timings, observer, true);
+  CurvedState state =
+      curve(std::move(onCad), options, *result.cad, result.timings, observer, true, budget, "");
   result.mesh = std::move(state.mesh);
   result.quality = std::move(state.quality);
   result.optimiser = std::move(state.optimiser);
   result.lowOrderOptimiser = std::move(state.lowOrderOptimiser);
-  StageClock geometry("geometry", result.timings, observer);
-  result.geometry = measureGeometryAccuracy(result.mesh, *result.cad, options.threads);
-  geometry.done();
+  finishJob(result, budget, observer);
   return result;
 }
 
@@ -639,6 +759,7 @@ void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,
   StageClock output("output", result.timings, observer);
   writeMeshFiles(result, paths, options);
   output.done();
+  result.job.seconds += result.timings.seconds.back().second;  // the job ends with its output
 }
 
 }  // namespace homesh

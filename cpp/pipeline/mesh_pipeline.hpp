@@ -54,6 +54,10 @@ struct MeshingOptions {
   double optimiseSeconds = 0.0;  // time limit of each optimiser run (0: none)
   // Time limit of each Gmsh run of the linear mesher (0: none), default from the parameter table.
   double linearSeconds = 600.0;
+  // Wall-time budget of the whole job (0: none), from the start of runMeshPipeline
+  // (core/job_budget.hpp): Gmsh and every optimiser run get at most what is left, repair rounds
+  // stop when the last one would no longer fit, the geometry check is skipped once it is spent.
+  double jobSeconds = 0.0;
   // Repair rounds (pipeline/repair.hpp) while elements are not proven valid, range in
   // core/parameters.hpp: each splits the offending linear cells' edges on curved faces (or refines
   // around them), then curves, optimises and checks again. 0: none.
@@ -166,6 +170,17 @@ class PipelineObserver {
   virtual bool cancelRequested() { return false; }
 };
 
+// What a job's time budget (MeshingOptions::jobSeconds) did: the report's "job".
+struct JobRecord {
+  double timeLimit = 0.0;  // the budget, seconds (0: none)
+  // The job's wall time: from the start of the pipeline to its end, plus the "output" stage
+  // when writeMeshOutputs wrote the mesh.
+  double seconds = 0.0;
+  std::vector<std::string> cut;      // stages the budget stopped early ("optimise", "repair 2")
+  std::vector<std::string> skipped;  // stages it left out ("repair 3", "geometry")
+  bool stopped() const { return !cut.empty() || !skipped.empty(); }
+};
+
 struct MeshResult {
   std::shared_ptr<const CadModel> cad;
   Mesh mesh;
@@ -184,8 +199,10 @@ struct MeshResult {
   StageTimings timings;
   MeshingOptions options;
   HealingRecord healing;  // what the CAD check found and healing did
-  // What a stage had to do otherwise than asked (Gmsh crashed and was run again another way).
+  // What a stage had to do otherwise than asked (Gmsh crashed and was run again another way;
+  // the job's time budget ended the repair rounds).
   std::vector<std::string> notes;
+  JobRecord job;
 };
 
 // Runs every stage: CAD, sizing, linear mesh, boundary layer (optional: "boundary_layer"),
@@ -198,7 +215,11 @@ struct MeshResult {
 // layer are made again). The result is the best mesh seen: fewest elements not
 // proven valid, then the best worst scaled Jacobian (a round never makes the result worse); with
 // a boundary layer, its macro prisms are then split ("split_layers") and the quality is that of
-// the split mesh. Throws
+// the split mesh. With options.jobSeconds, each Gmsh and optimiser run gets at most what is
+// left of that budget, a round starts only if what is left covers what the one before took
+// (the first: the linear mesh, curving, optimiser and quality before it), the optimiser and
+// "geometry" are left out once it is spent, and result.job (with result.notes) says so; spent
+// before the linear mesh is made, BudgetExceeded (core/isolated_call.hpp) names the stage. Throws
 // ParameterError, IoError, CadError, MeshingError or CancelledError.
 MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
                            PipelineObserver* observer = nullptr);
@@ -206,7 +227,8 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
 // Curves a linear tetrahedral mesh made elsewhere (FreeCAD FEM's Gmsh or Netgen mesher) on the
 // CAD it was made from: the mesh is put on the CAD (linear/cad_classification.hpp, stage
 // "classify"), then elevated, optimised and evaluated as runMeshPipeline does ("high_order",
-// "optimise", "quality", "geometry"). The mesh is the user's: no sizing, no linear meshing, no
+// "optimise", "quality", "geometry"; the optimiser and "geometry" under options.jobSeconds as
+// there). The mesh is the user's: no sizing, no linear meshing, no
 // repair rounds and no boundary layer (ParameterError when one is asked for).
 MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOptions options,
                           PipelineObserver* observer = nullptr);

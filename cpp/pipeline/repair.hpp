@@ -41,6 +41,9 @@ struct RepairRound {
   bool kept = false;       // the round's mesh is no worse than the best before it and was kept
   double seconds = 0.0;
   std::string failure;  // why the round's mesh could not be made (the rounds then stop)
+  // The job's time budget stopped a stage of the round early or left it out (its Gmsh run,
+  // then `failure` says so, or its optimiser run).
+  bool budgetStopped = false;
 };
 
 struct CurvedFaceEdge {

@@ -247,6 +247,17 @@ void appendHealing(JsonWriter& json, const HealingRecord& h) {
   json.endObject();
 }
 
+// "job": the time budget, the wall time, and what the budget stopped early or left out.
+void appendJob(JsonWriter& json, const JobRecord& job) {
+  json.beginObject("job");
+  json.value("time_limit", job.timeLimit);
+  json.value("seconds", job.seconds);
+  json.value("stopped", std::string(job.stopped() ? "time budget" : "finished"));
+  appendStrings(json, "cut", job.cut);
+  appendStrings(json, "skipped", job.skipped);
+  json.endObject();
+}
+
 }  // namespace
 
 std::string meshReportJson(const MeshResult& result, const std::string& input) {
@@ -282,6 +293,7 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
   appendRepairRounds(json, result.rounds);
   if (result.boundaryLayer) appendBoundaryLayer(json, result);
   appendStrings(json, "notes", result.notes);
+  appendJob(json, result.job);
   json.beginObject("timings_s");
   for (const auto& [stage, s] : result.timings.seconds) json.value(stage, s);
   json.endObject();
@@ -382,6 +394,7 @@ void appendRepairRounds(JsonWriter& json, const std::vector<RepairRound>& rounds
     json.value("reused_elements", r.reused);
     json.value("kept", r.kept);
     if (!r.failure.empty()) json.value("failure", r.failure);
+    if (r.budgetStopped) json.value("stopped", std::string("time budget"));
     json.value("seconds", r.seconds);
     json.endObject();
   }

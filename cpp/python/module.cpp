@@ -385,14 +385,27 @@ BoundaryLayerParameters boundaryLayerFrom(const bp::dict& d) {
   return p;
 }
 
+// A job's time limits from a dict keyed as the parameter table ("optimise_seconds",
+// "linear_seconds", "job_seconds"; homesh/api.py checked the types); a key left out keeps its
+// default. Ranges are checked by MeshingOptions::validate.
+void applyTimeLimits(MeshingOptions& options, const bp::object& limits) {
+  if (limits.is_none()) return;
+  const bp::dict d = bp::extract<bp::dict>(limits);
+  const auto read = [&d](const char* key, double& value) {
+    if (d.has_key(key)) value = bp::extract<double>(d[key]);
+  };
+  read("optimise_seconds", options.optimiseSeconds);
+  read("linear_seconds", options.linearSeconds);
+  read("job_seconds", options.jobSeconds);
+}
+
 MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity,
                            int optimise, const bp::object& sizing, int repairRounds,
-                           const bp::object& boundaryLayer, double optimiseSeconds = 0.0,
-                           double linearSeconds = 600.0, bool heal = true) {
+                           const bp::object& boundaryLayer, const bp::object& limits,
+                           bool heal = true) {
   MeshingOptions options;
   options.heal = heal;
-  options.optimiseSeconds = optimiseSeconds;
-  options.linearSeconds = linearSeconds;
+  applyTimeLimits(options, limits);
   if (!boundaryLayer.is_none())
     options.boundaryLayer = boundaryLayerFrom(bp::extract<bp::dict>(boundaryLayer));
   options.optimiseIterations = optimise;
@@ -548,11 +561,10 @@ std::vector<double> finiteNodes(const bp::object& nodes) {
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
                 int verbosity, bp::object progress, int optimise, const bp::object& sizing,
                 int repairRounds, const bp::object& boundaryLayer, const bp::object& cancel,
-                double optimiseSeconds, double linearSeconds, bool heal) {
+                const bp::object& limits, bool heal) {
   const CaseSetup setup = setupCase(path);
-  MeshingOptions options =
-      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds, boundaryLayer,
-                  optimiseSeconds, linearSeconds, heal);
+  MeshingOptions options = makeOptions(order, size, threads, verbosity, optimise, sizing,
+                                       repairRounds, boundaryLayer, limits, heal);
   if (!options.size && !options.sizing) options.sizing = setup.options.sizing;
   if (!options.boundaryLayer) options.boundaryLayer = setup.options.boundaryLayer;
   options.expectedDimension = setup.options.expectedDimension;
@@ -562,10 +574,10 @@ PyMesh meshFile(const std::string& path, int order, const bp::object& size, int 
 PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
                 int threads, int verbosity, bp::object progress, int optimise,
                 const bp::object& sizing, int repairRounds, const bp::object& boundaryLayer,
-                const bp::object& cancel, double optimiseSeconds, double linearSeconds, bool heal) {
+                const bp::object& cancel, const bp::object& limits, bool heal) {
   return runPipeline(CadSource::brepText(text, name),
                      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds,
-                                 boundaryLayer, optimiseSeconds, linearSeconds, heal),
+                                 boundaryLayer, limits, heal),
                      std::move(progress), cancel);
 }
 
@@ -573,7 +585,7 @@ PyMesh meshBrep(const std::string& text, const std::string& name, int order, con
 // the CAD of `source` (BRep text or a CAD file): pipeline's curveMeshOnCad.
 PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::object& tets,
                   int order, int threads, int verbosity, bp::object progress, int optimise,
-                  const bp::object& cancel, double optimiseSeconds) {
+                  const bp::object& cancel, const bp::object& limits) {
   Mesh linear;
   linear.dim = 3;
   linear.order = 1;
@@ -590,7 +602,7 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::ob
   linear.nodeCadIndex.assign(n, 0);
   linear.nodeCadParam.assign(2 * n, std::numeric_limits<double>::quiet_NaN());
   const MeshingOptions options = makeOptions(order, bp::object(), threads, verbosity, optimise,
-                                             bp::object(), 0, bp::object(), optimiseSeconds);
+                                             bp::object(), 0, bp::object(), limits);
   return runObserved(std::move(progress), cancel, [&](PipelineObserver* observer) {
     return curveMeshOnCad(source, linear, options, observer);
   });
@@ -598,16 +610,16 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::ob
 
 PyMesh curveBrep(const std::string& text, const std::string& name, const bp::object& nodes,
                  const bp::object& tets, int order, int threads, int verbosity, bp::object progress,
-                 int optimise, const bp::object& cancel, double optimiseSeconds) {
+                 int optimise, const bp::object& cancel, const bp::object& limits) {
   return curveOnCad(CadSource::brepText(text, name), nodes, tets, order, threads, verbosity,
-                    std::move(progress), optimise, cancel, optimiseSeconds);
+                    std::move(progress), optimise, cancel, limits);
 }
 
 PyMesh curveFile(const std::string& path, const bp::object& nodes, const bp::object& tets,
                  int order, int threads, int verbosity, bp::object progress, int optimise,
-                 const bp::object& cancel, double optimiseSeconds) {
+                 const bp::object& cancel, const bp::object& limits) {
   return curveOnCad(CadSource::file(path), nodes, tets, order, threads, verbosity,
-                    std::move(progress), optimise, cancel, optimiseSeconds);
+                    std::move(progress), optimise, cancel, limits);
 }
 
 // Rebuilds a mesh (without CAD) from the arrays PyMesh exposes, and evaluates its quality.
@@ -755,15 +767,13 @@ BOOST_PYTHON_MODULE(_core) {
       (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"), bp::arg("verbosity"),
        bp::arg("progress"), bp::arg("optimise") = 0, bp::arg("sizing") = bp::object(),
        bp::arg("repair_rounds") = 3, bp::arg("boundary_layer") = bp::object(),
-       bp::arg("cancel") = bp::object(), bp::arg("optimise_seconds") = 0.0,
-       bp::arg("linear_seconds") = 600.0, bp::arg("heal") = true));
+       bp::arg("cancel") = bp::object(), bp::arg("limits") = bp::object(), bp::arg("heal") = true));
   bp::def("mesh_brep", &meshBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
            bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
            bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = 3,
            bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object(),
-           bp::arg("optimise_seconds") = 0.0, bp::arg("linear_seconds") = 600.0,
-           bp::arg("heal") = true));
+           bp::arg("limits") = bp::object(), bp::arg("heal") = true));
   bp::def("predict_file", &predictFile,
           (bp::arg("path"), bp::arg("sizing") = bp::object(), bp::arg("octree_path") = "",
            bp::arg("threads") = 1));
@@ -776,11 +786,11 @@ BOOST_PYTHON_MODULE(_core) {
       "curve_brep", &curveBrep,
       (bp::arg("text"), bp::arg("name"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("order"),
        bp::arg("threads"), bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise"),
-       bp::arg("cancel") = bp::object(), bp::arg("optimise_seconds") = 0.0));
+       bp::arg("cancel") = bp::object(), bp::arg("limits") = bp::object()));
   bp::def("curve_file", &curveFile,
           (bp::arg("path"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("order"),
            bp::arg("threads"), bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise"),
-           bp::arg("cancel") = bp::object(), bp::arg("optimise_seconds") = 0.0));
+           bp::arg("cancel") = bp::object(), bp::arg("limits") = bp::object()));
   bp::def(
       "size_field", &sizeField,
       (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(), bp::arg("threads") = 1));

@@ -124,6 +124,7 @@ class HighOrderMeshProxy(_Proxy, ParameterGuard):
         add_parameter_property(obj, "optimise", "Mesh", " Boundary nodes slide on the CAD.")
         add_parameter_property(obj, "optimise_seconds", "Mesh")
         add_parameter_property(obj, "linear_seconds", "Mesh")
+        add_parameter_property(obj, "job_seconds", "Mesh")
         if "Heal" not in have:
             obj.addProperty("App::PropertyBool", "Heal", "Mesh",
                             "Check the shape and, where the check finds a problem (faces not "
@@ -249,6 +250,7 @@ def mesh_arguments(obj, values=None):
                  "optimise": int(get("OptimiserIterations")),
                  "optimise_seconds": get("OptimiserTimeLimit"),
                  "linear_seconds": get("LinearTimeLimit"),
+                 "job_seconds": get("JobTimeLimit"),
                  "heal": bool(values.get("Heal", getattr(obj, "Heal", True))),
                  "repair_rounds": int(get("RepairRounds")), "threads": int(get("Threads"))}
     sizing = values.get("Sizing", getattr(obj, "Sizing", None))
@@ -304,7 +306,8 @@ def job_for(obj, values=None):
         job = MeshJob(shape.exportBrepToString(), obj.Part.Label, function=homesh.curve,
                       nodes=nodes, tetrahedra=tets, order=arguments["order"],
                       optimise=arguments["optimise"], threads=arguments["threads"],
-                      optimise_seconds=arguments["optimise_seconds"])
+                      optimise_seconds=arguments["optimise_seconds"],
+                      job_seconds=arguments["job_seconds"])
         job.fem_elements = len(tets)
     job.values = values or {}
     return job

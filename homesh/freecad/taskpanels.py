@@ -22,7 +22,7 @@ from .job import confirm_large_mesh
 from .properties import definition, value_of
 
 _MESH_PARAMETERS = ("Order", "Size", "OptimiserIterations", "OptimiserTimeLimit",
-                    "LinearTimeLimit", "RepairRounds", "Threads")
+                    "LinearTimeLimit", "JobTimeLimit", "RepairRounds", "Threads")
 _SIZING_PARAMETERS = ("MinDelta", "MaxDelta", "Eps")
 
 
@@ -318,7 +318,7 @@ class TaskPanelHighOrderMesh:
 
 
 _LABELS = {"OptimiserIterations": "Optimiser sweeps", "OptimiserTimeLimit": "Time limit (s)",
-           "LinearTimeLimit": "Gmsh time limit (s)",
+           "LinearTimeLimit": "Gmsh time limit (s)", "JobTimeLimit": "Job time limit (s)",
            "RepairRounds": "Repair rounds"}
 
 

@@ -104,7 +104,9 @@ def test_models_of_extreme_scale(homesh_bin, tmp_path):
     ("--order", "11", "--order must be an integer from 1 to 10"),
     ("--eps", "-0.1", "--eps"), ("--threads", "0", "--threads"),
     ("--linear-time-limit", "-1", "--linear-time-limit"),
-    ("--time-limit", "nan", "--time-limit")])
+    ("--time-limit", "nan", "--time-limit"),
+    ("--job-time-limit", "-1", "--job-time-limit must be a number >= 0"),
+    ("--job-time-limit", "nan", "--job-time-limit")])
 def test_bad_parameters(homesh_bin, data, option, value, phrase):
     one_line_error(run([homesh_bin, "mesh", data / "sphere.brep", option, value]), 2, phrase)
 

@@ -3,14 +3,17 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <limits>
 #include <numeric>
 #include <set>
 #include <string>
+#include <thread>
 
 #include "core/error.hpp"
+#include "core/isolated_call.hpp"
 #include "core/parameters.hpp"
 #include "curving/order_elevation.hpp"
 #include "linear/edge_split.hpp"
@@ -281,6 +284,116 @@ TEST(RepairRounds, OrderEightStartsFromTheOptimisedOrderFourMeshAndEndsProvenVal
   options.optimiseIterations = 2;
   options.repairRounds = 0;
   EXPECT_FALSE(runMeshPipeline(CadSource::file(kSphereBox), options).lowOrderOptimiser);
+}
+
+// Spends the job's budget while the first pass curves: at the end of "high_order" it sleeps
+// until `seconds` have passed since the job began (the budget's clock starts just before the
+// "cad" stage), so every stage after it finds the budget spent, however fast the machine is.
+class BudgetBurner : public PipelineObserver {
+ public:
+  explicit BudgetBurner(double seconds) : seconds_(seconds) {}
+  void stageStarted(const std::string& stage) override {
+    if (stage == "cad") start_ = std::chrono::steady_clock::now();
+    started.push_back(stage);
+  }
+  void stageFinished(const std::string& stage, double /*seconds*/) override {
+    if (stage == "high_order")
+      std::this_thread::sleep_until(start_ + std::chrono::duration<double>(seconds_));
+  }
+  std::vector<std::string> started;
+
+ private:
+  double seconds_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+// The sphere in a box needs a repair round (above). With the job's budget spent once it is
+// curved, the optimiser, the round and the geometry check are left out, the report says so
+// ("stopped": "time budget", what was skipped, why the rounds ended), and the curved mesh is
+// still the result, with its invalid elements counted: nothing is lost.
+TEST(RepairRounds, ASpentJobBudgetEndsTheJobWithTheMeshSoFar) {
+  MeshingOptions options;
+  options.order = 4;
+  options.size = 1.2;
+  options.optimiseIterations = 20;
+  options.repairRounds = 3;
+  options.jobSeconds = 2.0;
+  BudgetBurner burner(options.jobSeconds);
+  const MeshResult result = runMeshPipeline(CadSource::file(kSphereBox), options, &burner);
+  ASSERT_GT(result.mesh.numElements(), 0u);
+  EXPECT_EQ(result.quality.validity.size(), result.mesh.numElements());
+  // Curving alone leaves this case invalid; neither the optimiser nor a round ran.
+  EXPECT_GT(result.quality.invalid + result.quality.undecided, 0u);
+  EXPECT_FALSE(result.optimiser.has_value());
+  EXPECT_TRUE(result.rounds.empty());
+  EXPECT_FALSE(result.geometry.has_value());
+  for (const char* stage : {"optimise", "repair 1", "geometry"}) {
+    EXPECT_EQ(std::count(burner.started.begin(), burner.started.end(), stage), 0) << stage;
+  }
+  EXPECT_EQ(result.job.timeLimit, 2.0);
+  EXPECT_TRUE(result.job.cut.empty());
+  EXPECT_EQ(result.job.skipped, (std::vector<std::string>{"optimise", "repair 1", "geometry"}));
+  // Only quality ran after the budget was spent (0.05 s measured on 397 order-4 tetrahedra);
+  // 10 s covers a machine loaded many times over.
+  EXPECT_GE(result.job.seconds, 2.0);
+  EXPECT_LT(result.job.seconds, 2.0 + 10.0);
+  const auto noted = [&result](const std::string& text) {
+    return std::any_of(result.notes.begin(), result.notes.end(),
+                       [&text](const std::string& n) { return n.find(text) != std::string::npos; });
+  };
+  EXPECT_TRUE(noted("repair rounds ended by the job time limit of 2 s (--job-time-limit"));
+  EXPECT_TRUE(noted("before round 1"));
+  EXPECT_TRUE(noted("the boundary's distance to the CAD was not measured"));
+  const std::string json = meshReportJson(result, "sphere_box");
+  const std::size_t job = json.find("\"job\": {");
+  ASSERT_NE(job, std::string::npos);
+  EXPECT_NE(json.find("\"stopped\": \"time budget\"", job), std::string::npos);
+  const std::size_t skipped = json.find("\"skipped\": [", job);
+  ASSERT_NE(skipped, std::string::npos) << json.substr(job, 300);
+  EXPECT_LT(json.find("\"repair 1\"", skipped), json.find(']', skipped)) << json.substr(job, 300);
+}
+
+// Spent before there is a mesh: one error naming the stage not reached and where the time went.
+TEST(RepairRounds, AJobBudgetSpentBeforeTheLinearMeshIsAnErrorNamingTheStage) {
+  MeshingOptions options;
+  options.order = 2;
+  options.size = 1.2;
+  options.jobSeconds = 1e-9;
+  try {
+    runMeshPipeline(CadSource::file(kSphereBox), options);
+    FAIL() << "a spent budget gave a mesh";
+  } catch (const BudgetExceeded& e) {
+    const std::string message = e.what();
+    for (const char* part :
+         {"the job time limit of", "--job-time-limit", "Python job_seconds", "FreeCAD JobTimeLimit",
+          "was spent before the linear stage (cad ", "no mesh was made"}) {
+      EXPECT_NE(message.find(part), std::string::npos) << part << " in: " << message;
+    }
+  }
+  options.size.reset();  // octree sizes: the sizing stage comes first
+  try {
+    runMeshPipeline(CadSource::file(kSphereBox), options);
+    FAIL() << "a spent budget gave a mesh";
+  } catch (const BudgetExceeded& e) {
+    EXPECT_NE(std::string(e.what()).find("before the sizing stage"), std::string::npos) << e.what();
+  }
+}
+
+TEST(RepairRounds, JobBudgetIsValidated) {
+  MeshingOptions options;
+  for (const double bad : {-1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    options.jobSeconds = bad;
+    try {
+      options.validate();
+      FAIL() << bad << " accepted";
+    } catch (const ParameterError& e) {
+      EXPECT_NE(std::string(e.what()).find("job time limit must be a number >= 0"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  options.jobSeconds = 0.0;
+  EXPECT_NO_THROW(options.validate());
 }
 
 TEST(RepairRounds, RoundsAreValidated) {
