@@ -1,6 +1,8 @@
 #include "core/input_file.hpp"
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <system_error>
 
 #include "core/error.hpp"
@@ -15,6 +17,14 @@ void requireRegularFile(const std::string& path, const std::string& what) {
   if (fs::is_directory(status)) throw IoError(what + " '" + path + "' is a directory, not a file");
   if (!fs::is_regular_file(status))
     throw IoError(what + " '" + path + "' is not a regular file (a FIFO, socket or device)");
+}
+
+std::string readFileBytes(const std::string& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(what + " '" + path + "' does not exist or cannot be read");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
 }
 
 }  // namespace homesh

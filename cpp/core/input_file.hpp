@@ -11,4 +11,8 @@ namespace homesh {
 // exist, is a directory, or is not a regular file (FIFO, socket, device).
 void requireRegularFile(const std::string& path, const std::string& what);
 
+// The whole content of the file at `path`, as bytes. Throws IoError naming `what` and the path
+// when it cannot be opened.
+std::string readFileBytes(const std::string& path, const std::string& what);
+
 }  // namespace homesh

@@ -6,14 +6,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <map>
-#include <sstream>
 #include <unordered_map>
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 #include "io/gmsh_element_types.hpp"
 
 namespace homesh {
@@ -360,11 +359,7 @@ Mesh assemble(RawMesh& raw, const std::string& path) {
 }  // namespace
 
 Mesh readMsh(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("mesh file '" + path + "' does not exist or cannot be read");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  Cursor c(buffer.str(), path);
+  Cursor c(readFileBytes(path, "mesh file"), path);
   if (c.word() != "$MeshFormat") c.fail("it does not start with $MeshFormat");
   const std::string version = c.word();
   const long long fileType = c.integer();

@@ -6,7 +6,6 @@
 #include <climits>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <optional>
@@ -16,6 +15,7 @@
 
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "core/input_file.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 #include "io/nektar_expansion.hpp"
@@ -759,11 +759,7 @@ void Reader::toEvenlySpaced() {
 }
 
 Mesh Reader::read() {
-  std::ifstream in(path_);
-  if (!in) throw IoError("mesh file '" + path_ + "' cannot be read");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const auto root = parseXml(buffer.str(), path_);
+  const auto root = parseXml(readFileBytes(path_, "mesh file"), path_);
   if (root->name != "NEKTAR") fail("the root element is <" + root->name + ">, not <NEKTAR>");
   const XmlElement* geometry = root->child("GEOMETRY");
   if (geometry == nullptr) fail("no <GEOMETRY>");

@@ -4,14 +4,13 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <optional>
-#include <sstream>
 #include <string_view>
 #include <unordered_map>
 #include <utility>
 
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 #include "io/foreign_mesh.hpp"
 
 namespace homesh {
@@ -277,11 +276,7 @@ void readElements(const UnvFile& f, std::size_t begin, std::size_t end, UnvData&
 }  // namespace
 
 Mesh readUnv(const std::string& path, std::vector<std::string>* notes) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("mesh file '" + path + "' does not exist or cannot be read");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const UnvFile f(buffer.str(), path);
+  const UnvFile f(readFileBytes(path, "mesh file"), path);
   UnvData d;
   std::size_t i = 0;
   while (i < f.size()) {

@@ -6,12 +6,11 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <string_view>
 #include <utility>
 
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 #include "io/foreign_mesh.hpp"
 #include "io/vtk_cells.hpp"
 #include "io/vtk_readers.hpp"
@@ -219,11 +218,7 @@ void skipField(Cursor& c, bool binary) {
 }  // namespace
 
 Mesh readLegacyVtk(const std::string& path, std::vector<std::string>* notes) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("mesh file '" + path + "' does not exist or cannot be read");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  Cursor c(buffer.str(), path);
+  Cursor c(readFileBytes(path, "mesh file"), path);
   const std::string version = c.restOfLine();
   const std::string prefix = "# vtk DataFile Version ";
   if (version.compare(0, prefix.size(), prefix) != 0)

@@ -10,13 +10,13 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <memory>
 #include <sstream>
 #include <string_view>
 #include <utility>
 
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 #include "io/base64.hpp"
 #include "io/foreign_mesh.hpp"
 #include "io/vtk_cells.hpp"
@@ -294,11 +294,7 @@ const XmlElement& namedArray(const VtuFile& file, const XmlElement& cells, const
 }  // namespace
 
 Mesh readVtu(const std::string& path, std::vector<std::string>* notes) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("mesh file '" + path + "' does not exist or cannot be read");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = buffer.str();
+  const std::string text = readFileBytes(path, "mesh file");
   // Appended data need not be XML (raw bytes): cut it out before parsing.
   std::string xml = text;
   std::string_view appended;
