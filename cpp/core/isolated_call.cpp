@@ -190,8 +190,10 @@ std::string runIsolated(const std::string& what, const IsolationLimits& limits,
 
   if (cancelled) throw CancelledError("cancelled during " + what);
   if (overTime)
-    throw BudgetExceeded(what + " stopped at its time budget of " + formatNumber(limits.seconds) +
-                         " s" + (limits.budgetName.empty() ? "" : " (" + limits.budgetName + ")"));
+    throw BudgetExceeded(
+        what + " stopped at its time budget of " +
+        formatNumber(limits.statedSeconds > 0.0 ? limits.statedSeconds : limits.seconds) + " s" +
+        (limits.budgetName.empty() ? "" : " (" + limits.budgetName + ")"));
   if (waited == pid && WIFSIGNALED(status)) {
     const int sig = WTERMSIG(status);
     if (sig == SIGKILL)

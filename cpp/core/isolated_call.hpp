@@ -19,7 +19,10 @@
 namespace homesh {
 
 struct IsolationLimits {
-  double seconds = 0.0;             // wall-time budget; 0: none
+  double seconds = 0.0;  // wall-time budget; 0: none
+  // The budget a message names when `seconds` is what is left of it (a retry's share); 0:
+  // `seconds` itself.
+  double statedSeconds = 0.0;
   std::string budgetName;           // how a message names the setting: "--linear-time-limit"
   std::function<bool()> cancelled;  // asked about every 50 ms while the child runs
   // Address space the child may add to the caller's (its allocations beyond fail with

@@ -259,18 +259,21 @@ Mesh meshWithGmsh(const CadModel& cad, const GmshRun& run) {
   return mesh;
 }
 
-IsolationLimits isolationLimits(const LinearMeshOptions& options) {
+// `stated`: the budget a message names when options.timeLimit is a retry's share of it.
+IsolationLimits isolationLimits(const LinearMeshOptions& options, double stated = 0.0) {
   IsolationLimits limits;
   limits.seconds = options.timeLimit;
+  limits.statedSeconds = stated;
   limits.budgetName = options.timeLimitName;
   limits.cancelled = options.cancelRequested;
   return limits;
 }
 
 // `work` (which uses Gmsh, holding the session it is given) in a child process when
-// options.isolate, else here; `work` returns its result as bytes either way.
+// options.isolate, else here; `work` returns its result as bytes either way. `stated`: as for
+// isolationLimits.
 std::string withGmsh(const LinearMeshOptions& options, const std::string& what,
-                     const std::function<std::string(GmshSession&)>& work) {
+                     const std::function<std::string(GmshSession&)>& work, double stated = 0.0) {
   if (!options.isolate) {
     GmshSession session(options.verbosity, 1);
     return work(session);
@@ -278,7 +281,7 @@ std::string withGmsh(const LinearMeshOptions& options, const std::string& what,
   // Held across the fork: no other thread of this process is inside Gmsh while the child
   // starts (its copy of a held lock would never be released), and the child's session uses it.
   std::unique_lock<std::mutex> held = holdGmsh();
-  return runIsolated(what, isolationLimits(options), [&] {
+  return runIsolated(what, isolationLimits(options, stated), [&] {
     GmshSession session(std::move(held), options.verbosity, 1);
     return work(session);
   });
@@ -316,12 +319,14 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       o.timeLimit = std::max(o.timeLimit - spent, 1e-3);
     }
-    const std::string bytes =
-        withGmsh(o, "Gmsh's meshing of " + cad.sourceName(), [&](GmshSession&) {
+    const std::string bytes = withGmsh(
+        o, "Gmsh's meshing of " + cad.sourceName(),
+        [&](GmshSession&) {
           std::string out;
           appendMeshBytes(out, meshWithGmsh(cad, r));
           return out;
-        });
+        },
+        options.timeLimit);
     std::size_t offset = 0;
     return readMeshBytes(bytes, offset);
   };

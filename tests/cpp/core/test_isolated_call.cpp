@@ -90,6 +90,24 @@ TEST(IsolatedCall, TheTimeBudgetEndsAHangingChild) {
   EXPECT_LT(elapsed, 5.0);
 }
 
+// A retry runs under what is left of its stage's budget (2.99997 s of 3, say); its message
+// names the budget the user set, not that share.
+TEST(IsolatedCall, AShareOfABudgetIsReportedAsTheBudget) {
+  IsolationLimits limits;
+  limits.seconds = 0.2;
+  limits.statedSeconds = 3.0;
+  std::string message;
+  try {
+    runIsolated("the retried work", limits, []() -> std::string {
+      std::this_thread::sleep_for(std::chrono::seconds(60));
+      return "";
+    });
+  } catch (const MeshingError& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("stopped at its time budget of 3 s"), std::string::npos) << message;
+}
+
 TEST(IsolatedCall, CancellingEndsTheChild) {
   IsolationLimits limits;
   const auto start = std::chrono::steady_clock::now();
