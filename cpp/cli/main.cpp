@@ -127,11 +127,11 @@ void printPrediction(const homesh::SizingResult& s, int dim) {
   const homesh::SizingParameters& p = s.octree->parameters();
   std::fprintf(stderr,
                "homesh: sizing octree: MinDelta %g, MaxDelta %g, EPS %g, %zu sources; %zu leaves "
-               "(%zu inside, %zu boundary), depth %d, %zu boundary samples (%zu curved), "
-               "smallest size %g, %.3f s\n",
+               "(%zu inside, %zu boundary), depth %d, %zu boundary samples (%zu curved, %zu on "
+               "thin walls), smallest size %g, %.3f s\n",
                p.minDelta, p.maxDelta, p.eps, p.sources.size(), st.leaves, st.insideLeaves,
                st.boundaryLeaves, st.maxLevel, st.boundarySamples, st.sizedSamples,
-               st.smallestDelta, s.seconds);
+               st.thinWallSamples, st.smallestDelta, s.seconds);
   std::fprintf(stderr, "homesh: predicted %.0f %s (%s %g)\n", s.prediction.elements,
                dim == 3 ? "tetrahedra" : "triangles", dim == 3 ? "domain volume" : "domain area",
                s.prediction.domainMeasure);
@@ -200,10 +200,12 @@ int runMesh(const homesh::MeshCommand& cmd) {
         continue;
       }
       std::fprintf(stderr,
-                   "homesh: repair %zu: %zu invalid, %zu undecided -> %s %zu elements -> %zu "
-                   "invalid, %zu undecided (%zu elements, %zu reused)%s\n",
-                   k + 1, r.invalid, r.undecided, r.action.c_str(), r.elements, r.invalidAfter,
-                   r.undecidedAfter, r.meshElements, r.reused, r.kept ? "" : ", not kept");
+                   "homesh: repair %zu: %zu invalid, %zu undecided, worst %.4f -> %s %zu "
+                   "elements -> %zu invalid, %zu undecided, worst %.4f (%zu elements, %zu "
+                   "reused)%s\n",
+                   k + 1, r.invalid, r.undecided, r.worst, r.action.c_str(), r.elements,
+                   r.invalidAfter, r.undecidedAfter, r.worstAfter, r.meshElements, r.reused,
+                   r.kept ? "" : ", not kept");
     }
     if (result.job.stopped()) {
       const auto list = [](const std::vector<std::string>& stages) {

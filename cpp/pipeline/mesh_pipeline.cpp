@@ -274,6 +274,24 @@ struct CurvedState {
 // rounds (the optimiser alone waits 10).
 constexpr int kPipelineStuckWindow = 5;
 
+// Once every element is proven valid, repair rounds go on for elements whose certified scaled
+// Jacobian is below this: slivers lying flat on a curved face and chords of one curved face, the
+// same configurations as the invalid ones, milder. Those rounds only split (a refinement remeshes
+// the whole model and brings new offenders elsewhere) and are kept only when the worst element
+// improves with every element still valid. (OpenCASCADE's linkrods.step: 3 elements at 0.043 to
+// 0.086, all four vertices on one cylinder.)
+constexpr double kPoorElement = 0.1;
+
+// The cells a repair round works on: those not proven valid or, with `poor` (none of those), the
+// ones whose certified scaled Jacobian is below kPoorElement, marked Invalid.
+std::vector<Validity> repairTargets(const QualitySummary& quality, bool poor) {
+  if (!poor) return quality.validity;
+  std::vector<Validity> flagged(quality.validity.size(), Validity::Valid);
+  for (std::size_t e = 0; e < flagged.size(); ++e)
+    if (quality.scaledJacobian[e] < kPoorElement) flagged[e] = Validity::Invalid;
+  return flagged;
+}
+
 // Layers of neighbours around a repair round's new elements that the optimiser moves too.
 constexpr int kRepairRegionLayers = 4;
 // Poor elements below this certified scaled Jacobian join the region too.
@@ -579,7 +597,9 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   bool splitFailed = false;  // the last round split and made things worse: refine instead
   for (int round = 1; round <= options.repairRounds; ++round) {
     const CurvedState& from = last && !splitFailed ? *last : best;
-    if (from.notValid() == 0) break;
+    const bool poor = from.notValid() == 0;  // only elements below kPoorElement are left
+    if (poor && (!(from.quality.scaled.min < kPoorElement) || splitFailed || options.boundaryLayer))
+      break;
     const std::string name = "repair " + std::to_string(round);
     if (budget.limited() && budget.left() < lastSeconds) {
       budget.skip(name);
@@ -598,16 +618,18 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     RepairRound record;
     record.invalid = from.quality.invalid;
     record.undecided = from.quality.undecided;
+    record.worst = from.quality.scaled.min;
     // Every flagged cell gets edges to split or a refinement sphere: the plan is never empty.
-    const RepairPlan plan = planRepair(from.linear, from.quality.validity, *result.cad);
+    const RepairPlan plan = planRepair(from.linear, repairTargets(from.quality, poor), *result.cad);
     Mesh next;
     if (!plan.splits.empty() && !splitFailed && !options.boundaryLayer) {
       // Local: only the cells around the split edges change; the rest wait for the next round.
       next = from.linear;
       record.edgesSplit = applySplits(next, plan.splits, *result.cad);
     }
+    if (poor && record.edgesSplit == 0) break;  // (a poor element is not worth a remesh)
     if (record.edgesSplit > 0) {
-      record.action = "split";
+      record.action = poor ? "split poor" : "split";
       record.elements = plan.splitCells;
     } else {
       // Nothing to split (or no split kept its cells positive): refine around every offender.
@@ -651,6 +673,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     record.reused = state.reused;
     record.invalidAfter = state.quality.invalid;
     record.undecidedAfter = state.quality.undecided;
+    record.worstAfter = state.quality.scaled.min;
     record.meshElements = state.mesh.numElements();
     record.kept = state.betterThan(best);
     splitFailed = !record.kept && record.action == "split";

@@ -31,10 +31,13 @@ namespace homesh {
 // One repair round, as the report records it.
 struct RepairRound {
   std::size_t invalid = 0, undecided = 0;  // elements not proven valid that the round found
-  std::string action;                      // "split", "refine" or "none" (nothing to act on)
-  std::size_t elements = 0;                // linear cells it acted on
-  std::size_t edgesSplit = 0;              // edges bisected ("split")
-  std::size_t sources = 0;                 // refinement spheres added ("refine")
+  double worst = 0.0, worstAfter = 0.0;    // certified scaled Jacobian before and after
+  // "split", "refine", or "split poor" (every element was valid; the round split the cells of
+  // those below the pipeline's poor-element threshold)
+  std::string action;
+  std::size_t elements = 0;                          // linear cells it acted on
+  std::size_t edgesSplit = 0;                        // edges bisected ("split")
+  std::size_t sources = 0;                           // refinement spheres added ("refine")
   std::size_t invalidAfter = 0, undecidedAfter = 0;  // of the mesh the round made
   std::size_t meshElements = 0;                      // elements of the mesh the round made
   std::size_t reused = 0;  // of those, elements whose curved nodes came from the round before

@@ -137,6 +137,7 @@ void appendSizing(JsonWriter& json, const SizingResult& sizing) {
   json.value("max_delta", p.maxDelta);
   json.value("eps", p.eps);
   json.value("gradation", p.gradation);
+  json.value("thin_wall", p.thinWall);
   json.beginArray("sources");
   for (const RefinementSource& src : p.sources) json.value("", src.describe());
   json.endArray();
@@ -153,6 +154,7 @@ void appendSizing(JsonWriter& json, const SizingResult& sizing) {
   json.value("max_level", s.maxLevel);
   json.value("boundary_samples", s.boundarySamples);
   json.value("curvature_samples", s.sizedSamples);
+  json.value("thin_wall_samples", s.thinWallSamples);
   json.value("smallest_delta", s.smallestDelta);
   json.endObject();
   json.value("seconds", sizing.seconds);
@@ -390,6 +392,8 @@ void appendRepairRounds(JsonWriter& json, const std::vector<RepairRound>& rounds
     json.value("refinement_spheres", r.sources);
     json.value("invalid_after", r.invalidAfter);
     json.value("undecided_after", r.undecidedAfter);
+    json.value("worst", r.worst);
+    json.value("worst_after", r.worstAfter);
     json.value("mesh_elements", r.meshElements);
     json.value("reused_elements", r.reused);
     json.value("kept", r.kept);

@@ -153,7 +153,10 @@ std::vector<BoundarySample> faceGrid(const CadModel& cad, int face, const FaceGr
       s.spacing = std::hypot(d.du.norm() * du, d.dv.norm() * dv);
       s.internal = internal;
       s.cadIndex = face;
-      if (curved) s.delta = sizeForCurvature(largestCurvature(d), params);
+      if (curved) {
+        s.curvature = largestCurvature(d);
+        s.delta = sizeForCurvature(s.curvature, params);
+      }
       found.push_back(s);
     }
   }
@@ -206,7 +209,8 @@ void sampleCurve(const CadModel& cad, int edge, bool reversed, const Eigen::Vect
       if (!(speed > 0.0)) continue;
       BoundarySample s;
       s.x = d.point;
-      s.delta = sizeForCurvature(d.d1.cross(d.d2).norm() / (speed * speed * speed), params);
+      s.curvature = d.d1.cross(d.d2).norm() / (speed * speed * speed);
+      s.delta = sizeForCurvature(s.curvature, params);
       s.spacing = speed * dt;
       s.internal = internal;
       s.cadIndex = edge;

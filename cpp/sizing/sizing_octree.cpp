@@ -16,6 +16,7 @@
 #include "core/error.hpp"
 #include "core/first_failure.hpp"
 #include "core/format.hpp"
+#include "sizing/wall_thickness.hpp"
 
 namespace homesh {
 namespace {
@@ -103,6 +104,7 @@ class OctreeBuilder {
     t_.samples_ = sampleBoundary(cad_, t_.dim_, t_.params_);
     if (t_.samples_.empty())
       throw CadError(cad_.sourceName() + " has no boundary to size the mesh from");
+    t_.stats_.thinWallSamples = applyThinWallSizes(t_.samples_, t_.params_, threads_);
     for (const BoundarySample& s : t_.samples_) {
       BoundarySample local = s;
       local.x = t_.toLocal(s.x);

@@ -24,6 +24,9 @@ void SizingParameters::validate() const {
                          formatNumber(maxDelta) + ")");
   if (!(eps > 0.0 && eps <= 1.0))
     throw ParameterError("EPS must lie in (0, 1], got " + formatNumber(eps));
+  if (!(thinWall >= 0.0 && thinWall <= 1.0))
+    throw ParameterError("the thin-wall sagitta ratio must lie in [0, 1], got " +
+                         formatNumber(thinWall));
   if (!positive(gradation))
     throw ParameterError("the gradation must be a positive number, got " + formatNumber(gradation));
   for (std::size_t i = 0; i < sources.size(); ++i)

@@ -3,7 +3,9 @@
 // The sizing field delta(x) is the target edge length at x: curvature-driven near the CAD
 // (the chord of a circle of radius R = 1/max|k| whose sagitta is EPS * R), graded away from it by
 // at most `gradation` per unit distance, clamped to [minDelta, maxDelta], and refined further by
-// the user's sources.
+// the user's sources. Where a curved wall is thin, the sagitta is bounded by thinWall times the
+// wall's local thickness t as well: the size there is the chord whose sagitta is
+// min(eps R, thinWall t) (sizing/wall_thickness.hpp).
 #pragma once
 
 #include <vector>
@@ -18,6 +20,11 @@ struct SizingParameters {
   double maxDelta = 0.0;   // size far from curved boundaries (>= minDelta)
   double eps = 0.05;       // sagitta relative to the radius of curvature, 0 < eps <= 1
   double gradation = 0.2;  // largest |d delta / d x| (> 0)
+  // Sagitta at most this fraction of the wall's local thickness, in [0, 1]; 0: no such bound
+  // (NekMesh's sizing, which a .mcf case keeps). 0.1: on OpenCASCADE's bottle (a 0.6 mm wall
+  // with fillets of radius 2.5 mm) the curvature size alone left six elements spanning the
+  // wall folded after curving and repair; with the bound none (bench/results/corpus.md).
+  double thinWall = 0.1;
   std::vector<RefinementSource> sources;
 
   // Throws ParameterError naming the offending parameter.

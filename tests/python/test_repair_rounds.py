@@ -16,7 +16,7 @@ SPHERE_BOX = Path(__file__).resolve().parents[2] / "examples" / "sphere_box.step
 CASE = ["--size", "1.2", "--order", "4"]
 ROUND_KEYS = {"invalid", "undecided", "action", "elements", "edges_split", "refinement_spheres",
               "invalid_after", "undecided_after", "mesh_elements", "reused_elements", "kept",
-              "seconds"}
+              "seconds", "worst", "worst_after"}
 
 
 def _mesh(homesh_bin, tmp_path, rounds):
@@ -46,8 +46,13 @@ def test_rounds_are_recorded(homesh_bin, tmp_path):
     assert 1 <= len(rounds) <= 3
     for r in rounds:
         assert set(r) == ROUND_KEYS
-        assert r["action"] in ("split", "refine")
+        assert r["action"] in ("split", "refine", "split poor")
         assert r["elements"] > 0 and r["seconds"] >= 0
+        if r["action"] == "split poor":  # every element valid, the worst below 0.1
+            assert r["invalid"] == r["undecided"] == 0 and r["worst"] < 0.1
+            if r["kept"]:
+                assert r["invalid_after"] == r["undecided_after"] == 0
+                assert r["worst_after"] > r["worst"]
     first = rounds[0]
     assert (first["invalid"], first["undecided"]) == \
         (before["quality"]["invalid_elements"], before["quality"]["undecided_elements"])
