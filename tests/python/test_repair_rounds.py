@@ -101,3 +101,26 @@ def test_order_eight_sphere_box_is_valid_for_gmsh_too(homesh_bin, tmp_path):
     assert "optimiser_order_4" in data
     assert {"optimise_low_order", "raise_order"} <= set(data["timings_s"])
     assert gmsh_worst(msh) > 0.0
+
+
+def test_poor_elements_are_split_once_every_element_is_valid(homesh_bin, tmp_path):
+    """Size 1.0 without the optimiser: five rounds make every element valid with the worst at
+    0.04 (an element flat on the sphere); a "split poor" round then splits its cell and the
+    worst rises above 0.1, every element still valid, and Gmsh agrees."""
+    msh, report = tmp_path / "poor.msh", tmp_path / "poor.json"
+    result = run([homesh_bin, "mesh", SPHERE_BOX, "--size", "1.0", "--order", "4",
+                  "--repair-rounds", "6", "-o", msh, "--report", report])
+    assert result.returncode == 0, result.stderr
+    data = json.loads(report.read_text())
+    poor = [r for r in data["rounds"] if r["action"] == "split poor"]
+    assert poor, [r["action"] for r in data["rounds"]]
+    first = poor[0]
+    assert first["invalid"] == first["undecided"] == 0 and first["worst"] < 0.1
+    assert first["edges_split"] > 0
+    kept = [r for r in poor if r["kept"]]
+    assert kept and kept[-1]["worst_after"] > first["worst"]
+    quality = data["quality"]
+    assert quality["invalid_elements"] == quality["undecided_elements"] == 0
+    assert quality["scaled_jacobian"]["min"] == kept[-1]["worst_after"]
+    assert quality["scaled_jacobian"]["min"] > 0.1
+    assert gmsh_worst(msh) > 0.0  # Gmsh's own Bezier-bounded verdict: valid too
