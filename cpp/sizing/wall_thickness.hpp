@@ -26,8 +26,9 @@ std::vector<double> wallThickness(const std::vector<BoundarySample>& samples,
 // The thin-wall bound of the sizing (SizingParameters::thinWall): at each curved wall sample of
 // radius R = 1 / curvature and thickness t, the size becomes the chord whose sagitta is
 // thinWall t where that is below the sample's size (maxDelta where it has none), and at least
-// minDelta. The thickness is searched only as far as it could change a size. Returns how many
-// samples it made smaller; with thinWall 0, none.
+// a third of that size and minDelta (a wall thinning out to nothing would otherwise ask for
+// minDelta all along). The thickness is searched only as far as it could change a size. Returns how
+// many samples it made smaller; with thinWall 0, none.
 std::size_t applyThinWallSizes(std::vector<BoundarySample>& samples, const SizingParameters& params,
                                int threads = 1);
 

@@ -122,6 +122,17 @@ TEST(WallThickness, ThinWallBoundsTheSizeOnlyWhereTheWallIsThin) {
   }
   EXPECT_EQ(limited, curved);
 
+  // A wall of 0.001 would ask for chordSize(1, 1e-4) = 0.028; the size is at most 3 times
+  // smaller than the curvature's.
+  std::vector<BoundarySample> foil = sampleBoundary(test::toModel(tube(0.999)), 3, params(0.1));
+  const std::vector<BoundarySample> foilPlain = foil;
+  EXPECT_GT(applyThinWallSizes(foil, params(0.1)), 0u);
+  for (std::size_t i = 0; i < foil.size(); ++i) {
+    if (curvedWall(foil[i])) {
+      EXPECT_DOUBLE_EQ(foil[i].delta, foilPlain[i].delta / 3.0);
+    }
+  }
+
   // A solid cylinder is no thin wall: its diameter (2) is beyond eps R / thinWall = 0.5.
   const CadModel thick = test::toModel(test::cylinder(1.0, 2.0));
   std::vector<BoundarySample> solid = sampleBoundary(thick, 3, params(0.1));
