@@ -4,6 +4,7 @@
 #include <BRepBndLib.hxx>
 #include <BRepBuilderAPI_Sewing.hxx>
 #include <BRepCheck_Analyzer.hxx>
+#include <BRepClass3d_SolidClassifier.hxx>
 #include <BRepGProp.hxx>
 #include <BRepTools_ReShape.hxx>
 #include <BRep_Builder.hxx>
@@ -206,16 +207,28 @@ std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tole
   // Only when every face ends up in a solid, and no solid lies inside another (an inner shell
   // is a void, not material): else the model is refused as it is, naming a free edge.
   if (made == 0 || count(solids, TopAbs_FACE) < count(shape, TopAbs_FACE)) return std::nullopt;
-  std::vector<Bnd_Box> boxes;
+  // A solid is inside another when its box is and one of its vertices lies strictly inside the
+  // other (a void's vertices all do; solids that merely touch, or whose boxes nest, like a
+  // resistor's leads and body, have theirs on or outside it: RLF_12545.igs).
+  std::vector<std::pair<TopoDS_Shape, Bnd_Box>> seen;
+  const auto nested = [](const TopoDS_Shape& inner, const Bnd_Box& innerBox,
+                         const TopoDS_Shape& outer, const Bnd_Box& outerBox) {
+    if (outerBox.IsOut(innerBox.CornerMin()) || outerBox.IsOut(innerBox.CornerMax())) return false;
+    BRepClass3d_SolidClassifier classifier(outer);
+    for (TopExp_Explorer v(inner, TopAbs_VERTEX); v.More(); v.Next()) {
+      classifier.Perform(BRep_Tool::Pnt(TopoDS::Vertex(v.Current())),
+                         1e-9 * outerBox.SquareExtent());
+      if (classifier.State() == TopAbs_IN) return true;
+    }
+    return false;
+  };
   for (TopExp_Explorer s(solids, TopAbs_SOLID); s.More(); s.Next()) {
     Bnd_Box box;
     BRepBndLib::Add(s.Current(), box);
-    const auto inside = [](const Bnd_Box& inner, const Bnd_Box& outer) {
-      return !outer.IsOut(inner.CornerMin()) && !outer.IsOut(inner.CornerMax());
-    };
-    for (const Bnd_Box& other : boxes)
-      if (inside(other, box) || inside(box, other)) return std::nullopt;
-    boxes.push_back(box);
+    for (const auto& [other, otherBox] : seen)
+      if (nested(other, otherBox, s.Current(), box) || nested(s.Current(), box, other, otherBox))
+        return std::nullopt;
+    seen.emplace_back(s.Current(), box);
   }
   actions.push_back("sewed the faces (tolerance " + formatNumber(tolerance) + ") into " +
                     std::to_string(made) + (made == 1 ? " closed shell" : " closed shells") +

@@ -3,6 +3,7 @@
 // closed is refused naming a free edge.
 #include <gtest/gtest.h>
 
+#include <BRepAlgoAPI_Cut.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRep_Builder.hxx>
 #include <TopExp_Explorer.hxx>
@@ -31,6 +32,16 @@ TopoDS_Shape looseFaces(bool all) {
   int n = 0;
   for (TopExp_Explorer f(box(), TopAbs_FACE); f.More(); f.Next())
     if (all || ++n < 6) b.Add(c, f.Current());
+  return c;
+}
+
+// The faces of two shapes, loose (no shell, no solid).
+TopoDS_Shape looseFacesOf(const TopoDS_Shape& one, const TopoDS_Shape& two) {
+  TopoDS_Compound c;
+  BRep_Builder b;
+  b.MakeCompound(c);
+  for (const TopoDS_Shape& s : {one, two})
+    for (TopExp_Explorer f(s, TopAbs_FACE); f.More(); f.Next()) b.Add(c, f.Current());
   return c;
 }
 
@@ -70,6 +81,25 @@ TEST(CadHealing, FacesThatCloseAreSewnIntoASolid) {
   EXPECT_EQ(cad.numFaces(), 6);
   ASSERT_FALSE(record.actions.empty());
   EXPECT_NE(record.actions[0].find("sewed"), std::string::npos);
+}
+
+// Two closed shells whose bounding boxes nest: one inside the other's material is a void and
+// the model is refused (which side is material is not known); a post standing in a frame's
+// hole is no void, the two are solids.
+TEST(CadHealing, AShellInsideAnotherIsRefusedOneInAHoleIsASolid) {
+  const TopoDS_Shape big = BRepPrimAPI_MakeBox(4.0, 4.0, 4.0).Shape();
+  const TopoDS_Shape small = BRepPrimAPI_MakeBox(gp_Pnt(1, 1, 1), 1.0, 1.0, 1.0).Shape();
+  HealingRecord voided;
+  EXPECT_THROW(
+      healModel(cadModelFromShape(looseFacesOf(big, small), "a box with a void"), true, voided),
+      CadError);
+  const TopoDS_Shape frame =
+      BRepAlgoAPI_Cut(big, BRepPrimAPI_MakeBox(gp_Pnt(1, 1, -1), 2.0, 2.0, 6.0).Shape()).Shape();
+  const TopoDS_Shape post = BRepPrimAPI_MakeBox(gp_Pnt(1.5, 1.5, 1), 1.0, 1.0, 2.0).Shape();
+  HealingRecord record;
+  const CadModel cad =
+      healModel(cadModelFromShape(looseFacesOf(frame, post), "a frame and a post"), true, record);
+  EXPECT_EQ(cad.numSolids(), 2);
 }
 
 TEST(CadHealing, WhatCannotBeClosedIsRefusedNamingAFreeEdge) {
