@@ -613,7 +613,6 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       break;
     }
     const std::size_t budgetEvents = budget.cutStages().size() + budget.skippedStages().size();
-    StageClock clock(name, result.timings, observer);
     const auto start = std::chrono::steady_clock::now();
     RepairRound record;
     record.invalid = from.quality.invalid;
@@ -627,7 +626,9 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       next = from.linear;
       record.edgesSplit = applySplits(next, plan.splits, *result.cad);
     }
-    if (poor && record.edgesSplit == 0) break;  // (a poor element is not worth a remesh)
+    // A poor element is not worth a remesh: without a split there is no round (nor its stage).
+    if (poor && record.edgesSplit == 0) break;
+    StageClock clock(name, result.timings, observer);
     if (record.edgesSplit > 0) {
       record.action = poor ? "split poor" : "split";
       record.elements = plan.splitCells;
@@ -676,7 +677,8 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     record.worstAfter = state.quality.scaled.min;
     record.meshElements = state.mesh.numElements();
     record.kept = state.betterThan(best);
-    splitFailed = !record.kept && record.action == "split";
+    // (A "split poor" round not kept ends the rounds: see the loop's start.)
+    splitFailed = !record.kept && (record.action == "split" || record.action == "split poor");
     if (record.kept) {
       best = std::move(state);
       last.reset();
