@@ -184,7 +184,7 @@ Findings inspect(const TopoDS_Shape& shape, double diagonal, bool planar,
 
 // Sews the faces and makes a solid of every closed shell; nullopt when no closed shell results.
 std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tolerance,
-                                          double diagonal, std::vector<std::string>& actions) {
+                                          double diagonal, HealingRecord& record) {
   BRepBuilderAPI_Sewing sewing(tolerance);
   sewing.Add(shape);
   sewing.Perform();
@@ -192,8 +192,9 @@ std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tole
   TopoDS_Compound solids;
   BRep_Builder builder;
   builder.MakeCompound(solids);
-  int made = 0;
+  int made = 0, shellCount = 0;
   for (TopExp_Explorer shells(sewn, TopAbs_SHELL); shells.More(); shells.Next()) {
+    ++shellCount;
     const TopoDS_Shell& shell = TopoDS::Shell(shells.Current());
     if (!BRep_Tool::IsClosed(shell)) continue;
     ShapeFix_Solid fix;
@@ -206,7 +207,11 @@ std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tole
   }
   // Only when every face ends up in a solid, and no solid lies inside another (an inner shell
   // is a void, not material): else the model is refused as it is, naming a free edge.
-  if (made == 0 || count(solids, TopAbs_FACE) < count(shape, TopAbs_FACE)) return std::nullopt;
+  if (made == 0 || count(solids, TopAbs_FACE) < count(shape, TopAbs_FACE)) {
+    record.sewing = "sewing closed " + std::to_string(made) + " of " +
+                    std::to_string(std::max(shellCount, made)) + " shells";
+    return std::nullopt;
+  }
   // A solid is inside another when its box is and one of its vertices lies strictly inside the
   // other (a void's vertices all do; solids that merely touch, or whose boxes nest, like a
   // resistor's leads and body, have theirs on or outside it: RLF_12545.igs).
@@ -226,13 +231,17 @@ std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tole
     Bnd_Box box;
     BRepBndLib::Add(s.Current(), box);
     for (const auto& [other, otherBox] : seen)
-      if (nested(other, otherBox, s.Current(), box) || nested(s.Current(), box, other, otherBox))
+      if (nested(other, otherBox, s.Current(), box) || nested(s.Current(), box, other, otherBox)) {
+        record.sewing =
+            "sewing gave closed shells one inside another: a void, and which side is material "
+            "is not known";
         return std::nullopt;
+      }
     seen.emplace_back(s.Current(), box);
   }
-  actions.push_back("sewed the faces (tolerance " + formatNumber(tolerance) + ") into " +
-                    std::to_string(made) + (made == 1 ? " closed shell" : " closed shells") +
-                    " and made " + (made == 1 ? "a solid of it" : "solids of them"));
+  record.actions.push_back("sewed the faces (tolerance " + formatNumber(tolerance) + ") into " +
+                           std::to_string(made) + (made == 1 ? " closed shell" : " closed shells") +
+                           " and made " + (made == 1 ? "a solid of it" : "solids of them"));
   return made == 1 ? TopoDS_Shape(TopExp_Explorer(solids, TopAbs_SOLID).Current())
                    : TopoDS_Shape(solids);
 }
@@ -249,7 +258,7 @@ TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal,
   const double tolerance = kTolerance * diagonal;
   bool sewn = false;
   if (found.unsewn || found.openSolid) {
-    if (auto solids = sewIntoSolids(shape, 10.0 * tolerance, diagonal, record.actions)) {
+    if (auto solids = sewIntoSolids(shape, 10.0 * tolerance, diagonal, record)) {
       shape = *solids;
       sewn = true;
     }
@@ -339,7 +348,9 @@ CadModel healModel(CadModel cad, bool enabled, HealingRecord& record) {
   TopExp::MapShapes(shape, TopAbs_EDGE, edges);
   TopExp::MapShapes(shape, TopAbs_SOLID, solids);
   const std::string healed =
-      enabled ? "; healing could not close it" : "; healing is off (it may close it)";
+      enabled ? "; healing could not close it" +
+                    (record.sewing.empty() ? std::string() : " (" + record.sewing + ")")
+              : "; healing is off (it may close it)";
   for (int s = 1; s <= solids.Extent(); ++s) {
     const int edge = firstFreeEdge(solids(s), edges);
     if (edge != 0)

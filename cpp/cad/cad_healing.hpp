@@ -26,6 +26,9 @@ struct HealingRecord {
   double tolerance = 0.0;             // of the fixes (model units)
   std::vector<std::string> problems;  // what the check found, in words, entities named
   std::vector<std::string> actions;   // what healing did (empty: the model is unchanged)
+  // Why sewing made no solids of the faces, when it was tried and did not ("closed 3 of 5
+  // shells"); the refusal quotes it.
+  std::string sewing;
   int facesBefore = 0, facesAfter = 0;
   int solidsBefore = 0, solidsAfter = 0;
   double seconds = 0.0;
