@@ -5,7 +5,7 @@
 // at most `gradation` per unit distance, clamped to [minDelta, maxDelta], and refined further by
 // the user's sources. Where a curved wall is thin, the sagitta is bounded by thinWall times the
 // wall's local thickness t as well: the size there is the chord whose sagitta is
-// min(eps R, thinWall t) (sizing/wall_thickness.hpp).
+// min(eps R, thinWall t), at least a third of the curvature size (sizing/wall_thickness.hpp).
 #pragma once
 
 #include <vector>
