@@ -25,6 +25,10 @@
 #include <string>
 #include <type_traits>
 
+// The per-point derivatives run hundreds of times per node update; GCC otherwise leaves the
+// cofactor and the regularisation out of line (a call per quadrature point).
+#define HOMESH_POINT_KERNEL [[gnu::always_inline]] inline
+
 namespace homesh {
 
 enum class Functional { LinearElastic, Hyperelastic, Winslow, Distortion };
@@ -60,7 +64,7 @@ struct Psi {
 // Compile-time functional: the optimiser's inner loops are instantiated per functional, so
 // this inlines without a branch per point.
 template <int D, Functional F, class T>
-Psi<T> psi(const T& S, const T& r) {
+HOMESH_POINT_KERNEL Psi<T> psi(const T& S, const T& r) {
   using std::log;
   Psi<T> p;
   if (!(r > 0.0)) {
@@ -99,7 +103,7 @@ Psi<T> psi(const T& S, const T& r) {
 }
 
 template <int D, class T>
-T determinant(const Eigen::Matrix<T, D, D>& F) {
+HOMESH_POINT_KERNEL T determinant(const Eigen::Matrix<T, D, D>& F) {
   if constexpr (D == 2) {
     return F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0);
   } else {
@@ -111,7 +115,7 @@ T determinant(const Eigen::Matrix<T, D, D>& F) {
 
 // The cofactor matrix dJ/dF.
 template <int D, class T>
-Eigen::Matrix<T, D, D> cofactor(const Eigen::Matrix<T, D, D>& F) {
+HOMESH_POINT_KERNEL Eigen::Matrix<T, D, D> cofactor(const Eigen::Matrix<T, D, D>& F) {
   Eigen::Matrix<T, D, D> c;
   if constexpr (D == 2) {
     c << F(1, 1), -F(1, 0), -F(0, 1), F(0, 0);
@@ -157,7 +161,7 @@ struct Regularised {
   T r = T(0), dr = T(0), ddr = T(0);
 };
 template <class T>
-Regularised<T> regularise(const T& J, double eps) {
+HOMESH_POINT_KERNEL Regularised<T> regularise(const T& J, double eps) {
   using std::sqrt;
   Regularised<T> out;
   // Far from inversion (eps^2 / J^2 below 1e-18, under the unit roundoff): J_r = J and
@@ -198,28 +202,22 @@ T energyDensity(Functional f, const Eigen::Matrix<T, D, D>& F, double eps) {
 
 // What W(F + delta a^T) needs of F, for every delta: |F + delta a^T|^2 = SF + 2 delta . fa +
 // |delta|^2 aa and det(F + delta a^T) = J + g . delta (matrix determinant lemma, g = cof(F) a).
-// A trial move then costs two dot products and psi instead of a 3x3 update and determinant.
+// A trial move then costs two dot products and psi instead of a 3x3 update and determinant
+// (optimise/node_patch.hpp keeps these terms per point, for every point of a node's patch).
 template <int D, class T>
 struct RankOneTerms {
   T SF = T(0), J = T(0), aa = T(0);
   Eigen::Matrix<T, D, 1> fa = Eigen::Matrix<T, D, 1>::Zero(), g = Eigen::Matrix<T, D, 1>::Zero();
 };
 
-// W(F + delta a^T) from the terms of F: the same value as energyDensity of the updated matrix
-// up to rounding. Not for the linear elastic W, whose |E|^2 is quartic in delta.
-template <int D, Functional Fn, class T>
-T energyDensityMoved(const RankOneTerms<D, T>& t, const Eigen::Matrix<T, D, 1>& delta, double eps) {
-  static_assert(Fn != Functional::LinearElastic, "linear elastic W needs the updated F");
-  const T S = t.SF + 2.0 * delta.dot(t.fa) + delta.squaredNorm() * t.aa;
-  return functional_detail::psi<D, Fn>(S, regularise(T(t.J + t.g.dot(delta)), eps).r).v;
-}
-
 // W(F) and its gradient and Hessian with respect to delta, where F(delta) = F + delta a^T;
-// with `terms`, also what energyDensityMoved needs.
+// with `terms`, also F's rank-one terms.
 template <int D, Functional Fn, class T>
-T energyDensityDerivatives(const Eigen::Matrix<T, D, D>& F, const Eigen::Matrix<T, D, 1>& a,
-                           double eps, Eigen::Matrix<T, D, 1>& gradient,
-                           Eigen::Matrix<T, D, D>& hessian, RankOneTerms<D, T>* terms = nullptr) {
+HOMESH_POINT_KERNEL T energyDensityDerivatives(const Eigen::Matrix<T, D, D>& F,
+                                               const Eigen::Matrix<T, D, 1>& a, double eps,
+                                               Eigen::Matrix<T, D, 1>& gradient,
+                                               Eigen::Matrix<T, D, D>& hessian,
+                                               RankOneTerms<D, T>* terms = nullptr) {
   using namespace functional_detail;
   using Vec = Eigen::Matrix<T, D, 1>;
   using Mat = Eigen::Matrix<T, D, D>;

@@ -63,11 +63,12 @@ JacobianSampler boundarySampler(CellType type, int order) {
 
 }  // namespace
 
-JacobianBounds elementJacobianBounds(const Mesh& mesh, const ElementBlock& block, std::size_t e) {
+JacobianBounds elementJacobianBounds(const Mesh& mesh, const ElementBlock& block, std::size_t e,
+                                     double tolerance) {
   const Eigen::Vector3d normal(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
   return boundJacobian(block.type, block.order,
                        gather(mesh, block.element(e), block.nodesPerElement()),
-                       mesh.dim == 2 ? &normal : nullptr);
+                       mesh.dim == 2 ? &normal : nullptr, tolerance);
 }
 
 QualitySummary evaluateQuality(const Mesh& mesh, int threads) {

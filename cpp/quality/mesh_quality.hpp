@@ -78,8 +78,9 @@ std::vector<FlaggedElement> flaggedElements(const Mesh& mesh, const QualitySumma
 
 // Certified Jacobian bounds of one element of `block` (of dimension mesh.dim), computed on its
 // node coordinates moved to the origin and scaled to unit size (every measure here is invariant
-// under both).
-JacobianBounds elementJacobianBounds(const Mesh& mesh, const ElementBlock& block, std::size_t e);
+// under both). `tolerance` as boundJacobian's.
+JacobianBounds elementJacobianBounds(const Mesh& mesh, const ElementBlock& block, std::size_t e,
+                                     double tolerance = kJacobianBoundTolerance);
 
 // Evaluates every element on `threads` threads (the result does not depend on their number).
 // Throws Error for a mesh without elements.

@@ -168,57 +168,6 @@ TEST(Functional, ValueMatchesTheDensityAlone) {
   }
 }
 
-// The line search's W(F + d a^T) from the terms of F (energyDensityMoved) is the same function
-// as W of the updated matrix. Compared in long double, where both sides carry only rounding:
-// each forms S and J with under 30 operations on terms no larger than `size` below, and psi
-// amplifies an error in J by at most |psi_r| (|psi_r| J_r is at most about |ln J_r| + 2 here),
-// so 64 u_ld (size + |ln J_r| + 2) (1 + 1 / J_r) bounds their difference; a formula error (a lost
-// factor 2 on d . fa, a wrong sign in g) is of the order of the terms themselves.
-template <int D, Functional Fn>
-void checkMoved(std::mt19937& rng, double eps) {
-  using LD = long double;
-  using MatL = Eigen::Matrix<LD, D, D>;
-  using VecL = Eigen::Matrix<LD, D, 1>;
-  std::uniform_real_distribution<double> u(-0.3, 0.3);
-  for (int trial = 0; trial < 50; ++trial) {
-    MatL F = MatL::Identity();
-    VecL a, d;
-    for (int i = 0; i < D * D; ++i) F(i) += u(rng);
-    for (int i = 0; i < D; ++i) {
-      a[i] = u(rng) * 3.0;
-      d[i] = u(rng);
-    }
-    MatL Fg;
-    VecL g;
-    RankOneTerms<D, LD> terms;
-    energyDensityDerivatives<D, Fn>(F, a, eps, g, Fg, &terms);
-    const LD moved = energyDensityMoved<D, Fn>(terms, d, eps);
-    const MatL updated = F + d * a.transpose();
-    const LD direct = energyDensity<D, Fn>(updated, eps);
-    const LD J = functional_detail::determinant<D>(updated);
-    const LD r = regularise(J, eps).r;
-    const LD size = updated.squaredNorm() + terms.SF + 2 * d.norm() * terms.fa.norm() +
-                    d.squaredNorm() * terms.aa + std::abs(terms.J) + terms.g.norm() * d.norm();
-    const LD bound = 64 * std::numeric_limits<LD>::epsilon() / 2 *
-                     (size + std::abs(std::log(r)) + 2) * (1 + 1 / r);
-    EXPECT_LE(std::abs(moved - direct), bound)
-        << functionalName(Fn) << " D=" << D << " trial " << trial << ": " << double(moved) << " vs "
-        << double(direct);
-  }
-}
-
-TEST(Functional, MovedDensityFromTheTermsEqualsTheDensityOfTheUpdatedMatrix) {
-  std::mt19937 rng(17);
-  for (const double eps : {1e-10, 0.3}) {
-    checkMoved<3, Functional::Hyperelastic>(rng, eps);
-    checkMoved<3, Functional::Winslow>(rng, eps);
-    checkMoved<3, Functional::Distortion>(rng, eps);
-    checkMoved<2, Functional::Hyperelastic>(rng, eps);
-    checkMoved<2, Functional::Winslow>(rng, eps);
-    checkMoved<2, Functional::Distortion>(rng, eps);
-  }
-}
-
 // ---- 2. The optimiser's assembly against finite differences -----------------------------------
 
 // A derivative of phi at 0 by fourth-order central differences, with a bound on its error.
