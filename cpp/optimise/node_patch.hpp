@@ -295,6 +295,21 @@ void rankOneTerms(NodePatch<D>& p, const typename NodePatch<D>::Run& run, double
   regulariseAll(J, n, eps, r, dr, ddr);
 }
 
+// What point i adds to the patch's sums, each times its weight: the energy, the size (|W| +
+// |F|^2), the factors of dS, g g^T and (dS g^T + g dS^T) in the gradient and Hessian (psi_S,
+// psi_J, psi_JJ, psi_SJ), and psi_S times S's second derivative 2 |a|^2 on the diagonal.
+struct PointSums {
+  double e, size, s, j, jj, sj, diag;
+};
+template <int D, Functional Fn>
+[[gnu::always_inline]] inline PointSums pointSums(double w, double SF, double aa, double r,
+                                                  double t, double dr, double ddr) {
+  const PsiTerms ps = psiFrom<D, Fn>(SF, r, t);
+  return {w * ps.v,           w * (std::abs(ps.v) + SF),          w * ps.s,
+          w * ps.r * dr,      w * (ps.rr * dr * dr + ps.r * ddr), w * ps.sr * dr,
+          w * ps.s * 2.0 * aa};
+}
+
 }  // namespace patch_detail
 
 // The patch energy sum_i w_i W(F_i) and its gradient and Hessian in the node's displacement;
@@ -350,30 +365,27 @@ double assemblePatch(NodePatch<D>& p, double eps, Eigen::Matrix<double, D, 1>& g
       fa[c] = p.fa(c);
       g[c] = p.g(c);
     }
+    // dS = 2 F a; the Hessian's psi_SJ term (dS g^T + g dS^T) vanishes for the elastic W.
     if constexpr (D == 3) {
       double g0 = 0, g1 = 0, g2 = 0, h00 = 0, h01 = 0, h02 = 0, h11 = 0, h12 = 0, h22 = 0;
 #pragma omp simd reduction(+ : e0, size, g0, g1, g2, h00, h01, h02, h11, h12, h22, diag)
       for (std::size_t i = 0; i < n; ++i) {
-        const patch_detail::PsiTerms ps = patch_detail::psiFrom<D, Fn>(SF[i], rr[i], tr[i]);
-        const double pj = ps.r * dr[i];
-        const double pjj = ps.rr * dr[i] * dr[i] + ps.r * ddr[i];
-        const double psj = ps.sr * dr[i];
-        const double wi = w[i];
-        e0 += wi * ps.v;
-        size += wi * (std::abs(ps.v) + SF[i]);
-        // dS = 2 F a; the Hessian's psi_SJ term (dS g^T + g dS^T) vanishes for the elastic W.
+        const patch_detail::PointSums t =
+            patch_detail::pointSums<D, Fn>(w[i], SF[i], aa[i], rr[i], tr[i], dr[i], ddr[i]);
         const double d0 = 2.0 * fa[0][i], d1 = 2.0 * fa[1][i], d2 = 2.0 * fa[2][i];
         const double q0 = g[0][i], q1 = g[1][i], q2 = g[2][i];
-        g0 += wi * (ps.s * d0 + pj * q0);
-        g1 += wi * (ps.s * d1 + pj * q1);
-        g2 += wi * (ps.s * d2 + pj * q2);
-        h00 += wi * (pjj * q0 * q0 + psj * 2.0 * d0 * q0);
-        h01 += wi * (pjj * q0 * q1 + psj * (d0 * q1 + q0 * d1));
-        h02 += wi * (pjj * q0 * q2 + psj * (d0 * q2 + q0 * d2));
-        h11 += wi * (pjj * q1 * q1 + psj * 2.0 * d1 * q1);
-        h12 += wi * (pjj * q1 * q2 + psj * (d1 * q2 + q1 * d2));
-        h22 += wi * (pjj * q2 * q2 + psj * 2.0 * d2 * q2);
-        diag += wi * ps.s * 2.0 * aa[i];  // psi_S times S's second derivative 2 |a|^2 I
+        e0 += t.e;
+        size += t.size;
+        diag += t.diag;
+        g0 += t.s * d0 + t.j * q0;
+        g1 += t.s * d1 + t.j * q1;
+        g2 += t.s * d2 + t.j * q2;
+        h00 += t.jj * q0 * q0 + t.sj * 2.0 * d0 * q0;
+        h01 += t.jj * q0 * q1 + t.sj * (d0 * q1 + q0 * d1);
+        h02 += t.jj * q0 * q2 + t.sj * (d0 * q2 + q0 * d2);
+        h11 += t.jj * q1 * q1 + t.sj * 2.0 * d1 * q1;
+        h12 += t.jj * q1 * q2 + t.sj * (d1 * q2 + q1 * d2);
+        h22 += t.jj * q2 * q2 + t.sj * 2.0 * d2 * q2;
       }
       gs[0] = g0;
       gs[1] = g1;
@@ -388,21 +400,18 @@ double assemblePatch(NodePatch<D>& p, double eps, Eigen::Matrix<double, D, 1>& g
       double g0 = 0, g1 = 0, h00 = 0, h01 = 0, h11 = 0;
 #pragma omp simd reduction(+ : e0, size, g0, g1, h00, h01, h11, diag)
       for (std::size_t i = 0; i < n; ++i) {
-        const patch_detail::PsiTerms ps = patch_detail::psiFrom<D, Fn>(SF[i], rr[i], tr[i]);
-        const double pj = ps.r * dr[i];
-        const double pjj = ps.rr * dr[i] * dr[i] + ps.r * ddr[i];
-        const double psj = ps.sr * dr[i];
-        const double wi = w[i];
-        e0 += wi * ps.v;
-        size += wi * (std::abs(ps.v) + SF[i]);
+        const patch_detail::PointSums t =
+            patch_detail::pointSums<D, Fn>(w[i], SF[i], aa[i], rr[i], tr[i], dr[i], ddr[i]);
         const double d0 = 2.0 * fa[0][i], d1 = 2.0 * fa[1][i];
         const double q0 = g[0][i], q1 = g[1][i];
-        g0 += wi * (ps.s * d0 + pj * q0);
-        g1 += wi * (ps.s * d1 + pj * q1);
-        h00 += wi * (pjj * q0 * q0 + psj * 2.0 * d0 * q0);
-        h01 += wi * (pjj * q0 * q1 + psj * (d0 * q1 + q0 * d1));
-        h11 += wi * (pjj * q1 * q1 + psj * 2.0 * d1 * q1);
-        diag += wi * ps.s * 2.0 * aa[i];
+        e0 += t.e;
+        size += t.size;
+        diag += t.diag;
+        g0 += t.s * d0 + t.j * q0;
+        g1 += t.s * d1 + t.j * q1;
+        h00 += t.jj * q0 * q0 + t.sj * 2.0 * d0 * q0;
+        h01 += t.jj * q0 * q1 + t.sj * (d0 * q1 + q0 * d1);
+        h11 += t.jj * q1 * q1 + t.sj * 2.0 * d1 * q1;
       }
       gs[0] = g0;
       gs[1] = g1;
