@@ -61,45 +61,63 @@ struct Psi {
   T v = T(0), s = T(0), r = T(0), sr = T(0), rr = T(0);
 };
 
-// Compile-time functional: the optimiser's inner loops are instantiated per functional, so
-// this inlines without a branch per point.
+// The transcendental of r each psi needs: ln r (the elastic energies), r^(2/d) (distortion),
+// none (Winslow: r itself). node_patch.hpp computes it in a loop of its own.
+template <int D, Functional F, class T>
+HOMESH_POINT_KERNEL T transcendentalOf(const T& r) {
+  using std::log;
+  if constexpr (F == Functional::Hyperelastic || F == Functional::LinearElastic) {
+    return log(r);
+  } else if constexpr (F == Functional::Distortion && D == 3) {
+    return cubeRoot(T(r * r));
+  } else {
+    return r;
+  }
+}
+
+// psi from S, r > 0 and t = transcendentalOf(r), without a branch (node_patch.hpp evaluates it in
+// vectorised loops). Compile-time functional: the optimiser's inner loops are instantiated per
+// functional, so this inlines without a branch per point.
+template <int D, Functional F, class T>
+HOMESH_POINT_KERNEL Psi<T> psiOf(const T& S, const T& r, const T& t) {
+  Psi<T> p;
+  const T ir = 1.0 / r;  // one division for every derivative
+  if constexpr (F == Functional::Hyperelastic) {
+    p.v = 0.5 * kMu * (S - double(D)) - kMu * t + 0.5 * kBulk * t * t;
+    p.s = T(0.5 * kMu);
+    p.r = (-kMu + kBulk * t) * ir;
+    p.rr = (kMu + kBulk * (1.0 - t)) * (ir * ir);
+  } else if constexpr (F == Functional::LinearElastic) {
+    p.v = 0.5 * kBulk * t * t + kMu * S;
+    p.s = T(kMu);
+    p.r = kBulk * t * ir;
+    p.rr = kBulk * (1.0 - t) * (ir * ir);
+  } else if constexpr (F == Functional::Winslow) {
+    p.v = S * ir;
+    p.s = ir;
+    p.sr = -ir * ir;
+    p.r = -S * ir * ir;
+    p.rr = 2.0 * S * ir * ir * ir;
+  } else {
+    constexpr double e = 2.0 / D;
+    const T c = 1.0 / (double(D) * t);  // t = r^(2/d)
+    p.v = S * c;
+    p.s = c;
+    p.sr = -e * c * ir;
+    p.r = -e * S * c * ir;
+    p.rr = e * (e + 1.0) * S * c * ir * ir;
+  }
+  return p;
+}
+
 template <int D, Functional F, class T>
 HOMESH_POINT_KERNEL Psi<T> psi(const T& S, const T& r) {
-  using std::log;
-  Psi<T> p;
   if (!(r > 0.0)) {
+    Psi<T> p;
     p.v = T(std::numeric_limits<double>::infinity());  // inverted, unregularised: a barrier
     return p;
   }
-  if constexpr (F == Functional::Hyperelastic) {
-    const T l = log(r);
-    const T ir = 1.0 / r;  // one division for both derivatives
-    p.v = 0.5 * kMu * (S - double(D)) - kMu * l + 0.5 * kBulk * l * l;
-    p.s = T(0.5 * kMu);
-    p.r = (-kMu + kBulk * l) * ir;
-    p.rr = (kMu + kBulk * (1.0 - l)) * (ir * ir);
-  } else if constexpr (F == Functional::LinearElastic) {
-    const T l = log(r);
-    p.v = 0.5 * kBulk * l * l + kMu * S;
-    p.s = T(kMu);
-    p.r = kBulk * l / r;
-    p.rr = kBulk * (1.0 - l) / (r * r);
-  } else if constexpr (F == Functional::Winslow) {
-    p.v = S / r;
-    p.s = 1.0 / r;
-    p.sr = -1.0 / (r * r);
-    p.r = -S / (r * r);
-    p.rr = 2.0 * S / (r * r * r);
-  } else {
-    constexpr double e = 2.0 / D;
-    const T rp = D == 2 ? r : cubeRoot(T(r * r));  // r^(2/d)
-    p.v = S / (double(D) * rp);
-    p.s = 1.0 / (double(D) * rp);
-    p.sr = -e / (double(D) * rp * r);
-    p.r = -e * S / (double(D) * rp * r);
-    p.rr = e * (e + 1.0) * S / (double(D) * rp * r * r);
-  }
-  return p;
+  return psiOf<D, F>(S, r, transcendentalOf<D, F>(r));
 }
 
 template <int D, class T>
@@ -160,24 +178,39 @@ template <class T>
 struct Regularised {
   T r = T(0), dr = T(0), ddr = T(0);
 };
+// Far from inversion (J > 1e9 eps: eps^2 / J^2 below 1e-18, under the unit roundoff): J_r = J
+// and dJ_r/dJ = 1 to rounding; the common case of a valid patch, without the square root.
+template <class T>
+HOMESH_POINT_KERNEL Regularised<T> regulariseFar(const T& J, double eps) {
+  Regularised<T> out;
+  out.r = J;
+  out.dr = T(1.0);
+  out.ddr = 2.0 * eps * eps / (J * J * J);
+  return out;
+}
+// The general formula. Every candidate is computed first and then selected, with no branch, so
+// a loop over points that calls it vectorises (node_patch.hpp): GCC does not if-convert a
+// division it would have to move out of a branch.
+template <class T>
+HOMESH_POINT_KERNEL Regularised<T> regulariseNear(const T& J, double eps) {
+  using std::sqrt;
+  const double e2 = eps * eps;
+  const T root = sqrt(J * J + 4.0 * e2);
+  const T above = 0.5 * (J + root);
+  const T below = 2.0 * e2 / (root - J);  // (J + root) / 2 cancels badly for J << 0
+  const bool rooted = root > 0.0;         // false only for eps = 0 and J = 0
+  Regularised<T> out;
+  out.r = J >= 0.0 ? above : below;
+  const T ratio = out.r / root;
+  const T curvature = 2.0 * e2 / (root * root * root);
+  out.dr = rooted ? ratio : T(J > 0.0 ? 1.0 : 0.0);
+  out.ddr = rooted ? curvature : T(0.0);
+  return out;
+}
 template <class T>
 HOMESH_POINT_KERNEL Regularised<T> regularise(const T& J, double eps) {
-  using std::sqrt;
-  Regularised<T> out;
-  // Far from inversion (eps^2 / J^2 below 1e-18, under the unit roundoff): J_r = J and
-  // dJ_r/dJ = 1 to rounding; the common case of a valid patch, without the square root.
-  if (J > 1e9 * eps) {
-    out.r = J;
-    out.dr = T(1.0);
-    out.ddr = 2.0 * eps * eps / (J * J * J);
-    return out;
-  }
-  const T root = sqrt(J * J + 4.0 * eps * eps);
-  // (J + root) / 2 cancels badly for J << 0: use the equivalent 2 eps^2 / (root - J).
-  out.r = J >= 0.0 ? T(0.5 * (J + root)) : T(2.0 * eps * eps / (root - J));
-  out.dr = root > 0.0 ? T(out.r / root) : T(J > 0.0 ? 1.0 : 0.0);
-  out.ddr = root > 0.0 ? T(2.0 * eps * eps / (root * root * root)) : T(0.0);
-  return out;
+  if (J > 1e9 * eps) return regulariseFar(J, eps);
+  return regulariseNear(J, eps);
 }
 
 // W(F).

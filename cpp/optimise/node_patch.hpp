@@ -1,7 +1,7 @@
 // The quadrature points around one node, stored structure-of-arrays, and the per-node energy
 // kernels of the optimiser on them: the patch energy with its gradient and Hessian in the node's
-// displacement, the energy after a trial displacement, and the rank-one update of an accepted
-// one.
+// displacement, and the energy after a trial displacement (the optimiser applies an accepted
+// one to its own F and J with the rank-one terms kept here).
 //
 // The formulas are functional.hpp's (W = psi(S, J_r), F(delta) = F + delta a^T); this file only
 // lays the points out so the loops over them vectorise: one array per component of F, of a and
@@ -124,76 +124,29 @@ class NodePatch {
 
 namespace patch_detail {
 
-// J_r and its derivatives (functional.hpp's regularise) written without branches, so the
-// compiler can vectorise the loop that calls it: every candidate is computed and one selected.
-struct Reg {
-  double r, dr, ddr;
-};
-// (Divisions are written outside the selections: GCC does not if-convert a division it would
-// have to move out of a branch.)
-[[gnu::always_inline]] inline Reg regularised(double J, double eps) {
-  const double e2 = eps * eps;
-  const double root = std::sqrt(J * J + 4.0 * e2);
-  const bool far = J > 1e9 * eps;
-  const double above = 0.5 * (J + root);
-  const double below = 2.0 * e2 / (root - J);  // (J + root) / 2 without J << 0's cancellation
-  const double inside = J >= 0.0 ? above : below;
-  const double ratio = inside / root;
-  const double ddFar = 2.0 * e2 / (J * J * J);
-  const double ddIn = 2.0 * e2 / (root * root * root);
-  const bool rooted = root > 0.0;  // false only for eps = 0 and J = 0
-  Reg out;
-  out.r = far ? J : inside;
-  out.dr = far ? 1.0 : (rooted ? ratio : (J > 0.0 ? 1.0 : 0.0));
-  out.ddr = far ? ddFar : (rooted ? ddIn : 0.0);
+// J_r and its derivatives (functional.hpp's regularise) with the far case selected, not
+// branched to, so the loop that calls it vectorises.
+[[gnu::always_inline]] inline Regularised<double> regularised(double J, double eps) {
+  const Regularised<double> far = regulariseFar(J, eps), near = regulariseNear(J, eps);
+  const bool isFar = J > 1e9 * eps;
+  Regularised<double> out;
+  out.r = isFar ? far.r : near.r;
+  out.dr = isFar ? far.dr : near.dr;
+  out.ddr = isFar ? far.ddr : near.ddr;
   return out;
 }
 
-// The transcendental psi needs of r: ln r (elastic energies), r^(2/3) (distortion in 3D).
+// The transcendental psi needs of r (functional.hpp's transcendentalOf) at n points.
 template <int D, Functional Fn>
 void transcendental(const double* r, double* t, std::size_t n) {
-  if constexpr (Fn == Functional::Hyperelastic || Fn == Functional::LinearElastic) {
-    for (std::size_t i = 0; i < n; ++i) t[i] = std::log(r[i]);
-  } else if constexpr (Fn == Functional::Distortion && D == 3) {
-    for (std::size_t i = 0; i < n; ++i) t[i] = std::cbrt(r[i] * r[i]);
-  } else {
-    for (std::size_t i = 0; i < n; ++i) t[i] = r[i];
-  }
+  for (std::size_t i = 0; i < n; ++i) t[i] = functional_detail::transcendentalOf<D, Fn>(r[i]);
 }
 
 // psi and its derivatives (functional.hpp's psi) from r and t = transcendental(r); the values
-// for !(r > 0) are the barrier's (infinite value, no derivatives).
-struct PsiTerms {
-  double v, s, r, sr, rr;
-};
+// for !(r > 0) are the barrier's (infinite value, no derivatives), selected, not branched to.
 template <int D, Functional Fn>
-[[gnu::always_inline]] inline PsiTerms psiFrom(double S, double r, double t) {
-  using namespace functional_detail;
-  PsiTerms p{};
-  const double ir = 1.0 / r;
-  if constexpr (Fn == Functional::Hyperelastic) {
-    p.v = 0.5 * kMu * (S - double(D)) - kMu * t + 0.5 * kBulk * t * t;
-    p.s = 0.5 * kMu;
-    p.r = (-kMu + kBulk * t) * ir;
-    p.rr = (kMu + kBulk * (1.0 - t)) * (ir * ir);
-    p.sr = 0.0;
-  } else if constexpr (Fn == Functional::Winslow) {
-    p.v = S * ir;
-    p.s = ir;
-    p.sr = -ir * ir;
-    p.r = -S * ir * ir;
-    p.rr = 2.0 * S * ir * ir * ir;
-  } else {
-    static_assert(Fn == Functional::Distortion, "psiFrom: the linear elastic W is not batched");
-    constexpr double e = 2.0 / D;
-    const double rp = t;  // r^(2/d)
-    const double c = 1.0 / (double(D) * rp);
-    p.v = S * c;
-    p.s = c;
-    p.sr = -e * c * ir;
-    p.r = -e * S * c * ir;
-    p.rr = e * (e + 1.0) * S * c * ir * ir;
-  }
+[[gnu::always_inline]] inline functional_detail::Psi<double> psiFrom(double S, double r, double t) {
+  functional_detail::Psi<double> p = functional_detail::psiOf<D, Fn>(S, r, t);
   const bool ok = r > 0.0;
   p.v = ok ? p.v : std::numeric_limits<double>::infinity();
   p.s = ok ? p.s : 0.0;
@@ -214,18 +167,18 @@ inline bool allFar(const double* J, std::size_t n, double eps) {
 inline void regulariseAll(const double* J, std::size_t n, double eps, double* r, double* dr,
                           double* ddr) {
   if (allFar(J, n, eps)) {
-    const double e2 = 2.0 * eps * eps;
 #pragma omp simd
     for (std::size_t i = 0; i < n; ++i) {
-      r[i] = J[i];
-      dr[i] = 1.0;
-      ddr[i] = e2 / (J[i] * J[i] * J[i]);
+      const Regularised<double> reg = regulariseFar(J[i], eps);
+      r[i] = reg.r;
+      dr[i] = reg.dr;
+      ddr[i] = reg.ddr;
     }
     return;
   }
 #pragma omp simd
   for (std::size_t i = 0; i < n; ++i) {
-    const Reg reg = regularised(J[i], eps);
+    const Regularised<double> reg = regularised(J[i], eps);
     r[i] = reg.r;
     dr[i] = reg.dr;
     ddr[i] = reg.ddr;
@@ -304,7 +257,7 @@ struct PointSums {
 template <int D, Functional Fn>
 [[gnu::always_inline]] inline PointSums pointSums(double w, double SF, double aa, double r,
                                                   double t, double dr, double ddr) {
-  const PsiTerms ps = psiFrom<D, Fn>(SF, r, t);
+  const functional_detail::Psi<double> ps = psiFrom<D, Fn>(SF, r, t);
   return {w * ps.v,           w * (std::abs(ps.v) + SF),          w * ps.s,
           w * ps.r * dr,      w * (ps.rr * dr * dr + ps.r * ddr), w * ps.sr * dr,
           w * ps.s * 2.0 * aa};
