@@ -18,6 +18,7 @@
 #include "core/first_failure.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
+#include "optimise/cad_local_model.hpp"
 #include "optimise/mesh_topology.hpp"
 #include "optimise/node_patch.hpp"
 #include "quality/jacobian_sampler.hpp"
@@ -230,6 +231,8 @@ class Optimiser {
         record.maxRelativeMove = moved.relative;
         record.visits = moved.visits;
         result_.visits += moved.visits;
+        result_.slides += moved.slides;
+        result_.cadEvaluations += moved.cadEvaluations;
         record.energy = totalEnergy();
         result_.history.push_back(record);
         result_.iterations = it;
@@ -325,7 +328,8 @@ class Optimiser {
         out.gradient = grad;
         out.hessian = hess;
       } else {
-        chainRule(threadCad(), node, coordinates.data(), grad, hess, out.gradient, out.hessian);
+        localModel(threadCad(), node, coordinates.data())
+            .chainRule(grad, hess, out.gradient, out.hessian);
       }
       return out;
     });
@@ -351,6 +355,9 @@ class Optimiser {
   const bool converting_;
   std::vector<CadModel> cadPerThread_;  // evaluation caches are per thread
   std::vector<std::uint8_t> slide_;     // per node: 1 on a CAD curve, 2 on a CAD face, else 0
+  std::vector<std::int32_t> cadSlot_;   // per node: its index in cadModel_, -1 if it stays
+  // per sliding node: its curve's (face's) model at the parameters it was built at
+  std::vector<LocalCadModel<D>> cadModel_;
   std::map<int, ParameterRange> curveRange_;
   std::map<int, SurfaceBounds> faceRange_;
   OptimiserResult result_;
@@ -627,7 +634,12 @@ class Optimiser {
         if (faceRange_.count(index) == 0) faceRange_[index] = cad_->faceBounds(index);
       }
     }
-    if (std::any_of(slide_.begin(), slide_.end(), [](std::uint8_t k) { return k != 0; }))
+    cadSlot_.assign(mesh_.numNodes(), -1);
+    std::int32_t slots = 0;
+    for (std::size_t node = 0; node < mesh_.numNodes(); ++node)
+      if (slide_[node] != 0) cadSlot_[node] = slots++;
+    cadModel_.assign(static_cast<std::size_t>(slots), LocalCadModel<D>{});
+    if (slots > 0)
       for (int t = 0; t < options_.threads; ++t) cadPerThread_.push_back(cad_->clone());
   }
 
@@ -701,6 +713,7 @@ class Optimiser {
     };
     NodePatch<D> points;
     std::vector<Run> runs;
+    std::size_t slides = 0, cadEvaluations = 0;  // sliding visits, CAD evaluations
   };
 
   // The Newton step -H^-1 g with H shifted to be positive definite (smallest eigenvalue at least
@@ -861,34 +874,41 @@ class Optimiser {
     return frame_ * cad.evaluateSurface(entity, param[0], param[1]).point;
   }
 
-  // The chain rule from the node's coordinates to its parameters at `param`: g = X^T grad and
-  // h = X^T hess X + grad . X'' with X = dx/dparam (exact: the second term is the curvature's).
-  void chainRule(const CadModel& cad, std::int64_t node, const double* param, const Vec& grad,
-                 const Mat& hess, Eigen::VectorXd& g, Eigen::MatrixXd& h) const {
-    const int n = slide_[node];
+  // The second-order model of the node's curve (face) at parameters `param` (t, or (u, v)).
+  LocalCadModel<D> localModel(const CadModel& cad, std::int64_t node, const double* param) const {
     const int entity = mesh_.nodeCadIndex[node];
-    Eigen::Matrix<double, D, Eigen::Dynamic> jac(D, n);
-    h.resize(n, n);
-    if (n == 1) {
-      const CurveDerivatives c = cad.evaluateCurve(entity, param[0]);
-      jac.col(0) = frame_ * c.d1;
-      h(0, 0) = jac.col(0).dot(hess * jac.col(0)) + grad.dot(frame_ * c.d2);
-    } else {
-      const SurfaceDerivatives s = cad.evaluateSurface(entity, param[0], param[1]);
-      jac.col(0) = frame_ * s.du;
-      jac.col(1) = frame_ * s.dv;
-      h = jac.transpose() * hess * jac;
-      h(0, 0) += grad.dot(frame_ * s.duu);
-      h(1, 1) += grad.dot(frame_ * s.dvv);
-      h(0, 1) += grad.dot(frame_ * s.duv);
-      h(1, 0) = h(0, 1);
+    LocalCadModel<D> m =
+        slide_[node] == 1
+            ? LocalCadModel<D>::curve(cad.evaluateCurve(entity, param[0]), frame_)
+            : LocalCadModel<D>::surface(cad.evaluateSurface(entity, param[0], param[1]), frame_);
+    m.at0[0] = param[0];
+    m.at0[1] = slide_[node] == 1 ? 0.0 : param[1];
+    return m;
+  }
+
+  // The model at the node's current parameters: the one its last accepted step left (the CAD
+  // evaluation of that step gave the derivatives too), else a fresh evaluation. Counts the
+  // evaluations in `patch`.
+  const LocalCadModel<D>& currentModel(const CadModel& cad, std::int64_t node, Patch& patch) {
+    const double* param = &mesh_.nodeCadParam[2 * node];
+    LocalCadModel<D>& m = cadModel_[static_cast<std::size_t>(cadSlot_[node])];
+    const bool current =
+        m.parameters != 0 && m.at0[0] == param[0] && (slide_[node] == 1 || m.at0[1] == param[1]);
+    if (!current) {
+      m = localModel(cad, node, param);
+      ++patch.cadEvaluations;
     }
-    g = jac.transpose() * grad;
+    return m;
   }
 
   // A Newton step of a node on a CAD curve (face) in its parameter t ((u, v)), then a
-  // backtracking line search whose trial points are evaluated on the CAD, so the node never
-  // leaves it.
+  // backtracking line search. The full step is evaluated on the CAD (it is accepted at about 98
+  // % of visits); the shorter trial points lie on the curve's (face's) second-order model at the
+  // node (cad_local_model.hpp), and the one the model accepts is evaluated on the CAD and kept if
+  // it passes the same test there. So the node never leaves the CAD, and the accepted
+  // evaluation's derivatives are the node's model for its next visit: about one CAD evaluation
+  // per visit. Where the model misled (its point passed, the CAD's did not), the search goes on
+  // with exact points.
   template <Functional Fn>
   double slide(std::int64_t node, Patch& patch, double eps, double e0, double magnitude,
                const Vec& grad, const Mat& hess) {
@@ -904,14 +924,20 @@ class Optimiser {
                  double magnitude, const Vec& grad, const Mat& hess) {
     double* param = &mesh_.nodeCadParam[2 * node];
     const int entity = mesh_.nodeCadIndex[node];
+    ++patch.slides;
+    const LocalCadModel<D>& model = currentModel(cad, node, patch);
     Eigen::VectorXd g;
     Eigen::MatrixXd h;
-    chainRule(cad, node, param, grad, hess, g, h);
+    model.chainRule(grad, hess, g, h);
     if (!g.allFinite() || !h.allFinite()) return 0.0;
     Eigen::VectorXd step;
     double slope = 0.0;
     if (!newtonStep(h, g, step, slope) || !resolvable(slope, magnitude, patch.points.size()))
       return 0.0;
+    bool exact = false;  // set once the model has misled the search at this node
+    // The model's error seen at the full step (the CAD's point is known there) and that step's
+    // length in parameters: the error shrinks like the cube of the step (cad_local_model.hpp).
+    double fullError = 0.0, fullStep = 0.0;
     double alpha = 1.0;
     for (int ls = 0; ls < kLineSearchSteps; ++ls, alpha *= 0.5) {
       double trial[2] = {param[0], param[1]};
@@ -923,15 +949,33 @@ class Optimiser {
         trial[0] = std::clamp(param[0] + alpha * step[0], b.uMin, b.uMax);
         trial[1] = std::clamp(param[1] + alpha * step[1], b.vMin, b.vMax);
       }
-      const Vec x = pointOn(cad, node, trial);
-      const Vec d = x - position_[node];
-      if (patchEnergyAfter<D, Fn>(patch.points, d, eps) <= e0 + kArmijo * alpha * slope) {
-        position_[node] = x;
+      const double bound = e0 + kArmijo * alpha * slope;
+      const double dp[2] = {trial[0] - param[0], trial[1] - param[1]};
+      if (ls > 0 && !exact) {
+        // Rejected on the model only when it misses the bound by more than the model's error
+        // can change the energy: (|grad| + |hess| |d|) times twice the cubic scaling of the
+        // error at the full step, so that borderline points are decided on the CAD.
+        const Vec d = model.at(dp) - position_[node];
+        const double r = std::min(1.0, std::hypot(dp[0], dp[1]) / fullStep);
+        const double slack = (grad.norm() + hess.norm() * d.norm()) * 2.0 * fullError * r * r * r;
+        if (!(patchEnergyAfter<D, Fn>(patch.points, d, eps) <= bound + slack)) continue;
+      }
+      ++patch.cadEvaluations;
+      LocalCadModel<D> next = localModel(cad, node, trial);
+      const Vec d = next.point - position_[node];
+      if (patchEnergyAfter<D, Fn>(patch.points, d, eps) <= bound) {
+        position_[node] = next.point;
         param[0] = trial[0];
         param[1] = trial[1];
         applyMove(patch, d);
+        cadModel_[static_cast<std::size_t>(cadSlot_[node])] = next;
         return d.norm();
       }
+      if (ls == 0) {
+        fullError = (next.point - model.at(dp)).norm();
+        fullStep = std::hypot(dp[0], dp[1]);
+      }
+      exact = ls > 0;
     }
     return 0.0;
   }
@@ -941,6 +985,7 @@ class Optimiser {
   struct Moves {
     double absolute = 0.0, relative = 0.0;
     std::size_t visits = 0;
+    std::size_t slides = 0, cadEvaluations = 0;  // see Patch
   };
 
   // After a node's visit: mark the elements it moved, and decide which nodes the next sweep
@@ -974,13 +1019,13 @@ class Optimiser {
   Moves relax(const std::vector<std::int64_t>& nodes, const std::vector<std::size_t>& starts,
               bool onlyActive) {
     double moved = 0.0, relative = 0.0;
-    std::size_t visits = 0;
+    std::size_t visits = 0, slides = 0, cadEvaluations = 0;
     FirstFailure failure;
     const std::int64_t colours = static_cast<std::int64_t>(starts.size()) - 1;
     const bool observed = observer_ != nullptr || options_.timeLimit > 0.0;
     bool cancel = false;  // shared: one thread asks, the barrier after `single` publishes it
 #pragma omp parallel num_threads(options_.threads) reduction(max : moved, relative) \
-    reduction(+ : visits)
+    reduction(+ : visits, slides, cadEvaluations)
     {
       Patch patch;
       for (std::int64_t c = 0; c < colours; ++c) {
@@ -1007,13 +1052,15 @@ class Optimiser {
           }
         }
       }
+      slides += patch.slides;
+      cadEvaluations += patch.cadEvaluations;
     }
     failure.rethrow();
     // run() keeps its best state: a half-done sweep is never kept.
     if (cancel)
       throw CancelledError(budgetSpent_ ? "time budget spent during an optimiser sweep"
                                         : "cancelled during an optimiser sweep");
-    return {moved, relative, visits};
+    return {moved, relative, visits, slides, cadEvaluations};
   }
 
   // One iteration: a Newton step on every free node, then `focusPasses` more on the nodes of
@@ -1048,8 +1095,12 @@ class Optimiser {
         focus.insert(focus.end(), g.begin(), g.end());
         starts.push_back(focus.size());
       }
-      for (int p = 0; p < options_.focusPasses; ++p)
-        moved.visits += relax(focus, starts, false).visits;
+      for (int p = 0; p < options_.focusPasses; ++p) {
+        const Moves m = relax(focus, starts, false);
+        moved.visits += m.visits;
+        moved.slides += m.slides;
+        moved.cadEvaluations += m.cadEvaluations;
+      }
       writeBack();
       evaluate(take(kStale));  // the elements the focused passes changed
     }

@@ -142,7 +142,11 @@ struct OptimiserResult {
   std::size_t invalidBefore = 0, invalidAfter = 0;
   std::size_t undecidedBefore = 0, undecidedAfter = 0;
   std::size_t freeNodes = 0, colours = 0, regionElements = 0;
-  std::size_t visits = 0;     // Newton steps tried in all sweeps (node updates)
+  std::size_t visits = 0;  // Newton steps tried in all sweeps (node updates)
+  // Visits of nodes sliding on the CAD, and the CAD evaluations they made: the full Newton step
+  // and the shorter trial points the local model accepted (cad_local_model.hpp), plus a fresh
+  // model where the node's last accepted evaluation is not at its parameters (first visit).
+  std::size_t slides = 0, cadEvaluations = 0;
   double setupSeconds = 0.0;  // colouring, ideal elements, initial quality
   double sweepSeconds = 0.0;  // the sweeps with their focused passes and quality checks
   double seconds = 0.0;       // everything, including the quality checks

@@ -458,6 +458,8 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
       r->seconds += second.seconds;
       r->sweepSeconds += second.sweepSeconds;
       r->visits += second.visits;
+      r->slides += second.slides;
+      r->cadEvaluations += second.cadEvaluations;
       state.layerRelease = std::max(state.layerRelease, step);
     }
     if (cut) budget.cut(where);

@@ -351,6 +351,8 @@ void appendOptimiser(JsonWriter& json, const OptimiserResult& r, const std::stri
   json.value("energy_after", r.energyAfter);
   json.value("free_nodes", r.freeNodes);
   json.value("node_visits", r.visits);
+  json.value("sliding_visits", r.slides);
+  json.value("cad_evaluations", r.cadEvaluations);
   json.value("colours", r.colours);
   json.value("region_elements", r.regionElements);
   json.value("seconds", r.seconds);
