@@ -52,6 +52,104 @@ int cube(int p) {
   return p * p * p;
 }
 
+// The node ids by key. Keys of edge and triangle nodes (support 2 or 3, almost every new node)
+// are packed into 128 bits and kept in an open-addressing table: one probe of a flat array
+// instead of a bucket list of heap nodes (the lookups were the largest single cost of a run
+// on OpenCASCADE's bottle). Other keys (quadrilateral faces and cell interiors) and vertex ids
+// of 2^32 or more go to a hash map. The ids are the same as with one map: the caller numbers a
+// node when its key is first seen.
+class NodeIndex {
+ public:
+  // The id of `key`, or `fresh` (then stored for it) when it is new; `inserted` says which.
+  std::int64_t findOrInsert(const NodeKey& key, std::int64_t fresh, bool& inserted) {
+    std::uint64_t lo = 0, hi = 0;
+    if (!pack(key, lo, hi)) {
+      const auto [it, added] = other_.try_emplace(key, fresh);
+      inserted = added;
+      return it->second;
+    }
+    if (2 * (used_ + 1) > slots_.size()) grow();
+    Slot& slot = probe(slots_, lo, hi);
+    inserted = slot.hi == 0;
+    if (inserted) {
+      slot = {lo, hi, fresh};
+      ++used_;
+    }
+    return slot.id;
+  }
+
+  // Every (key, id), the packed ones decoded (vertex 0's weight is P^3 less the others').
+  template <class Fn>
+  void forEach(int order, Fn&& fn) const {
+    for (const Slot& slot : slots_)
+      if (slot.hi != 0) fn(unpack(slot.lo, slot.hi, cube(order)), slot.id);
+    for (const auto& [key, id] : other_) fn(key, id);
+  }
+
+ private:
+  struct Slot {
+    std::uint64_t lo = 0, hi = 0;  // hi == 0: empty (a packed key's size, 2 or 3, is in hi)
+    std::int64_t id = 0;
+  };
+
+  // lo: vertex 0 | vertex 1 << 32; hi: size | index 1 << 2 | index 2 << 12 | vertex 2 << 22.
+  static bool pack(const NodeKey& key, std::uint64_t& lo, std::uint64_t& hi) {
+    if (key.size != 2 && key.size != 3) return false;
+    constexpr std::int64_t kVertexLimit = std::int64_t{1} << 32;
+    for (int i = 0; i < key.size; ++i)
+      if (key.vertex[i] < 0 || key.vertex[i] >= kVertexLimit || key.index[i] < 0 ||
+          key.index[i] >= 1024)
+        return false;
+    const auto u = [](std::int64_t v) { return static_cast<std::uint64_t>(v); };
+    lo = u(key.vertex[0]) | u(key.vertex[1]) << 32;
+    hi = u(key.size) | u(key.index[1]) << 2;
+    if (key.size == 3) hi |= u(key.index[2]) << 12 | u(key.vertex[2]) << 22;
+    return true;
+  }
+
+  static NodeKey unpack(std::uint64_t lo, std::uint64_t hi, int total) {
+    NodeKey key;
+    key.size = static_cast<int>(hi & 3U);
+    key.vertex[0] = static_cast<std::int64_t>(lo & 0xffffffffU);
+    key.vertex[1] = static_cast<std::int64_t>(lo >> 32);
+    key.index[1] = static_cast<int>((hi >> 2) & 1023U);
+    if (key.size == 3) {
+      key.index[2] = static_cast<int>((hi >> 12) & 1023U);
+      key.vertex[2] = static_cast<std::int64_t>(hi >> 22);
+    }
+    key.index[0] = total - key.index[1] - key.index[2];
+    return key;
+  }
+
+  static std::uint64_t mix(std::uint64_t x) {  // splitmix64's finaliser
+    x ^= x >> 30;
+    x *= 0xbf58476d1ce4e5b9ULL;
+    x ^= x >> 27;
+    x *= 0x94d049bb133111ebULL;
+    return x ^ (x >> 31);
+  }
+
+  // The slot holding (lo, hi), or the empty one where it would go (linear probing; the table
+  // is at most half full, so an empty slot exists).
+  static Slot& probe(std::vector<Slot>& slots, std::uint64_t lo, std::uint64_t hi) {
+    const std::size_t mask = slots.size() - 1;
+    std::size_t i = mix(lo ^ mix(hi)) & mask;
+    while (slots[i].hi != 0 && (slots[i].lo != lo || slots[i].hi != hi)) i = (i + 1) & mask;
+    return slots[i];
+  }
+
+  void grow() {
+    std::vector<Slot> bigger(std::max<std::size_t>(1024, 2 * slots_.size()));
+    for (const Slot& slot : slots_)
+      if (slot.hi != 0) probe(bigger, slot.lo, slot.hi) = slot;
+    slots_.swap(bigger);
+  }
+
+  std::vector<Slot> slots_;  // size a power of two
+  std::size_t used_ = 0;
+  std::unordered_map<NodeKey, std::int64_t, NodeKeyHash> other_;
+};
+
 // The vertex weights x P^3 of lattice point c of an order-P cell (node_ordering.hpp's lattice:
 // quadrilateral corners (0,0) (P,0) (P,P) (0,P); prism triangle at k = 0 then k = P;
 // hexahedron quadrilateral at k = 0 then k = P).
@@ -142,7 +240,7 @@ struct Elevator {
   const int order;
   const BoundaryClassification classes;
   Mesh out;
-  std::unordered_map<NodeKey, std::int64_t, NodeKeyHash> ids;
+  NodeIndex ids;
 
   Elevator(const Mesh& lin, int p) : linear(lin), order(p), classes(lin) {
     out.dim = lin.dim;
@@ -178,8 +276,10 @@ struct Elevator {
   // `curved`: the position from the source element's own map (null: on the straight element).
   std::int64_t node(const NodeKey& key, CellType cell, int cellEntity, const double* curved) {
     if (key.size == 1) return key.vertex[0];
-    const auto [it, inserted] = ids.try_emplace(key, 0);
-    if (!inserted) return it->second;
+    bool inserted = false;
+    const std::int64_t id =
+        ids.findOrInsert(key, static_cast<std::int64_t>(out.numNodes()), inserted);
+    if (!inserted) return id;
     double p[3] = {0.0, 0.0, 0.0};
     if (curved != nullptr) {
       std::copy(curved, curved + 3, p);
@@ -190,8 +290,8 @@ struct Elevator {
               linear.xyz[3 * key.vertex[i] + c] * key.index[i] / static_cast<double>(cube(order));
     }
     const auto [dim, entity] = classify(key, cell, cellEntity);
-    it->second = out.addNode(p, dim, entity, kNaN, kNaN);
-    return it->second;
+    out.addNode(p, dim, entity, kNaN, kNaN);  // its index is `id`, the node count before
+    return id;
   }
 
   void elevateBlock(const ElementBlock& block) {
@@ -277,8 +377,8 @@ class BoundaryPlacer {
         placed_(elevator.out.numNodes(), 0),
         firstNew_(firstNew) {
     const auto p = static_cast<std::size_t>(order_);
-    for (const auto& [key, id] : elevator.ids) {
-      if (static_cast<std::size_t>(id) < firstNew_) continue;
+    elevator.ids.forEach(order_, [&](const NodeKey& key, std::int64_t id) {
+      if (static_cast<std::size_t>(id) < firstNew_) return;
       if (key.size == 2) {
         auto& nodes = edges_[{key.vertex[0], key.vertex[1]}];
         if (nodes.empty()) {
@@ -297,7 +397,7 @@ class BoundaryPlacer {
       } else if (key.size == 4 && mesh_.nodeCadDim[id] == 2) {
         const QuadKey sortedKey{key.vertex[0], key.vertex[1], key.vertex[2], key.vertex[3]};
         const auto cycle = elevator.classes.quadCycle.find(sortedKey);
-        if (cycle == elevator.classes.quadCycle.end()) continue;
+        if (cycle == elevator.classes.quadCycle.end()) return;
         auto& nodes = quads_[cycle->second];
         if (nodes.empty()) nodes.assign((p + 1) * (p + 1), -1);
         // Weights (P-i)(P-j)P, i(P-j)P, ijP, (P-i)jP of the corners in cyclic order.
@@ -313,7 +413,7 @@ class BoundaryPlacer {
         const int j = (weight(c[2]) + weight(c[3])) / scale;
         nodes[quadIndex(order_, i, j)] = id;
       }
-    }
+    });
   }
 
   void run() {
