@@ -34,12 +34,16 @@ struct LayerSplitStats {
   std::size_t projected = 0;                              // new nodes on a CAD face or curve
   double maxProjection = 0.0;  // largest move onto the CAD, relative to the layer's height
   // The first layer's height along the wall normal at the wall's quadrature points (degree
-  // 2P): its range over the points measured and, with grown heights, the worst relative
-  // deviation from z_1 times the grown height interpolated there (0 without them), on the
-  // smooth wall and in the cells with a vertex at a sharp corner (where the walls' normals
-  // spread by more than 30 degrees: there the column follows the corner's bisector, and the
-  // height along each wall's normal falls towards the corner by design).
+  // 2P), the distance to where the normal line meets the layer's top: its range over the points
+  // measured and, with grown heights, the worst relative deviation from z_1 times the grown height
+  // interpolated there (0 without them), on the smooth wall and in the cells with a vertex at a
+  // sharp corner (where the walls' normals spread by more than 30 degrees: there the column follows
+  // the corner's bisector, and the height along each wall's normal falls towards the corner by
+  // design).
   std::size_t firstHeightMeasured = 0, cornerCells = 0;
+  // Quadrature points whose normal line leaves the cell's top through a neighbour's: measured
+  // there as the top point's component along the normal instead (heightAlongNormal).
+  std::size_t firstHeightOffNormal = 0;
   double firstHeightCornerDeviation = 0.0;
   std::size_t plainColumns = 0;  // columns split at z unchanged (LayerHeights::plain)
   double firstHeightMin = 0.0, firstHeightMax = 0.0, firstHeightDeviation = 0.0;

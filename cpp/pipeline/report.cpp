@@ -193,6 +193,8 @@ void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
     json.value("worst_deviation", s.firstHeightDeviation);
     json.value("corner_cells", s.cornerCells);
     json.value("worst_deviation_at_corners", s.firstHeightCornerDeviation);
+    json.value("points", s.firstHeightMeasured);
+    json.value("points_off_normal", s.firstHeightOffNormal);
     json.endObject();
   }
   json.beginArray("shrunk");
