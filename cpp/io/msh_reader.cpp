@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/input_file.hpp"
 #include "io/gmsh_element_types.hpp"
+#include "io/text_cursor.hpp"
 
 namespace homesh {
 namespace {
@@ -21,40 +22,14 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // A cursor over the whole file, for ASCII tokens and binary values alike.
-class Cursor {
+class Cursor : public TextCursor {
  public:
-  Cursor(std::string data, std::string path) : data_(std::move(data)), path_(std::move(path)) {}
+  Cursor(std::string data, std::string path)
+      : TextCursor(std::move(data)), path_(std::move(path)) {}
 
   [[noreturn]] void fail(const std::string& what) const {
     throw IoError("'" + path_ + "' is not a valid MSH file: " + what + " (byte " +
                   std::to_string(pos_) + ")");
-  }
-  bool atEnd() {
-    skipSpace();
-    return pos_ >= data_.size();
-  }
-  void skipSpace() {
-    while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_])) != 0)
-      ++pos_;
-  }
-  // Before binary data: consume the rest of the current line and its newline only (binary bytes
-  // may look like white space).
-  void endOfLine() {
-    while (pos_ < data_.size() && data_[pos_] != '\n') ++pos_;
-    if (pos_ < data_.size()) ++pos_;
-  }
-  std::string word() {
-    skipSpace();
-    const std::size_t start = pos_;
-    while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_])) == 0)
-      ++pos_;
-    return data_.substr(start, pos_ - start);
-  }
-  // The rest of the current line (for quoted names).
-  std::string line() {
-    const std::size_t start = pos_;
-    while (pos_ < data_.size() && data_[pos_] != '\n') ++pos_;
-    return data_.substr(start, pos_ - start);
   }
   double real() {
     skipSpace();
@@ -112,9 +87,7 @@ class Cursor {
   }
 
  private:
-  std::string data_;
   std::string path_;
-  std::size_t pos_ = 0;
 };
 
 struct RawElement {

@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/input_file.hpp"
 #include "io/foreign_mesh.hpp"
+#include "io/text_cursor.hpp"
 #include "io/vtk_cells.hpp"
 #include "io/vtk_readers.hpp"
 
@@ -41,47 +42,14 @@ std::pair<std::size_t, bool> typeSize(const std::string& type) {
   return {0, false};
 }
 
-class Cursor {
+class Cursor : public TextCursor {
  public:
-  Cursor(std::string data, std::string path) : data_(std::move(data)), path_(std::move(path)) {}
+  Cursor(std::string data, std::string path)
+      : TextCursor(std::move(data)), path_(std::move(path)) {}
 
   [[noreturn]] void fail(const std::string& what) const {
     throw IoError("'" + path_ + "' is not a valid VTK file: line " + std::to_string(line_) + ": " +
                   what);
-  }
-  bool atEnd() {
-    skipSpace();
-    return pos_ >= data_.size();
-  }
-  void skipSpace() {
-    while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_])) != 0) {
-      if (data_[pos_] == '\n') ++line_;
-      ++pos_;
-    }
-  }
-  // The rest of the current line, without its line break; moves to the next line.
-  std::string restOfLine() {
-    const std::size_t start = pos_;
-    while (pos_ < data_.size() && data_[pos_] != '\n') ++pos_;
-    std::string s = data_.substr(start, pos_ - start);
-    if (!s.empty() && s.back() == '\r') s.pop_back();
-    if (pos_ < data_.size()) ++pos_, ++line_;
-    return s;
-  }
-  std::string word() {
-    skipSpace();
-    const std::size_t start = pos_;
-    while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_])) == 0)
-      ++pos_;
-    return data_.substr(start, pos_ - start);
-  }
-  // The next word, left to be read again.
-  std::string peekWord() {
-    const std::size_t pos = pos_;
-    const int line = line_;
-    std::string w = word();
-    pos_ = pos, line_ = line;
-    return w;
   }
   long long integer(const std::string& what) {
     const std::string w = word();
@@ -130,8 +98,6 @@ class Cursor {
     pos_ += n * size;
     return out;
   }
-  // Before binary data: the rest of the keyword's line.
-  void endOfLine() { restOfLine(); }
 
  private:
   // One value from its bytes in the machine's (little-endian) order.
@@ -169,10 +135,7 @@ class Cursor {
     }
   }
 
-  std::string data_;
   std::string path_;
-  std::size_t pos_ = 0;
-  int line_ = 1;
 };
 
 std::vector<std::int64_t> integers(const std::vector<double>& v, Cursor& c,
