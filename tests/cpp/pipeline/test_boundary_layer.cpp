@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "core/expression.hpp"
+#include "curving/layer_split.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 #include "io/mesh_readers.hpp"
@@ -544,5 +545,48 @@ TEST(BoundaryLayer2D, T106IsValidWithTheLayerReleasedOnlyParallelToTheWall) {
   RecordProperty("plain_columns", std::to_string(r.layerSplit->plainColumns));
 }
 
+// A 2D macro layer that fans out: four order-4 quadrilaterals on an annulus of inner radius
+// R = 0.1 and thickness H = 1 (ten times R), each spanning 1 rad, whose lines across the layer
+// lean: node (xi, zeta) at angle theta0 + xi + s zeta, s = 0.08. Split in two layers of half
+// the height, the first layer's top is the circle of radius R + H/2, so its height along the
+// wall normal is H/2 everywhere; the top point at the wall point's own reference coordinate is
+// 0.04 rad to the side (inside the cell from the first quadrature point, xi = 0.047, on), and
+// its component along the normal is (R + H/2) cos 0.04 - R, 4.8e-4 short. The map's degree-5
+// remainder on five equispaced nodes, |d^5 x / d xi^5| max|prod (xi - xi_i)| / 5! <= 0.6 * 0.0046
+// / 120 = 2.3e-5 (2e-8 across the layer), bounds the error of the heights: 1e-4 holds them and
+// tells them from the component.
+TEST(BoundaryLayerSplit, TheFirstHeightIsMeasuredWhereTheWallNormalMeetsTheLayersTop) {
+  constexpr double kR = 0.1, kH = 1.0, kDTheta = 1.0, kLean = 0.08;
+  constexpr int kCells = 4, kOrder = 4;
+  Mesh macro;
+  macro.dim = 2;
+  macro.order = kOrder;
+  const ReferenceElement& ref = ReferenceElement::get(CellType::Quadrilateral, kOrder);
+  ElementBlock quads;
+  quads.type = CellType::Quadrilateral;
+  quads.order = kOrder;
+  std::map<std::pair<long long, long long>, std::int64_t> ids;  // shared nodes by position
+  for (int c = 0; c < kCells; ++c) {
+    for (int i = 0; i < ref.numNodes(); ++i) {
+      const double xi = ref.nodes()(i, 0), zeta = ref.nodes()(i, 1);
+      const double theta = (c + xi) * kDTheta + zeta * kLean;
+      const double r = kR + zeta * kH;
+      const double p[3] = {r * std::cos(theta), r * std::sin(theta), 0.0};
+      const auto key = std::make_pair(std::llround(p[0] * 1e9), std::llround(p[1] * 1e9));
+      auto [it, added] = ids.try_emplace(key, 0);
+      if (added) it->second = macro.addNode(p, 2, 1, std::nan(""), std::nan(""));
+      quads.nodes.push_back(it->second);
+    }
+    quads.entity.push_back(1);
+  }
+  macro.blocks.push_back(quads);
+  macro.checkConsistency();
+  LayerSplitStats stats;
+  splitBoundaryLayer(macro, {0.0, 0.5, 1.0}, nullptr, &stats);
+  ASSERT_GT(stats.firstHeightMeasured, 0U);
+  EXPECT_EQ(stats.firstHeightOffNormal, 0U);
+  EXPECT_NEAR(stats.firstHeightMin, kH / 2, 1e-4);
+  EXPECT_NEAR(stats.firstHeightMax, kH / 2, 1e-4);
+}
 }  // namespace
 }  // namespace homesh
