@@ -368,7 +368,7 @@ def size_field(shape, min_delta=None, max_delta=None, eps=None, sources=(), name
 
 
 def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
-         optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=3,
+         optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=8,
          boundary_layer=None, cancel=None, optimise_seconds=0.0, linear_seconds=600.0,
          heal=True, job_seconds=0.0):
     """Meshes a CAD shape with curved elements of the given order.

@@ -41,7 +41,7 @@ struct MeshCommand {
   SizingFlags sizing;
   int verbosity = 0;               // -v: 1, -vv: 2
   int optimiseIterations = 0;      // --optimise: 100, --maxiter N
-  int repairRounds = 3;            // --repair-rounds N, range in core/parameters.hpp
+  int repairRounds = 8;            // --repair-rounds N, range and default in core/parameters.hpp
   double timeLimit = 0.0;          // --time-limit S: seconds per optimiser run (0: none)
   bool heal = true;                // --no-heal: the CAD is only checked
   double linearTimeLimit = 600.0;  // --linear-time-limit S: seconds per Gmsh run (0: none)

@@ -38,7 +38,7 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        "mesh so far is kept (the report's \"job\" says \"stopped\": \"time budget\"); with no "
        "mesh yet, the job fails naming its stage; 0: no limit"},
       {"repair_rounds", "RepairRounds", "--repair-rounds", "repair rounds", ParameterKind::Integer,
-       0, 20, false, 3, false, "mesh",
+       0, 20, false, 8, false, "mesh",
        "Most repair rounds while elements are not proven valid (split or refine around them, "
        "curve, optimise and check again)"},
       {"threads", "Threads", "--threads", "threads", ParameterKind::Integer, 1, 1024, false, 1,

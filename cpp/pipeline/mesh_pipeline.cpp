@@ -636,8 +636,16 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       record.elements = plan.splitCells;
     } else {
       // Nothing to split (or no split kept its cells positive): refine around every offender.
-      const std::vector<RefinementSource>& added =
+      std::vector<RefinementSource> added =
           plan.splits.empty() ? plan.sources : plan.allSources;  // (splitFailed: every offender)
+      // A round that refines around the same cell of the same mesh again (a refine that was not
+      // kept, then a split that was not kept, both from the best state) would make the same
+      // mesh again: its sphere asks for half the size the earlier one did, so repeats refine
+      // further instead of cycling.
+      for (RefinementSource& s : added)
+        for (const RefinementSource& earlier : sources)
+          if (earlier.kind == s.kind && earlier.a == s.a && earlier.radius == s.radius)
+            s.delta = std::min(s.delta, 0.5 * earlier.delta);
       record.action = "refine";
       record.elements = added.size();
       record.sources = added.size();

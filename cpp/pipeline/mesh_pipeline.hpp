@@ -61,7 +61,7 @@ struct MeshingOptions {
   // Repair rounds (pipeline/repair.hpp) while elements are not proven valid, range in
   // core/parameters.hpp: each splits the offending linear cells' edges on curved faces (or refines
   // around them), then curves, optimises and checks again. 0: none.
-  int repairRounds = 3;
+  int repairRounds = 8;  // core/parameters.hpp's default (a test checks they agree)
   // A macro boundary layer on these CAD faces (linear/boundary_layer.hpp), curved and optimised
   // with the rest and split into its thin layers last (curving/layer_split.hpp).
   std::optional<BoundaryLayerParameters> boundaryLayer;

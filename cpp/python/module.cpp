@@ -558,6 +558,11 @@ std::vector<double> finiteNodes(const bp::object& nodes) {
 }
 
 // A CAD file or a NekMesh .mcf case: a case's CAD and sizes (unless given here) are used.
+// The Python functions' default, read from the one parameter table.
+int defaultRepairRounds() {
+  return static_cast<int>(parameterDefinition("repair_rounds").defaultValue);
+}
+
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
                 int verbosity, bp::object progress, int optimise, const bp::object& sizing,
                 int repairRounds, const bp::object& boundaryLayer, const bp::object& cancel,
@@ -766,12 +771,12 @@ BOOST_PYTHON_MODULE(_core) {
       "mesh_file", &meshFile,
       (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"), bp::arg("verbosity"),
        bp::arg("progress"), bp::arg("optimise") = 0, bp::arg("sizing") = bp::object(),
-       bp::arg("repair_rounds") = 3, bp::arg("boundary_layer") = bp::object(),
+       bp::arg("repair_rounds") = defaultRepairRounds(), bp::arg("boundary_layer") = bp::object(),
        bp::arg("cancel") = bp::object(), bp::arg("limits") = bp::object(), bp::arg("heal") = true));
   bp::def("mesh_brep", &meshBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
            bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
-           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = 3,
+           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = defaultRepairRounds(),
            bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object(),
            bp::arg("limits") = bp::object(), bp::arg("heal") = true));
   bp::def("predict_file", &predictFile,

@@ -79,7 +79,7 @@ class HighOrderMeshObject(unittest.TestCase):
         part = box_with_hole(self.doc)
         obj = homesh.freecad.make_high_order_mesh(self.doc, part, order=4, size=1.0)
         self.assertEqual(obj.OptimiserIterations, 20)
-        self.assertEqual(obj.RepairRounds, 3)
+        self.assertEqual(obj.RepairRounds, 8)
         obj.RepairRounds = 0  # the optimiser alone, on the same linear mesh
         obj.OptimiserIterations = 0
         self.doc.recompute()
@@ -102,7 +102,7 @@ class HighOrderMeshObject(unittest.TestCase):
         self.assertGreater(int((on_hole & moved).sum()), 10)
         np.testing.assert_allclose(radius(mesh.nodes[on_hole]), 1.0, atol=1e-7)
         # The default path, repair rounds on: certified valid (0.715 measured).
-        obj.RepairRounds = 3
+        obj.RepairRounds = 8
         self.doc.recompute()
         self.assertTrue(obj.isValid())
         self.assertEqual(obj.InvalidElements, 0)

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include "cli/arguments.hpp"
+#include "core/parameters.hpp"
+#include "pipeline/mesh_pipeline.hpp"
 
 namespace homesh {
 namespace {
@@ -42,7 +44,11 @@ TEST(Arguments, Defaults) {
 }
 
 TEST(Arguments, RepairRounds) {
-  EXPECT_EQ(parse({"mesh", "part.brep"}).mesh.repairRounds, 3);
+  // The CLI's, the pipeline's and the parameter table's defaults agree.
+  const auto table = static_cast<int>(parameterDefinition("repair_rounds").defaultValue);
+  EXPECT_EQ(table, 8);
+  EXPECT_EQ(parse({"mesh", "part.brep"}).mesh.repairRounds, table);
+  EXPECT_EQ(MeshingOptions{}.repairRounds, table);
   EXPECT_EQ(parse({"mesh", "part.brep", "--repair-rounds", "0"}).mesh.repairRounds, 0);
   EXPECT_EQ(parse({"mesh", "part.brep", "--repair-rounds", "20"}).mesh.repairRounds, 20);
   for (const char* bad : {"-1", "21", "2.5", "x"})
