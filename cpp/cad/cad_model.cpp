@@ -24,6 +24,7 @@
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS.hxx>
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -47,6 +48,14 @@ struct CadModel::Impl {
   mutable std::vector<std::unique_ptr<BRepAdaptor_Surface>> surfaces;
   mutable std::vector<Handle(ShapeAnalysis_Surface)> analysers;
   mutable std::vector<std::unique_ptr<BRepTopAdaptor_FClass2d>> classifiers;
+  // Per face: its surface's periods, native or from a closed seam (below), built once.
+  struct Periods {
+    bool built = false;
+    std::array<double, 2> period{};  // 0: not periodic in that direction
+    std::array<double, 2> first{};   // start of the range a closed direction wraps into
+    std::array<bool, 2> wraps{};     // closed, not periodic: evaluation must wrap
+  };
+  mutable std::vector<Periods> periods;
 
   void index() {
     TopExp::MapShapes(shape, TopAbs_VERTEX, vertices);
@@ -57,6 +66,7 @@ struct CadModel::Impl {
     surfaces.resize(faces.Extent() + 1);
     analysers.resize(faces.Extent() + 1);
     classifiers.resize(faces.Extent() + 1);
+    periods.resize(faces.Extent() + 1);
     Bnd_Box box;  // the geometric box, not enlarged by the shape's tolerances
     BRepBndLib::AddOptimal(shape, box, false, false);
     if (!box.IsVoid()) {
@@ -105,6 +115,60 @@ struct CadModel::Impl {
         return std::make_unique<BRepTopAdaptor_FClass2d>(face, BRep_Tool::Tolerance(face));
       });
     return *slot;
+  }
+
+  // A surface that is closed in a direction without being periodic there (a B-spline revolved
+  // through 360 degrees, its first and last rows of poles the same) has a seam like a periodic
+  // one, but OCCT evaluates it beyond its range by extrapolation, not by coming round: a node
+  // placed across the seam in an unwrapped chart would land far off the surface. Such a
+  // direction gets its range as a period, and evaluation wraps into the range.
+  const Periods& facePeriods(int f) const {
+    const BRepAdaptor_Surface& s = surface(f);
+    Periods& out = periods[f];
+    if (out.built) return out;
+    withOcctErrors(cadEntityName(2, f), [&] {
+      const TopoDS_Face face = TopoDS::Face(faces(f));
+      const Handle(Geom_Surface) geometry = BRep_Tool::Surface(face);
+      double range[2][2];
+      geometry->Bounds(range[0][0], range[0][1], range[1][0], range[1][1]);
+      const double tol = 10.0 * std::max(BRep_Tool::Tolerance(face), 1e-7 * diagonal);
+      for (int d = 0; d < 2; ++d) {
+        if (d == 0 ? s.IsUPeriodic() : s.IsVPeriodic()) {
+          out.period[d] = d == 0 ? s.UPeriod() : s.VPeriod();
+          continue;
+        }
+        const double a = range[d][0], b = range[d][1];
+        const double oa = range[1 - d][0], ob = range[1 - d][1];
+        if (!std::isfinite(a) || !std::isfinite(b) || !(b > a) || !std::isfinite(oa) ||
+            !std::isfinite(ob))
+          continue;
+        bool closed = true;
+        for (int k = 0; k <= 8 && closed; ++k) {
+          const double o = oa + (ob - oa) * k / 8.0;
+          const gp_Pnt pa = d == 0 ? geometry->Value(a, o) : geometry->Value(o, a);
+          const gp_Pnt pb = d == 0 ? geometry->Value(b, o) : geometry->Value(o, b);
+          closed = pa.Distance(pb) <= tol;
+        }
+        if (!closed) continue;
+        out.period[d] = b - a;
+        out.first[d] = a;
+        out.wraps[d] = true;
+      }
+    });
+    out.built = true;
+    return out;
+  }
+
+  // (u, v) wrapped into a closed, non-periodic surface's range where it has one.
+  std::array<double, 2> wrapClosed(int f, double u, double v) const {
+    const Periods& p = facePeriods(f);
+    std::array<double, 2> uv{u, v};
+    for (int d = 0; d < 2; ++d)
+      if (p.wraps[d] && std::isfinite(uv[d])) {
+        const double t = std::fmod(uv[d] - p.first[d], p.period[d]);
+        uv[d] = p.first[d] + (t < 0.0 ? t + p.period[d] : t);
+      }
+    return uv;
   }
 
   ShapeAnalysis_Surface& analyser(int f) const {
@@ -354,10 +418,11 @@ SurfaceBounds CadModel::faceBounds(int face) const {
 
 SurfaceDerivatives CadModel::evaluateSurface(int face, double u, double v) const {
   const auto& s = impl_->surface(face);
+  const std::array<double, 2> uv = impl_->wrapClosed(face, u, v);
   return withOcctErrors(cadEntityName(2, face), [&] {
     gp_Pnt p;
     gp_Vec du, dv, duu, dvv, duv;
-    s.D2(u, v, p, du, dv, duu, dvv, duv);
+    s.D2(uv[0], uv[1], p, du, dv, duu, dvv, duv);
     return SurfaceDerivatives{toEigen(p),   toEigen(du),  toEigen(dv),
                               toEigen(duu), toEigen(duv), toEigen(dvv)};
   });
@@ -376,7 +441,8 @@ SurfaceProjection CadModel::projectOnSurface(int face, const Eigen::Vector3d& p,
     };
     std::optional<SurfaceProjection> local;
     if (guess) {
-      const gp_Pnt2d start((*guess)[0], (*guess)[1]);
+      const std::array<double, 2> g = impl_->wrapClosed(face, (*guess)[0], (*guess)[1]);
+      const gp_Pnt2d start(g[0], g[1]);
       local = result(analyser.NextValueOfUV(start, target, precision));
       // Kept when it lies on the surface, or is a foot point (the residual normal to a regular
       // surface there) no farther than its start; a local search can stop where the
@@ -402,8 +468,9 @@ SurfaceProjection CadModel::projectOnSurface(int face, const Eigen::Vector3d& p,
 PrincipalCurvatures CadModel::curvature(int face, double u, double v) const {
   const auto& s = impl_->surface(face);
   const bool reversed = occtFace(*this, face).Orientation() == TopAbs_REVERSED;
+  const std::array<double, 2> uv = impl_->wrapClosed(face, u, v);
   return withOcctErrors("curvature of " + cadEntityName(2, face), [&] {
-    BRepLProp_SLProps props(s, u, v, 2, 1e-9 * impl_->diagonal);
+    BRepLProp_SLProps props(s, uv[0], uv[1], 2, 1e-9 * impl_->diagonal);
     PrincipalCurvatures k;
     if (!props.IsCurvatureDefined()) return k;
     k.defined = true;
@@ -459,11 +526,7 @@ std::array<double, 2> CadModel::edgeParameterOnFace(int edge, int face, double t
 }
 
 std::array<double, 2> CadModel::facePeriods(int face) const {
-  const auto& s = impl_->surface(face);
-  return withOcctErrors(cadEntityName(2, face), [&] {
-    return std::array<double, 2>{s.IsUPeriodic() ? s.UPeriod() : 0.0,
-                                 s.IsVPeriodic() ? s.VPeriod() : 0.0};
-  });
+  return impl_->facePeriods(face).period;
 }
 
 bool CadModel::faceContains(int face, double u, double v) const {

@@ -124,7 +124,10 @@ class CadModel {
   // (via the edge's p-curve on that face).
   std::array<double, 2> edgeParameterOnFace(int edge, int face, double t) const;
   // Periods of the face's surface in u and v; 0 where that direction is not periodic (a
-  // sphere or cylinder is periodic in u, a torus in both).
+  // sphere or cylinder is periodic in u, a torus in both). A direction in which the surface is
+  // closed without being periodic (a B-spline revolved through 360 degrees) has its parameter
+  // range as its period, and evaluateSurface, curvature and projectOnSurface's guess wrap into
+  // that range, so such a seam behaves as a periodic one.
   std::array<double, 2> facePeriods(int face) const;
   // Whether (u, v) lies on the face: inside its trimming loops or on them within the face's
   // tolerance (classified in the face's own parameter range; wrap periodic values first).

@@ -2,13 +2,24 @@
 #pragma once
 
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakeSolid.hxx>
+#include <BRepBuilderAPI_NurbsConvert.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
 #include <BRepPrimAPI_MakeTorus.hxx>
 #include <BRepTools.hxx>
+#include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
 #include <Eigen/Geometry>
+#include <Geom_BSplineSurface.hxx>
+#include <Precision.hxx>
+#include <ShapeFix_Solid.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
 #include <TopoDS_Shape.hxx>
+#include <TopoDS_Shell.hxx>
 #include <filesystem>
 #include <random>
 #include <sstream>
@@ -45,6 +56,26 @@ inline TopoDS_Shape cylinder(double r, double h) {
 }
 inline TopoDS_Shape torus(double major, double minor) {
   return BRepPrimAPI_MakeTorus(major, minor).Shape();
+}
+// A solid torus bounded by one rational B-spline face that is closed in both directions but
+// not periodic (as revolved B-splines in STEP files often are), so its seams are found by
+// CadModel's closure test, not by OCCT's periodicity flags.
+inline TopoDS_Shape nurbsTorus(double major, double minor) {
+  const TopoDS_Shape converted = BRepBuilderAPI_NurbsConvert(torus(major, minor)).Shape();
+  TopExp_Explorer faces(converted, TopAbs_FACE);
+  Handle(Geom_BSplineSurface) surface = Handle(Geom_BSplineSurface)::DownCast(
+      BRep_Tool::Surface(TopoDS::Face(faces.Current()))->Copy());
+  surface->SetUNotPeriodic();
+  surface->SetVNotPeriodic();
+  const TopoDS_Face face = BRepBuilderAPI_MakeFace(surface, Precision::Confusion()).Face();
+  TopoDS_Shell shell;
+  BRep_Builder builder;
+  builder.MakeShell(shell);
+  builder.Add(shell, face);
+  BRepBuilderAPI_MakeSolid solid(shell);
+  ShapeFix_Solid fix(solid.Solid());
+  fix.Perform();
+  return fix.Solid();
 }
 inline TopoDS_Shape box(double x, double y, double z) {
   return BRepPrimAPI_MakeBox(x, y, z).Shape();

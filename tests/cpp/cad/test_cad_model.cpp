@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <BRep_Tool.hxx>
+#include <Geom_Surface.hxx>
 #include <STEPControl_Writer.hxx>
 #include <TopExp.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
@@ -234,6 +235,45 @@ TEST(CadModel, PeriodsTrimmingAndTolerances) {
   EXPECT_FALSE(holed.faceContains(top, outside[0], outside[1]));
   for (int d = 0; d <= 2; ++d) EXPECT_GT(holed.tolerance(d, 1), 0.0);
   EXPECT_THROW(holed.tolerance(3, 1), Error);
+}
+
+// A B-spline surface closed in a direction without being periodic there evaluates beyond its
+// range by extrapolation: CadModel gives such a direction its range as a period and wraps
+// (u, v) into the range, so a chart unwrapped across the seam still lands on the surface.
+TEST(CadModel, AClosedNonPeriodicSeamWrapsLikeAPeriodicOne) {
+  const TopoDS_Shape shape = test::nurbsTorus(2.0, 0.5);
+  TopTools_IndexedMapOfShape faces;
+  TopExp::MapShapes(shape, TopAbs_FACE, faces);
+  ASSERT_EQ(faces.Extent(), 1);
+  const Handle(Geom_Surface) surface = BRep_Tool::Surface(TopoDS::Face(faces(1)));
+  // The case under test: closed in both directions, periodic in neither.
+  ASSERT_FALSE(surface->IsUPeriodic());
+  ASSERT_FALSE(surface->IsVPeriodic());
+  double u0, u1, v0, v1;
+  surface->Bounds(u0, u1, v0, v1);
+  const CadModel cad = test::toModel(shape);
+  const auto periods = cad.facePeriods(1);
+  EXPECT_DOUBLE_EQ(periods[0], u1 - u0);
+  EXPECT_DOUBLE_EQ(periods[1], v1 - v0);
+  // The same point one period (or a fraction more) away, in either direction: the B-spline's
+  // own evaluation agrees to rounding (1e-12 of the torus's size 5, ample for a few dozen
+  // operations of double precision); extrapolated, it would be off by about the tube's radius.
+  const double u = u0 + 0.1 * (u1 - u0), v = v0 + 0.85 * (v1 - v0);
+  const SurfaceDerivatives at = cad.evaluateSurface(1, u, v);
+  for (const auto& shift :
+       {std::array<double, 2>{periods[0], 0.0}, std::array<double, 2>{-periods[0], periods[1]},
+        std::array<double, 2>{0.0, 2.0 * periods[1]}}) {
+    const SurfaceDerivatives moved = cad.evaluateSurface(1, u + shift[0], v + shift[1]);
+    EXPECT_LT((moved.point - at.point).norm(), 1e-12 * 5.0);
+    EXPECT_LT((moved.du - at.du).norm(), 1e-9 * at.du.norm());
+  }
+  // A guess outside the range starts the projection at its wrapped copy.
+  const Eigen::Vector3d target = at.point + 0.01 * at.du.cross(at.dv).normalized();
+  const SurfaceProjection p =
+      cad.projectOnSurface(1, target, std::array<double, 2>{u - periods[0], v + periods[1]});
+  EXPECT_NEAR(p.distance, 0.01, 1e-9);
+  EXPECT_NEAR(p.u, u, 1e-6 * periods[0]);
+  EXPECT_NEAR(p.v, v, 1e-6 * periods[1]);
 }
 
 TEST(CadModel, ClearErrorsNameTheProblem) {

@@ -46,6 +46,24 @@ TEST(MeshPipeline, RunsEveryStageAndReports) {
   EXPECT_NE(json.find("\"tet\": " + std::to_string(result.mesh.numElements())), std::string::npos);
 }
 
+// Curved nodes of the mesh edges and triangles that cross a seam of a closed but not periodic
+// B-spline surface (both seams of the NURBS torus) land on the surface, not on the far side of
+// its parameter range: OpenCASCADE's Pump_TopCover.brep had nodes 84 mm (0.18 of its diagonal)
+// off two revolved faces and 19 tetrahedra inverted before CadModel wrapped such seams.
+TEST(MeshPipeline, CurvedNodesAcrossAClosedBSplineSeamLieOnTheSurface) {
+  MeshingOptions options;
+  options.order = 4;
+  options.size = 0.5;
+  options.repairRounds = 0;  // the placement itself is under test
+  const MeshResult r =
+      runMeshPipeline(CadSource::brepText(test::brepText(test::nurbsTorus(2.0, 0.5))), options);
+  ASSERT_TRUE(r.geometry.has_value());
+  // Order-4 interpolation of the tube (radius 0.5, chords of about 0.5, so 1 rad of arc) is
+  // off by about r (h/r)^5 / (4^4 5!) ~ 1e-5 of the radius, 1e-6 of the diagonal (5.1); a node
+  // placed across the seam wrongly is off by the tube's size, 0.1 of the diagonal.
+  EXPECT_LT(r.geometry->maxDistanceRelative(), 1e-4);
+}
+
 TEST(MeshPipeline, DefaultSizingIsTheOctreeWithATwentiethOfTheDiagonal) {
   MeshingOptions options;
   options.order = 1;
