@@ -557,12 +557,12 @@ std::vector<double> finiteNodes(const bp::object& nodes) {
   return xyz;
 }
 
-// A CAD file or a NekMesh .mcf case: a case's CAD and sizes (unless given here) are used.
 // The Python functions' default, read from the one parameter table.
 int defaultRepairRounds() {
   return static_cast<int>(parameterDefinition("repair_rounds").defaultValue);
 }
 
+// A CAD file or a NekMesh .mcf case: a case's CAD and sizes (unless given here) are used.
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
                 int verbosity, bp::object progress, int optimise, const bp::object& sizing,
                 int repairRounds, const bp::object& boundaryLayer, const bp::object& cancel,

@@ -315,3 +315,16 @@ def test_the_command_line_takes_a_time_limit(homesh_bin, data, tmp_path):
     assert json.loads(report.read_text())["optimiser"]["stopped"] == "time budget"
     bad = run([homesh_bin, "mesh", data / "sphere.brep", "--time-limit", "-2"])
     assert bad.returncode == 2 and "--time-limit must be a number >= 0" in bad.stderr
+
+
+def test_keyword_defaults_are_the_parameter_tables():
+    # mesh()'s plain numeric defaults are written in its signature; the one parameter table is
+    # what the core, the command line and FreeCAD read, so they must agree (optimise differs on
+    # purpose: off in Python, 20 sweeps for a FreeCAD object; size and the sizing keywords use
+    # None for "automatic").
+    import inspect
+    signature = inspect.signature(homesh.mesh).parameters
+    table = {p["key"]: p["default"] for p in homesh.parameters()}
+    for key in ("order", "threads", "repair_rounds", "optimise_seconds", "linear_seconds",
+                "job_seconds"):
+        assert signature[key].default == table[key], key
