@@ -20,6 +20,20 @@ bool isLayerCell(const Mesh& mesh, const ElementBlock& block) {
          (block.type == CellType::Quadrilateral && mesh.dim == 2);
 }
 
+std::vector<char> layerFanTriangles(const Mesh& mesh, const ElementBlock& block) {
+  std::vector<char> fan(block.count(), 0);
+  if (mesh.dim != 2 || block.type != CellType::Triangle) return fan;
+  std::set<std::int64_t> wall;
+  for (const ElementBlock& b : mesh.blocks)
+    if (isLayerCell(mesh, b))
+      for (std::size_t e = 0; e < b.count(); ++e) wall.insert({b.element(e)[0], b.element(e)[1]});
+  if (wall.empty()) return fan;
+  for (std::size_t e = 0; e < block.count(); ++e)
+    for (int k = 0; k < 3; ++k)
+      if (wall.count(block.element(e)[k]) != 0) fan[e] = 1;
+  return fan;
+}
+
 namespace {
 
 constexpr std::int64_t kNone = std::numeric_limits<std::int64_t>::max();
@@ -28,7 +42,8 @@ constexpr std::int64_t kNone = std::numeric_limits<std::int64_t>::max();
 // this (cos 15 degrees: the normals spread by more than about 30 degrees).
 constexpr double kCornerMeanNormal = 0.966;
 
-// A node of the split layer: up to three wall vertices with integer weights (summing to the
+// A node of the split layer: up to three columns (named by their macro top vertices, one per
+// column even where a fan's columns share a wall vertex) with integer weights (summing to the
 // order P) and the level across the layer, 0 (wall) .. n P (top).
 using NodeKey = std::array<std::int64_t, 7>;
 
@@ -188,16 +203,32 @@ class LayerSplitter {
 
   Mesh run() {
     for (const ElementBlock& b : macro_.blocks)
-      if (layerCell(b)) pairWallAndTop(b);
-    forEachColumn(macro_, [this](std::int64_t wall, std::int64_t, const Eigen::Vector3d& n) {
-      normals_[wall].add(n);
-    });
-    for (const ElementBlock& b : macro_.blocks) {
       if (layerCell(b))
-        out_.blocks.push_back(splitCells(b));
-      else if (b.type != CellType::Quadrilateral && b.type != CellType::Line)
-        out_.blocks.push_back(b);
+        for (std::size_t e = 0; e < b.count(); ++e)
+          for (int k = 0; k < wallVertices(b); ++k) wallVertices_.insert(b.element(e)[k]);
+    for (const ElementBlock& b : macro_.blocks) {
+      fans_.push_back(layerFanTriangles(macro_, b));
+      for (std::size_t e = 0; e < b.count(); ++e)
+        if (fans_.back()[e] != 0) fanCorners_.insert(b.element(e)[fanApex(b.element(e))]);
     }
+    for (const ElementBlock& b : macro_.blocks)
+      if (layerCell(b)) pairWallAndTop(b);
+    forEachColumn(macro_, [this](std::int64_t, std::int64_t top, const Eigen::Vector3d& n) {
+      normals_[top].add(n);
+    });
+    // The layer's cells first (they set their columns' levels, which the fans between them
+    // share), then the fans; the blocks keep the macro mesh's order.
+    std::vector<std::optional<ElementBlock>> split(macro_.blocks.size());
+    for (std::size_t i = 0; i < macro_.blocks.size(); ++i)
+      if (layerCell(macro_.blocks[i])) split[i] = splitCells(macro_.blocks[i]);
+    for (std::size_t i = 0; i < macro_.blocks.size(); ++i) {
+      const ElementBlock& b = macro_.blocks[i];
+      if (layerCell(b) || b.type == CellType::Quadrilateral || b.type == CellType::Line) continue;
+      const std::vector<char>& fan = fans_[i];
+      split[i] = std::find(fan.begin(), fan.end(), 1) != fan.end() ? splitFans(b, fan) : b;
+    }
+    for (std::optional<ElementBlock>& b : split)
+      if (b) out_.blocks.push_back(std::move(*b));
     // Faces, then curves: a node on both ends on its curve.
     for (const ElementBlock& b : macro_.blocks)
       if (b.type == CellType::Quadrilateral && !layerCell(b)) out_.blocks.push_back(splitSides(b));
@@ -219,8 +250,12 @@ class LayerSplitter {
   LayerSplitStats& stats_;
   int p_, n_;
   Mesh out_;
-  std::map<std::int64_t, NormalSum> normals_;   // wall node -> its cells' wall normals
-  std::map<std::int64_t, std::int64_t> topOf_;  // wall vertex -> top vertex
+  std::map<std::int64_t, NormalSum> normals_;  // column (top node) -> its cells' wall normals
+  // wall vertex -> top vertex, but at a fan's corner (several columns on one wall vertex)
+  std::map<std::int64_t, std::int64_t> topOf_;
+  std::set<std::int64_t> fanCorners_, wallVertices_;
+  std::vector<std::vector<char>> fans_;  // per macro block: layerFanTriangles
+  std::vector<char> cellCorner_;         // per macro layer cell, in split order: at a sharp corner
   std::map<NodeKey, std::int64_t> nodes_;
   std::map<std::int64_t, double> height_;  // wall vertex -> macro layer height there
   std::vector<char> projected_;
@@ -238,14 +273,152 @@ class LayerSplitter {
       const std::int64_t* v = b.element(e);
       for (int k = 0; k < wallVertices(b); ++k) {
         const std::int64_t top = topVertex(b, v, k);
+        height_[v[k]] =
+            (Eigen::Vector3d(&macro_.xyz[3 * top]) - Eigen::Vector3d(&macro_.xyz[3 * v[k]])).norm();
+        if (fanCorners_.count(v[k]) != 0) continue;
         const auto [it, fresh] = topOf_.emplace(v[k], top);
         if (!fresh && it->second != top)
           throw MeshingError("boundary-layer split: wall node " + std::to_string(v[k]) +
                              " has two top nodes");
-        height_[v[k]] =
-            (Eigen::Vector3d(&macro_.xyz[3 * top]) - Eigen::Vector3d(&macro_.xyz[3 * v[k]])).norm();
       }
     }
+  }
+
+  // The vertex of fan triangle v on the wall (the fan's corner).
+  int fanApex(const std::int64_t* v) const {
+    for (int k = 0; k < 3; ++k)
+      if (wallVertices_.count(v[k]) != 0) return k;
+    throw MeshingError("boundary-layer split: a fan triangle has no vertex on the wall");
+  }
+
+  // Splits the fan triangles of a triangle block (`fan`: layerFanTriangles), keeping the others.
+  // Fan triangle (C, B, D) (C its corner on the wall, counter-clockwise) is a sector whose
+  // columns C -> B and C -> D are split at their levels s_0 = 0 < ... < s_n = 1: the first
+  // layer is the triangle (C, B_1, D_1), each further one the two triangles (B_k, B_k+1, D_k+1)
+  // and (B_k, D_k+1, D_k) of the band between levels, every one the macro triangle's own map on
+  // a triangle of its reference element (a sub-map: valid where the macro triangle is). A node
+  // has integer coordinates (sigma, L) in the sector, sigma 0 .. P from C -> B to C -> D and
+  // level L 0 .. n P, which name it (the columns' nodes are the layer cells' beside them).
+  ElementBlock splitFans(const ElementBlock& b, const std::vector<char>& fan) {
+    const ReferenceElement& ref = ReferenceElement::get(CellType::Triangle, p_);
+    const std::map<LatticePoint, int> index = latticeIndex(ref);
+    const int nn = ref.numNodes();
+    ElementBlock out;
+    out.type = CellType::Triangle;
+    out.order = p_;
+    const std::array<Eigen::Vector2d, 3> corner{Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0),
+                                                Eigen::Vector2d(0, 1)};
+    const std::array<LatticePoint, 3> cornerLattice{LatticePoint{0, 0, 0}, LatticePoint{p_, 0, 0},
+                                                    LatticePoint{0, p_, 0}};
+    Eigen::MatrixXd x(nn, 3);
+    Eigen::MatrixXd points(nn, 2);
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      const std::int64_t* v = b.element(e);
+      if (fan[e] == 0) {
+        out.nodes.insert(out.nodes.end(), v, v + nn);
+        out.entity.push_back(b.entity[e]);
+        continue;
+      }
+      ++stats_.fanTriangles;
+      const int a = fanApex(v), bi = (a + 1) % 3, di = (a + 2) % 3;
+      const auto ua = static_cast<std::size_t>(a), ub = static_cast<std::size_t>(bi),
+                 ud = static_cast<std::size_t>(di);
+      const std::int64_t tb = v[bi], td = v[di];
+      const Column& colB = fanColumn(v[a], tb);
+      const Column& colD = fanColumn(v[a], td);
+      const std::vector<double>& sb = colB.levels;
+      const std::vector<double>& sd = colD.levels;
+      // A layer cell beside the fan may have shifted its column's nodes (Column::shift): the
+      // fan's own nodes follow, the shift interpolated across the sector at the same level.
+      const auto shiftAt = [&](const Eigen::Vector2d& xi) {
+        const Eigen::Vector2d rb = corner[ub] - corner[ua], rd = corner[ud] - corner[ua];
+        Eigen::Matrix2d frame;
+        frame << rb, rd;
+        const Eigen::Vector2d m = frame.fullPivLu().solve(xi - corner[ua]);  // weights of B, D
+        const double level = m[0] + m[1];
+        if (!(level > 0.0)) return Eigen::Vector3d(Eigen::Vector3d::Zero());
+        const double d = m[1] / level;
+        return Eigen::Vector3d((1.0 - d) * colB.shiftAt(level) * colB.shift +
+                               d * colD.shiftAt(level) * colD.shift);
+      };
+      for (int i = 0; i < nn; ++i)
+        for (int d = 0; d < 3; ++d) x(i, d) = macro_.xyz[3 * v[i] + d];
+      // A point of the sector: its reference coordinates and its (sigma, L); the corner has
+      // sigma -1.
+      struct SectorPoint {
+        Eigen::Vector2d xi;
+        int sigma, level;
+      };
+      const auto onColumn = [&](bool d, int k) {
+        const auto kk = static_cast<std::size_t>(k);
+        const double s = (d ? sd : sb)[kk];
+        return SectorPoint{corner[ua] + s * ((d ? corner[ud] : corner[ub]) - corner[ua]),
+                           d ? p_ : 0, k * p_};
+      };
+      std::vector<std::array<SectorPoint, 3>> pieces;
+      pieces.push_back({SectorPoint{corner[ua], -1, 0}, onColumn(false, 1), onColumn(true, 1)});
+      for (int k = 1; k < n_; ++k) {
+        pieces.push_back({onColumn(false, k), onColumn(false, k + 1), onColumn(true, k + 1)});
+        pieces.push_back({onColumn(false, k), onColumn(true, k + 1), onColumn(true, k)});
+      }
+      for (const std::array<SectorPoint, 3>& piece : pieces) {
+        for (int r = 0; r < nn; ++r) {
+          const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
+          const double w[3] = {double(p_ - c[0] - c[1]) / p_, double(c[0]) / p_, double(c[1]) / p_};
+          points.row(r) =
+              (w[0] * piece[0].xi + w[1] * piece[1].xi + w[2] * piece[2].xi).transpose();
+        }
+        const Eigen::MatrixXd values = ref.valuesAt(points);
+        for (int r = 0; r < nn; ++r) {
+          const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
+          const int w[3] = {p_ - c[0] - c[1], c[0], c[1]};
+          // The corner's own weight makes sigma undefined only at the corner itself; elsewhere
+          // in the first layer sigma follows from the two other vertices.
+          int sigma = 0, level = 0, apexWeight = 0;
+          for (std::size_t i = 0; i < 3; ++i) {
+            if (piece[i].sigma < 0) {
+              apexWeight = w[i];
+              continue;
+            }
+            sigma += w[i] * piece[i].sigma;
+            level += w[i] * piece[i].level;
+          }
+          std::int64_t id = 0;
+          if (apexWeight == p_) {
+            id = v[a];
+          } else if (level == n_ * p_ * p_) {  // the macro triangle's top edge
+            const int along = sigma / p_;
+            LatticePoint m{0, 0, 0};
+            for (std::size_t i = 0; i < 3; ++i)
+              m[i] = ((p_ - along) * cornerLattice[ub][i] + along * cornerLattice[ud][i]) / p_;
+            id = v[index.at(m)];
+          } else {
+            // In the first layer a node with the corner's weight lies on a column only when
+            // one of the others has none; elsewhere it is the piece's own.
+            NodeKey key{};
+            if (apexWeight > 0 && w[1] > 0 && w[2] > 0) {
+              key = makeKey({{{tb, w[1]}, {td, w[2]}, {v[a], apexWeight}}}, -1);
+            } else {
+              const int sg = apexWeight > 0 ? (w[2] > 0 ? p_ : 0) : sigma / p_;
+              key = makeKey({{{tb, p_ - sg}, {td, sg}, {kNone, 0}}}, level / p_);
+            }
+            const auto it = nodes_.find(key);
+            if (it != nodes_.end()) {
+              id = it->second;
+            } else {
+              const Eigen::RowVector3d pt =
+                  values.row(r) * x + shiftAt(points.row(r).transpose()).transpose();
+              const double xyz[3] = {pt(0), pt(1), pt(2)};
+              id = out_.addNode(xyz, macro_.dim, b.entity[e], std::nan(""), std::nan(""));
+              nodes_.emplace(key, id);
+            }
+          }
+          out.nodes.push_back(id);
+        }
+        out.entity.push_back(b.entity[e]);
+      }
+    }
+    return out;
   }
 
   double zAt(int k, int a) const {
@@ -285,14 +458,16 @@ class LayerSplitter {
       return s <= s1 ? s / s1 : levels.size() > 2 ? (1.0 - s) / (1.0 - s1) : 0.0;
     }
   };
-  std::map<std::int64_t, Column> columns_;      // wall node -> how its column is split
+  std::map<std::int64_t, Column> columns_;      // column (top node) -> how it is split
   static constexpr double kMaxShiftLean = 1.0;  // tangent of the lean: 45 degrees
   const Column& column(const ElementBlock& b, const std::map<LatticePoint, int>& index,
                        const std::int64_t* v, LatticePoint c) {
     const std::size_t across = b.type == CellType::Prism ? 2 : 1;
     c[across] = 0;
     const std::int64_t w = v[index.at(c)];
-    const auto found = columns_.find(w);
+    c[across] = p_;
+    const std::int64_t topNode = v[index.at(c)];
+    const auto found = columns_.find(topNode);
     if (found != columns_.end()) return found->second;
     Column col;
     col.levels = z_;
@@ -300,22 +475,16 @@ class LayerSplitter {
     const double l[3] = {prism ? double(p_ - c[0] - c[1]) / p_ : double(p_ - c[0]) / p_,
                          double(c[0]) / p_, prism ? double(c[1]) / p_ : 0.0};
     const double target = grownHeight(v, wallVertices(b), l);
-    const auto normal = normals_.find(w);
-    if (n_ > 1 && plain_.count(w) == 0 && std::isfinite(target) && target > 0.0 &&
+    const auto normal = normals_.find(topNode);
+    if (n_ > 1 && plain_.count(topNode) == 0 && std::isfinite(target) && target > 0.0 &&
         normal != normals_.end() && normal->second.sum.norm() > 0.0) {
-      LatticePoint t = c;
-      t[across] = p_;
       const Eigen::Vector3d x0(&macro_.xyz[3 * static_cast<std::size_t>(w)]);
       const Eigen::Vector3d rise =
-          Eigen::Vector3d(&macro_.xyz[3 * static_cast<std::size_t>(v[index.at(t)])]) - x0;
+          Eigen::Vector3d(&macro_.xyz[3 * static_cast<std::size_t>(topNode)]) - x0;
       const Eigen::Vector3d n = normal->second.sum.normalized();
       const double height = rise.dot(n);
       if (height > 0.0) {
-        const double z1 = z_[1];
-        const double first =
-            std::clamp(z1 * target / height, 0.5 * z1, std::min(2.0 * z1, 0.5 * (z1 + z_[2])));
-        for (std::size_t k = 1; k + 1 < col.levels.size(); ++k)
-          col.levels[k] = first + (z_[k] - z1) * (1.0 - first) / (1.0 - z1);
+        const double first = setFirstLevel(col, z_[1] * target / height);
         // Only where the column leans by less than kMaxShiftLean: at a sharp corner the column
         // follows the corner's bisector by design, and no shift gives both walls their height.
         // (Where the adjusted column makes a thin cell invalid, the pipeline splits it plain.)
@@ -323,12 +492,40 @@ class LayerSplitter {
         if (lean.norm() < kMaxShiftLean * height) col.shift = -first * lean;
       }
     }
-    return columns_.emplace(w, std::move(col)).first->second;
+    return columns_.emplace(topNode, std::move(col)).first->second;
   }
 
-  // Whether the walls of the cells around wall vertex `w` meet at a sharp corner.
-  bool atCorner(std::int64_t w) const {
-    const auto n = normals_.find(w);
+  // Sets the column's levels from its first, `wanted` kept within [z_1 / 2, 2 z_1] (and below the
+  // second level's share): the others keep their progression in what remains. Returns it.
+  double setFirstLevel(Column& col, double wanted) const {
+    const double z1 = z_[1];
+    const double first = std::clamp(wanted, 0.5 * z1, std::min(2.0 * z1, 0.5 * (z1 + z_[2])));
+    for (std::size_t k = 1; k + 1 < col.levels.size(); ++k)
+      col.levels[k] = first + (z_[k] - z1) * (1.0 - first) / (1.0 - z1);
+    return first;
+  }
+
+  // A fan's column from its corner `corner` to `top` (straight, with no wall of its own): a
+  // layer cell's where one shares it, else levels that give the first layer its grown height
+  // along the column (z unchanged where the column is plain).
+  const Column& fanColumn(std::int64_t corner, std::int64_t top) {
+    const auto found = columns_.find(top);
+    if (found != columns_.end()) return found->second;
+    Column col;
+    col.levels = z_;
+    const auto c = static_cast<std::size_t>(corner);
+    const double target = grown_ != nullptr && c < grown_->size() ? (*grown_)[c] : std::nan("");
+    const double height = (Eigen::Vector3d(&macro_.xyz[3 * static_cast<std::size_t>(top)]) -
+                           Eigen::Vector3d(&macro_.xyz[3 * c]))
+                              .norm();
+    if (n_ > 1 && plain_.count(top) == 0 && std::isfinite(target) && target > 0.0 && height > 0.0)
+      setFirstLevel(col, z_[1] * target / height);
+    return columns_.emplace(top, std::move(col)).first->second;
+  }
+
+  // Whether the walls of the cells sharing the column below `top` meet at a sharp corner.
+  bool atCorner(std::int64_t top) const {
+    const auto n = normals_.find(top);
     return n != normals_.end() && n->second.sharp();
   }
 
@@ -336,6 +533,7 @@ class LayerSplitter {
   // (exact to degree 2P), in stats_: its range and, with grown heights, its worst deviation
   // from z_1 H*.
   void measureFirstLayer() {
+    std::size_t cell = 0;  // the macro cell, in split order
     for (const ElementBlock& b : out_.blocks) {
       if (!layerCell(b)) continue;
       const bool prism = b.type == CellType::Prism;
@@ -346,8 +544,7 @@ class LayerSplitter {
       Eigen::MatrixXd gradients;
       for (std::size_t e = 0; e < b.count(); e += static_cast<std::size_t>(n_)) {
         const std::int64_t* v = b.element(e);  // the column's first layer
-        bool corner = false;
-        for (int k = 0; k < wallVertices(b); ++k) corner = corner || atCorner(v[k]);
+        const bool corner = cellCorner_.at(cell++) != 0;
         if (corner) ++stats_.cornerCells;
         for (int q = 0; q < rule.size(); ++q) {
           const auto qq = static_cast<std::size_t>(q);
@@ -395,9 +592,17 @@ class LayerSplitter {
     out.entity.resize(b.count() * static_cast<std::size_t>(n_));
     Eigen::MatrixXd x(nn, 3);
     Eigen::MatrixXd points(nn, dim);
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      bool corner = false;
+      for (int k = 0; k < wallVertices(b); ++k)
+        corner = corner || atCorner(topVertex(b, b.element(e), k));
+      cellCorner_.push_back(corner ? 1 : 0);
+    }
     for (int k = 0; k < n_; ++k) {
       for (std::size_t e = 0; e < b.count(); ++e) {
         const std::int64_t* v = b.element(e);
+        const std::int64_t t[3] = {topVertex(b, v, 0), topVertex(b, v, 1),
+                                   prism ? topVertex(b, v, 2) : kNone};
         // The macro cell's basis at the k-th thin cell's nodes, on its columns' levels.
         for (int r = 0; r < nn; ++r) {
           const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
@@ -416,8 +621,8 @@ class LayerSplitter {
           const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
           const std::int64_t level = std::int64_t(k) * p_ + c[across];
           const NodeKey key =
-              prism ? makeKey({{{v[0], p_ - c[0] - c[1]}, {v[1], c[0]}, {v[2], c[1]}}}, level)
-                    : makeKey({{{v[0], p_ - c[0]}, {v[1], c[0]}, {kNone, 0}}}, level);
+              prism ? makeKey({{{t[0], p_ - c[0] - c[1]}, {t[1], c[0]}, {t[2], c[1]}}}, level)
+                    : makeKey({{{t[0], p_ - c[0]}, {t[1], c[0]}, {kNone, 0}}}, level);
           std::int64_t id = 0;
           if (level == 0 || level == std::int64_t(n_) * p_) {
             LatticePoint m = c;
@@ -503,10 +708,9 @@ class LayerSplitter {
           const int acrossLocal = c[static_cast<std::size_t>(frame->acrossAxis)];
           const int a = frame->away ? acrossLocal : p_ - acrossLocal;
           const std::int64_t level = std::int64_t(k) * p_ + a;
-          const NodeKey key =
-              quad ? makeKey({{{frame->wall[0], p_ - along}, {frame->wall[1], along}, {kNone, 0}}},
-                             level)
-                   : makeKey({{{frame->wall[0], p_}, {kNone, 0}, {kNone, 0}}}, level);
+          const std::int64_t t0 = topOf_.at(frame->wall[0]), t1 = topOf_.at(frame->wall[1]);
+          const NodeKey key = quad ? makeKey({{{t0, p_ - along}, {t1, along}, {kNone, 0}}}, level)
+                                   : makeKey({{{t0, p_}, {kNone, 0}, {kNone, 0}}}, level);
           const auto it = nodes_.find(key);
           if (it == nodes_.end())
             throw MeshingError(std::string("boundary-layer split: a side ") +
@@ -663,20 +867,38 @@ void keepColumnsPlain(const Mesh& macro, int layers, std::size_t element, LayerH
   std::size_t base = 0;
   for (const ElementBlock& b : macro.blocks) {
     if (cellDimension(b.type) != macro.dim) continue;
-    const bool cell = isLayerCell(macro, b);
-    const std::size_t count = b.count() * static_cast<std::size_t>(cell ? layers : 1);
-    if (element >= base + count) {
-      base += count;
-      continue;
+    if (isLayerCell(macro, b)) {
+      const std::size_t count = b.count() * static_cast<std::size_t>(layers);
+      if (element >= base + count) {
+        base += count;
+        continue;
+      }
+      const std::size_t e = (element - base) / static_cast<std::size_t>(layers);
+      const ReferenceElement& ref = ReferenceElement::get(b.type, b.order);
+      const std::size_t across = b.type == CellType::Prism ? 2 : 1;
+      for (int r = 0; r < ref.numNodes(); ++r)
+        if (ref.lattice()[static_cast<std::size_t>(r)][across] == b.order)
+          heights.plain.insert(b.element(e)[r]);
+      return;
     }
-    if (!cell) return;
-    const std::size_t e = (element - base) / static_cast<std::size_t>(layers);
-    const ReferenceElement& ref = ReferenceElement::get(b.type, b.order);
-    const std::size_t across = b.type == CellType::Prism ? 2 : 1;
-    for (int r = 0; r < ref.numNodes(); ++r)
-      if (ref.lattice()[static_cast<std::size_t>(r)][across] == 0)
-        heights.plain.insert(b.element(e)[r]);
-    return;
+    const std::vector<char> fan = layerFanTriangles(macro, b);
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      const std::size_t count = fan[e] != 0 ? 2 * static_cast<std::size_t>(layers) - 1 : 1;
+      if (element >= base + count) {
+        base += count;
+        continue;
+      }
+      if (fan[e] == 0) return;
+      // Its two vertices off the wall are its columns' tops (the corner is on no column).
+      std::set<std::int64_t> wall;
+      for (const ElementBlock& l : macro.blocks)
+        if (isLayerCell(macro, l))
+          for (std::size_t c = 0; c < l.count(); ++c)
+            wall.insert({l.element(c)[0], l.element(c)[1]});
+      for (int k = 0; k < 3; ++k)
+        if (wall.count(b.element(e)[k]) == 0) heights.plain.insert(b.element(e)[k]);
+      return;
+    }
   }
 }
 

@@ -12,7 +12,8 @@
 // the level across the layer. The layer's side quadrilaterals and its climbing lines on the CAD are
 // split alike, and their new nodes are projected onto their CAD face or curve (from the
 // interpolated point, which lies within the macro element's interpolation error of it). Tetrahedra
-// and triangles are kept.
+// and triangles are kept, but a 2D fan's triangles (layerFanTriangles), each split into 2n - 1
+// triangles on its columns' levels.
 #pragma once
 
 #include <cstddef>
@@ -28,6 +29,12 @@ namespace homesh {
 // Whether the block holds a macro layer's cells: prisms in 3D, quadrilaterals in 2D (whose
 // other quadrilaterals, in 3D, are the layer's sides on the CAD).
 bool isLayerCell(const Mesh& mesh, const ElementBlock& block);
+
+// In 2D, per element of `block`, 1 for a triangle of a macro layer's fan (at a sharp convex corner
+// of the wall, linear/boundary_layer.hpp): a triangle with a vertex on the wall of a layer
+// quadrilateral (the fill never reaches the wall); that vertex is the fan's corner, the two
+// others tops of its columns. All 0 for any other block, and in 3D.
+std::vector<char> layerFanTriangles(const Mesh& mesh, const ElementBlock& block);
 
 struct LayerSplitStats {
   std::size_t prisms = 0, quadrilaterals = 0, lines = 0;  // macro elements split
@@ -46,6 +53,7 @@ struct LayerSplitStats {
   std::size_t firstHeightOffNormal = 0;
   double firstHeightCornerDeviation = 0.0;
   std::size_t plainColumns = 0;  // columns split at z unchanged (LayerHeights::plain)
+  std::size_t fanTriangles = 0;  // macro fan triangles split (2 n - 1 triangles each)
   double firstHeightMin = 0.0, firstHeightMax = 0.0, firstHeightDeviation = 0.0;
 };
 
@@ -62,7 +70,7 @@ struct LayerSplitStats {
 void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops = true);
 
 // The heights a split keeps: `grown`, grownLayerHeights of the linear mesh the layer was grown
-// in (whose vertex ids the macro mesh keeps); the columns above the wall nodes in `plain` are
+// in (whose vertex ids the macro mesh keeps); the columns whose top nodes are in `plain` are
 // split at z unchanged (where an adjusted column made a thin cell invalid).
 struct LayerHeights {
   std::vector<double> grown;
@@ -75,9 +83,9 @@ struct LayerHeights {
 Mesh splitBoundaryLayer(const Mesh& macro, const std::vector<double>& z, const CadModel* cad,
                         LayerSplitStats* stats = nullptr, const LayerHeights* heights = nullptr);
 
-// Adds to heights.plain the wall nodes of the macro cell that split element `element` (an
-// index among the split mesh's elements, in block order, `layers` thin cells per macro cell)
-// came from; nothing for an element outside the layer.
+// Adds to heights.plain the columns (top nodes) of the macro cell that split element `element`
+// (an index among the split mesh's elements, in block order: `layers` thin cells per macro cell,
+// 2 layers - 1 per fan triangle) came from; nothing for an element outside the layer.
 void keepColumnsPlain(const Mesh& macro, int layers, std::size_t element, LayerHeights& heights);
 
 // Per node (3 values): for the nodes of a macro layer's top (prisms' and, in 2D,

@@ -14,6 +14,12 @@
 // The prisms are the macro elements the later stages curve and optimise; the split into thin
 // layers (curving/layer_split.hpp) comes last. Every prism has its wall triangle as vertices
 // 0, 1, 2 (Gmsh's prism order) and its top as 3, 4, 5.
+//
+// 2D: quadrilaterals (wall 0, 1; tops 3 above 0 and 2 above 1) from chosen curves of a planar
+// face. Where two layer curves meet at a sharp convex corner, the corner node gets a fan: a
+// column along each curve's own normal (each side's quadrilateral uses its own) and columns
+// between them, with triangles (corner, top, top) between consecutive columns, appended to the
+// triangle block; they are part of the layer (layerFanTriangles in curving/layer_split.hpp).
 #pragma once
 
 #include <array>
@@ -65,6 +71,10 @@ struct BoundaryLayerRecord {
   // (The first split layer's height, as measured, is the split's: LayerSplitStats.)
   std::vector<LayerShrink> shrunk;
   std::size_t cells = 0;  // macro cells: prisms (3D), quadrilaterals (2D)
+  // 2D: triangles of the fans at sharp convex corners of the wall (a column per wall curve's
+  // normal there and between them, instead of one along the bisector): part of the layer, split
+  // into thin triangles (curving/layer_split.hpp).
+  std::size_t fanTriangles = 0;
   std::size_t sideQuadrilaterals = 0, wallNodes = 0;
   int shrinkPasses = 0;
   // The optimiser keeps the macro layer as grown unless elements stay invalid; then it lets the

@@ -297,13 +297,22 @@ constexpr int kRepairRegionLayers = 4;
 // Poor elements below this certified scaled Jacobian join the region too.
 constexpr double kRepairRegionThreshold = 0.2;
 
-// The nodes of a macro boundary layer's prisms (2D: quadrilaterals; empty when there are none).
+// The nodes of a macro boundary layer's prisms (2D: quadrilaterals and the fans' triangles;
+// empty when there are none).
 std::vector<char> layerNodes(const Mesh& mesh) {
   std::vector<char> fixed;
   for (const ElementBlock& b : mesh.blocks) {
     if (!isLayerCell(mesh, b)) continue;
     fixed.resize(mesh.numNodes(), 0);
     for (const std::int64_t id : b.nodes) fixed[static_cast<std::size_t>(id)] = 1;
+  }
+  if (fixed.empty()) return fixed;
+  for (const ElementBlock& b : mesh.blocks) {
+    const std::vector<char> fan = layerFanTriangles(mesh, b);
+    const auto n = static_cast<std::size_t>(b.nodesPerElement());
+    for (std::size_t e = 0; e < b.count(); ++e)
+      if (fan[e] != 0)
+        for (std::size_t i = 0; i < n; ++i) fixed[static_cast<std::size_t>(b.element(e)[i])] = 1;
   }
   return fixed;
 }

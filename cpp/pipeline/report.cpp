@@ -208,6 +208,7 @@ void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
   }
   json.endArray();
   json.value("macro_cells", r.cells);
+  json.value("fan_triangles", r.fanTriangles);
   json.value("side_quadrilaterals", r.sideQuadrilaterals);
   json.value("wall_nodes", r.wallNodes);
   json.value("shrink_passes", static_cast<std::size_t>(r.shrinkPasses));

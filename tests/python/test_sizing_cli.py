@@ -53,6 +53,9 @@ def test_mcf_case_meshes_with_its_prediction(homesh_bin, tmp_path, case):
         assert layer["faces"] == faces and layer["layers"] == layers
         split, kind = ("prism", "wedge18") if case.startswith("3d") else ("quad", "quad9")
         assert report["elements"][split] == layers * layer["macro_cells"] > 0
+        # The NACA 0012's sharp trailing edge (its normals 163.5 degrees apart) gets a fan of
+        # ceil(163.5 / 40) = 5 triangles; the other walls are smooth.
+        assert layer["fan_triangles"] == (5 if case == "2d_bl_naca0012" else 0)
         assert sum(len(b.data) for b in mesh.cells if b.type == kind) == report["elements"][split]
         assert "not made yet" not in result.stderr
         return
