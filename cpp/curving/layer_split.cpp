@@ -20,18 +20,37 @@ bool isLayerCell(const Mesh& mesh, const ElementBlock& block) {
          (block.type == CellType::Quadrilateral && mesh.dim == 2);
 }
 
-std::vector<char> layerFanTriangles(const Mesh& mesh, const ElementBlock& block) {
-  std::vector<char> fan(block.count(), 0);
-  if (mesh.dim != 2 || block.type != CellType::Triangle) return fan;
+namespace {
+
+// Whether layer fans can be in the block: 2D triangles.
+bool mayHoldFans(const Mesh& mesh, const ElementBlock& block) {
+  return mesh.dim == 2 && block.type == CellType::Triangle;
+}
+
+// The wall vertices of a 2D mesh's layer quadrilaterals (0 and 1 of each).
+std::set<std::int64_t> layerWall(const Mesh& mesh) {
   std::set<std::int64_t> wall;
   for (const ElementBlock& b : mesh.blocks)
-    if (isLayerCell(mesh, b))
+    if (isLayerCell(mesh, b) && b.type == CellType::Quadrilateral)
       for (std::size_t e = 0; e < b.count(); ++e) wall.insert({b.element(e)[0], b.element(e)[1]});
+  return wall;
+}
+
+std::vector<char> fanTriangles(const ElementBlock& block, const std::set<std::int64_t>& wall) {
+  std::vector<char> fan(block.count(), 0);
   if (wall.empty()) return fan;
   for (std::size_t e = 0; e < block.count(); ++e)
     for (int k = 0; k < 3; ++k)
       if (wall.count(block.element(e)[k]) != 0) fan[e] = 1;
   return fan;
+}
+
+}  // namespace
+
+std::vector<char> layerFanTriangles(const Mesh& mesh, const ElementBlock& block) {
+  if (mayHoldFans(mesh, block)) return fanTriangles(block, layerWall(mesh));
+  std::vector<char> none(block.count(), 0);  // (a braced list would hold two chars)
+  return none;
 }
 
 namespace {
@@ -865,6 +884,7 @@ Mesh splitBoundaryLayer(const Mesh& macro, const std::vector<double>& z, const C
 
 void keepColumnsPlain(const Mesh& macro, int layers, std::size_t element, LayerHeights& heights) {
   std::size_t base = 0;
+  std::optional<std::set<std::int64_t>> wall;  // made at the first block that may hold fans
   for (const ElementBlock& b : macro.blocks) {
     if (cellDimension(b.type) != macro.dim) continue;
     if (isLayerCell(macro, b)) {
@@ -881,7 +901,15 @@ void keepColumnsPlain(const Mesh& macro, int layers, std::size_t element, LayerH
           heights.plain.insert(b.element(e)[r]);
       return;
     }
-    const std::vector<char> fan = layerFanTriangles(macro, b);
+    if (!mayHoldFans(macro, b)) {  // one element each
+      if (element >= base + b.count()) {
+        base += b.count();
+        continue;
+      }
+      return;
+    }
+    if (!wall) wall = layerWall(macro);
+    const std::vector<char> fan = fanTriangles(b, *wall);
     for (std::size_t e = 0; e < b.count(); ++e) {
       const std::size_t count = fan[e] != 0 ? 2 * static_cast<std::size_t>(layers) - 1 : 1;
       if (element >= base + count) {
@@ -890,13 +918,8 @@ void keepColumnsPlain(const Mesh& macro, int layers, std::size_t element, LayerH
       }
       if (fan[e] == 0) return;
       // Its two vertices off the wall are its columns' tops (the corner is on no column).
-      std::set<std::int64_t> wall;
-      for (const ElementBlock& l : macro.blocks)
-        if (isLayerCell(macro, l))
-          for (std::size_t c = 0; c < l.count(); ++c)
-            wall.insert({l.element(c)[0], l.element(c)[1]});
       for (int k = 0; k < 3; ++k)
-        if (wall.count(b.element(e)[k]) == 0) heights.plain.insert(b.element(e)[k]);
+        if (wall->count(b.element(e)[k]) == 0) heights.plain.insert(b.element(e)[k]);
       return;
     }
   }

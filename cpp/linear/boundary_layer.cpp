@@ -837,7 +837,6 @@ class LayerGrower2D {
   std::vector<WallNode> wall_;
   std::map<std::int64_t, std::size_t> wallIndex_;
   std::vector<Vec> wallInward_;  // per wall segment, its inward unit normal
-  std::size_t fanCells_ = 0;
 
   std::string where(const WallNode& w) const { return pointText(at(out_, w.id)); }
 

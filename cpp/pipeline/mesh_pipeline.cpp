@@ -491,9 +491,11 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
     // The raised wall lies on the CAD at the full order while the layer's top is the low
     // order's, raised: around a coarse wall (the NACA's nose, T106's edges) the heights follow
     // the low order's wall (57 % off at the NACA's nose at order 6). In 2D the top is placed
-    // parallel to the raised wall again (0.04 % there); in 3D that forced the cylinder's layer
+    // parallel to the raised wall again (0.04 % there), unless the low order had to let the top
+    // move freely (placing it back would undo that); in 3D that forced the cylinder's layer
     // free at three times the time, so 3D keeps the raised top.
-    if (state.mesh.dim == 2) blendLayerInteriors(state.mesh, &cad);
+    if (state.mesh.dim == 2 && state.layerRelease != LayerRelease::Free)
+      blendLayerInteriors(state.mesh, &cad);
   } else {
     if (clocked) clock.emplace("high_order", timings, observer);
     state.mesh = elevateOrder(state.linear, options.order, &cad);
