@@ -209,6 +209,7 @@ void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
   json.endArray();
   json.value("macro_cells", r.cells);
   json.value("fan_triangles", r.fanTriangles);
+  json.value("wall_splits", r.wallSplits);
   json.value("side_quadrilaterals", r.sideQuadrilaterals);
   json.value("wall_nodes", r.wallNodes);
   json.value("shrink_passes", static_cast<std::size_t>(r.shrinkPasses));
