@@ -221,14 +221,13 @@ class LayerSplitter {
   }
 
   Mesh run() {
-    for (const ElementBlock& b : macro_.blocks)
-      if (layerCell(b))
-        for (std::size_t e = 0; e < b.count(); ++e)
-          for (int k = 0; k < wallVertices(b); ++k) wallVertices_.insert(b.element(e)[k]);
+    if (macro_.dim == 2) wallVertices_ = layerWall(macro_);  // (fans are 2D only)
     for (const ElementBlock& b : macro_.blocks) {
-      fans_.push_back(layerFanTriangles(macro_, b));
-      for (std::size_t e = 0; e < b.count(); ++e)
-        if (fans_.back()[e] != 0) fanCorners_.insert(b.element(e)[fanApex(b.element(e))]);
+      fans_.push_back(mayHoldFans(macro_, b) ? fanTriangles(b, wallVertices_)
+                                             : std::vector<char>());
+      const std::vector<char>& fan = fans_.back();
+      for (std::size_t e = 0; e < fan.size(); ++e)
+        if (fan[e] != 0) fanCorners_.insert(b.element(e)[fanApex(b.element(e))]);
     }
     for (const ElementBlock& b : macro_.blocks)
       if (layerCell(b)) pairWallAndTop(b);
@@ -273,7 +272,7 @@ class LayerSplitter {
   // wall vertex -> top vertex, but at a fan's corner (several columns on one wall vertex)
   std::map<std::int64_t, std::int64_t> topOf_;
   std::set<std::int64_t> fanCorners_, wallVertices_;
-  std::vector<std::vector<char>> fans_;  // per macro block: layerFanTriangles
+  std::vector<std::vector<char>> fans_;  // per macro block: its fan flags (empty: none there)
   std::vector<char> cellCorner_;         // per macro layer cell, in split order: at a sharp corner
   std::map<NodeKey, std::int64_t> nodes_;
   std::map<std::int64_t, double> height_;  // wall vertex -> macro layer height there

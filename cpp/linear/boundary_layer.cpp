@@ -784,6 +784,19 @@ class LayerGrower {
   }
 };
 
+// Node `id`'s parameter on CAD curve `curve`: its own where it lies on that curve, the
+// vertex's on the curve where it is a CAD vertex (the end nearest `near` on a closed curve),
+// else its projection's.
+double parameterOnCurve(const Mesh& mesh, const CadModel& cad, int curve, std::int64_t id,
+                        std::optional<double> near = std::nullopt) {
+  const auto i = static_cast<std::size_t>(id);
+  if (mesh.nodeCadDim[i] == 1 && mesh.nodeCadIndex[i] == curve &&
+      std::isfinite(mesh.nodeCadParam[2 * i]))
+    return mesh.nodeCadParam[2 * i];
+  if (mesh.nodeCadDim[i] == 0) return cad.vertexParameter(mesh.nodeCadIndex[i], curve, near);
+  return cad.projectOnCurve(curve, at(mesh, id)).t;
+}
+
 // The CAD curve's unit tangent at parameter t, pointing towards parameter `towards`: a chord a
 // thousandth of the span long (not the derivative, which vanishes where the parametrisation
 // does: the NACA splines' cosine spacing at their ends; shorter chords there drown in rounding).
@@ -1036,18 +1049,8 @@ class LayerGrower2D {
     const std::int64_t other = seg[0] == w.id ? seg[1] : seg[0];
     const int curve = wallCurve_[s];
     try {
-      const auto parameter = [&](std::int64_t id) {
-        const auto i = static_cast<std::size_t>(id);
-        if (out_.nodeCadDim[i] == 1 && out_.nodeCadIndex[i] == curve &&
-            std::isfinite(out_.nodeCadParam[2 * i]))
-          return out_.nodeCadParam[2 * i];
-        return cad_.projectOnCurve(curve, at(out_, id)).t;
-      };
-      const double to = parameter(other);
-      const auto i = static_cast<std::size_t>(w.id);
-      const double t = out_.nodeCadDim[i] == 0
-                           ? cad_.vertexParameter(out_.nodeCadIndex[i], curve, to)
-                           : parameter(w.id);
+      const double to = parameterOnCurve(out_, cad_, curve, other);
+      const double t = parameterOnCurve(out_, cad_, curve, w.id, to);
       const Vec tangent = curveTangent(cad_, curve, t, to);  // from w into the curve
       Vec n = normal_.cross(tangent);
       if (!(n.norm() > 0.0) || to == t) return std::nullopt;
@@ -1299,14 +1302,8 @@ int splitTightWallSegments(Mesh& planar, const CadModel& cad, const BoundaryLaye
         if (layer.count(curve) == 0) continue;
         const std::int64_t* l = b.element(e);
         double t[2];
-        for (int k = 0; k < 2; ++k) {
-          const auto i = static_cast<std::size_t>(l[k]);
-          if (planar.nodeCadDim[i] == 1 && planar.nodeCadIndex[i] == curve &&
-              std::isfinite(planar.nodeCadParam[2 * i]))
-            t[k] = planar.nodeCadParam[2 * i];
-          else
-            t[k] = cad.projectOnCurve(curve, at(planar, l[k])).t;
-        }
+        t[0] = parameterOnCurve(planar, cad, curve, l[0]);
+        t[1] = parameterOnCurve(planar, cad, curve, l[1], t[0]);
         if (t[0] == t[1]) continue;
         const Vec mid = 0.5 * (at(planar, l[0]) + at(planar, l[1]));
         const double length = (at(planar, l[1]) - at(planar, l[0])).norm();
