@@ -1,5 +1,6 @@
 #include "curving/curve_node_placement.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -47,6 +48,20 @@ std::vector<double> equispacedPositions(int order) {
   return z;
 }
 
+std::optional<CurveDerivatives> offsetCurve(const CurveDerivatives& c, const CurveOffset& offset) {
+  // n = u / |u| with u = c' x k; n' = (u' - n (n . u')) / |u| with u' = c'' x k.
+  const Eigen::Vector3d u = c.d1.cross(offset.planeNormal);
+  const double speed = u.norm();
+  if (!(speed > 0.0)) return std::nullopt;
+  const Eigen::Vector3d normal = u / speed;
+  const Eigen::Vector3d du = c.d2.cross(offset.planeNormal);
+  CurveDerivatives o;
+  o.point = c.point + offset.height * normal;
+  o.d1 = c.d1 + offset.height * (du - normal * normal.dot(du)) / speed;
+  o.d2.setZero();
+  return o;
+}
+
 bool strictlyMonotone(const std::vector<double>& t) {
   if (t.size() < 2) return true;
   const double sign = t.back() > t.front() ? 1.0 : -1.0;
@@ -56,7 +71,8 @@ bool strictlyMonotone(const std::vector<double>& t) {
 }
 
 CurvePlacement placeOnCurve(const CadModel& cad, int edge, double ta, double tb,
-                            const std::vector<double>& z) {
+                            const std::vector<double>& z,
+                            const std::optional<CurveOffset>& offset) {
   if (z.size() < 2 || z.front() != 0.0 || z.back() != 1.0 || !strictlyMonotone(z))
     throw ParameterError("curve node placement needs increasing positions from 0 to 1");
   if (!(ta != tb) || !std::isfinite(ta) || !std::isfinite(tb))
@@ -84,6 +100,12 @@ CurvePlacement placeOnCurve(const CadModel& cad, int edge, double ta, double tb,
     p.point = c.point;
     p.jacobian.setZero();
     p.jacobian.col(0) = c.d1;
+    if (offset) {
+      if (const std::optional<CurveDerivatives> o = offsetCurve(c, *offset)) {
+        p.point = o->point;
+        p.jacobian.col(0) = o->d1;
+      }
+    }
     return p;
   };
   minimiseSprings(system, map);

@@ -8,6 +8,7 @@
 // strictly monotone and replaced by the (monotone) start where it is not.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -28,10 +29,23 @@ struct CurvePlacement {
   bool optimised = false;  // false: the optimum was not monotone, t is the linear start
 };
 
+// A curve's offset in a plane: the points at signed distance `height` along the unit normal
+// t x planeNormal (t the curve's unit tangent in increasing parameter).
+struct CurveOffset {
+  double height = 0.0;
+  Eigen::Vector3d planeNormal = Eigen::Vector3d::UnitZ();
+};
+
+// The offset's point and first derivative (d2 left zero) where the curve has `c`; std::nullopt
+// where c' is zero or along the plane normal.
+std::optional<CurveDerivatives> offsetCurve(const CurveDerivatives& c, const CurveOffset& offset);
+
 // Places the nodes between ta and tb (ta != tb) at reference positions z (z.front() = 0 <
-// ... < z.back() = 1). Throws ParameterError for bad z or ta == tb.
+// ... < z.back() = 1). With `offset`, the spacing is that of the nodes' images on the offset
+// curve instead. Throws ParameterError for bad z or ta == tb.
 CurvePlacement placeOnCurve(const CadModel& cad, int edge, double ta, double tb,
-                            const std::vector<double>& z);
+                            const std::vector<double>& z,
+                            const std::optional<CurveOffset>& offset = std::nullopt);
 
 // Whether the values strictly increase or strictly decrease.
 bool strictlyMonotone(const std::vector<double>& t);

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -10,6 +11,7 @@
 #include <set>
 
 #include "core/error.hpp"
+#include "curving/curve_node_placement.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 
@@ -105,6 +107,24 @@ Eigen::Vector3d wallNormal(const Mesh& mesh, const ReferenceElement& ref, const 
   if (!(n.norm() > 0.0)) return Eigen::Vector3d::Zero();
   n.normalize();
   return n.dot(towards) < 0.0 ? Eigen::Vector3d(-n) : n;
+}
+
+// The unit normal of CAD curve `curve` in the mesh's plane at mesh node `node` (on the curve,
+// or one of its vertices: the end nearer parameter `near`), on the side of `towards`; zero
+// where the curve's derivative vanishes or OCCT cannot evaluate it.
+Eigen::Vector3d curveNormal(const Mesh& mesh, const CadModel& cad, std::int64_t node, int curve,
+                            double near, const Eigen::Vector3d& towards) {
+  try {
+    const double t = nodeCurveParameter(
+        cad, mesh, node, curve, std::isfinite(near) ? std::optional<double>(near) : std::nullopt);
+    const Eigen::Vector3d plane(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
+    Eigen::Vector3d n = plane.cross(cad.evaluateCurve(curve, t).d1);
+    if (!(n.norm() > 0.0)) return Eigen::Vector3d::Zero();
+    n.normalize();
+    return n.dot(towards) < 0.0 ? Eigen::Vector3d(-n) : n;
+  } catch (const Error&) {
+    return Eigen::Vector3d::Zero();
+  }
 }
 
 // The height of the top (reference coordinate zeta = 1) of layer cell `v` above the wall point
@@ -854,12 +874,34 @@ void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops) {
               rise += l[k] * (x(top(k)) - x(v[k]));
               h += l[k] * (x(top(k)) - x(v[k])).norm();
             }
-            Eigen::Vector3d direction =
-                wallNormal(mesh, ref, v, double(c[0]) / p, prism ? double(c[1]) / p : 0.0, rise);
+            // In 2D the CAD curve's own normals where the wall nodes are on it: the wall's
+            // polynomial tilts its normal by degrees near the ends of a short wall around a
+            // tight tip (T106's trailing edge, 3 degrees on a wall 0.0035 long), which the
+            // top, 0.053 away, turns into a fold.
+            const int curve = mesh.dim == 2 && cad != nullptr && mesh.nodeCadDim[w] == 1
+                                  ? mesh.nodeCadIndex[w]
+                                  : 0;
+            std::array<Eigen::Vector3d, 3> atCorner;
+            Eigen::Vector3d direction = Eigen::Vector3d::Zero();
+            bool exact = curve > 0;
+            if (exact) {
+              const double near = mesh.nodeCadParam[2 * static_cast<std::size_t>(w)];
+              direction = curveNormal(mesh, *cad, w, curve, near, rise);
+              for (int k = 0; k < walls; ++k)
+                atCorner[static_cast<std::size_t>(k)] =
+                    curveNormal(mesh, *cad, v[k], curve, near, x(top(k)) - x(v[k]));
+              exact = !direction.isZero() && !atCorner[0].isZero() && !atCorner[1].isZero();
+            }
+            if (!exact) {
+              direction =
+                  wallNormal(mesh, ref, v, double(c[0]) / p, prism ? double(c[1]) / p : 0.0, rise);
+              for (int k = 0; k < walls; ++k)
+                atCorner[static_cast<std::size_t>(k)] =
+                    wallNormal(mesh, ref, v, corner[k][0], corner[k][1], x(top(k)) - x(v[k]));
+            }
             for (int k = 0; k < walls; ++k) {
               const Eigen::Vector3d climb = x(top(k)) - x(v[k]);
-              direction += l[k] * (climb.normalized() -
-                                   wallNormal(mesh, ref, v, corner[k][0], corner[k][1], climb));
+              direction += l[k] * (climb.normalized() - atCorner[static_cast<std::size_t>(k)]);
             }
             if (!(direction.norm() > 0.0)) continue;
             setOnCad(id, x(w) + h * direction.normalized());

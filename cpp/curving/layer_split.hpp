@@ -60,7 +60,9 @@ struct LayerSplitStats {
 // Shapes a freshly elevated macro layer after its curved wall: each high-order node of a cell's
 // top (but its vertices) goes to the wall's node below it, offset by the height and direction
 // interpolated from the vertices' climbs (the top runs parallel to the wall and meets the top
-// vertices), then the nodes between wall and top go to the blend (1 - t) W + t T at the same
+// vertices; the direction is the wall's normal, in 2D with `cad` the CAD curve's own at the wall
+// node, corrected by the vertices' climbs against the same normals there), then the nodes
+// between wall and top go to the blend (1 - t) W + t T at the same
 // wall position, t the node's level, so each cell's first split layer has its share of the
 // height everywhere. Cells: prisms (3D), quadrilaterals (2D). Nodes on a CAD face (the layer's
 // sides in 3D) are projected back onto it (with `cad`; without, they stay); nodes on CAD curves

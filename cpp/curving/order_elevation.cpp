@@ -1,11 +1,13 @@
 #include "curving/order_elevation.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -13,6 +15,7 @@
 #include "core/error.hpp"
 #include "curving/curve_node_placement.hpp"
 #include "curving/face_node_placement.hpp"
+#include "curving/layer_split.hpp"
 #include "element/reference_element.hpp"
 
 namespace homesh {
@@ -364,6 +367,21 @@ void projectNewNodes(Mesh& mesh, std::size_t firstNew, const CadModel& cad,
   }
 }
 
+// The high-order nodes on the wall of a 2D layer cell are spaced as their images on the offset
+// curve at this fraction of the cell's height, not in arc length. Around a wall curved more
+// tightly than the layer is thick (T106's edges, radius about 0.005 under up to 0.053)
+// arc-length nodes bunch the top's nodes where the wall turns fastest: the parallel top then
+// swings between them (with the layer fixed, T106's order-4 cells at both edges were invalid,
+// min J / max J -0.25 and -0.16). Spaced on the offset, the nodes share the turn evenly.
+// NekMesh's 2D cases with 2 and 4 layers at orders 2, 3, 4, 6: every fraction from 0.2 to 0.5
+// gives valid meshes with the first layer within 4 %; the worst element moves between 0.03 and
+// 0.10 with it, with no trend; 0.25 gave the best, 0.103 (arc length: 0.039, and 10.6 %).
+constexpr double kLayerSpacingHeight = 0.25;
+// The offset is dropped where its speed falls below this fraction of the wall's: it folds
+// (or nearly) on a concave wall of radius under the offset height. T106's wall dips to 0.11
+// on a concave wiggle beside the trailing edge and must keep the offset there.
+constexpr double kOffsetFold = 0.05;
+
 // Places the new nodes on the CAD: edges on curves by arc-length spacing in t, edges inside
 // faces by the same spacing in (u, v), triangle interiors by a relaxed lattice in (u, v)
 // (curve_node_placement.hpp, face_node_placement.hpp); whatever fails its checks is projected.
@@ -414,6 +432,16 @@ class BoundaryPlacer {
         nodes[quadIndex(order_, i, j)] = id;
       }
     });
+    if (mesh_.dim == 2)
+      for (const ElementBlock& b : mesh_.blocks) {
+        if (!isLayerCell(mesh_, b)) continue;
+        for (std::size_t e = 0; e < b.count(); ++e) {
+          const std::int64_t* v = b.element(e);  // wall 0, 1; tops 3, 2
+          wallTops_[{std::min(v[0], v[1]), std::max(v[0], v[1])}] =
+              v[0] < v[1] ? std::array<std::int64_t, 2>{v[3], v[2]}
+                          : std::array<std::int64_t, 2>{v[2], v[3]};
+        }
+      }
   }
 
   void run() {
@@ -438,6 +466,7 @@ class BoundaryPlacer {
   std::map<FaceKey, std::vector<std::int64_t>> triangles_;
   std::map<QuadKey, std::vector<std::int64_t>> quads_;  // by corners in cyclic order
   std::map<int, FaceChart> charts_;
+  std::map<std::pair<std::int64_t, std::int64_t>, std::array<std::int64_t, 2>> wallTops_;
 
   const FaceChart& chart(int face) {
     auto it = charts_.find(face);
@@ -481,11 +510,44 @@ class BoundaryPlacer {
     const double ta = nodeCurveParameter(cad_, mesh_, a, curve, hint(a, b));
     const double tb = nodeCurveParameter(cad_, mesh_, b, curve, hint(b, a));
     if (!(ta != tb)) return;  // a degenerate span: projection decides
-    const CurvePlacement placement = placeOnCurve(cad_, curve, ta, tb, z);
+    const CurvePlacement placement =
+        placeOnCurve(cad_, curve, ta, tb, z, layerOffset(a, b, curve, ta, tb, z));
     ++stats_.curveEdges;
     if (!placement.optimised) ++stats_.curveEdgesAtStart;
     for (std::size_t i = 1; i + 1 < nodes.size(); ++i)
       setCurveNode(nodes[i], curve, placement.t[i]);
+  }
+
+  // For the wall edge (a, b) of a 2D layer cell: the offset curve at a quarter of the cell's
+  // height, on the layer's side, whose spacing the edge's nodes then follow (std::nullopt for
+  // any other edge, or where that offset folds: a concave wall tighter than the height).
+  std::optional<CurveOffset> layerOffset(std::int64_t a, std::int64_t b, int curve, double ta,
+                                         double tb, const std::vector<double>& z) const {
+    const auto found = wallTops_.find({std::min(a, b), std::max(a, b)});
+    if (found == wallTops_.end()) return std::nullopt;
+    const std::int64_t topA = found->second[a < b ? 0 : 1], topB = found->second[a < b ? 1 : 0];
+    const Eigen::Vector3d climbA = point(topA) - point(a), climbB = point(topB) - point(b);
+    const Eigen::Vector3d k = (point(b) - point(a)).cross(climbA);
+    if (!(k.norm() > 0.0)) return std::nullopt;
+    CurveOffset offset;
+    offset.planeNormal = k.normalized();
+    const CurveDerivatives start = cad_.evaluateCurve(curve, ta);
+    const double side = start.d1.cross(offset.planeNormal).dot(climbA) > 0.0 ? 1.0 : -1.0;
+    offset.height = side * kLayerSpacingHeight * 0.5 * (climbA.norm() + climbB.norm());
+    // Folding: the offset's speed along c' is linear in the height, 1 + s (r - 1) at a fraction
+    // s of it (r: at the full height). Lowered until it is at least kOffsetFold at the nodes'
+    // starting parameters (a concave stretch tighter than the height, or a wiggle in a spline).
+    double fraction = 1.0;
+    for (const double s : z) {
+      const CurveDerivatives c = cad_.evaluateCurve(curve, ta + s * (tb - ta));
+      const std::optional<CurveDerivatives> o = offsetCurve(c, offset);
+      if (!o) return std::nullopt;
+      const double r = o->d1.dot(c.d1) / c.d1.squaredNorm();
+      if (r < kOffsetFold) fraction = std::min(fraction, (1.0 - kOffsetFold) / (1.0 - r));
+    }
+    if (!(fraction > kOffsetFold)) return std::nullopt;
+    offset.height *= fraction;
+    return offset;
   }
 
   void placeFaceEdge(const std::vector<std::int64_t>& nodes, const std::vector<double>& z) {

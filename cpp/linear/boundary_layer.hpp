@@ -75,8 +75,8 @@ struct BoundaryLayerRecord {
   // normal there and between them, instead of one along the bisector): part of the layer, split
   // into thin triangles (curving/layer_split.hpp).
   std::size_t fanTriangles = 0;
-  // 2D: wall segments halved before the growth, where the curve turns by more than 60 degrees
-  // along one and it is at least 1.5 times as long as the layer is thick there.
+  // 2D: wall segments halved before the growth, where the curve turns by more than 30 degrees
+  // along one.
   std::size_t wallSplits = 0;
   std::size_t sideQuadrilaterals = 0, wallNodes = 0;
   int shrinkPasses = 0;

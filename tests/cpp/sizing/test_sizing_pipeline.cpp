@@ -1,9 +1,11 @@
 // Linear meshes made from the sizing octree: NekMesh's peer cases (.mcf), prediction against
-// the actual count, element sizes against the specification, EPS halving, several solids.
+// the actual count, element sizes against the specification, a tight turn inside a long spline,
+// EPS halving, several solids.
 #include <gtest/gtest.h>
 
 #include <BOPAlgo_Builder.hxx>
 #include <BRepBuilderAPI_Transform.hxx>
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -11,6 +13,7 @@
 #include "core/error.hpp"
 #include "pipeline/case_setup.hpp"
 #include "pipeline/mesh_pipeline.hpp"
+#include "sizing/sizing_parameters.hpp"
 #include "test_support.hpp"
 
 namespace homesh {
@@ -79,6 +82,46 @@ TEST_P(PeerCase, PredictionWithinTenPercentAndSizesFollowTheSpecification) {
 INSTANTIATE_TEST_SUITE_P(NekMeshMeshgen, PeerCase,
                          ::testing::Values("3d_sphere", "3d_bl_cyl", "2d_bl_aerofoil", "2d_bl_t106",
                                            "2d_bl_naca0012"));
+
+// T106's blade is one spline per side whose trailing edge turns through 180 degrees within a
+// radius of about 0.005 on a curve 1.5 long: 40 samples evenly spaced in its parameter found
+// none of that turn, and the mesh there had edges 0.09 long (the octree's size there 0.24).
+// Halving every sample interval along which the tangent turns further than the size rule
+// allows finds it: the linear mesh's edges at the edge are within twice the curvature size
+// (the largest curvature on the CAD by dense sampling; twice: between two samples the
+// curvature can peak above what both see, by at most the turn they allow, 0.5 rad at EPS 1).
+TEST(SizingPipeline, T106TrailingEdgeGetsItsCurvatureSize) {
+  const MeshResult r = meshCase("2d_bl_t106");
+  ASSERT_TRUE(r.sizing.has_value());
+  const CadModel& cad = *r.cad;
+  const int blade = 12;  // Edge12: the pressure side and the trailing edge
+  const ParameterRange range = cad.edgeRange(blade);
+  double kMax = 0.0;
+  Eigen::Vector3d tip = Eigen::Vector3d::Zero();
+  for (int i = 0; i <= 200000; ++i) {
+    const CurveDerivatives c =
+        cad.evaluateCurve(blade, range.first + (range.last - range.first) * i / 200000.0);
+    const double k = c.d1.cross(c.d2).norm() / std::pow(c.d1.norm(), 3);
+    if (k > kMax) {
+      kMax = k;
+      tip = c.point;
+    }
+  }
+  ASSERT_GT(kMax, 100.0);                                          // radius under 0.01
+  ASSERT_NEAR(tip.x(), 0.853, 0.01);                               // at the trailing edge
+  const double size = std::max(0.01, chordSize(1.0 / kMax, 1.0));  // MinDelta 0.01, EPS 1
+  EXPECT_LE(r.sizing->octree->delta(tip), 2.0 * size);
+  const ElementBlock& b = boundaryBlock(r.mesh);
+  std::size_t near = 0;
+  for (std::size_t e = 0; e < b.count(); ++e) {
+    const Eigen::Vector3d p = test::nodePoint(r.mesh, b.element(e)[0]);
+    const Eigen::Vector3d q = test::nodePoint(r.mesh, b.element(e)[1]);
+    if ((0.5 * (p + q) - tip).norm() > 0.02) continue;
+    ++near;
+    EXPECT_LE((p - q).norm(), 2.0 * size) << "edge at " << (0.5 * (p + q)).transpose();
+  }
+  EXPECT_GE(near, 2U);
+}
 
 TEST(SizingPipeline, HalvingEpsRefinesTheSphereAsTheChordFormulaPredicts) {
   // Boundary triangles on the sphere's (curved) faces: their number scales with 1/delta^2, and
