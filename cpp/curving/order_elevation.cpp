@@ -387,7 +387,8 @@ constexpr double kOffsetFold = 0.05;
 // (curve_node_placement.hpp, face_node_placement.hpp); whatever fails its checks is projected.
 class BoundaryPlacer {
  public:
-  BoundaryPlacer(Elevator& elevator, std::size_t firstNew, const CadModel& cad, CurvingStats& stats)
+  BoundaryPlacer(Elevator& elevator, std::size_t firstNew, const CadModel& cad, CurvingStats& stats,
+                 bool layer)
       : mesh_(elevator.out),
         order_(elevator.order),
         cad_(cad),
@@ -432,7 +433,7 @@ class BoundaryPlacer {
         nodes[quadIndex(order_, i, j)] = id;
       }
     });
-    if (mesh_.dim == 2)
+    if (layer && mesh_.dim == 2)
       for (const ElementBlock& b : mesh_.blocks) {
         if (!isLayerCell(mesh_, b)) continue;
         for (std::size_t e = 0; e < b.count(); ++e) {
@@ -712,20 +713,22 @@ class BoundaryPlacer {
 
 }  // namespace
 
-Mesh changeOrder(const Mesh& mesh, int order, const CadModel* cad, CurvingStats* stats) {
+Mesh changeOrder(const Mesh& mesh, int order, const CadModel* cad, CurvingStats* stats,
+                 bool layer) {
   if (order < 1 || order > 10)
     throw ParameterError("order must be between 1 and 10, got " + std::to_string(order));
   Elevator elevator(mesh, order);
   for (const ElementBlock& block : mesh.blocks) elevator.elevateBlock(block);
   CurvingStats local;
   if (cad != nullptr)
-    BoundaryPlacer(elevator, mesh.numNodes(), *cad, stats != nullptr ? *stats : local).run();
+    BoundaryPlacer(elevator, mesh.numNodes(), *cad, stats != nullptr ? *stats : local, layer).run();
   compactNodes(elevator.out);
   elevator.out.checkConsistency();
   return std::move(elevator.out);
 }
 
-Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad, CurvingStats* stats) {
+Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad, CurvingStats* stats,
+                  bool layer) {
   if (linear.order != 1)
     throw ParameterError("order elevation needs a linear mesh, got order " +
                          std::to_string(linear.order));
@@ -735,7 +738,8 @@ Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad, CurvingSta
   for (const ElementBlock& block : linear.blocks) elevator.elevateBlock(block);
   CurvingStats local;
   if (cad != nullptr)
-    BoundaryPlacer(elevator, linear.numNodes(), *cad, stats != nullptr ? *stats : local).run();
+    BoundaryPlacer(elevator, linear.numNodes(), *cad, stats != nullptr ? *stats : local, layer)
+        .run();
   elevator.out.checkConsistency();
   return std::move(elevator.out);
 }

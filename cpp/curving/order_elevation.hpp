@@ -34,15 +34,19 @@ struct CurvingStats {
 };
 
 // `linear` must have order 1. `cad` may be null (no projection: a straight-sided order-P mesh).
+// With `layer` (a 2D mesh whose quadrilaterals are a macro boundary layer, wall 0-1 and tops
+// 3-2), the wall edges' nodes are spaced on the layer's offset (curve_node_placement.hpp)
+// instead of in arc length; without it quadrilaterals are cells like any other.
 // Throws ParameterError for an order outside 1..10.
-Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad,
-                  CurvingStats* stats = nullptr);
+Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad, CurvingStats* stats = nullptr,
+                  bool layer = false);
 
 // The same for a mesh of any order: each new node is the source element's own (curved) map
 // evaluated at the node's reference position, so raising the order keeps the geometry exactly
 // and lowering it interpolates it (what NekMesh does before optimising at a lower order). Nodes
 // the new mesh no longer uses are dropped and the rest renumbered in order. With `cad`, new
 // nodes on CAD curves and faces are placed on them as above.
-Mesh changeOrder(const Mesh& mesh, int order, const CadModel* cad, CurvingStats* stats = nullptr);
+Mesh changeOrder(const Mesh& mesh, int order, const CadModel* cad, CurvingStats* stats = nullptr,
+                 bool layer = false);
 
 }  // namespace homesh

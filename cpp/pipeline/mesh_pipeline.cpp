@@ -390,6 +390,10 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
                   const CurvedState* previous = nullptr) {
   CurvedState state;
   state.linear = std::move(linear);
+  // Quadrilaterals (2D) and prisms are a macro boundary layer only when one was grown here;
+  // otherwise (a mesh given to curveMeshOnCad, tetrahedra only today) the layer's fixing,
+  // blending and wall spacing stay out of it.
+  const bool layered = options.boundaryLayer.has_value();
   checkHighOrderMemory(state.linear, options.order);
   // For `mesh`, just elevated to `order`: takes the curved nodes of unchanged cells from
   // `before` (previous's mesh of that order, if any) and optimises the whole mesh, or only
@@ -425,7 +429,7 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
     // The macro layer keeps the shape its growth and blend gave it (its split then has the
     // heights asked for) while the rest adapts; only where elements stay invalid is it
     // released, around them, and its inner nodes blended again afterwards.
-    o.fixedNodes = layerNodes(mesh);
+    if (layered) o.fixedNodes = layerNodes(mesh);
     OptimiserProgress cancel(observer, stage, o.maxIterations);
     std::optional<OptimiserResult> r = optimiseMesh(mesh, o, &cancel, &cad);
     if (r->cancelled) throw CancelledError("cancelled during optimise");
@@ -479,27 +483,27 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
   std::optional<StageClock> clock;
   if (options.optimiseIterations > 0 && options.order > kContinuationOrder) {
     if (clocked) clock.emplace("high_order", timings, observer);
-    state.lowOrder = elevateOrder(state.linear, kContinuationOrder, &cad);
-    blendLayerInteriors(state.lowOrder, &cad);
+    state.lowOrder = elevateOrder(state.linear, kContinuationOrder, &cad, nullptr, layered);
+    if (layered) blendLayerInteriors(state.lowOrder, &cad);
     if (clocked) clock->done();
     state.lowOrderOptimiser = curveAt(
         kContinuationOrder, state.lowOrder,
         previous != nullptr && previous->lowOrder.numNodes() > 0 ? &previous->lowOrder : nullptr,
         "optimise_low_order");
     if (clocked) clock.emplace("raise_order", timings, observer);
-    state.mesh = changeOrder(state.lowOrder, options.order, &cad);
+    state.mesh = changeOrder(state.lowOrder, options.order, &cad, nullptr, layered);
     // The raised wall lies on the CAD at the full order while the layer's top is the low
     // order's, raised: around a coarse wall (the NACA's nose, T106's edges) the heights follow
     // the low order's wall (57 % off at the NACA's nose at order 6). In 2D the top is placed
     // parallel to the raised wall again (0.04 % there), unless the low order had to let the top
     // move freely (placing it back would undo that); in 3D that forced the cylinder's layer
     // free at three times the time, so 3D keeps the raised top.
-    if (state.mesh.dim == 2 && state.layerRelease != LayerRelease::Free)
+    if (layered && state.mesh.dim == 2 && state.layerRelease != LayerRelease::Free)
       blendLayerInteriors(state.mesh, &cad);
   } else {
     if (clocked) clock.emplace("high_order", timings, observer);
-    state.mesh = elevateOrder(state.linear, options.order, &cad);
-    blendLayerInteriors(state.mesh, &cad);
+    state.mesh = elevateOrder(state.linear, options.order, &cad, nullptr, layered);
+    if (layered) blendLayerInteriors(state.mesh, &cad);
   }
   if (clocked) clock->done();
   state.optimiser = curveAt(options.order, state.mesh,
