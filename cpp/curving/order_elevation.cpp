@@ -377,9 +377,10 @@ void projectNewNodes(Mesh& mesh, std::size_t firstNew, const CadModel& cad,
 // gives valid meshes with the first layer within 4 %; the worst element moves between 0.03 and
 // 0.10 with it, with no trend; 0.25 gave the best, 0.103 (arc length: 0.039, and 10.6 %).
 constexpr double kLayerSpacingHeight = 0.25;
-// The offset is dropped where its speed falls below this fraction of the wall's: it folds
-// (or nearly) on a concave wall of radius under the offset height. T106's wall dips to 0.11
-// on a concave wiggle beside the trailing edge and must keep the offset there.
+// The offset's height is lowered where its speed would fall below this fraction of the wall's
+// (it folds, or nearly, on a concave wall of radius under the offset height: T106's splines
+// have concave wiggles beside both edges), and dropped if that leaves less than this fraction
+// of it.
 constexpr double kOffsetFold = 0.05;
 
 // Places the new nodes on the CAD: edges on curves by arc-length spacing in t, edges inside
@@ -528,10 +529,9 @@ class BoundaryPlacer {
     if (found == wallTops_.end()) return std::nullopt;
     const std::int64_t topA = found->second[a < b ? 0 : 1], topB = found->second[a < b ? 1 : 0];
     const Eigen::Vector3d climbA = point(topA) - point(a), climbB = point(topB) - point(b);
-    const Eigen::Vector3d k = (point(b) - point(a)).cross(climbA);
-    if (!(k.norm() > 0.0)) return std::nullopt;
     CurveOffset offset;
-    offset.planeNormal = k.normalized();
+    offset.planeNormal =
+        Eigen::Vector3d(mesh_.planeNormal[0], mesh_.planeNormal[1], mesh_.planeNormal[2]);
     const CurveDerivatives start = cad_.evaluateCurve(curve, ta);
     const double side = start.d1.cross(offset.planeNormal).dot(climbA) > 0.0 ? 1.0 : -1.0;
     offset.height = side * kLayerSpacingHeight * 0.5 * (climbA.norm() + climbB.norm());
