@@ -21,6 +21,7 @@
 #include "optimise/cad_local_model.hpp"
 #include "optimise/mesh_topology.hpp"
 #include "optimise/node_patch.hpp"
+#include "optimise/work_partition.hpp"
 #include "quality/jacobian_sampler.hpp"
 #include "quality/mesh_quality.hpp"
 
@@ -195,6 +196,7 @@ class Optimiser {
     if (overBudget()) return stoppedInSetup(before, t0);
 
     chooseFreeNodes();
+    partition();
     colour();
     computeGradients();
     resetMarks();
@@ -287,6 +289,7 @@ class Optimiser {
     convertToWorkingSet();
     buildIncidence();
     chooseFreeNodes();
+    partition();
     changed_.resize(totalElements_);
     for (std::size_t i = 0; i < totalElements_; ++i) changed_[i] = i;
     computeGradients();
@@ -387,9 +390,14 @@ class Optimiser {
   // Per node: visit it in the next sweep (it or a neighbour moved by more than
   // options_.activeTolerance of its element size since its last visit).
   std::unique_ptr<std::atomic<std::uint8_t>[]> active_;
-  std::vector<std::int64_t> free_;  // free nodes, grouped by colour
-  std::vector<std::size_t> colourStart_;
-  std::vector<int> colourOf_;  // colour of each free node, -1 for fixed nodes
+  // Owner-computes split (work_partition.hpp): one part per thread; every phase of a sweep hands
+  // an element (a node) to its part's thread first.
+  int parts_ = 1;
+  std::vector<int> elementPart_;          // per global element
+  std::vector<int> nodePart_;             // per node
+  std::vector<std::int64_t> free_;        // free nodes, grouped by colour, then by part
+  std::vector<std::size_t> colourStart_;  // colour c, part p: [c * parts_ + p], [.. + 1])
+  std::vector<int> colourOf_;             // colour of each free node, -1 for fixed nodes
 
   void setFrame() {
     if constexpr (D == 3) {
@@ -667,40 +675,114 @@ class Optimiser {
     }
     std::vector<std::vector<std::int64_t>> groups(colours);
     for (const std::int64_t node : free_) groups[colourOf[node]].push_back(node);
-    free_.clear();
-    colourStart_.assign(1, 0);
-    for (const auto& g : groups) {
-      free_.insert(free_.end(), g.begin(), g.end());
-      colourStart_.push_back(free_.size());
-    }
+    free_ = groupByColourAndPart(groups, colourStart_);
     result_.colours = static_cast<std::size_t>(colours);
+  }
+
+  // The nodes of each colour group, each group's ordered by part (stable); `starts` gets the
+  // ranges: colour c, part p is [starts[c * parts_ + p], starts[c * parts_ + p + 1]).
+  std::vector<std::int64_t> groupByColourAndPart(
+      const std::vector<std::vector<std::int64_t>>& groups,
+      std::vector<std::size_t>& starts) const {
+    std::vector<std::int64_t> nodes;
+    starts.assign(1, 0);
+    std::vector<std::size_t> begin;
+    for (const auto& g : groups) {
+      const std::vector<std::int64_t> byPart = groupByPart(
+          g, parts_, [&](std::int64_t n) { return nodePart_[static_cast<std::size_t>(n)]; }, begin);
+      const std::size_t base = nodes.size();
+      nodes.insert(nodes.end(), byPart.begin(), byPart.end());
+      for (std::size_t p = 1; p < begin.size(); ++p) starts.push_back(base + begin[p]);
+    }
+    return nodes;
+  }
+
+  // One part per thread, by recursive coordinate bisection of the elements' centroids weighted
+  // by their energy points (elements without a free node weigh nothing: no sweep touches them);
+  // a node belongs to the part of most of its elements.
+  void partition() {
+    parts_ = options_.threads;
+    elementPart_.assign(totalElements_, 0);
+    nodePart_.assign(mesh_.numNodes(), 0);
+    if (parts_ == 1) return;
+    std::vector<char> moves(totalElements_, 0);
+    for (const std::size_t g : changed_) moves[g] = 1;
+    std::vector<std::array<double, 3>> centroid(totalElements_);
+    std::vector<double> weight(totalElements_, 0.0);
+    for (std::size_t bi = 0; bi < blocks_.size(); ++bi) {
+      const Block<D>& b = blocks_[bi];
+      for (std::size_t e = 0; e < b.cells->count(); ++e) {
+        const std::size_t g = blockOffset_[bi] + e;
+        const std::int64_t* v = b.cells->element(e);
+        std::array<double, 3> c{0.0, 0.0, 0.0};
+        for (int k = 0; k < b.nodes; ++k)
+          for (int i = 0; i < 3; ++i) c[i] += mesh_.xyz[3 * v[k] + i] / b.nodes;
+        centroid[g] = c;
+        if (moves[g] != 0) weight[g] = b.points;
+      }
+    }
+    elementPart_ = bisectByCoordinates(centroid, weight, parts_);
+    nodePart_ = nodeOwners(mesh_.numNodes(), parts_, [&](std::size_t n, auto add) {
+      for (std::size_t k = incidenceStart_[n]; k < incidenceStart_[n + 1]; ++k)
+        add(elementPart_[globalIndex(incidence_[k])]);
+    });
+  }
+
+  // body(i, thread) for every i < elements.size(), on the threads: element elements[i] goes to
+  // its part's thread first (OwnerFirstQueue), so its F stays in that CPU's cache; before the
+  // partition exists (the input's quality), to any thread. The first exception is rethrown
+  // after the loop.
+  template <class Body>
+  void forEachOwned(const std::vector<std::size_t>& elements, std::size_t chunk, Body body) const {
+    std::vector<std::size_t> position(elements.size()), begin;
+    for (std::size_t i = 0; i < position.size(); ++i) position[i] = i;
+    const bool split = !elementPart_.empty();
+    position = groupByPart(
+        position, split ? parts_ : 1,
+        [&](std::size_t i) { return split ? elementPart_[elements[i]] : 0; }, begin);
+    OwnerFirstQueue queue(std::move(begin), chunk);
+    FirstFailure failure;
+#pragma omp parallel num_threads(options_.threads)
+    {
+      const int me = omp_get_thread_num();
+      std::size_t lo = 0, hi = 0;
+      while (queue.next(me, lo, hi))
+        for (std::size_t k = lo; k < hi; ++k) {
+          try {
+            body(position[k], me);
+          } catch (...) {
+            failure.capture();
+          }
+        }
+    }
+    failure.rethrow();
   }
 
   // F and J at every quadrature point of the given elements (global indices; by default every
   // element that contains a free node): one matrix product per element (its node coordinates
   // times the tabulated basis gradients).
-  void computeGradients() { computeGradients(changed_); }
+  void computeGradients() {
+    computeGradients(changed_);
+  }
   void computeGradients(const std::vector<std::size_t>& elements) {
-    const std::size_t* changed = elements.data();
-#pragma omp parallel num_threads(options_.threads)
-    {
-      Eigen::Matrix<double, D, Eigen::Dynamic> x, dx;
-#pragma omp for schedule(dynamic, 16)
-      for (std::int64_t i = 0; i < static_cast<std::int64_t>(elements.size()); ++i) {
-        const auto [bi, e] = locate(changed[i]);
-        Block<D>& b = blocks_[bi];
-        const std::int64_t* v = b.cells->element(e);
-        x.resize(D, b.nodes);
-        for (int n = 0; n < b.nodes; ++n) x.col(n) = position_[v[n]];
-        dx.noalias() = x * b.gradientTable;
-        for (int q = 0; q < b.points; ++q) {
-          const Mat F = dx.template middleCols<D>(static_cast<Eigen::Index>(q) * D) *
-                        b.invT(e, q).transpose();
-          for (int k = 0; k < D * D; ++k) b.componentF(e, k)[q] = F(k % D, k / D);
-          b.J[e * b.points + q] = functional_detail::determinant<D>(F);
-        }
+    std::vector<Eigen::Matrix<double, D, Eigen::Dynamic>> scratchX(options_.threads),
+        scratchDx(options_.threads);
+    forEachOwned(elements, 16, [&](std::size_t i, int thread) {
+      auto& x = scratchX[static_cast<std::size_t>(thread)];
+      auto& dx = scratchDx[static_cast<std::size_t>(thread)];
+      const auto [bi, e] = locate(elements[i]);
+      Block<D>& b = blocks_[bi];
+      const std::int64_t* v = b.cells->element(e);
+      x.resize(D, b.nodes);
+      for (int n = 0; n < b.nodes; ++n) x.col(n) = position_[v[n]];
+      dx.noalias() = x * b.gradientTable;
+      for (int q = 0; q < b.points; ++q) {
+        const Mat F =
+            dx.template middleCols<D>(static_cast<Eigen::Index>(q) * D) * b.invT(e, q).transpose();
+        for (int k = 0; k < D * D; ++k) b.componentF(e, k)[q] = F(k % D, k / D);
+        b.J[e * b.points + q] = functional_detail::determinant<D>(F);
       }
-    }
+    });
   }
 
   // The quadrature points of a node's elements (NodePatch), and where each element's run of
@@ -995,10 +1077,12 @@ class Optimiser {
   void record(std::int64_t node, double relative) {
     const bool moved = relative > 0.0;
     const bool wakes = relative > options_.activeTolerance;
-    active_[node].store(wakes ? 1 : 0, std::memory_order_relaxed);
+    // Loads before stores: the flags mostly hold their value already, and a store (even of the
+    // same value) takes the cache line from the other threads working on neighbouring nodes.
+    if (const std::uint8_t want = wakes ? 1 : 0;
+        active_[node].load(std::memory_order_relaxed) != want)
+      active_[node].store(want, std::memory_order_relaxed);
     if (!moved) return;
-    // Loads before stores: the flags are mostly set already, and a store (even of the same
-    // value) takes the cache line from the other threads working on neighbouring nodes.
     constexpr std::uint8_t both = kStale | kDrifted;
     for (std::size_t k = incidenceStart_[node]; k < incidenceStart_[node + 1]; ++k) {
       const Incidence& inc = incidence_[k];
@@ -1014,20 +1098,28 @@ class Optimiser {
     }
   }
 
-  // One Newton step on each of `nodes` (grouped by colour: starts[c]..starts[c+1]); with
-  // `onlyActive`, on those of them that are active (see record()).
+  // One Newton step on each of `nodes` (grouped by colour and part: see groupByColourAndPart);
+  // with `onlyActive`, on those of them that are active (see record()). A colour group's nodes
+  // go to their part's thread first.
   Moves relax(const std::vector<std::int64_t>& nodes, const std::vector<std::size_t>& starts,
               bool onlyActive) {
     double moved = 0.0, relative = 0.0;
     std::size_t visits = 0, slides = 0, cadEvaluations = 0;
     FirstFailure failure;
-    const std::int64_t colours = static_cast<std::int64_t>(starts.size()) - 1;
+    const auto colours = static_cast<std::int64_t>((starts.size() - 1) / parts_);
+    std::vector<OwnerFirstQueue> queues;
+    queues.reserve(static_cast<std::size_t>(colours));
+    for (std::int64_t c = 0; c < colours; ++c) {
+      const auto first = starts.begin() + c * parts_;
+      queues.emplace_back(std::vector<std::size_t>(first, first + parts_ + 1), 8);
+    }
     const bool observed = observer_ != nullptr || options_.timeLimit > 0.0;
     bool cancel = false;  // shared: one thread asks, the barrier after `single` publishes it
 #pragma omp parallel num_threads(options_.threads) reduction(max : moved, relative) \
     reduction(+ : visits, slides, cadEvaluations)
     {
       Patch patch;
+      const int me = omp_get_thread_num();
       for (std::int64_t c = 0; c < colours; ++c) {
         if (observed) {
           // A sweep of a large high-order mesh takes seconds: a cancel request is honoured
@@ -1036,21 +1128,21 @@ class Optimiser {
           cancel = (observer_ != nullptr && observer_->cancelRequested()) || overBudget();
           if (cancel) break;
         }
-        const auto lo = static_cast<std::int64_t>(starts[c]);
-        const auto hi = static_cast<std::int64_t>(starts[c + 1]);
-#pragma omp for schedule(dynamic, 8)
-        for (std::int64_t i = lo; i < hi; ++i) {
-          try {
-            if (onlyActive && active_[nodes[i]].load(std::memory_order_relaxed) == 0) continue;
-            const double d = visit(nodes[i], patch);
-            ++visits;
-            moved = std::max(moved, d);
-            relative = std::max(relative, d / nodeSize_[nodes[i]]);
-            record(nodes[i], d / nodeSize_[nodes[i]]);
-          } catch (...) {
-            failure.capture();
+        std::size_t lo = 0, hi = 0;
+        while (queues[static_cast<std::size_t>(c)].next(me, lo, hi))
+          for (std::size_t i = lo; i < hi; ++i) {
+            try {
+              if (onlyActive && active_[nodes[i]].load(std::memory_order_relaxed) == 0) continue;
+              const double d = visit(nodes[i], patch);
+              ++visits;
+              moved = std::max(moved, d);
+              relative = std::max(relative, d / nodeSize_[nodes[i]]);
+              record(nodes[i], d / nodeSize_[nodes[i]]);
+            } catch (...) {
+              failure.capture();
+            }
           }
-        }
+#pragma omp barrier
       }
       slides += patch.slides;
       cadEvaluations += patch.cadEvaluations;
@@ -1089,12 +1181,8 @@ class Optimiser {
             }
         }
       }
-      std::vector<std::int64_t> focus;
-      std::vector<std::size_t> starts(1, 0);
-      for (const auto& g : groups) {
-        focus.insert(focus.end(), g.begin(), g.end());
-        starts.push_back(focus.size());
-      }
+      std::vector<std::size_t> starts;
+      const std::vector<std::int64_t> focus = groupByColourAndPart(groups, starts);
       for (int p = 0; p < options_.focusPasses; ++p) {
         const Moves m = relax(focus, starts, false);
         moved.visits += m.visits;
@@ -1174,22 +1262,14 @@ class Optimiser {
   }
 
   void bound(const std::vector<std::size_t>& elements, double tolerance) {
-    FirstFailure failure;
-    const std::size_t* list = elements.data();  // an index loop: OpenMP splits it
-#pragma omp parallel for num_threads(options_.threads) schedule(dynamic, 16)
-    for (std::int64_t i = 0; i < static_cast<std::int64_t>(elements.size()); ++i) {
-      try {
-        const auto [bi, e] = locate(list[i]);
-        const JacobianBounds bounds =
-            elementJacobianBounds(mesh_, *blocks_[bi].cells, e, tolerance);
-        scaled_[list[i]] = bounds.scaledJacobian();
-        estimate_[list[i]] = bounds.scaledJacobianEstimate();
-        validity_[list[i]] = bounds.validity;
-      } catch (...) {
-        failure.capture();
-      }
-    }
-    failure.rethrow();
+    forEachOwned(elements, 16, [&](std::size_t i, int /*thread*/) {
+      const std::size_t g = elements[i];
+      const auto [bi, e] = locate(g);
+      const JacobianBounds bounds = elementJacobianBounds(mesh_, *blocks_[bi].cells, e, tolerance);
+      scaled_[g] = bounds.scaledJacobian();
+      estimate_[g] = bounds.scaledJacobianEstimate();
+      validity_[g] = bounds.validity;
+    });
   }
 
   IterationRecord summarise(int iteration, double moved, Clock::time_point t0) const {
@@ -1238,19 +1318,16 @@ class Optimiser {
   double totalEnergy() const {
     std::vector<double> energy(changed_.size());  // summed in order: the same for any thread count
     functional_detail::dispatch(options_.functional, [&](auto fn) {
-      const std::size_t* list = changed_.data();
-      double* out = energy.data();
-#pragma omp parallel for num_threads(options_.threads) schedule(static)
-      for (std::int64_t i = 0; i < static_cast<std::int64_t>(changed_.size()); ++i) {
-        const auto [bi, e] = locate(list[i]);
+      forEachOwned(changed_, 64, [&](std::size_t i, int /*thread*/) {
+        const auto [bi, e] = locate(changed_[i]);
         const Block<D>& b = blocks_[bi];
         double sum = 0.0;
         for (int q = 0; q < b.points; ++q) {
           const std::size_t p = e * b.points + q;
           sum += b.weights[p] * energyDensity<D, decltype(fn)::value>(b.matrixF(e, q), 1e-10);
         }
-        out[i] = sum;
-      }
+        energy[i] = sum;
+      });
     });
     double total = 0.0;
     for (const double x : energy) total += x;

@@ -1,0 +1,80 @@
+// Owner-computes work split for the optimiser's threads (and, later, MPI ranks): every element
+// belongs to one part, a spatially compact region of the mesh, and the part's thread is the one
+// that computes, updates and reads that element's cached deformation gradients in every phase
+// of a sweep. An element's F then stays in its owner's cache between the visits of its nodes
+// and the sweep's refresh, instead of moving between CPUs each time another thread touches it.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+namespace homesh {
+
+// Splits points (one per element: its centroid) with weights (the work each element costs)
+// into `parts` sets by recursive coordinate bisection: each set is cut across its longest
+// extent at the weighted median, into halves whose part counts are floor(parts / 2) and the
+// rest, until one set is left per part. The parts' weights differ by at most the largest
+// single weight per level of cuts. Returns each point's part in [0, parts). Deterministic:
+// ties are broken by index.
+std::vector<int> bisectByCoordinates(const std::vector<std::array<double, 3>>& points,
+                                     const std::vector<double>& weights, int parts);
+
+// The owner of each node: the part that owns most of its elements (the lowest such part on a
+// tie). Generic over the incidence storage: `partsOfNode(node, add)` calls add(part) once per
+// element of the node.
+template <class PartsOfNode>
+std::vector<int> nodeOwners(std::size_t numNodes, int parts, PartsOfNode partsOfNode) {
+  std::vector<int> owner(numNodes, 0);
+  std::vector<int> count(static_cast<std::size_t>(parts), 0);
+  for (std::size_t n = 0; n < numNodes; ++n) {
+    std::fill(count.begin(), count.end(), 0);
+    partsOfNode(n, [&](int p) { ++count[static_cast<std::size_t>(p)]; });
+    int best = 0;
+    for (int p = 1; p < parts; ++p)
+      if (count[static_cast<std::size_t>(p)] > count[static_cast<std::size_t>(best)]) best = p;
+    owner[n] = best;
+  }
+  return owner;
+}
+
+// Items grouped by part (part t's are [begin[t], begin[t + 1])), handed out in chunks: a
+// thread takes its own part's chunks first and then helps the other parts with theirs, so the
+// work stays with its owner where the parts are balanced and no thread idles where they are
+// not. Safe to call next() from every thread at once; each item is handed out exactly once.
+class OwnerFirstQueue {
+ public:
+  OwnerFirstQueue(std::vector<std::size_t> begin, std::size_t chunk);
+
+  // The next chunk [lo, hi) for the thread of part `part`; false when every item is taken.
+  bool next(int part, std::size_t& lo, std::size_t& hi);
+
+ private:
+  struct alignas(64) Cursor {  // one cache line each: parts take their own chunks unshared
+    std::atomic<std::size_t> next{0};
+  };
+  bool take(std::size_t part, std::size_t& lo, std::size_t& hi);
+
+  std::vector<std::size_t> begin_;
+  std::size_t chunk_;
+  std::unique_ptr<Cursor[]> cursors_;
+};
+
+// Stable grouping of `items` by part: returns the items reordered part by part (each part's in
+// their given order) and fills `begin` with parts + 1 offsets.
+template <class Item, class PartOf>
+std::vector<Item> groupByPart(const std::vector<Item>& items, int parts, PartOf partOf,
+                              std::vector<std::size_t>& begin) {
+  begin.assign(static_cast<std::size_t>(parts) + 1, 0);
+  for (const Item& item : items) ++begin[static_cast<std::size_t>(partOf(item)) + 1];
+  for (std::size_t p = 0; p < static_cast<std::size_t>(parts); ++p) begin[p + 1] += begin[p];
+  std::vector<std::size_t> fill(begin.begin(), begin.end() - 1);
+  std::vector<Item> grouped(items.size());
+  for (const Item& item : items) grouped[fill[static_cast<std::size_t>(partOf(item))]++] = item;
+  return grouped;
+}
+
+}  // namespace homesh
