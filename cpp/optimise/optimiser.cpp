@@ -396,7 +396,7 @@ class Optimiser {
   std::vector<int> elementPart_;          // per global element
   std::vector<int> nodePart_;             // per node
   std::vector<std::int64_t> free_;        // free nodes, grouped by colour, then by part
-  std::vector<std::size_t> colourStart_;  // colour c, part p: [c * parts_ + p], [.. + 1])
+  std::vector<std::size_t> colourStart_;  // colour c, part p: [cs[c * parts_ + p], cs[.. + 1])
   std::vector<int> colourOf_;             // colour of each free node, -1 for fixed nodes
 
   void setFrame() {
@@ -698,8 +698,8 @@ class Optimiser {
   }
 
   // One part per thread, by recursive coordinate bisection of the elements' centroids weighted
-  // by their energy points (elements without a free node weigh nothing: no sweep touches them);
-  // a node belongs to the part of most of its elements.
+  // by their energy points (elements without a free node weigh nothing: no node visit or
+  // refresh of F touches them); a node belongs to the part of most of its elements.
   void partition() {
     parts_ = options_.threads;
     elementPart_.assign(totalElements_, 0);
@@ -729,8 +729,8 @@ class Optimiser {
   }
 
   // body(i, thread) for every i < elements.size(), on the threads: element elements[i] goes to
-  // its part's thread first (OwnerFirstQueue), so its F stays in that CPU's cache; before the
-  // partition exists (the input's quality), to any thread. The first exception is rethrown
+  // its part's thread first (OwnerFirstQueue), where its F and nodes were last written; before
+  // the partition exists (the input's quality), to any thread. The first exception is rethrown
   // after the loop.
   template <class Body>
   void forEachOwned(const std::vector<std::size_t>& elements, std::size_t chunk, Body body) const {

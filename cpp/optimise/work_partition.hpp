@@ -1,8 +1,9 @@
 // Owner-computes work split for the optimiser's threads (and, later, MPI ranks): every element
-// belongs to one part, a spatially compact region of the mesh, and the part's thread is the one
-// that computes, updates and reads that element's cached deformation gradients in every phase
-// of a sweep. An element's F then stays in its owner's cache between the visits of its nodes
-// and the sweep's refresh, instead of moving between CPUs each time another thread touches it.
+// belongs to one part, a spatially compact region of the mesh, and every phase of a sweep gives
+// an element (a node) to its part's thread first. An element's cached deformation gradients
+// are then written and read by one thread, except on the cut between parts (a node's visit
+// updates all its elements) and where a thread helps another part, instead of moving between
+// CPUs whenever another thread happens to take the element.
 #pragma once
 
 #include <algorithm>
@@ -16,10 +17,11 @@ namespace homesh {
 
 // Splits points (one per element: its centroid) with weights (the work each element costs)
 // into `parts` sets by recursive coordinate bisection: each set is cut across its longest
-// extent at the weighted median, into halves whose part counts are floor(parts / 2) and the
-// rest, until one set is left per part. The parts' weights differ by at most the largest
-// single weight per level of cuts. Returns each point's part in [0, parts). Deterministic:
-// ties are broken by index.
+// extent where floor(parts / 2) / parts of its weight lies below the cut, the two sides taking
+// floor(parts / 2) parts and the rest, until one set is left per part. Each cut misses its
+// share by at most half the largest single weight, so a part's weight is within that times the
+// levels of cuts above it (ceil(log2(parts))) of the total / parts. Returns each point's part
+// in [0, parts). Deterministic: ties are broken by index.
 std::vector<int> bisectByCoordinates(const std::vector<std::array<double, 3>>& points,
                                      const std::vector<double>& weights, int parts);
 

@@ -37,11 +37,12 @@ TEST(WorkPartition, BisectionBalancesTheWeights) {
       ASSERT_LT(part[i], parts);
       sum[static_cast<std::size_t>(part[i])] += weights[i];
     }
-    // Each level of cuts misses its share by at most half the largest weight (3), and a part
-    // lies under ceil(log2(parts)) levels, each of whose errors the deeper cuts may scale by
-    // at most 1 (they split a set's error among its parts).
+    // Each cut misses its share by at most half the largest weight (1.5), and a part lies under
+    // ceil(log2(parts)) cuts, each of whose errors the deeper cuts scale by at most 1 (they
+    // share a set's error among its parts); 1e-9 covers the rounding of sums of 1000 weights.
+    // (Cutting by count instead of weight misses by 4 to 12 here.)
     const double levels = std::ceil(std::log2(parts));
-    for (const double s : sum) EXPECT_NEAR(s, total / parts, 3.0 * std::max(levels, 1.0)) << parts;
+    for (const double s : sum) EXPECT_NEAR(s, total / parts, 1.5 * levels + 1e-9) << parts;
   }
 }
 
@@ -115,7 +116,7 @@ TEST(WorkPartition, EveryItemIsHandedOutOnceAcrossThreads) {
   OwnerFirstQueue queue(begin, 7);
   std::vector<std::atomic<int>> count(begin.back());
   for (auto& c : count) c.store(0);
-#pragma omp parallel num_threads(4)
+#pragma omp parallel num_threads(2)  // parts 2 and 3 have no thread of their own
   {
     std::size_t lo = 0, hi = 0;
     while (queue.next(omp_get_thread_num(), lo, hi))
