@@ -91,6 +91,7 @@ Eigen::Vector3d splitPoint(const Mesh& mesh, const CadModel& cad, const CurvedFa
 CurvedFaceEdges::CurvedFaceEdges(const Mesh& linear, const CadModel& cad)
     : mesh_(linear),
       nodeFaces_(linear.numNodes()),
+      onBoundary_(linear.numNodes(), 0),
       boundary_(boundaryEdges(linear)),
       cells_(cellsOf(linear)) {
   std::map<int, bool> curved;
@@ -103,6 +104,7 @@ CurvedFaceEdges::CurvedFaceEdges(const Mesh& linear, const CadModel& cad)
     if (cellDimension(block.type) != linear.dim - 1 || block.order != 1) continue;
     const int nv = cellNumVertices(block.type);
     for (std::size_t e = 0; e < block.count(); ++e) {
+      for (int k = 0; k < nv; ++k) onBoundary_[static_cast<std::size_t>(block.element(e)[k])] = 1;
       const int entity = block.entity[e];
       if (entity <= 0) continue;
       auto it = curved.find(entity);
@@ -158,6 +160,26 @@ std::optional<CurvedFaceEdge> CurvedFaceEdges::longestOnFace(std::size_t cell) c
   return found;
 }
 
+std::optional<CurvedFaceEdge> CurvedFaceEdges::longestBoundaryChord(std::size_t cell) const {
+  const std::int64_t* v = cells_.at(cell);
+  const int nv = mesh_.dim + 1;
+  for (int i = 0; i < nv; ++i)
+    if (onBoundary_[static_cast<std::size_t>(v[i])] == 0) return std::nullopt;
+  std::optional<CurvedFaceEdge> found;
+  double longest = 0.0;
+  for (int i = 0; i < nv; ++i)
+    for (int j = i + 1; j < nv; ++j) {
+      const MeshEdge edge = meshEdge(v[i], v[j]);
+      if (boundary_.count(edge) > 0) continue;
+      const double length = (nodePoint(mesh_, v[i]) - nodePoint(mesh_, v[j])).norm();
+      if (length > longest) {
+        longest = length;
+        found = CurvedFaceEdge{edge, 0, false};
+      }
+    }
+  return found;
+}
+
 RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
                       const CadModel& cad) {
   // Cells of every shape, in element order; splits only in an all-simplex mesh.
@@ -205,6 +227,8 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
     if (finder) {
       edges = finder->interior(c);
       if (edges.empty())
+        if (const auto chord = finder->longestBoundaryChord(c)) edges.push_back(*chord);
+      if (edges.empty())
         if (const auto onFace = finder->longestOnFace(c)) edges.push_back(*onFace);
     }
     if (!edges.empty()) {
@@ -243,7 +267,7 @@ std::size_t applySplits(Mesh& linear, const std::vector<CurvedFaceEdge>& splits,
       if (splitEdge(linear, split.edge, node)) ++done;
       continue;
     }
-    const Eigen::Vector3d point = splitPoint(linear, cad, split);
+    const Eigen::Vector3d point = split.entity > 0 ? splitPoint(linear, cad, split) : mid;
     // The midpoint always halves positive cells into positive cells.
     if (!splitInteriorEdge(linear, split.edge, point) &&
         !splitInteriorEdge(linear, split.edge, mid))

@@ -51,7 +51,9 @@ struct RepairRound {
 
 struct CurvedFaceEdge {
   MeshEdge edge;
-  int entity = 0;         // the curved CAD face (curve in 2D) both ends lie on
+  // The curved CAD face (curve in 2D) both ends lie on; 0 for a chord between boundary nodes
+  // of different entities (CurvedFaceEdges::longestBoundaryChord).
+  int entity = 0;
   bool boundary = false;  // the edge lies on that face (else it is an interior chord)
 };
 
@@ -68,10 +70,19 @@ class CurvedFaceEdges {
   // boundary triangles and of no CAD curve; 2D: a boundary line), if any: where curving moves
   // the cell's boundary most.
   std::optional<CurvedFaceEdge> longestOnFace(std::size_t cell) const;
+  // When every vertex of cell `cell` lies on the boundary (on any CAD face, curve or vertex),
+  // its longest interior edge (on no boundary cell), if it has one (entity 0). Such a cell has
+  // no node the optimiser can move off the CAD: its Jacobian at a vertex is fixed by the curved
+  // boundary edges there, which only slide on the CAD. A cell with two faces on the boundary
+  // (an ear over a boundary edge whose faces are nearly flat against each other, across a CAD
+  // curve or on one face) has exactly one interior edge; splitting it gives the cell an
+  // interior vertex.
+  std::optional<CurvedFaceEdge> longestBoundaryChord(std::size_t cell) const;
 
  private:
   const Mesh& mesh_;
   std::vector<std::vector<int>> nodeFaces_;  // curved CAD faces per node, sorted
+  std::vector<char> onBoundary_;             // per node: a vertex of a boundary cell
   std::set<MeshEdge> boundary_;
   std::map<MeshEdge, int> faceEdges_;  // edges on a curved face (not on a CAD curve in 3D)
   std::vector<const std::int64_t*> cells_;
@@ -87,22 +98,24 @@ struct RepairPlan {
 
 // Locates the elements whose verdict is not Valid (`validity` per element of the curved mesh,
 // in element order) in `linear`. A flagged cell with interior edges on one curved face gets
-// those split; else one with an edge on a curved face gets its longest such edge split (the
-// face's triangles there are halved, which halves the sagitta curving has to follow); else it
-// gets a sphere of radius its longest edge, centred at its centroid, of size half its mean edge
-// length. A mesh with other cells than simplices (a boundary layer's prisms) gets spheres only.
-// Throws ParameterError when `validity` does not match the linear mesh's cell count.
+// those split; else one whose vertices all lie on the boundary gets its longest interior edge
+// split (longestBoundaryChord); else one with an edge on a curved face gets its longest such
+// edge split (the face's triangles there are halved, which halves the sagitta curving has to
+// follow); else it gets a sphere of radius its longest edge, centred at its centroid, of size
+// half its mean edge length. A mesh with other cells than simplices (a boundary layer's prisms)
+// gets spheres only. Throws ParameterError when `validity` does not match the linear mesh's cell
+// count.
 RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
                       const CadModel& cad);
 
-// Splits the plan's edges in turn (linear/edge_split.hpp) and returns how many it split. An
-// interior edge's new node goes at its midpoint when that lies on the solid's side of the curved
-// face (the side of the cells around the edge, from the signed distances of their other
-// vertices to the face); where the chord crosses to the other side (a tetrahedron outside a
-// convex face), it goes to the mirror image of the midpoint in the face, and back to the
-// midpoint if that would make a cell of non-positive volume. A boundary edge's new node is the
-// midpoint projected onto its face (curve), with its parameters; such an edge is skipped when
-// that would make a cell of non-positive volume.
+// Splits the plan's edges in turn (linear/edge_split.hpp) and returns how many it split. A
+// chord between different entities (entity 0) is split at its midpoint. An interior edge's new
+// node goes at its midpoint when that lies on the solid's side of the curved face (the side of the
+// cells around the edge, from the signed distances of their other vertices to the face); where the
+// chord crosses to the other side (a tetrahedron outside a convex face), it goes to the mirror
+// image of the midpoint in the face, and back to the midpoint if that would make a cell of
+// non-positive volume. A boundary edge's new node is the midpoint projected onto its face (curve),
+// with its parameters; such an edge is skipped when that would make a cell of non-positive volume.
 std::size_t applySplits(Mesh& linear, const std::vector<CurvedFaceEdge>& splits,
                         const CadModel& cad);
 

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <string>
 #include <thread>
@@ -167,6 +168,71 @@ MeshEdge firstInteriorEdge(const Mesh& mesh) {
 // A repair round's split changes the cells around one edge; every other element must come back
 // with its old curved nodes (here marked by a shift the new elevation cannot reproduce), and
 // only the split cells are fresh.
+// A cell whose four vertices all lie on the boundary has no node the optimiser can move off the
+// CAD; the plan splits its longest interior edge (a new node inside the solid), where before it
+// only asked for refinement (on a box's planar faces there is no curved-face edge to split). A
+// cell with a vertex inside still gets a refinement sphere.
+TEST(RepairPlan, ACellWithEveryVertexOnTheBoundaryGetsItsLongestInteriorEdgeSplit) {
+  const CadModel cad = test::toModel(test::box(1, 1, 1));
+  Mesh mesh = generateLinearMesh(cad, LinearMeshOptions::uniform(0.5));
+  const std::set<MeshEdge> boundary = boundaryEdges(mesh);
+  std::vector<char> onBoundary(mesh.numNodes(), 0);
+  for (const ElementBlock& b : mesh.blocks)
+    if (b.type == CellType::Triangle)
+      for (const std::int64_t n : b.nodes) onBoundary[static_cast<std::size_t>(n)] = 1;
+  const ElementBlock& tets = mesh.blocks.front();
+  ASSERT_EQ(tets.type, CellType::Tetrahedron);
+  std::optional<std::size_t> allOn, inner;
+  MeshEdge expected{-1, -1};
+  for (std::size_t e = 0; e < tets.count(); ++e) {
+    const std::int64_t* v = tets.element(e);
+    int on = 0;
+    for (int i = 0; i < 4; ++i) on += onBoundary[static_cast<std::size_t>(v[i])];
+    if (on < 4) {
+      if (!inner) inner = e;
+      continue;
+    }
+    double longest = 0.0;
+    MeshEdge edge{-1, -1};
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        if (boundary.count(meshEdge(v[i], v[j])) > 0) continue;
+        const double l = (nodePoint(mesh, v[i]) - nodePoint(mesh, v[j])).norm();
+        if (l > longest) {
+          longest = l;
+          edge = meshEdge(v[i], v[j]);
+        }
+      }
+    if (edge[0] >= 0 && !allOn) {
+      allOn = e;
+      expected = edge;
+    }
+  }
+  ASSERT_TRUE(allOn.has_value());
+  ASSERT_TRUE(inner.has_value());
+
+  std::vector<Validity> validity(tets.count(), Validity::Valid);
+  validity[*allOn] = Validity::Invalid;
+  validity[*inner] = Validity::Invalid;
+  const RepairPlan plan = planRepair(mesh, validity, cad);
+  ASSERT_EQ(plan.splits.size(), 1u);
+  EXPECT_EQ(plan.splits[0].edge, expected);
+  EXPECT_EQ(plan.splits[0].entity, 0);
+  EXPECT_FALSE(plan.splits[0].boundary);
+  EXPECT_EQ(plan.splitCells, 1u);
+  EXPECT_EQ(plan.refineCells, 1u);  // the cell with a vertex inside
+
+  const std::size_t nodes = mesh.numNodes(), triangles = countTriangles(mesh);
+  EXPECT_EQ(applySplits(mesh, plan.splits, cad), 1u);
+  ASSERT_EQ(mesh.numNodes(), nodes + 1);
+  EXPECT_EQ(mesh.nodeCadDim.back(), 3);  // the new node is inside the solid
+  const Eigen::Vector3d mid = 0.5 * (nodePoint(mesh, expected[0]) + nodePoint(mesh, expected[1]));
+  EXPECT_EQ(nodePoint(mesh, static_cast<std::int64_t>(nodes)), mid);
+  EXPECT_EQ(countTriangles(mesh), triangles);
+  for (const double v : cellVolumes(mesh)) EXPECT_GT(v, 0.0);
+  mesh.checkConsistency();
+}
+
 TEST(CurvedReuse, UnchangedCellsKeepTheirCurvedNodesAndOnlySplitCellsAreFresh) {
   const CadModel cad = test::toModel(test::box(1, 1, 1));
   const Mesh oldLinear = generateLinearMesh(cad, LinearMeshOptions::uniform(0.4));
