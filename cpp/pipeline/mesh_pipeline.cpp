@@ -642,7 +642,8 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     record.undecided = from.quality.undecided;
     record.worst = from.quality.scaled.min;
     // Every flagged cell gets edges to split or a refinement sphere: the plan is never empty.
-    const RepairPlan plan = planRepair(from.linear, repairTargets(from.quality, poor), *result.cad);
+    const RepairPlan plan = planRepair(from.linear, repairTargets(from.quality, poor), *result.cad,
+                                       options.optimiseIterations > 0);
     Mesh next;
     if (!plan.splits.empty() && !splitFailed && !options.boundaryLayer) {
       // Local: only the cells around the split edges change; the rest wait for the next round.

@@ -181,7 +181,7 @@ std::optional<CurvedFaceEdge> CurvedFaceEdges::longestBoundaryChord(std::size_t 
 }
 
 RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
-                      const CadModel& cad) {
+                      const CadModel& cad, bool optimised) {
   // Cells of every shape, in element order; splits only in an all-simplex mesh.
   std::vector<const std::int64_t*> cells;
   std::vector<int> vertexCount;
@@ -226,7 +226,7 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
     std::vector<CurvedFaceEdge> edges;
     if (finder) {
       edges = finder->interior(c);
-      if (edges.empty())
+      if (edges.empty() && optimised)
         if (const auto chord = finder->longestBoundaryChord(c)) edges.push_back(*chord);
       if (edges.empty())
         if (const auto onFace = finder->longestOnFace(c)) edges.push_back(*onFace);

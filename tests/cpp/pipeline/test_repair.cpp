@@ -169,9 +169,9 @@ MeshEdge firstInteriorEdge(const Mesh& mesh) {
 // with its old curved nodes (here marked by a shift the new elevation cannot reproduce), and
 // only the split cells are fresh.
 // A cell whose four vertices all lie on the boundary has no node the optimiser can move off the
-// CAD; the plan splits its longest interior edge (a new node inside the solid), where before it
-// only asked for refinement (on a box's planar faces there is no curved-face edge to split). A
-// cell with a vertex inside still gets a refinement sphere.
+// CAD; with the optimiser to follow, the plan splits its longest interior edge (a new node
+// inside the solid), where before it only asked for refinement (on a box's planar faces there is no
+// curved-face edge to split). A cell with a vertex inside still gets a refinement sphere.
 TEST(RepairPlan, ACellWithEveryVertexOnTheBoundaryGetsItsLongestInteriorEdgeSplit) {
   const CadModel cad = test::toModel(test::box(1, 1, 1));
   Mesh mesh = generateLinearMesh(cad, LinearMeshOptions::uniform(0.5));
@@ -214,7 +214,11 @@ TEST(RepairPlan, ACellWithEveryVertexOnTheBoundaryGetsItsLongestInteriorEdgeSpli
   std::vector<Validity> validity(tets.count(), Validity::Valid);
   validity[*allOn] = Validity::Invalid;
   validity[*inner] = Validity::Invalid;
-  const RepairPlan plan = planRepair(mesh, validity, cad);
+  // Without the optimiser after it, the midpoint would stay where it is: refinement instead.
+  const RepairPlan still = planRepair(mesh, validity, cad, false);
+  EXPECT_TRUE(still.splits.empty());
+  EXPECT_EQ(still.refineCells, 2u);
+  const RepairPlan plan = planRepair(mesh, validity, cad, true);
   ASSERT_EQ(plan.splits.size(), 1u);
   EXPECT_EQ(plan.splits[0].edge, expected);
   EXPECT_EQ(plan.splits[0].entity, 0);
