@@ -6,6 +6,7 @@
 #include <iterator>
 #include <limits>
 #include <map>
+#include <optional>
 #include <utility>
 
 #include "core/error.hpp"
@@ -86,6 +87,26 @@ Eigen::Vector3d splitPoint(const Mesh& mesh, const CadModel& cad, const CurvedFa
   return foot - depth * normal;  // the mirror image: as far from the face, on the cells' side
 }
 
+// The longest edge of the simplex on `v` (nv vertices) for which `select(edge)` gives a record,
+// that record; none if it gives none.
+template <class Select>
+std::optional<CurvedFaceEdge> longestEdge(const Mesh& mesh, const std::int64_t* v, int nv,
+                                          Select select) {
+  std::optional<CurvedFaceEdge> found;
+  double longest = 0.0;
+  for (int i = 0; i < nv; ++i)
+    for (int j = i + 1; j < nv; ++j) {
+      std::optional<CurvedFaceEdge> candidate = select(meshEdge(v[i], v[j]));
+      if (!candidate) continue;
+      const double length = (nodePoint(mesh, v[i]) - nodePoint(mesh, v[j])).norm();
+      if (length > longest) {
+        longest = length;
+        found = candidate;
+      }
+    }
+  return found;
+}
+
 }  // namespace
 
 CurvedFaceEdges::CurvedFaceEdges(const Mesh& linear, const CadModel& cad)
@@ -142,22 +163,12 @@ std::vector<CurvedFaceEdge> CurvedFaceEdges::interior(std::size_t cell) const {
 }
 
 std::optional<CurvedFaceEdge> CurvedFaceEdges::longestOnFace(std::size_t cell) const {
-  std::optional<CurvedFaceEdge> found;
-  double longest = 0.0;
-  const std::int64_t* v = cells_.at(cell);
-  const int nv = mesh_.dim + 1;
-  for (int i = 0; i < nv; ++i)
-    for (int j = i + 1; j < nv; ++j) {
-      const MeshEdge edge = meshEdge(v[i], v[j]);
-      const auto it = faceEdges_.find(edge);
-      if (it == faceEdges_.end()) continue;
-      const double length = (nodePoint(mesh_, v[i]) - nodePoint(mesh_, v[j])).norm();
-      if (length > longest) {
-        longest = length;
-        found = CurvedFaceEdge{edge, it->second, true};
-      }
-    }
-  return found;
+  return longestEdge(mesh_, cells_.at(cell), mesh_.dim + 1,
+                     [&](const MeshEdge& edge) -> std::optional<CurvedFaceEdge> {
+                       const auto it = faceEdges_.find(edge);
+                       if (it == faceEdges_.end()) return std::nullopt;
+                       return CurvedFaceEdge{edge, it->second, true};
+                     });
 }
 
 std::optional<CurvedFaceEdge> CurvedFaceEdges::longestBoundaryChord(std::size_t cell) const {
@@ -165,19 +176,10 @@ std::optional<CurvedFaceEdge> CurvedFaceEdges::longestBoundaryChord(std::size_t 
   const int nv = mesh_.dim + 1;
   for (int i = 0; i < nv; ++i)
     if (onBoundary_[static_cast<std::size_t>(v[i])] == 0) return std::nullopt;
-  std::optional<CurvedFaceEdge> found;
-  double longest = 0.0;
-  for (int i = 0; i < nv; ++i)
-    for (int j = i + 1; j < nv; ++j) {
-      const MeshEdge edge = meshEdge(v[i], v[j]);
-      if (boundary_.count(edge) > 0) continue;
-      const double length = (nodePoint(mesh_, v[i]) - nodePoint(mesh_, v[j])).norm();
-      if (length > longest) {
-        longest = length;
-        found = CurvedFaceEdge{edge, 0, false};
-      }
-    }
-  return found;
+  return longestEdge(mesh_, v, nv, [&](const MeshEdge& edge) -> std::optional<CurvedFaceEdge> {
+    if (boundary_.count(edge) > 0) return std::nullopt;
+    return CurvedFaceEdge{edge, 0, false};
+  });
 }
 
 RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
