@@ -18,6 +18,7 @@
 #include "curving/order_elevation.hpp"
 #include "linear/cad_classification.hpp"
 #include "linear/linear_mesher.hpp"
+#include "linear/tet_flips.hpp"
 #include "pipeline/curved_reuse.hpp"
 #include "pipeline/repair.hpp"
 #include "sizing/octree_export.hpp"
@@ -618,8 +619,9 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   std::vector<RefinementSource> sources;  // accumulated over the refine rounds
   std::optional<CurvedState> last;        // the last round's state when it was not kept
   bool splitFailed = false;  // the last round split and made things worse: refine instead
+  bool flipFailed = false;   // the last round flipped and made things worse: refine instead
   for (int round = 1; round <= options.repairRounds; ++round) {
-    const CurvedState& from = last && !splitFailed ? *last : best;
+    const CurvedState& from = last && !splitFailed && !flipFailed ? *last : best;
     const bool poor = from.notValid() == 0;  // only elements below kPoorElement are left
     if (poor && (!(from.quality.scaled.min < kPoorElement) || splitFailed || options.boundaryLayer))
       break;
@@ -652,10 +654,23 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     }
     // A poor element is not worth a remesh: without a split there is no round (nor its stage).
     if (poor && record.edgesSplit == 0) break;
+    // Flagged cells with no edge to split (slivers with vertices inside, which the optimiser
+    // could not inflate) are flipped away where a flip makes better cells, judged where the
+    // optimiser left the vertices: local, where a refinement remeshes the whole model.
+    if (plan.splits.empty() && !flipFailed && !options.boundaryLayer &&
+        options.optimiseIterations > 0 && from.linear.dim == 3) {
+      next = from.linear;
+      const FlipOutcome flipped =
+          flipAwayCells(next, plan.unsplit, curvedVertexPositions(from.linear, from.mesh));
+      record.flips = flipped.flips;
+      record.elements = flipped.cellsFlipped;
+    }
     StageClock clock(name, result.timings, observer);
     if (record.edgesSplit > 0) {
       record.action = poor ? "split poor" : "split";
       record.elements = plan.splitCells;
+    } else if (record.flips > 0) {
+      record.action = "flip";
     } else {
       // Nothing to split (or no split kept its cells positive): refine around every offender.
       std::vector<RefinementSource> added =
@@ -711,6 +726,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     record.kept = state.betterThan(best);
     // (A "split poor" round not kept ends the rounds: see the loop's start.)
     splitFailed = !record.kept && (record.action == "split" || record.action == "split poor");
+    flipFailed = !record.kept && record.action == "flip";
     if (record.kept) {
       best = std::move(state);
       last.reset();

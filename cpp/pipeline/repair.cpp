@@ -241,8 +241,34 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
     }
     ++plan.refineCells;
     plan.sources.push_back(sphere);
+    plan.unsplit.push_back(c);
   }
   return plan;
+}
+
+std::vector<double> curvedVertexPositions(const Mesh& linear, const Mesh& curved) {
+  std::vector<double> positions = linear.xyz;
+  std::size_t count = 0;
+  for (const ElementBlock& block : linear.blocks)
+    if (cellDimension(block.type) == linear.dim) count += block.count();
+  if (count != curved.numElements())
+    throw ParameterError("vertex positions: a linear mesh of " + std::to_string(count) +
+                         " elements and a curved mesh of " + std::to_string(curved.numElements()));
+  auto from = curved.blocks.begin();
+  for (const ElementBlock& block : linear.blocks) {
+    if (cellDimension(block.type) != linear.dim) continue;
+    while (from != curved.blocks.end() && cellDimension(from->type) != curved.dim) ++from;
+    if (from == curved.blocks.end() || from->type != block.type || from->count() != block.count())
+      throw ParameterError("vertex positions: the linear and curved meshes' blocks differ");
+    const int nv = cellNumVertices(block.type);
+    for (std::size_t e = 0; e < block.count(); ++e)
+      for (int k = 0; k < nv; ++k)
+        for (int c = 0; c < 3; ++c)
+          positions[3 * static_cast<std::size_t>(block.element(e)[k]) + c] =
+              curved.xyz[3 * static_cast<std::size_t>(from->element(e)[k]) + c];
+    ++from;
+  }
+  return positions;
 }
 
 std::size_t applySplits(Mesh& linear, const std::vector<CurvedFaceEdge>& splits,

@@ -32,11 +32,12 @@ namespace homesh {
 struct RepairRound {
   std::size_t invalid = 0, undecided = 0;  // elements not proven valid that the round found
   double worst = 0.0, worstAfter = 0.0;    // certified scaled Jacobian before and after
-  // "split", "refine", or "split poor" (every element was valid; the round split the cells of
-  // those below the pipeline's poor-element threshold)
+  // "split", "flip", "refine", or "split poor" (every element was valid; the round split the
+  // cells of those below the pipeline's poor-element threshold)
   std::string action;
   std::size_t elements = 0;                          // linear cells it acted on
   std::size_t edgesSplit = 0;                        // edges bisected ("split")
+  std::size_t flips = 0;                             // flips made ("flip")
   std::size_t sources = 0;                           // refinement spheres added ("refine")
   std::size_t invalidAfter = 0, undecidedAfter = 0;  // of the mesh the round made
   std::size_t meshElements = 0;                      // elements of the mesh the round made
@@ -94,6 +95,7 @@ struct RepairPlan {
   std::vector<RefinementSource> sources;     // spheres around the flagged cells without such edges
   std::vector<RefinementSource> allSources;  // spheres around every flagged cell
   std::size_t splitCells = 0, refineCells = 0;
+  std::vector<std::size_t> unsplit;  // the flagged cells without an edge to split (`sources`)
 };
 
 // Locates the elements whose verdict is not Valid (`validity` per element of the curved mesh,
@@ -119,6 +121,11 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
 // with its parameters; such an edge is skipped when that would make a cell of non-positive volume.
 std::size_t applySplits(Mesh& linear, const std::vector<CurvedFaceEdge>& splits,
                         const CadModel& cad);
+
+// The linear mesh's node coordinates with every cell's vertices where the curved mesh made from
+// it (elements in the same order, as elevation keeps them) has them: where the optimiser moved
+// them. Throws ParameterError when the two meshes do not have the same elements.
+std::vector<double> curvedVertexPositions(const Mesh& linear, const Mesh& curved);
 
 // `base` capped by the refinement spheres, each growing by `growth` per unit distance outside
 // its sphere (size(x) = min(base(x), min over sources (delta + growth * distance))).

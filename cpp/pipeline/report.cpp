@@ -395,6 +395,7 @@ void appendRepairRounds(JsonWriter& json, const std::vector<RepairRound>& rounds
     json.value("action", r.action);
     json.value("elements", r.elements);
     json.value("edges_split", r.edgesSplit);
+    json.value("flips", r.flips);
     json.value("refinement_spheres", r.sources);
     json.value("invalid_after", r.invalidAfter);
     json.value("undecided_after", r.undecidedAfter);

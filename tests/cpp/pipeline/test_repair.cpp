@@ -165,9 +165,6 @@ MeshEdge firstInteriorEdge(const Mesh& mesh) {
   return {-1, -1};
 }
 
-// A repair round's split changes the cells around one edge; every other element must come back
-// with its old curved nodes (here marked by a shift the new elevation cannot reproduce), and
-// only the split cells are fresh.
 // A cell whose four vertices all lie on the boundary has no node the optimiser can move off the
 // CAD; with the optimiser to follow, the plan splits its longest interior edge (a new node
 // inside the solid), where before it only asked for refinement (on a box's planar faces there is no
@@ -218,13 +215,16 @@ TEST(RepairPlan, ACellWithEveryVertexOnTheBoundaryGetsItsLongestInteriorEdgeSpli
   const RepairPlan still = planRepair(mesh, validity, cad, false);
   EXPECT_TRUE(still.splits.empty());
   EXPECT_EQ(still.refineCells, 2u);
+  EXPECT_EQ(still.unsplit,
+            (std::vector<std::size_t>{std::min(*allOn, *inner), std::max(*allOn, *inner)}));
   const RepairPlan plan = planRepair(mesh, validity, cad, true);
   ASSERT_EQ(plan.splits.size(), 1u);
   EXPECT_EQ(plan.splits[0].edge, expected);
   EXPECT_EQ(plan.splits[0].entity, 0);
   EXPECT_FALSE(plan.splits[0].boundary);
   EXPECT_EQ(plan.splitCells, 1u);
-  EXPECT_EQ(plan.refineCells, 1u);  // the cell with a vertex inside
+  EXPECT_EQ(plan.refineCells, 1u);                            // the cell with a vertex inside
+  EXPECT_EQ(plan.unsplit, std::vector<std::size_t>{*inner});  // what a round may flip
 
   const std::size_t nodes = mesh.numNodes(), triangles = countTriangles(mesh);
   EXPECT_EQ(applySplits(mesh, plan.splits, cad), 1u);
@@ -237,6 +237,9 @@ TEST(RepairPlan, ACellWithEveryVertexOnTheBoundaryGetsItsLongestInteriorEdgeSpli
   mesh.checkConsistency();
 }
 
+// A repair round's split changes the cells around one edge; every other element must come back
+// with its old curved nodes (here marked by a shift the new elevation cannot reproduce), and
+// only the split cells are fresh.
 TEST(CurvedReuse, UnchangedCellsKeepTheirCurvedNodesAndOnlySplitCellsAreFresh) {
   const CadModel cad = test::toModel(test::box(1, 1, 1));
   const Mesh oldLinear = generateLinearMesh(cad, LinearMeshOptions::uniform(0.4));
@@ -286,6 +289,31 @@ TEST(CurvedReuse, UnchangedCellsKeepTheirCurvedNodesAndOnlySplitCellsAreFresh) {
   Mesh target = otherOrder;
   EXPECT_THROW(reuseCurvedNodes(oldLinear, oldCurved, newLinear, target), ParameterError);
   EXPECT_THROW(reuseCurvedNodes(newLinear, oldCurved, newLinear, newCurved), ParameterError);
+}
+
+// Where flips judge shapes: every linear node where the curved mesh's elements have their
+// vertices (the optimiser moves interior vertices too), the other coordinates unchanged.
+TEST(CurvedVertexPositions, AreTheCurvedElementsVertices) {
+  const CadModel cad = test::toModel(test::box(1, 1, 1));
+  const Mesh linear = generateLinearMesh(cad, LinearMeshOptions::uniform(0.4));
+  Mesh curved = elevateOrder(linear, 3, &cad);
+  for (std::size_t i = 0; i < curved.numNodes(); ++i)
+    if (curved.nodeCadDim[i] == 3) curved.xyz[3 * i + 1] += 1e-2 * static_cast<double>(i % 5 + 1);
+  const std::vector<double> positions = curvedVertexPositions(linear, curved);
+  ASSERT_EQ(positions.size(), linear.xyz.size());
+  const ElementBlock& cells = linear.blocks.front();
+  const ElementBlock& elements = curved.blocks.front();
+  ASSERT_EQ(cells.type, CellType::Tetrahedron);
+  std::size_t moved = 0;
+  for (std::size_t e = 0; e < cells.count(); ++e)
+    for (int k = 0; k < 4; ++k) {
+      const std::int64_t n = cells.element(e)[k], m = elements.element(e)[k];
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(positions[3 * n + c], curved.xyz[3 * m + c]);
+      moved += positions[3 * n + 1] != linear.xyz[3 * n + 1] ? 1 : 0;
+    }
+  EXPECT_GT(moved, 0u);  // the box at 0.4 has interior vertices
+  const Mesh coarser = generateLinearMesh(cad, LinearMeshOptions::uniform(0.8));
+  EXPECT_THROW(curvedVertexPositions(coarser, curved), ParameterError);
 }
 
 // The sphere in a box at size 1.2, order 4: curving and 20 optimiser sweeps leave invalid
