@@ -4,6 +4,7 @@
 // skipped once it is spent, and the budget remembers what it stopped or skipped, for the report.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <string>
 #include <vector>
@@ -23,12 +24,18 @@ class JobBudget {
   double left() const;
   bool spent() const { return limited() && left() <= 0.0; }
 
-  // Whether what is left is less than `own` (a stage's own limit; 0: none): the budget, not the
-  // stage's limit, then decides when the stage stops.
+  // Seconds kept back for the stages that run whatever is left (the quality check and the
+  // output after an optimiser run): a stage that the budget stops gets what is left less this,
+  // so that the job still ends within its budget. 0 until set; negative values count as 0.
+  void reserve(double seconds) { reserve_ = std::max(seconds, 0.0); }
+  double reserved() const { return reserve_; }
+
+  // Whether what is left, less the reserve, is less than `own` (a stage's own limit; 0: none):
+  // the budget, not the stage's limit, then decides when the stage stops.
   bool binds(double own) const;
-  // The limit a stage whose own limit is `own` (0: none) runs under: `own`, or what is left
-  // when binds(own), at least kFloorSeconds (a limit of 0 would mean none); 0 when neither
-  // limits.
+  // The limit a stage whose own limit is `own` (0: none) runs under: `own`, or what is left less
+  // the reserve when binds(own), at least kFloorSeconds (a limit of 0 would mean none); 0 when
+  // neither limits.
   double stageLimit(double own) const;
   static constexpr double kFloorSeconds = 1e-3;
 
@@ -40,6 +47,7 @@ class JobBudget {
 
  private:
   double seconds_;
+  double reserve_ = 0.0;
   std::chrono::steady_clock::time_point start_;
   std::vector<std::string> cut_, skipped_;
 };

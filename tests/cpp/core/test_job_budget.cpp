@@ -41,6 +41,27 @@ TEST(JobBudget, AStageGetsTheSmallerOfItsLimitAndWhatIsLeft) {
   }
 }
 
+// The reserve (for the quality check and output that follow a stage) comes off what a stage
+// the budget stops may take; what is left and whether the budget is spent stay as they are.
+TEST(JobBudget, TheReserveComesOffWhatAStageMayTake) {
+  JobBudget budget(1000.0);
+  EXPECT_EQ(budget.reserved(), 0.0);
+  budget.reserve(300.0);
+  EXPECT_EQ(budget.reserved(), 300.0);
+  EXPECT_GT(budget.left(), 900.0);
+  EXPECT_FALSE(budget.spent());
+  EXPECT_FALSE(budget.binds(600.0));  // 600 s fits in 1000 - 300
+  EXPECT_EQ(budget.stageLimit(600.0), 600.0);
+  EXPECT_TRUE(budget.binds(800.0));  // 800 s does not
+  const double limit = budget.stageLimit(800.0);
+  EXPECT_GT(limit, 600.0);
+  EXPECT_LE(limit, 700.0);
+  budget.reserve(5000.0);  // more than the budget: the floor, never 0 (no limit)
+  EXPECT_EQ(budget.stageLimit(0.0), JobBudget::kFloorSeconds);
+  budget.reserve(-1.0);
+  EXPECT_EQ(budget.reserved(), 0.0);
+}
+
 TEST(JobBudget, ASpentBudgetGivesTheFloorNeverZero) {
   const JobBudget budget(1e-9);
   while (budget.left() > 0.0) {
