@@ -27,12 +27,12 @@ double JobBudget::left() const {
 
 bool JobBudget::binds(double own) const {
   if (!limited()) return false;
-  return own <= 0.0 || left() - reserve_ < own;
+  return own <= 0.0 || available() < own;
 }
 
 double JobBudget::stageLimit(double own) const {
   if (!binds(own)) return own;
-  return std::max(left() - reserve_, kFloorSeconds);
+  return std::max(available(), kFloorSeconds);
 }
 
 }  // namespace homesh

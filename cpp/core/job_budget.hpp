@@ -20,21 +20,25 @@ class JobBudget {
   bool limited() const { return seconds_ > 0.0; }
   double seconds() const { return seconds_; }
   double elapsed() const;
-  // Seconds left: infinity without a budget; 0 or less once spent.
+  // Seconds left: infinity without a budget; 0 or less once the budget's time is over.
   double left() const;
-  bool spent() const { return limited() && left() <= 0.0; }
 
   // Seconds kept back for the stages that run whatever is left (the quality check and the
-  // output after an optimiser run): a stage that the budget stops gets what is left less this,
-  // so that the job still ends within its budget. 0 until set; negative values count as 0.
+  // output after an optimiser run), so that the job still ends within its budget. 0 until set;
+  // negative values count as 0.
   void reserve(double seconds) { reserve_ = std::max(seconds, 0.0); }
   double reserved() const { return reserve_; }
+  // What optional stages may use: left() less the reserve (infinity without a budget).
+  double available() const { return left() - reserve_; }
+  // Nothing available: the optional stages (the optimiser, repair rounds, the geometry check)
+  // are left out.
+  bool spent() const { return limited() && available() <= 0.0; }
 
-  // Whether what is left, less the reserve, is less than `own` (a stage's own limit; 0: none):
-  // the budget, not the stage's limit, then decides when the stage stops.
+  // Whether what is available is less than `own` (a stage's own limit; 0: none): the budget,
+  // not the stage's limit, then decides when the stage stops.
   bool binds(double own) const;
-  // The limit a stage whose own limit is `own` (0: none) runs under: `own`, or what is left less
-  // the reserve when binds(own), at least kFloorSeconds (a limit of 0 would mean none); 0 when
+  // The limit a stage whose own limit is `own` (0: none) runs under: `own`, or what is
+  // available when binds(own), at least kFloorSeconds (a limit of 0 would mean none); 0 when
   // neither limits.
   double stageLimit(double own) const;
   static constexpr double kFloorSeconds = 1e-3;

@@ -151,6 +151,17 @@ class TetTopology {
       if (std::find(fb.begin(), fb.end(), f) != fb.end()) return false;
     return cellsWith({a, b}).empty();
   }
+  // Whether a flip may add the interior face (a, b, c): its vertices not all on one CAD face
+  // (a 3-2 flip adds a face whose edges all exist, so the edge rule does not see it).
+  bool newFaceAllowed(std::int64_t a, std::int64_t b, std::int64_t c) const {
+    const auto& fb = faces_[static_cast<std::size_t>(b)];
+    const auto& fc = faces_[static_cast<std::size_t>(c)];
+    const auto& fa = faces_[static_cast<std::size_t>(a)];
+    return std::none_of(fa.begin(), fa.end(), [&](std::int32_t f) {
+      return std::find(fb.begin(), fb.end(), f) != fb.end() &&
+             std::find(fc.begin(), fc.end(), f) != fc.end();
+    });
+  }
   bool boundaryEdge(std::int64_t a, std::int64_t b) const {
     return boundaryEdges_.count(edgeKey(a, b)) != 0;
   }
@@ -245,7 +256,10 @@ std::optional<Flip> bestEdgeRemoval(const TetTopology& topo, std::int64_t a, std
   bool found = false;
   for (const std::vector<Triangle>& tris : tables[static_cast<std::size_t>(n)]) {
     bool allowed = true;
-    for (const Triangle& t : tris)
+    for (const Triangle& t : tris) {
+      allowed = allowed && topo.newFaceAllowed(ring[static_cast<std::size_t>(t[0])],
+                                               ring[static_cast<std::size_t>(t[1])],
+                                               ring[static_cast<std::size_t>(t[2])]);
       for (int s = 0; s < 3 && allowed; ++s) {
         const int i = t[static_cast<std::size_t>(s)], j = t[static_cast<std::size_t>((s + 1) % 3)];
         const int gap = std::abs(i - j);
@@ -253,6 +267,7 @@ std::optional<Flip> bestEdgeRemoval(const TetTopology& topo, std::int64_t a, std
           allowed = topo.newEdgeAllowed(ring[static_cast<std::size_t>(i)],
                                         ring[static_cast<std::size_t>(j)]);
       }
+    }
     if (!allowed) continue;
     std::vector<Tet> made;
     double worst = std::numeric_limits<double>::infinity();
@@ -356,17 +371,17 @@ FlipOutcome flipAwayCells(Mesh& mesh, const std::vector<std::size_t>& cells,
     if (changed[c] != 0) continue;  // an earlier flip took it away
     const Tet t = topo.tet(c);
     std::optional<Flip> best;
+    // Among the flips that pass the gain test, the one whose worst new cell is best.
     const auto consider = [&best](std::optional<Flip> f) {
-      if (f && (!best || f->worstMade > best->worstMade)) best = std::move(f);
+      if (!f || !(f->worstMade > 0.0) || !(f->worstMade > f->worstRemoved + kFlipShapeGain)) return;
+      if (!best || f->worstMade > best->worstMade) best = std::move(f);
     };
     for (int i = 0; i < 4; ++i)
       for (int j = i + 1; j < 4; ++j)
         consider(bestEdgeRemoval(topo, t[static_cast<std::size_t>(i)],
                                  t[static_cast<std::size_t>(j)], tables));
     for (int p = 0; p < 4; ++p) consider(faceRemoval(topo, c, p));
-    if (!best || !(best->worstMade > 0.0) ||
-        !(best->worstMade > best->worstRemoved + kFlipShapeGain))
-      continue;
+    if (!best) continue;
     const std::int32_t entity = topo.entity(c);
     for (const std::size_t r : best->removed) {
       topo.remove(r);

@@ -38,16 +38,17 @@ struct FlipOutcome {
 
 // For each cell of `cells` (indices among the mesh's tetrahedra, in element order) that no
 // earlier flip of this call changed: every edge removal (rings of 3 to 7 cells) and face removal
-// that takes the cell away is judged, and the one whose worst new cell has the best shape is
-// made if that shape is positive and beats the worst shape among the cells it removes by
-// kFlipShapeGain. Shapes are judged at `positions` (3 per node; empty: the mesh's own
-// coordinates), e.g. where the optimiser has moved the vertices of the curved mesh made from this
-// one; every new cell must also have positive volume at the mesh's own coordinates (the linear
-// mesh stays a valid mesh). The cells are taken to be positive as stored (Gmsh's orientation,
-// which splits keep): the orientation of new cells follows from that. A flip is left out when
-// it would add an edge that already exists or whose ends lie on one boundary face (the
-// entity of a boundary triangle on each: a chord of a curved face is what curving cannot
-// follow), or when its cells lie in different solids. Cells that stay keep their order; new cells follow them (the element order changes).
+// that takes the cell away is judged, and of those whose worst new cell has a positive shape
+// that beats the worst shape among the cells they remove by kFlipShapeGain, the one whose worst
+// new cell is best is made. Shapes are judged at `positions` (3 per node; empty: the mesh's own
+// coordinates), e.g. where the optimiser has moved the vertices of the curved mesh made from
+// this one; every new cell must also have positive volume at the mesh's own coordinates (the
+// linear mesh stays a valid mesh). The cells are taken to be positive as stored (Gmsh's
+// orientation, which splits keep): the orientation of new cells follows from that. A flip is
+// left out when it would add an edge that already exists or whose ends lie on one boundary face,
+// or a face whose vertices all do (the face of a node is the entity of a boundary triangle on it:
+// a chord of a curved face is what curving cannot follow), or when its cells lie in different
+// solids. Cells that stay keep their order; new cells follow them (the element order changes).
 // Throws ParameterError when the mesh is not a linear tetrahedral mesh with its tetrahedra in one
 // block, a cell index is out of range, or `positions` does not have 3 values per node.
 FlipOutcome flipAwayCells(Mesh& mesh, const std::vector<std::size_t>& cells,

@@ -495,10 +495,12 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
   // run whatever is left, kBudgetReserve times the elevation just timed.
   std::chrono::steady_clock::time_point elevationStart;
   const auto startElevation = [&] { elevationStart = std::chrono::steady_clock::now(); };
-  const auto reserveAfterElevation = [&] {
+  // `scale`: how much more the final order's stages cost than the order just elevated to
+  // (continuation elevates to kContinuationOrder first).
+  const auto reserveAfterElevation = [&](double scale) {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - elevationStart).count();
-    budget.reserve(std::max(budget.reserved(), kBudgetReserve * seconds));
+    budget.reserve(std::max(budget.reserved(), kBudgetReserve * scale * seconds));
   };
   std::optional<StageClock> clock;
   if (options.optimiseIterations > 0 && options.order > kContinuationOrder) {
@@ -506,7 +508,10 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
     startElevation();
     state.lowOrder = elevateOrder(state.linear, kContinuationOrder, &cad, nullptr, layered);
     if (layered) blendLayerInteriors(state.lowOrder, &cad);
-    reserveAfterElevation();
+    // Until the final order is made: scaled by the nodes per simplex of the two orders.
+    const CellType simplex = state.linear.dim == 3 ? CellType::Tetrahedron : CellType::Triangle;
+    reserveAfterElevation(static_cast<double>(cellNumNodes(simplex, options.order)) /
+                          cellNumNodes(simplex, kContinuationOrder));
     if (clocked) clock->done();
     state.lowOrderOptimiser = curveAt(
         kContinuationOrder, state.lowOrder,
@@ -523,13 +528,13 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
     // free at three times the time, so 3D keeps the raised top.
     if (layered && state.mesh.dim == 2 && state.layerRelease != LayerRelease::Free)
       blendLayerInteriors(state.mesh, &cad);
-    reserveAfterElevation();
+    reserveAfterElevation(1.0);
   } else {
     if (clocked) clock.emplace("high_order", timings, observer);
     startElevation();
     state.mesh = elevateOrder(state.linear, options.order, &cad, nullptr, layered);
     if (layered) blendLayerInteriors(state.mesh, &cad);
-    reserveAfterElevation();
+    reserveAfterElevation(1.0);
   }
   if (clocked) clock->done();
   state.optimiser = curveAt(options.order, state.mesh,
@@ -651,11 +656,11 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     if (poor && (!(from.quality.scaled.min < kPoorElement) || splitFailed || options.boundaryLayer))
       break;
     const std::string name = "repair " + std::to_string(round);
-    if (budget.limited() && budget.left() < lastSeconds) {
+    if (budget.limited() && budget.available() < lastSeconds) {
       budget.skip(name);
       result.notes.push_back(
           "repair rounds ended by " + jobLimitText(budget) + ": " +
-          formatSeconds(std::max(budget.left(), 0.0)) + " s left before round " +
+          formatSeconds(std::max(budget.available(), 0.0)) + " s left before round " +
           std::to_string(round) + ", less than the " + formatSeconds(lastSeconds) + " s " +
           (round == 1 ? std::string("the first linear mesh, curving and optimiser took")
                       : "round " + std::to_string(round - 1) + " took") +
@@ -685,10 +690,14 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     if (plan.splits.empty() && !flipFailed && !options.boundaryLayer &&
         options.optimiseIterations > 0 && from.linear.dim == 3) {
       next = from.linear;
-      const FlipOutcome flipped =
-          flipAwayCells(next, plan.unsplit, curvedVertexPositions(from.linear, from.mesh));
-      record.flips = flipped.flips;
-      record.elements = flipped.cellsFlipped;
+      try {
+        const FlipOutcome flipped =
+            flipAwayCells(next, plan.unsplit, curvedVertexPositions(from.linear, from.mesh));
+        record.flips = flipped.flips;
+        record.elements = flipped.cellsFlipped;
+      } catch (const ParameterError& e) {  // a mesh the flips do not handle: refine instead
+        result.notes.push_back(name + ": no flips (" + e.what() + "); refined instead");
+      }
     }
     StageClock clock(name, result.timings, observer);
     if (record.edgesSplit > 0) {

@@ -42,7 +42,7 @@ TEST(JobBudget, AStageGetsTheSmallerOfItsLimitAndWhatIsLeft) {
 }
 
 // The reserve (for the quality check and output that follow a stage) comes off what a stage
-// the budget stops may take; what is left and whether the budget is spent stay as they are.
+// the budget stops may take and off what the optional stages may use; what is left stays.
 TEST(JobBudget, TheReserveComesOffWhatAStageMayTake) {
   JobBudget budget(1000.0);
   EXPECT_EQ(budget.reserved(), 0.0);
@@ -56,7 +56,13 @@ TEST(JobBudget, TheReserveComesOffWhatAStageMayTake) {
   const double limit = budget.stageLimit(800.0);
   EXPECT_GT(limit, 600.0);
   EXPECT_LE(limit, 700.0);
-  budget.reserve(5000.0);  // more than the budget: the floor, never 0 (no limit)
+  EXPECT_GT(budget.available(), 600.0);
+  EXPECT_LE(budget.available(), 700.0);
+  // More than the budget: nothing is available, so the optional stages are left out (spent),
+  // and a stage that runs anyway gets the floor, never 0 (no limit).
+  budget.reserve(5000.0);
+  EXPECT_TRUE(budget.spent());
+  EXPECT_GT(budget.left(), 900.0);
   EXPECT_EQ(budget.stageLimit(0.0), JobBudget::kFloorSeconds);
   budget.reserve(-1.0);
   EXPECT_EQ(budget.reserved(), 0.0);

@@ -164,6 +164,16 @@ TEST(TetFlips, EdgeRemovalReplacesTheCellsAroundALongAxis) {
   }
 }
 
+// One flip can take several of the cells asked for away: each is counted once, and those it
+// took are not tried again.
+TEST(TetFlips, OneFlipTakesEveryCellAroundTheAxis) {
+  Mesh mesh = bipyramid(5, 3.0);
+  const FlipOutcome out = flipAwayCells(mesh, {0, 1, 2, 3, 4});
+  EXPECT_EQ(out.flips, 1u);
+  EXPECT_EQ(out.cellsFlipped, 5u);
+  EXPECT_EQ(mesh.numElements(), 6u);
+}
+
 // Poles near the ring: the cells around the axis are the best there is; nothing changes.
 TEST(TetFlips, NoFlipWithoutAGain) {
   for (int n = 3; n <= 7; ++n) {
@@ -227,7 +237,22 @@ TEST(TetFlips, TheBoundaryAChordOfOneFaceAndTwoSolidsStopAFlip) {
     addTriangles(mesh, {{0, 1, 2}});
     EXPECT_EQ(flipAwayCells(mesh, {0}).flips, 0u);
   }
-  {  // cells of two solids
+  {  // the three vertices of a 3-2 flip's new face on one CAD face: it would be a chord face
+    Mesh mesh = bipyramid(3, 3.0);
+    addTriangles(mesh, {{0, 2, 3}, {0, 3, 4}});
+    EXPECT_EQ(flipAwayCells(mesh, {0}).flips, 0u);
+  }
+  {  // ... on two faces, none holding all three: allowed
+    Mesh mesh = bipyramid(3, 3.0);
+    addTriangles(mesh, {{0, 2, 3}, {0, 3, 4}}, {1, 2});
+    EXPECT_EQ(flipAwayCells(mesh, {0}).flips, 1u);
+  }
+  {  // a ring of cells of two solids around the axis
+    Mesh mesh = bipyramid(4, 3.0);
+    mesh.blocks[0].entity[0] = 2;
+    EXPECT_EQ(flipAwayCells(mesh, {0}).flips, 0u);
+  }
+  {  // cells of two solids on one face
     Mesh mesh = twoFlatCells();
     mesh.blocks[0].entity[1] = 2;
     EXPECT_EQ(flipAwayCells(mesh, {0, 1}).flips, 0u);
