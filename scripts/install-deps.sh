@@ -1,6 +1,7 @@
 #!/bin/sh
 # Installs the Debian 12 packages HOMesh needs to build, run and test (idempotent: does nothing
-# when all are present). Needs root, or sudo.
+# when all are present). Needs root, or sudo. occt-misc is OpenCASCADE's sample data: the CAD
+# corpus benchmark and a repair-round test mesh its files.
 set -eu
 
 PACKAGES="
@@ -11,6 +12,7 @@ PACKAGES="
   libboost-python-dev libboost-numpy-dev python3-dev python3-numpy
   libgtest-dev python3-pytest python3-meshio python3-vtk9
   xvfb xauth ccache
+  occt-misc
 "
 
 missing=""

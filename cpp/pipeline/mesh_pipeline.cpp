@@ -560,6 +560,7 @@ void finishJob(MeshResult& result, JobBudget& budget, PipelineObserver* observer
   }
   result.job.timeLimit = budget.seconds();
   result.job.seconds = budget.elapsed();
+  result.job.reserved = budget.limited() ? budget.reserved() : 0.0;
   result.job.cut = budget.cutStages();
   result.job.skipped = budget.skippedStages();
 }

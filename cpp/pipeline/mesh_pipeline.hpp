@@ -176,6 +176,9 @@ struct JobRecord {
   // The job's wall time: from the start of the pipeline to its end, plus the "output" stage
   // when writeMeshOutputs wrote the mesh.
   double seconds = 0.0;
+  // What the budget kept back at the end for the stages that always run (JobBudget::reserve):
+  // a job it stopped took at least timeLimit less this.
+  double reserved = 0.0;
   std::vector<std::string> cut;      // stages the budget stopped early ("optimise", "repair 2")
   std::vector<std::string> skipped;  // stages it left out ("repair 3", "geometry")
   bool stopped() const { return !cut.empty() || !skipped.empty(); }

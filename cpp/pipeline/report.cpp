@@ -258,6 +258,7 @@ void appendJob(JsonWriter& json, const JobRecord& job) {
   json.beginObject("job");
   json.value("time_limit", job.timeLimit);
   json.value("seconds", job.seconds);
+  json.value("reserved", job.reserved);
   json.value("stopped", std::string(job.stopped() ? "time budget" : "finished"));
   appendStrings(json, "cut", job.cut);
   appendStrings(json, "skipped", job.skipped);
