@@ -87,7 +87,11 @@ bool sameOrientation(const Tet& t, std::int64_t a, std::int64_t b, std::int64_t 
 class TetTopology {
  public:
   TetTopology(const Mesh& mesh, const ElementBlock& block, const std::vector<double>& xyz)
-      : mesh_(mesh), xyz_(xyz), aroundNode_(mesh.numNodes()), faces_(mesh.numNodes()) {
+      : mesh_(mesh),
+        xyz_(xyz),
+        aroundNode_(mesh.numNodes()),
+        faces_(mesh.numNodes()),
+        boundaryEdges_(boundaryEdges(mesh)) {
     for (std::size_t e = 0; e < block.count(); ++e) {
       const std::int64_t* v = block.element(e);
       add({v[0], v[1], v[2], v[3]}, block.entity[e]);
@@ -101,7 +105,6 @@ class TetTopology {
           auto& faces = faces_[static_cast<std::size_t>(v[k])];
           if (std::find(faces.begin(), faces.end(), b.entity[e]) == faces.end())
             faces.push_back(b.entity[e]);
-          boundaryEdges_.insert(edgeKey(v[k], v[(k + 1) % nv]));
         }
         if (nv == 3) {
           std::array<std::int64_t, 3> f{v[0], v[1], v[2]};
@@ -145,25 +148,15 @@ class TetTopology {
   // lie in the boundary). Ends on the boundary of different faces are allowed: across a thin wall
   // every edge joins two boundary nodes.
   bool newEdgeAllowed(std::int64_t a, std::int64_t b) const {
-    const auto& fa = faces_[static_cast<std::size_t>(a)];
-    const auto& fb = faces_[static_cast<std::size_t>(b)];
-    for (const std::int32_t f : fa)
-      if (std::find(fb.begin(), fb.end(), f) != fb.end()) return false;
-    return cellsWith({a, b}).empty();
+    return !onOneFace({a, b}) && cellsWith({a, b}).empty();
   }
   // Whether a flip may add the interior face (a, b, c): its vertices not all on one CAD face
   // (a 3-2 flip adds a face whose edges all exist, so the edge rule does not see it).
   bool newFaceAllowed(std::int64_t a, std::int64_t b, std::int64_t c) const {
-    const auto& fb = faces_[static_cast<std::size_t>(b)];
-    const auto& fc = faces_[static_cast<std::size_t>(c)];
-    const auto& fa = faces_[static_cast<std::size_t>(a)];
-    return std::none_of(fa.begin(), fa.end(), [&](std::int32_t f) {
-      return std::find(fb.begin(), fb.end(), f) != fb.end() &&
-             std::find(fc.begin(), fc.end(), f) != fc.end();
-    });
+    return !onOneFace({a, b, c});
   }
   bool boundaryEdge(std::int64_t a, std::int64_t b) const {
-    return boundaryEdges_.count(edgeKey(a, b)) != 0;
+    return boundaryEdges_.count(meshEdge(a, b)) != 0;
   }
   bool boundaryFace(std::array<std::int64_t, 3> f) const {
     std::sort(f.begin(), f.end());
@@ -182,8 +175,15 @@ class TetTopology {
   std::size_t size() const { return tets_.size(); }
 
  private:
-  static std::pair<std::int64_t, std::int64_t> edgeKey(std::int64_t a, std::int64_t b) {
-    return a < b ? std::make_pair(a, b) : std::make_pair(b, a);
+  // Whether some boundary face holds every node of `nodes`.
+  bool onOneFace(std::initializer_list<std::int64_t> nodes) const {
+    const auto& first = faces_[static_cast<std::size_t>(*nodes.begin())];
+    return std::any_of(first.begin(), first.end(), [&](std::int32_t f) {
+      return std::all_of(nodes.begin(), nodes.end(), [&](std::int64_t v) {
+        const auto& faces = faces_[static_cast<std::size_t>(v)];
+        return std::find(faces.begin(), faces.end(), f) != faces.end();
+      });
+    });
   }
   Eigen::Vector3d point(std::int64_t v) const {
     const std::size_t i = 3 * static_cast<std::size_t>(v);
@@ -197,7 +197,7 @@ class TetTopology {
   std::vector<char> alive_;
   std::vector<std::vector<std::size_t>> aroundNode_;
   std::vector<std::vector<std::int32_t>> faces_;  // per node, the boundary faces it lies on
-  std::set<std::pair<std::int64_t, std::int64_t>> boundaryEdges_;
+  std::set<MeshEdge> boundaryEdges_;
   std::set<std::array<std::int64_t, 3>> boundaryFaces_;
 };
 
