@@ -379,7 +379,7 @@ namespace {
 
 // Meshes the current Gmsh model's entity of dimension `dim` inside its discrete boundary, which
 // Gmsh keeps as it is; sizes grow from the boundary's edge lengths, at most `maxSize` (> 0).
-void generateFill(int dim, double maxSize, const std::string& what) {
+void generateFill(int dim, double maxSize, const std::string& what, const std::string& hint) {
   gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
   gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
   gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 1);
@@ -388,8 +388,7 @@ void generateFill(int dim, double maxSize, const std::string& what) {
   try {
     gmsh::model::mesh::generate(dim);
   } catch (const std::string& message) {
-    throw MeshingError("Gmsh could not fill " + what + ": " + message +
-                       " (the layer's top may cross itself or a wall)");
+    throw MeshingError("Gmsh could not fill " + what + ": " + message + hint);
   }
 }
 
@@ -399,7 +398,7 @@ void generateFill(int dim, double maxSize, const std::string& what) {
 // all be of `gmshType`, appended to `cells` with entity `entity`.
 void readFill(Mesh& mesh, const std::map<std::array<double, 3>, std::int64_t>& known,
               const std::vector<int>& boundary, int dim, int tag, int gmshType, int entity,
-              ElementBlock& cells) {
+              ElementBlock& cells, const std::string& what) {
   std::map<std::size_t, std::int64_t> fresh;
   std::vector<std::size_t> nodeTags;
   std::vector<double> coords, params;
@@ -408,7 +407,7 @@ void readFill(Mesh& mesh, const std::map<std::array<double, 3>, std::int64_t>& k
     for (std::size_t i = 0; i < nodeTags.size(); ++i) {
       const auto it = known.find({coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]});
       if (it == known.end())
-        throw MeshingError("Gmsh moved or added a node on the boundary inside the layer");
+        throw MeshingError("Gmsh moved or added a node on the boundary of " + what);
       fresh[nodeTags[i]] = it->second;
     }
   }
@@ -421,7 +420,7 @@ void readFill(Mesh& mesh, const std::map<std::array<double, 3>, std::int64_t>& k
   const auto nv = static_cast<std::size_t>(cellNumVertices(cells.type));
   for (std::size_t k = 0; k < types.size(); ++k) {
     if (types[k] != gmshType)
-      throw MeshingError("Gmsh filled the layer's inside with elements of type " +
+      throw MeshingError("Gmsh filled " + what + " with elements of type " +
                          std::to_string(types[k]) + " where only " + cellShortName(cells.type) +
                          "s were expected");
     for (const std::size_t t : elementNodes[k]) {
@@ -451,7 +450,7 @@ void readMeshAndBlock(const std::string& bytes, Mesh& mesh, ElementBlock& cells)
 }  // namespace
 
 ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_t, 3>>& boundary,
-                            const LinearMeshOptions& options, int solid) {
+                            const LinearMeshOptions& options, int solid, const FillRegion& region) {
   if (boundary.empty()) throw MeshingError("no surface to fill with tetrahedra");
   // Gmsh tags are the node ids + 1 (tags start at 1); its new nodes get larger tags.
   std::vector<char> used(mesh.numNodes(), 0);
@@ -474,8 +473,8 @@ ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_
   tets.type = CellType::Tetrahedron;
   const double maxSize = options.sizeField ? options.maxSize : options.size;
   const std::string bytes =
-      withGmsh(options, "Gmsh's filling of the boundary layer's inside", [&](GmshSession&) {
-        withGmshErrors("filling the volume inside the boundary layer", [&] {
+      withGmsh(options, "Gmsh's filling of " + region.what, [&](GmshSession&) {
+        withGmshErrors("filling " + region.what, [&] {
           gmsh::model::add("homesh-fill");
           gmsh::model::addDiscreteEntity(2, 1);
           gmsh::model::mesh::addNodes(2, 1, tags, coords);
@@ -485,19 +484,19 @@ ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_
           const int loop = gmsh::model::geo::addSurfaceLoop({1});
           const int volume = gmsh::model::geo::addVolume({loop});
           gmsh::model::geo::synchronize();
-          generateFill(3, maxSize, "the volume inside the boundary layer");
+          generateFill(3, maxSize, region.what, region.hint);
           std::map<std::array<double, 3>, std::int64_t> known;
           for (std::size_t i = 0; i < used.size(); ++i)
             if (used[i] != 0)
               known.emplace(
                   std::array<double, 3>{mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]},
                   static_cast<std::int64_t>(i));
-          readFill(mesh, known, {1}, 3, volume, kGmshTetrahedron, solid, tets);
+          readFill(mesh, known, {1}, 3, volume, kGmshTetrahedron, solid, tets, region.what);
         });
         return meshAndBlockBytes(mesh, tets);
       });
   readMeshAndBlock(bytes, mesh, tets);
-  if (tets.count() == 0) throw MeshingError("Gmsh made no tetrahedra inside the boundary layer");
+  if (tets.count() == 0) throw MeshingError("Gmsh made no tetrahedra in " + region.what);
   orientTetrahedra(mesh, tets);
   return tets;
 }
@@ -577,10 +576,12 @@ ElementBlock fillTriangles(Mesh& mesh, const std::vector<std::array<std::int64_t
             if (l != outer) surfaceLoops.push_back(curveLoops[l]);
           const int surface = gmsh::model::geo::addPlaneSurface(surfaceLoops);
           gmsh::model::geo::synchronize();
-          generateFill(2, maxSize, "the region inside the boundary layer");
+          generateFill(2, maxSize, "the region inside the boundary layer",
+                       " (the layer's top may cross itself or a wall)");
           std::vector<int> curves;
           for (std::size_t l = 0; l < loops.size(); ++l) curves.push_back(static_cast<int>(l) + 1);
-          readFill(mesh, byPoint, curves, 2, surface, kGmshTriangle, face, tris);
+          readFill(mesh, byPoint, curves, 2, surface, kGmshTriangle, face, tris,
+                   "the region inside the boundary layer");
         });
         return meshAndBlockBytes(mesh, tris);
       });

@@ -53,12 +53,6 @@ struct LinearMeshOptions {
 // MeshingError.
 Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options);
 
-// Tetrahedra filling the volume enclosed by `boundary`, a closed surface of triangles on
-// existing nodes of `mesh`, which Gmsh keeps as it is (no node added or moved on it). New
-// interior nodes are appended to `mesh` (CAD dimension 3, solid `solid`); the tetrahedra are
-// positively oriented. Sizes grow from the boundary's edge lengths, at most options.maxSize (or
-// options.size). Throws MeshingError when Gmsh cannot fill the surface (it is not closed, or
-// intersects itself).
 // Triangles filling the planar region enclosed by `boundary`, closed loops of segments on
 // existing nodes of `mesh` (one outer loop, the others holes), which Gmsh keeps as they are. New
 // nodes are appended (CAD dimension 2, face `face`, no parameters); the triangles are oriented
@@ -67,7 +61,21 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options);
 ElementBlock fillTriangles(Mesh& mesh, const std::vector<std::array<std::int64_t, 2>>& boundary,
                            const LinearMeshOptions& options, int face);
 
+// What a fill is of, for its messages: "the volume inside the boundary layer", and a hint at the
+// likely cause appended when Gmsh cannot fill it.
+struct FillRegion {
+  std::string what = "the volume inside the boundary layer";
+  std::string hint = " (the layer's top may cross itself or a wall)";
+};
+
+// Tetrahedra filling the volume enclosed by `boundary`, a closed surface of triangles on
+// existing nodes of `mesh`, which Gmsh keeps as it is (no node added or moved on it). New
+// interior nodes are appended to `mesh` (CAD dimension 3, solid `solid`); the tetrahedra are
+// positively oriented. Sizes grow from the boundary's edge lengths, at most options.maxSize (or
+// options.size). Throws MeshingError when Gmsh cannot fill the surface (it is
+// not closed, or intersects itself).
 ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_t, 3>>& boundary,
-                            const LinearMeshOptions& options, int solid);
+                            const LinearMeshOptions& options, int solid,
+                            const FillRegion& region = {});
 
 }  // namespace homesh

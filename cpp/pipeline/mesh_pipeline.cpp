@@ -17,10 +17,12 @@
 #include "core/system_memory.hpp"
 #include "curving/order_elevation.hpp"
 #include "linear/cad_classification.hpp"
+#include "linear/cavity_remesh.hpp"
 #include "linear/linear_mesher.hpp"
 #include "linear/tet_flips.hpp"
 #include "pipeline/curved_reuse.hpp"
 #include "pipeline/repair.hpp"
+#include "pipeline/report.hpp"
 #include "sizing/octree_export.hpp"
 
 namespace homesh {
@@ -343,6 +345,13 @@ std::string limitName(const char* key) {
   return std::string(p.label) + ": " + p.option + ", Python " + p.key + ", FreeCAD " + p.property;
 }
 
+// "repair rounds (--repair-rounds, Python repair_rounds, FreeCAD RepairRounds)".
+std::string parameterText(const char* key) {
+  const ParameterDefinition& p = parameterDefinition(key);
+  return std::string(p.label) + " (" + p.option + ", Python " + p.key + ", FreeCAD " + p.property +
+         ")";
+}
+
 // Seconds in messages: three digits are enough ("3.19 s").
 std::string formatSeconds(double s) {
   char buf[32];
@@ -548,7 +557,46 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
 
 // The geometry stage (left out once the job's budget is spent: it only measures), then the
 // job's record.
-void finishJob(MeshResult& result, JobBudget& budget, PipelineObserver* observer) {
+// The closing note of a mesh with elements not proven valid: how many, where on the CAD, and
+// what was tried on them (the optimiser, the repair rounds and their actions), so that a one-line
+// message names the stage that gave up and the entity. `linearGiven`: the caller gave the linear
+// mesh (no repair rounds can remesh it).
+std::string notValidNote(const MeshResult& result, bool linearGiven) {
+  const QualitySummary& q = result.quality;
+  const std::size_t count = q.invalid + q.undecided;
+  std::string text = std::to_string(count) + (count == 1 ? " element" : " elements") +
+                     " not proven valid (" + std::to_string(q.invalid) + " invalid, " +
+                     std::to_string(q.undecided) + " undecided)";
+  const std::string where = notValidLocation(result.mesh, q);
+  if (!where.empty()) text += " " + where;
+  text += result.options.optimiseIterations == 0
+              ? "; the optimiser did not run (" + parameterText("optimise") +
+                    " 0; optimising may make them valid)"
+              : std::string("; after the optimiser");
+  if (linearGiven) return text + "; no repair rounds (the linear mesh was given)";
+  if (result.rounds.empty())
+    return text + (result.options.repairRounds == 0
+                       ? "; no repair rounds (" + parameterText("repair_rounds") + " 0)"
+                       : std::string("; no repair round ran"));
+  text += "; " + std::to_string(result.rounds.size()) + " repair round" +
+          (result.rounds.size() == 1 ? "" : "s") + " (";
+  for (std::size_t k = 0; k < result.rounds.size(); ++k) {
+    const RepairRound& r = result.rounds[k];
+    text += (k == 0 ? "" : ", ") + r.action +
+            (!r.failure.empty() ? " failed"
+             : r.kept           ? ""
+                                : " not kept");
+  }
+  text += ")";
+  if (static_cast<int>(result.rounds.size()) == result.options.repairRounds)
+    text += ", all that " + parameterText("repair_rounds") + " allows";
+  return text;
+}
+
+void finishJob(MeshResult& result, JobBudget& budget, PipelineObserver* observer,
+               bool linearGiven) {
+  if (result.quality.invalid + result.quality.undecided > 0)
+    result.notes.push_back(notValidNote(result, linearGiven));
   if (budget.spent()) {
     budget.skip("geometry");
     result.notes.push_back("the boundary's distance to the CAD was not measured: " +
@@ -649,10 +697,11 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   // Repair rounds: each works from the previous round's mesh; the best state is kept.
   std::vector<RefinementSource> sources;  // accumulated over the refine rounds
   std::optional<CurvedState> last;        // the last round's state when it was not kept
-  bool splitFailed = false;  // the last round split and made things worse: refine instead
-  bool flipFailed = false;   // the last round flipped and made things worse: refine instead
+  bool splitFailed = false;   // the last round split and made things worse: refine instead
+  bool flipFailed = false;    // the last round flipped and made things worse: refine instead
+  bool remeshFailed = false;  // the last round remeshed cavities and made things worse: refine
   for (int round = 1; round <= options.repairRounds; ++round) {
-    const CurvedState& from = last && !splitFailed && !flipFailed ? *last : best;
+    const CurvedState& from = last && !splitFailed && !flipFailed && !remeshFailed ? *last : best;
     const bool poor = from.notValid() == 0;  // only elements below kPoorElement are left
     if (poor && (!(from.quality.scaled.min < kPoorElement) || splitFailed || options.boundaryLayer))
       break;
@@ -701,11 +750,49 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       }
     }
     StageClock clock(name, result.timings, observer);
+    // Nothing to split or flip: the cavities around the offenders are meshed again and the rest
+    // of the mesh stays; where that fails, or made things worse the last time, the whole model
+    // is meshed again, finer around them, instead.
+    bool remeshed = false;
+    // (Without the optimiser a cavity's new cells are curved as they come, on the same boundary
+    // triangles: only a finer boundary helps there.)
+    if (record.edgesSplit == 0 && record.flips == 0 && !remeshFailed && !options.boundaryLayer &&
+        options.optimiseIterations > 0 && from.linear.dim == 3) {
+      const std::vector<std::size_t>& cells = plan.splits.empty() ? plan.unsplit : plan.flagged;
+      next = from.linear;
+      try {
+        LinearMeshOptions o = linearOptions;
+        limitGmsh(o, name);
+        const CavityOutcome cavities = remeshCavities(next, cells, o);
+        record.cavities = cavities.cavities;
+        record.elements = cells.size();
+        remeshed = cavities.cavities > 0;
+      } catch (const ParameterError& e) {
+        result.notes.push_back(name + ": no local remesh (" + e.what() + "); refined instead");
+      } catch (const MeshingError& e) {
+        if (dynamic_cast<const BudgetExceeded*>(&e) != nullptr && gmshByBudget) {
+          // The budget ran out inside Gmsh: the rounds end, the best stays.
+          budget.cut(name);
+          record.budgetStopped = true;
+          record.action = "remesh";
+          record.failure = e.what();
+          record.seconds =
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+          result.rounds.push_back(record);
+          clock.done();
+          break;
+        }
+        result.notes.push_back(name + ": no local remesh (" + e.what() + "); refined instead");
+      }
+      if (!remeshed) next = Mesh();
+    }
     if (record.edgesSplit > 0) {
       record.action = poor ? "split poor" : "split";
       record.elements = plan.splitCells;
     } else if (record.flips > 0) {
       record.action = "flip";
+    } else if (remeshed) {
+      record.action = "remesh";
     } else {
       // Nothing to split (or no split kept its cells positive): refine around every offender.
       std::vector<RefinementSource> added =
@@ -762,6 +849,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     // (A "split poor" round not kept ends the rounds: see the loop's start.)
     splitFailed = !record.kept && (record.action == "split" || record.action == "split poor");
     flipFailed = !record.kept && record.action == "flip";
+    remeshFailed = !record.kept && record.action == "remesh";
     if (record.kept) {
       best = std::move(state);
       last.reset();
@@ -810,7 +898,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     split.done();
   }
 
-  finishJob(result, budget, observer);
+  finishJob(result, budget, observer, false);
   return result;
 }
 
@@ -837,7 +925,7 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
   result.quality = std::move(state.quality);
   result.optimiser = std::move(state.optimiser);
   result.lowOrderOptimiser = std::move(state.lowOrderOptimiser);
-  finishJob(result, budget, observer);
+  finishJob(result, budget, observer, true);
   return result;
 }
 

@@ -32,13 +32,15 @@ namespace homesh {
 struct RepairRound {
   std::size_t invalid = 0, undecided = 0;  // elements not proven valid that the round found
   double worst = 0.0, worstAfter = 0.0;    // certified scaled Jacobian before and after
-  // "split", "flip", "refine", or "split poor" (every element was valid; the round split the
-  // cells of those below the pipeline's poor-element threshold)
+  // "split", "flip", "remesh" (cavities around the flagged cells filled again), "refine" (the
+  // whole model meshed again, finer around them), or "split poor" (every element was valid; the
+  // round split the cells of those below the pipeline's poor-element threshold)
   std::string action;
   std::size_t elements = 0;                          // linear cells it acted on
   std::size_t edgesSplit = 0;                        // edges bisected ("split")
   std::size_t flips = 0;                             // flips made ("flip")
   std::size_t sources = 0;                           // refinement spheres added ("refine")
+  std::size_t cavities = 0;                          // cavities filled again ("remesh")
   std::size_t invalidAfter = 0, undecidedAfter = 0;  // of the mesh the round made
   std::size_t meshElements = 0;                      // elements of the mesh the round made
   std::size_t reused = 0;  // of those, elements whose curved nodes came from the round before
@@ -96,6 +98,7 @@ struct RepairPlan {
   std::vector<RefinementSource> allSources;  // spheres around every flagged cell
   std::size_t splitCells = 0, refineCells = 0;
   std::vector<std::size_t> unsplit;  // the flagged cells without an edge to split (`sources`)
+  std::vector<std::size_t> flagged;  // every flagged cell (`allSources`)
 };
 
 // Locates the elements whose verdict is not Valid (`validity` per element of the curved mesh,

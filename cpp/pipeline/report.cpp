@@ -1,8 +1,12 @@
 #include "pipeline/report.hpp"
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "cad/cad_model.hpp"
@@ -46,6 +50,45 @@ void appendCounts(JsonWriter& json, const Mesh& mesh) {
   json.beginObject("boundary");
   for (const auto& [name, count] : boundary) json.value(name, count);
   json.endObject();
+}
+
+std::string notValidLocation(const Mesh& mesh, const QualitySummary& quality,
+                             std::size_t maxEntities) {
+  const std::size_t flagged = quality.invalid + quality.undecided;
+  if (flagged == 0) return {};
+  // (dimension, index) -> elements there; ordered by count below.
+  std::map<std::pair<int, int>, std::size_t> count;
+  bool classified = false;
+  for (const FlaggedElement& f : flaggedElements(mesh, quality, flagged)) {
+    // The boundary's entities (3D: faces, then curves; 2D: curves), else the element's own.
+    const bool solid = mesh.dim == 3;
+    const std::vector<int>& first = solid ? f.cadFaces : f.cadCurves;
+    const std::vector<int> none;
+    const std::vector<int>& second = solid ? f.cadCurves : none;
+    const int firstDim = solid ? 2 : 1;
+    for (int e : first) ++count[{firstDim, e}];
+    if (first.empty())
+      for (int e : second) ++count[{1, e}];
+    if (first.empty() && second.empty() && f.entity > 0) ++count[{mesh.dim, -f.entity}];
+    classified = classified || !f.cadFaces.empty() || !f.cadCurves.empty();
+  }
+  if (!classified) return {};
+  std::vector<std::pair<std::pair<int, int>, std::size_t>> order(count.begin(), count.end());
+  // Most elements first; then boundary entities of the higher dimension, then inside.
+  const auto rank = [](const std::pair<int, int>& e) { return e.second < 0 ? 3 : 3 - e.first; };
+  std::stable_sort(order.begin(), order.end(), [&rank](const auto& a, const auto& b) {
+    return a.second != b.second ? a.second > b.second : rank(a.first) < rank(b.first);
+  });
+  std::string text = "at";
+  for (std::size_t k = 0; k < order.size() && k < maxEntities; ++k) {
+    const auto [dim, index] = order[k].first;
+    text += std::string(k == 0 ? " " : ", ") + (index < 0 ? "inside " : "") +
+            cadEntityName(dim, std::abs(index)) + " (" + std::to_string(order[k].second) +
+            (k == 0 ? (order[k].second == 1 ? " element)" : " elements)") : ")");
+  }
+  if (order.size() > maxEntities)
+    text += " and " + std::to_string(order.size() - maxEntities) + " more entities";
+  return text;
 }
 
 const char* validityName(Validity v) {
@@ -93,6 +136,8 @@ void appendQuality(JsonWriter& json, const Mesh& mesh, const QualitySummary& q) 
     json.value("entity", f.entity);
     json.value("verdict", validityName(f.validity));
     json.numbers("scaled_jacobian", std::vector<double>{f.lower, f.upper});
+    json.numbers("cad_faces", std::vector<std::size_t>(f.cadFaces.begin(), f.cadFaces.end()));
+    json.numbers("cad_curves", std::vector<std::size_t>(f.cadCurves.begin(), f.cadCurves.end()));
     json.endObject();
   }
   json.endArray();
@@ -398,6 +443,7 @@ void appendRepairRounds(JsonWriter& json, const std::vector<RepairRound>& rounds
     json.value("edges_split", r.edgesSplit);
     json.value("flips", r.flips);
     json.value("refinement_spheres", r.sources);
+    json.value("cavities", r.cavities);
     json.value("invalid_after", r.invalidAfter);
     json.value("undecided_after", r.undecidedAfter);
     json.value("worst", r.worst);

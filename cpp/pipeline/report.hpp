@@ -19,6 +19,15 @@ namespace homesh {
 inline constexpr std::size_t kMaxFlaggedElements = 100;
 void appendQuality(JsonWriter& json, const Mesh& mesh, const QualitySummary& quality);
 
+// Where the elements not proven valid lie on the CAD, for a message: "at Face12 (5 elements),
+// Face40 (3), Edge7 (1), inside Solid1 (2)". An element counts at every CAD face its nodes lie
+// on; one with no node on a face counts at the curves it touches, and one with neither inside its
+// own entity (3D: solid; 2D: face). Entities with most elements come first, at most
+// `maxEntities` named and the rest counted. Empty when every element is valid or the mesh has no
+// CAD classification (read from a file).
+std::string notValidLocation(const Mesh& mesh, const QualitySummary& quality,
+                             std::size_t maxEntities = 6);
+
 // "invalid", "undecided" or "valid".
 const char* validityName(Validity v);
 

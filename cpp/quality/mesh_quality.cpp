@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <utility>
+#include <vector>
 
 #include "core/error.hpp"
 #include "element/quadrature.hpp"
@@ -150,8 +153,25 @@ std::vector<FlaggedElement> flaggedElements(const Mesh& mesh, const QualitySumma
       const Validity v = quality.validity[index];
       if (v == Validity::Valid) continue;
       if (out.size() >= limit) return out;
-      out.push_back({index, block.type, block.entity[e], v, quality.scaledJacobian[index],
-                     quality.scaledJacobianUpper[index]});
+      FlaggedElement f;
+      f.index = index;
+      f.type = block.type;
+      f.entity = block.entity[e];
+      f.validity = v;
+      f.lower = quality.scaledJacobian[index];
+      f.upper = quality.scaledJacobianUpper[index];
+      const std::int64_t* nodes = block.element(e);
+      for (int k = 0; k < block.nodesPerElement(); ++k) {
+        const auto n = static_cast<std::size_t>(nodes[k]);
+        if (n >= mesh.nodeCadIndex.size() || mesh.nodeCadIndex[n] <= 0) continue;
+        if (mesh.nodeCadDim[n] == 2) f.cadFaces.push_back(mesh.nodeCadIndex[n]);
+        if (mesh.nodeCadDim[n] == 1) f.cadCurves.push_back(mesh.nodeCadIndex[n]);
+      }
+      for (std::vector<int>* list : {&f.cadFaces, &f.cadCurves}) {
+        std::sort(list->begin(), list->end());
+        list->erase(std::unique(list->begin(), list->end()), list->end());
+      }
+      out.push_back(std::move(f));
     }
   }
   return out;

@@ -14,7 +14,7 @@ from test_optimise import gmsh_worst
 SPHERE_BOX = Path(__file__).resolve().parents[2] / "examples" / "sphere_box.step"
 # Order 4 at size 1.2: curving alone leaves tetrahedra outside the sphere invalid.
 CASE = ["--size", "1.2", "--order", "4"]
-ROUND_KEYS = {"invalid", "undecided", "action", "elements", "edges_split", "flips",
+ROUND_KEYS = {"invalid", "undecided", "action", "elements", "edges_split", "flips", "cavities",
               "refinement_spheres", "invalid_after", "undecided_after", "mesh_elements",
               "reused_elements", "kept", "seconds", "worst", "worst_after"}
 
@@ -35,8 +35,23 @@ def test_no_rounds_exits_4_with_the_mesh_written(homesh_bin, tmp_path):
     assert msh.is_file()
     assert report["rounds"] == []
     assert not any(stage.startswith("repair") for stage in report["timings_s"])
-    assert len(quality["flagged_elements"]) == quality["invalid_elements"] + \
-        quality["undecided_elements"]
+    flagged = quality["invalid_elements"] + quality["undecided_elements"]
+    assert len(quality["flagged_elements"]) == flagged
+    # Where they are on the CAD, in the report and in one closing note the CLI prints: the
+    # faces with most of them first (the sphere's, which curving bends under them).
+    per_face = {}
+    for element in quality["flagged_elements"]:
+        assert element["cad_faces"] or element["cad_curves"], element
+        for face in element["cad_faces"]:
+            assert 1 <= face <= report["cad"]["faces"]
+            per_face[face] = per_face.get(face, 0) + 1
+    [note] = [n for n in report["notes"]
+              if n.startswith("%d element%s not proven valid" % (flagged, "s" * (flagged > 1)))]
+    most = max(per_face.values())
+    assert " at Face%d (%d element" % (min(f for f, n in per_face.items() if n == most), most) \
+        in note, note
+    assert "FreeCAD RepairRounds) 0" in note, note
+    assert "homesh: note: " + note in result.stderr
 
 
 def test_rounds_are_recorded(homesh_bin, tmp_path):
@@ -46,7 +61,7 @@ def test_rounds_are_recorded(homesh_bin, tmp_path):
     assert 1 <= len(rounds) <= 3
     for r in rounds:
         assert set(r) == ROUND_KEYS
-        assert r["action"] in ("split", "refine", "split poor")
+        assert r["action"] in ("split", "remesh", "refine", "split poor")
         assert r["elements"] > 0 and r["seconds"] >= 0
         if r["action"] == "split poor":  # every element valid, the worst below 0.1
             assert r["invalid"] == r["undecided"] == 0 and r["worst"] < 0.1

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <numeric>
 #include <optional>
@@ -23,6 +24,7 @@
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/repair.hpp"
 #include "pipeline/report.hpp"
+#include "quality/mesh_quality.hpp"
 #include "test_support.hpp"
 
 namespace homesh {
@@ -329,6 +331,42 @@ TEST(RepairRounds, SphereInBoxEndsProvenValid) {
   ASSERT_GT(without.quality.invalid + without.quality.undecided, 0u)
       << "the case no longer needs repair: choose a coarser one";
   EXPECT_TRUE(without.rounds.empty());
+  // Where they are: each flagged element names the CAD faces its nodes lie on, and those nodes
+  // do lie on them (to the projection's 1e-9 of the diagonal, far below the mesh's size); the
+  // closing note gives the count, the faces and what was tried.
+  const double diagonal = without.cad->boundingDiagonal();
+  std::vector<const std::int64_t*> cells;  // the volume elements, in the verdicts' order
+  for (const ElementBlock& b : without.mesh.blocks)
+    if (cellDimension(b.type) == 3)
+      for (std::size_t e = 0; e < b.count(); ++e) cells.push_back(b.element(e));
+  const int nodesPerCell = cellNumNodes(CellType::Tetrahedron, without.mesh.order);
+  const std::size_t flagged = without.quality.invalid + without.quality.undecided;
+  for (const FlaggedElement& f : flaggedElements(without.mesh, without.quality, flagged)) {
+    ASSERT_FALSE(f.cadFaces.empty() && f.cadCurves.empty()) << "element " << f.index;
+    for (int face : f.cadFaces) {
+      ASSERT_GE(face, 1);
+      ASSERT_LE(face, without.cad->numFaces());
+      std::size_t on = 0;
+      for (int k = 0; k < nodesPerCell; ++k) {
+        const auto n = static_cast<std::size_t>(cells[f.index][k]);
+        if (without.mesh.nodeCadDim[n] != 2 || without.mesh.nodeCadIndex[n] != face) continue;
+        const Eigen::Vector3d x(&without.mesh.xyz[3 * n]);
+        EXPECT_LT(without.cad->projectOnSurface(face, x).distance, 1e-7 * diagonal);
+        ++on;
+      }
+      EXPECT_GT(on, 0u);
+    }
+  }
+  const std::string note =
+      std::to_string(flagged) + (flagged == 1 ? " element" : " elements") + " not proven valid";
+  const auto closing = std::find_if(without.notes.begin(), without.notes.end(),
+                                    [&](auto& n) { return n.rfind(note, 0) == 0; });
+  ASSERT_NE(closing, without.notes.end());
+  EXPECT_NE(closing->find(" at Face"), std::string::npos) << *closing;
+  EXPECT_NE(closing->find(
+                "repair rounds (--repair-rounds, Python repair_rounds, FreeCAD RepairRounds) 0"),
+            std::string::npos)
+      << *closing;
 
   options.repairRounds = 3;
   const MeshResult result = runMeshPipeline(CadSource::file(kSphereBox), options);

@@ -1,0 +1,243 @@
+#include "linear/cavity_remesh.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <set>
+#include <string>
+#include <utility>
+
+#include "core/error.hpp"
+#include "linear/edge_split.hpp"
+
+namespace homesh {
+namespace {
+
+using Triangle = std::array<std::int64_t, 3>;
+
+// The faces of a positive tetrahedron (0, 1, 2, 3), each ordered so that its normal (right-hand
+// rule) points out of the cell.
+constexpr int kOutwardFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+Triangle sortedKey(const Triangle& t) {
+  Triangle k = t;
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
+// The cavity's surface, per solid: faces of marked cells that no other marked cell of the same
+// solid shares, oriented out of the cavity.
+std::map<std::pair<int, Triangle>, Triangle> cavitySurface(const ElementBlock& tets,
+                                                           const std::vector<char>& marked) {
+  std::map<std::pair<int, Triangle>, std::pair<int, Triangle>> faces;  // -> (count, oriented)
+  for (std::size_t c = 0; c < tets.count(); ++c) {
+    if (marked[c] == 0) continue;
+    const std::int64_t* v = tets.element(c);
+    for (const auto& f : kOutwardFaces) {
+      const Triangle t{v[f[0]], v[f[1]], v[f[2]]};
+      auto& entry = faces[{tets.entity[c], sortedKey(t)}];
+      ++entry.first;
+      entry.second = t;
+    }
+  }
+  std::map<std::pair<int, Triangle>, Triangle> surface;
+  for (const auto& [key, entry] : faces)
+    if (entry.first == 1) surface.emplace(key, entry.second);
+  return surface;
+}
+
+// Vertices where the surface of one solid's cavity is not a closed 2-manifold: an edge on other
+// than two of its triangles, or triangles around the vertex that form more than one fan.
+std::set<std::pair<int, std::int64_t>> nonManifoldVertices(
+    const std::map<std::pair<int, Triangle>, Triangle>& surface) {
+  std::map<std::pair<int, MeshEdge>, int> edgeCount;
+  std::map<std::pair<int, std::int64_t>, std::vector<MeshEdge>> link;  // opposite edges
+  for (const auto& [key, t] : surface)
+    for (int i = 0; i < 3; ++i) {
+      ++edgeCount[{key.first, meshEdge(t[i], t[(i + 1) % 3])}];
+      link[{key.first, t[i]}].push_back(meshEdge(t[(i + 1) % 3], t[(i + 2) % 3]));
+    }
+  std::set<std::pair<int, std::int64_t>> bad;
+  for (const auto& [key, n] : edgeCount)
+    if (n != 2) {
+      bad.insert({key.first, key.second[0]});
+      bad.insert({key.first, key.second[1]});
+    }
+  for (const auto& [vertex, edges] : link) {
+    if (bad.count(vertex) > 0) continue;
+    // One fan: the link's edges are connected (walk them from the first).
+    std::set<std::int64_t> reached{edges.front()[0]};
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (const MeshEdge& e : edges)
+        if ((reached.count(e[0]) > 0) != (reached.count(e[1]) > 0)) {
+          reached.insert(e[0]);
+          reached.insert(e[1]);
+          grew = true;
+        }
+    }
+    std::set<std::int64_t> all;
+    for (const MeshEdge& e : edges) {
+      all.insert(e[0]);
+      all.insert(e[1]);
+    }
+    if (reached.size() != all.size()) bad.insert(vertex);
+  }
+  return bad;
+}
+
+double tetVolume(const Mesh& mesh, const std::int64_t* v) {
+  return simplexVolume(mesh, v);
+}
+
+}  // namespace
+
+CavityOutcome remeshCavities(Mesh& mesh, const std::vector<std::size_t>& cells,
+                             const LinearMeshOptions& options) {
+  if (mesh.dim != 3 || mesh.order != 1)
+    throw ParameterError("cavity remeshing needs a linear volume mesh (order 1, 3D)");
+  ElementBlock* found = nullptr;
+  for (ElementBlock& b : mesh.blocks) {
+    if (cellDimension(b.type) != 3) continue;
+    if (b.type != CellType::Tetrahedron || found != nullptr)
+      throw ParameterError("cavity remeshing needs the cells in one block of tetrahedra");
+    found = &b;
+  }
+  if (found == nullptr) throw ParameterError("cavity remeshing: the mesh has no tetrahedra");
+  const ElementBlock& tets = *found;
+  const std::size_t count = tets.count();
+  for (const std::size_t c : cells)
+    if (c >= count)
+      throw ParameterError("cavity remeshing: cell " + std::to_string(c) + " of a mesh of " +
+                           std::to_string(count) + " tetrahedra");
+  CavityOutcome outcome;
+  if (cells.empty()) return outcome;
+
+  // Cells around each node.
+  std::vector<std::size_t> start(mesh.numNodes() + 1, 0);
+  for (std::size_t c = 0; c < count; ++c)
+    for (int i = 0; i < 4; ++i) ++start[static_cast<std::size_t>(tets.element(c)[i]) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::size_t> around(start.back()), fill(start.begin(), start.end() - 1);
+  for (std::size_t c = 0; c < count; ++c)
+    for (int i = 0; i < 4; ++i) around[fill[static_cast<std::size_t>(tets.element(c)[i])]++] = c;
+
+  // The cavity: every cell of the requested cell's solid that shares a vertex with it.
+  std::vector<char> marked(count, 0);
+  const auto take = [&](std::int64_t node, int solid) {
+    const auto n = static_cast<std::size_t>(node);
+    for (std::size_t k = start[n]; k < start[n + 1]; ++k)
+      if (tets.entity[around[k]] == solid) marked[around[k]] = 1;
+  };
+  for (const std::size_t c : cells)
+    for (int i = 0; i < 4; ++i) take(tets.element(c)[i], tets.entity[c]);
+
+  // Grown where its surface is not a closed 2-manifold (cavities touching at an edge or a vertex,
+  // a cell hanging on by an edge): all of the solid's cells around such a vertex join.
+  constexpr int kGrowthPasses = 8;
+  std::map<std::pair<int, Triangle>, Triangle> surface;
+  for (int pass = 0;; ++pass) {
+    surface = cavitySurface(tets, marked);
+    const auto bad = nonManifoldVertices(surface);
+    if (bad.empty()) break;
+    if (pass == kGrowthPasses)
+      throw MeshingError("the cavity around " + std::to_string(cells.size()) +
+                         " cells did not become a closed manifold surface in " +
+                         std::to_string(kGrowthPasses) + " passes");
+    for (const auto& [solid, node] : bad) take(node, solid);
+  }
+
+  // Connected cavities: marked cells of one solid joined through shared faces.
+  std::vector<std::size_t> parent(count);
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto root = [&parent](std::size_t c) {
+    while (parent[c] != c) c = parent[c] = parent[parent[c]];
+    return c;
+  };
+  {
+    std::map<std::pair<int, Triangle>, std::size_t> firstCell;
+    for (std::size_t c = 0; c < count; ++c) {
+      if (marked[c] == 0) continue;
+      const std::int64_t* v = tets.element(c);
+      for (const auto& f : kOutwardFaces) {
+        const auto [it, fresh] = firstCell.emplace(
+            std::make_pair(tets.entity[c], sortedKey({v[f[0]], v[f[1]], v[f[2]]})), c);
+        if (!fresh) parent[root(c)] = root(it->second);
+      }
+    }
+  }
+  std::map<std::size_t, std::vector<std::size_t>> cavities;  // root -> cells
+  for (std::size_t c = 0; c < count; ++c)
+    if (marked[c] != 0) cavities[root(c)].push_back(c);
+
+  // Each cavity filled again, on a copy: a failure leaves the mesh as it was.
+  Mesh work = mesh;
+  ElementBlock added;
+  added.type = CellType::Tetrahedron;
+  for (const auto& [rootCell, members] : cavities) {
+    const int solid = tets.entity[rootCell];
+    std::set<Triangle> own;  // the cavity's faces, as keys
+    double removed = 0.0, longest = 0.0;
+    for (const std::size_t c : members) {
+      const std::int64_t* v = tets.element(c);
+      removed += tetVolume(mesh, v);
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+          longest = std::max(longest, (nodePoint(mesh, v[i]) - nodePoint(mesh, v[j])).norm());
+      for (const auto& f : kOutwardFaces) own.insert(sortedKey({v[f[0]], v[f[1]], v[f[2]]}));
+    }
+    std::vector<Triangle> boundary;
+    for (const auto& [key, t] : surface)
+      if (key.first == solid && own.count(key.second) > 0) boundary.push_back(t);
+    // Sizes from the surface: no cap below the cavity's longest edge.
+    LinearMeshOptions fillOptions = options;
+    fillOptions.sizeField = nullptr;
+    fillOptions.size = longest;
+    const std::string what =
+        "a cavity of " + std::to_string(members.size()) + " cells in Solid" + std::to_string(solid);
+    const ElementBlock cavityCells =
+        fillTetrahedra(work, boundary, fillOptions, solid, {what, " (its surface is closed)"});
+    double filled = 0.0;
+    for (std::size_t c = 0; c < cavityCells.count(); ++c) {
+      const double v = tetVolume(work, cavityCells.element(c));
+      if (!(v > 0.0))
+        throw MeshingError("Gmsh's fill of " + what + " has a cell of non-positive volume");
+      filled += v;
+    }
+    // The two sums cover one polyhedron: they differ by rounding only (a few units of the last
+    // place per cell), far below this bound unless Gmsh filled something else.
+    if (std::abs(filled - removed) > 1e-9 * removed * static_cast<double>(members.size() + 10))
+      throw MeshingError("Gmsh's fill of " + what + " has volume " + std::to_string(filled) +
+                         " where the cavity has " + std::to_string(removed));
+    added.nodes.insert(added.nodes.end(), cavityCells.nodes.begin(), cavityCells.nodes.end());
+    added.entity.insert(added.entity.end(), cavityCells.entity.begin(), cavityCells.entity.end());
+    outcome.cellsRemoved += members.size();
+    outcome.cellsAdded += cavityCells.count();
+    ++outcome.cavities;
+  }
+
+  // The cells that stay, in their order, then the fills'.
+  for (ElementBlock& b : work.blocks) {
+    if (b.type != CellType::Tetrahedron || cellDimension(b.type) != 3) continue;
+    ElementBlock kept;
+    kept.type = b.type;
+    kept.order = b.order;
+    for (std::size_t c = 0; c < b.count(); ++c) {
+      if (marked[c] != 0) continue;
+      kept.nodes.insert(kept.nodes.end(), b.element(c), b.element(c) + 4);
+      kept.entity.push_back(b.entity[c]);
+    }
+    kept.nodes.insert(kept.nodes.end(), added.nodes.begin(), added.nodes.end());
+    kept.entity.insert(kept.entity.end(), added.entity.begin(), added.entity.end());
+    b = std::move(kept);
+  }
+  work.checkConsistency();
+  mesh = std::move(work);
+  return outcome;
+}
+
+}  // namespace homesh
