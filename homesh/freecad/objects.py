@@ -369,11 +369,14 @@ def apply_result(obj, mesh, predicted=None, touch=True, values=None, npz_path=No
     obj.MinScaledJacobian = float(quality["min"])
     obj.InvalidElements = int(quality["invalid_elements"])
     obj.UndecidedElements = int(quality["undecided_elements"])
-    obj.Status = summary_text(obj, mesh, quality, predicted)
+    notes = job_notes(mesh)
+    obj.Status = summary_text(obj, mesh, quality, predicted, notes)
     if not_valid(obj):
         FreeCAD.Console.PrintWarning("HOMesh: %s\n" % obj.Status)
     else:
         FreeCAD.Console.PrintMessage("HOMesh: %s\n" % obj.Status)
+    for note in notes:  # what the job cut short or left out, and what it tried
+        FreeCAD.Console.PrintMessage("HOMesh: note: %s\n" % note)
     if touch:
         obj.purgeTouched()
     if FreeCAD.GuiUp and obj.ViewObject is not None:
@@ -385,7 +388,26 @@ def not_valid(obj):
     return obj.InvalidElements > 0 or obj.UndecidedElements > 0
 
 
-def summary_text(obj, mesh, quality, predicted=None):
+def job_notes(mesh):
+    """The notes of the job that made ``mesh`` (its report's), or [] for a mesh without a
+    report (one read back from a document)."""
+    try:
+        return list(mesh.report().get("notes", []))
+    except Exception:  # noqa: BLE001 - a mesh without a pipeline result has no report
+        return []
+
+
+def where_not_valid(notes):
+    """From the core's closing note on a mesh not proven valid ("9 elements not proven valid
+    (...) at Face85 (3 elements), Face96 (2); after ..."): the "at ..." part, or ""."""
+    for note in notes:
+        head, _, _ = note.partition(";")
+        if " not proven valid (" in head and ") at " in head:
+            return head[head.index(") at ") + 2:]
+    return ""
+
+
+def summary_text(obj, mesh, quality, predicted=None, notes=()):
     text = ("%s: %d nodes, %d elements of order %d, worst scaled Jacobian %.3f"
             % (obj.Label, mesh.num_nodes, mesh.num_elements, mesh.order, quality["min"]))
     if predicted:
@@ -393,6 +415,9 @@ def summary_text(obj, mesh, quality, predicted=None):
     if quality["invalid_elements"] or quality["undecided_elements"]:
         text += (": NOT VALID, %d invalid and %d undecided elements (worst %.3g)"
                  % (quality["invalid_elements"], quality["undecided_elements"], quality["min"]))
+        where = where_not_valid(notes)
+        if where:
+            text += " " + where
     else:
         text += ", all elements proven valid"
     return text

@@ -2,6 +2,7 @@
 recomputing, export, and invalid input."""
 
 import os
+import re
 import tempfile
 import unittest
 
@@ -85,6 +86,14 @@ class HighOrderMeshObject(unittest.TestCase):
         self.doc.recompute()
         plain = obj.MinScaledJacobian
         plain_nodes = homesh.freecad.get_mesh(obj).nodes.copy()
+        # Curving alone leaves elements invalid; the status names the part's faces they touch
+        # as FreeCAD numbers them, and curving inverts elements only at curved faces.
+        self.assertGreater(obj.InvalidElements, 0)
+        named = [int(f) for f in re.findall(r"Face(\d+)", obj.Status)]
+        self.assertTrue(named, obj.Status)
+        self.assertTrue(all(1 <= f <= len(part.Shape.Faces) for f in named), obj.Status)
+        self.assertTrue(any(part.Shape.Faces[f - 1].Surface.TypeId != "Part::GeomPlane"
+                            for f in named), obj.Status)
         obj.OptimiserIterations = 20
         self.doc.recompute()
         self.assertTrue(obj.isValid())

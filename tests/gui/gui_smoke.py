@@ -250,6 +250,7 @@ try:
     settle()
     print("HOMesh GUI: coarse mesh: %s" % bad.Status)
     assert bad.InvalidElements > 0 and "NOT VALID" in bad.Status
+    assert " at Face" in bad.Status, bad.Status  # where on the part, from the core's note
     assert bad.ViewObject.Proxy.getIcon().endswith("homesh_mesh_invalid.svg")
     mesh.ViewObject.Visibility = False
     bad.ViewObject.Show = "Invalid elements"
