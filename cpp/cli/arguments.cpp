@@ -393,8 +393,9 @@ options:
                       boundary nodes sliding on the CAD curves and faces
   -n, --maxiter N     at most N optimiser sweeps (default 100)
       --repair-rounds N  at most N repair rounds while elements are not proven valid
-                      (split their edges on curved faces, flip slivers away, or refine around
-                      them; then curve, optimise and check again); default 8, 0 for none
+                      (split their edges on curved faces, flip slivers away, remesh the
+                      cavity around them, or refine around them; then curve, optimise and
+                      check again); default 8, 0 for none
       --time-limit S  each optimiser run stops after S seconds with its best state
                       (report: "stopped": "time budget"); default 0, no limit
       --no-heal       check the CAD only; do not sew, fix or merge small edges and faces

@@ -39,8 +39,8 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        "mesh yet, the job fails naming its stage; 0: no limit"},
       {"repair_rounds", "RepairRounds", "--repair-rounds", "repair rounds", ParameterKind::Integer,
        0, 20, false, 8, false, "mesh",
-       "Most repair rounds while elements are not proven valid (split, flip or refine around "
-       "them, curve, optimise and check again)"},
+       "Most repair rounds while elements are not proven valid (split, flip, remesh or refine "
+       "around them, curve, optimise and check again)"},
       {"threads", "Threads", "--threads", "threads", ParameterKind::Integer, 1, 1024, false, 1,
        false, "mesh", "Threads the sizing octree and the optimiser use"},
       {"min_delta", "MinDelta", "--min-delta", "MinDelta", ParameterKind::Length, 0, kNoLimit, true,
