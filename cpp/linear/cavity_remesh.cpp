@@ -98,15 +98,7 @@ double tetVolume(const Mesh& mesh, const std::int64_t* v) {
 
 CavityOutcome remeshCavities(Mesh& mesh, const std::vector<std::size_t>& cells,
                              const LinearMeshOptions& options) {
-  if (mesh.dim != 3 || mesh.order != 1)
-    throw ParameterError("cavity remeshing needs a linear volume mesh (order 1, 3D)");
-  ElementBlock* found = nullptr;
-  for (ElementBlock& b : mesh.blocks) {
-    if (cellDimension(b.type) != 3) continue;
-    if (b.type != CellType::Tetrahedron || found != nullptr)
-      throw ParameterError("cavity remeshing needs the cells in one block of tetrahedra");
-    found = &b;
-  }
+  const ElementBlock* found = tetrahedronBlock(mesh, "cavity remeshes");
   if (found == nullptr) throw ParameterError("cavity remeshing: the mesh has no tetrahedra");
   const ElementBlock& tets = *found;
   const std::size_t count = tets.count();

@@ -19,6 +19,19 @@ double simplexVolumeAt(const Mesh& mesh, const std::array<Eigen::Vector3d, 4>& p
 
 }  // namespace
 
+ElementBlock* tetrahedronBlock(Mesh& mesh, const std::string& what) {
+  if (mesh.dim != 3 || mesh.order != 1)
+    throw ParameterError(what + " need a linear volume mesh (order 1, 3D)");
+  ElementBlock* block = nullptr;
+  for (ElementBlock& b : mesh.blocks) {
+    if (cellDimension(b.type) != 3) continue;
+    if (b.type != CellType::Tetrahedron || block != nullptr)
+      throw ParameterError(what + " need the cells in one block of tetrahedra");
+    block = &b;
+  }
+  return block;
+}
+
 std::set<MeshEdge> boundaryEdges(const Mesh& mesh) {
   std::set<MeshEdge> edges;
   for (const ElementBlock& block : mesh.blocks) {

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <limits>
 #include <set>
+#include <string>
 
 #include "core/mesh.hpp"
 
@@ -37,6 +38,11 @@ inline Eigen::Vector3d nodePoint(const Mesh& mesh, std::int64_t i) {
 // The edges of the mesh's lower-dimensional cells (boundary triangles' edges in 3D, boundary
 // lines in 2D), smaller id first.
 std::set<MeshEdge> boundaryEdges(const Mesh& mesh);
+
+// The block holding a linear volume mesh's tetrahedra, or nullptr when it has none. Throws
+// ParameterError naming `what` ("flips") when the mesh is not linear and 3D, or its cells are
+// not all tetrahedra in one block (what local changes to its connectivity need).
+ElementBlock* tetrahedronBlock(Mesh& mesh, const std::string& what);
 
 // Signed volume (3D) or area against mesh.planeNormal (2D) of the simplex on `nodes`.
 double simplexVolume(const Mesh& mesh, const std::int64_t* nodes);

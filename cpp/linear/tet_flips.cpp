@@ -341,15 +341,7 @@ double tetShape(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eige
 
 FlipOutcome flipAwayCells(Mesh& mesh, const std::vector<std::size_t>& cells,
                           const std::vector<double>& positions) {
-  if (mesh.dim != 3 || mesh.order != 1)
-    throw ParameterError("flips need a linear volume mesh (order 1, 3D)");
-  ElementBlock* block = nullptr;
-  for (ElementBlock& b : mesh.blocks) {
-    if (cellDimension(b.type) != 3) continue;
-    if (b.type != CellType::Tetrahedron || block != nullptr)
-      throw ParameterError("flips need the cells in one block of tetrahedra");
-    block = &b;
-  }
+  ElementBlock* block = tetrahedronBlock(mesh, "flips");
   if (block == nullptr) return {};
   if (!positions.empty() && positions.size() != mesh.xyz.size())
     throw ParameterError("flips: " + std::to_string(positions.size()) + " position values for " +

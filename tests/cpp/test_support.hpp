@@ -1,10 +1,12 @@
 // Shared helpers of the C++ tests: analytic CAD shapes, temporary files, mesh measures.
 #pragma once
 
+#include <BOPAlgo_Builder.hxx>
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakeSolid.hxx>
 #include <BRepBuilderAPI_NurbsConvert.hxx>
+#include <BRepBuilderAPI_Transform.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
@@ -26,6 +28,7 @@
 #include <string>
 
 #include "cad/cad_model.hpp"
+#include "core/error.hpp"
 #include "core/mesh.hpp"
 
 namespace homesh::test {
@@ -79,6 +82,19 @@ inline TopoDS_Shape nurbsTorus(double major, double minor) {
 }
 inline TopoDS_Shape box(double x, double y, double z) {
   return BRepPrimAPI_MakeBox(x, y, z).Shape();
+}
+
+// Two unit boxes side by side along x, sharing the face x = 1: a general fuse keeps both solids
+// and the shared face once (11 faces).
+inline TopoDS_Shape twoBoxes() {
+  BOPAlgo_Builder builder;
+  builder.AddArgument(box(1.0, 1.0, 1.0));
+  gp_Trsf shift;
+  shift.SetTranslation(gp_Vec(1.0, 0.0, 0.0));
+  builder.AddArgument(BRepBuilderAPI_Transform(box(1.0, 1.0, 1.0), shift, true).Shape());
+  builder.Perform();
+  if (builder.HasErrors()) throw Error("two boxes: the general fuse failed");
+  return builder.Shape();
 }
 
 // A 4 x 4 x 2 box with a vertical hole of radius 1 through its centre (7 faces).

@@ -4,8 +4,6 @@
 // face, the cells far from the request as they were, the other solid untouched.
 #include <gtest/gtest.h>
 
-#include <BOPAlgo_Builder.hxx>
-#include <BRepBuilderAPI_Transform.hxx>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -181,14 +179,8 @@ TEST(CavityRemesh, RandomRequestsKeepTheMeshConforming) {
 // Two boxes sharing a face (a general fuse keeps both solids and the face once). A cavity around
 // a cell of one solid at the shared face stays in that solid; the other's cells are as they were.
 TEST(CavityRemesh, ACavityStaysInItsSolid) {
-  BOPAlgo_Builder builder;
-  builder.AddArgument(test::box(1.0, 1.0, 1.0));
-  gp_Trsf shift;
-  shift.SetTranslation(gp_Vec(1.0, 0.0, 0.0));
-  builder.AddArgument(BRepBuilderAPI_Transform(test::box(1.0, 1.0, 1.0), shift, true).Shape());
-  builder.Perform();
-  ASSERT_FALSE(builder.HasErrors());
-  const CadModel cad = test::toModel(builder.Shape());
+  const CadModel cad = test::toModel(test::twoBoxes());
+  ASSERT_EQ(cad.numSolids(), 2);
   const Mesh original = generateLinearMesh(cad, LinearMeshOptions::uniform(0.3));
   const ElementBlock& cells = tetBlock(original);
   std::map<int, std::set<std::int64_t>> nodesOf;

@@ -3,8 +3,6 @@
 // EPS halving, several solids.
 #include <gtest/gtest.h>
 
-#include <BOPAlgo_Builder.hxx>
-#include <BRepBuilderAPI_Transform.hxx>
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -147,14 +145,8 @@ TEST(SizingPipeline, HalvingEpsRefinesTheSphereAsTheChordFormulaPredicts) {
 
 TEST(SizingPipeline, SeveralSolidsWithAnInternalFace) {
   // Two boxes sharing a face (general fuse keeps both solids and the shared face once).
-  BOPAlgo_Builder builder;
-  builder.AddArgument(test::box(1.0, 1.0, 1.0));
-  gp_Trsf shift;
-  shift.SetTranslation(gp_Vec(1.0, 0.0, 0.0));
-  builder.AddArgument(BRepBuilderAPI_Transform(test::box(1.0, 1.0, 1.0), shift, true).Shape());
-  builder.Perform();
-  ASSERT_FALSE(builder.HasErrors());
-  const CadModel cad = test::toModel(builder.Shape());
+  const TopoDS_Shape twoBoxes = test::twoBoxes();
+  const CadModel cad = test::toModel(twoBoxes);
   ASSERT_EQ(cad.numSolids(), 2);
   SizingParameters p;
   p.minDelta = 0.1;
@@ -166,8 +158,7 @@ TEST(SizingPipeline, SeveralSolidsWithAnInternalFace) {
   MeshingOptions options;
   options.order = 1;
   options.sizing = p;
-  const MeshResult r =
-      runMeshPipeline(CadSource::brepText(test::brepText(builder.Shape())), options);
+  const MeshResult r = runMeshPipeline(CadSource::brepText(test::brepText(twoBoxes)), options);
   const auto actual = static_cast<double>(r.mesh.numElements());
   // Promised 10 %; measured 0.964 .. 0.972 over 1e-12 perturbations of the boxes' size.
   EXPECT_NEAR(r.sizing->prediction.elements / actual, 1.0, 0.10);
