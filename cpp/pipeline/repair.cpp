@@ -225,7 +225,6 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
     const RefinementSource sphere =
         RefinementSource::sphere(centroid, longest, 0.5 * total / edgeCount);
     plan.allSources.push_back(sphere);
-    plan.flagged.push_back(c);
     std::vector<CurvedFaceEdge> edges;
     if (finder) {
       edges = finder->interior(c);

@@ -98,7 +98,6 @@ struct RepairPlan {
   std::vector<RefinementSource> allSources;  // spheres around every flagged cell
   std::size_t splitCells = 0, refineCells = 0;
   std::vector<std::size_t> unsplit;  // the flagged cells without an edge to split (`sources`)
-  std::vector<std::size_t> flagged;  // every flagged cell (`allSources`)
 };
 
 // Locates the elements whose verdict is not Valid (`validity` per element of the curved mesh,
