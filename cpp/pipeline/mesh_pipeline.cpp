@@ -767,6 +767,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
         LinearMeshOptions o = linearOptions;
         limitGmsh(o, name);
         const CavityOutcome cavities = remeshCavities(next, cells, o);
+        compactNodes(next);  // the removed cells' inner nodes (reuse matches cells by position)
         record.cavities = cavities.cavities;
         record.elements = cells.size();
         remeshed = cavities.cavities > 0;

@@ -71,7 +71,12 @@ def parameter_widget(obj, prop):
                                                 ", or 0 for automatic"
                                                 if p["zero_is_automatic"] else ""))
     widget.setObjectName(prop)
-    widget.setMinimumWidth(60)
+    # Wide enough for "automatic" (or a few digits) beside the arrows: with the size policy
+    # below the layout would otherwise squeeze it to "tomatic".
+    metrics = widget.fontMetrics()
+    advance = getattr(metrics, "horizontalAdvance", metrics.width)
+    widget.setMinimumWidth(max(60, advance("automatic" if p["zero_is_automatic"] else "0000")
+                               + 40))
     widget.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Fixed)
     return widget
 
