@@ -48,7 +48,7 @@ def _length_unit():
 
 def parameter_widget(obj, prop):
     """A spin box for table property ``prop`` of ``obj``: its range, its unit, its doc and range
-    as the tooltip, 0 shown as "automatic" where 0 means that."""
+    as the tooltip, 0 shown as "auto" where 0 means automatic."""
     p = definition(prop)
     value = value_of(obj, prop)
     if p["kind"] == "integer":
@@ -57,7 +57,9 @@ def parameter_widget(obj, prop):
         widget.setValue(int(value))
     else:
         widget = QtWidgets.QDoubleSpinBox()
-        widget.setDecimals(6 if p["kind"] == "length" else 4)
+        # Seconds need no more than a tenth (600.0000 did not fit the panel's field).
+        seconds = p["key"].endswith("_seconds")
+        widget.setDecimals(6 if p["kind"] == "length" else 1 if seconds else 4)
         low = 0.0 if p["zero_is_automatic"] or p["min_exclusive"] else p["min"]
         high = p["max"] if p["max"] != float("inf") else 1e9
         widget.setRange(low, high)
@@ -66,17 +68,13 @@ def parameter_widget(obj, prop):
             widget.setSuffix(_length_unit())
         widget.setValue(value)
     if p["zero_is_automatic"]:
-        widget.setSpecialValueText("automatic")
+        # "auto": the panel's narrow field showed "automatic" as "tomatic"; the tooltip says it.
+        widget.setSpecialValueText("auto")
     widget.setToolTip("%s.\nAllowed: %s%s." % (p["doc"], p["range"],
                                                 ", or 0 for automatic"
                                                 if p["zero_is_automatic"] else ""))
     widget.setObjectName(prop)
-    # Wide enough for "automatic" (or a few digits) beside the arrows: with the size policy
-    # below the layout would otherwise squeeze it to "tomatic".
-    metrics = widget.fontMetrics()
-    advance = getattr(metrics, "horizontalAdvance", metrics.width)
-    widget.setMinimumWidth(max(60, advance("automatic" if p["zero_is_automatic"] else "0000")
-                               + 40))
+    widget.setMinimumWidth(60)
     widget.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Fixed)
     return widget
 

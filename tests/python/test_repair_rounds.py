@@ -168,3 +168,21 @@ def test_a_sliver_the_splits_leave_is_flipped_away(homesh_bin, tmp_path):
     quality = data["quality"]
     assert quality["invalid_elements"] == quality["undecided_elements"] == 0
     assert gmsh_worst(msh) > 0.0
+
+
+def test_a_failed_split_is_followed_by_a_whole_refine_not_a_cavity_remesh(homesh_bin, tmp_path):
+    """Size 1.4, order 4, with the optimiser: the first round's splits (edges on the sphere) make
+    things worse; the offenders' trouble is the curved boundary, which a cavity remesh keeps as
+    it is, so the next round refines the whole model (a finer sphere) and the mesh is certified
+    valid. (Remeshing cavities there instead cycled split / remesh for all 8 rounds and ended
+    with 9 to 11 invalid elements.)"""
+    msh, report = tmp_path / "r.msh", tmp_path / "r.json"
+    result = run([homesh_bin, "mesh", SPHERE_BOX, "--size", "1.4", "--order", "4", "--optimise",
+                  "-o", msh, "--report", report])
+    assert result.returncode == 0, result.stderr
+    rounds = json.loads(report.read_text())["rounds"]
+    actions = [(r["action"], r["kept"]) for r in rounds]
+    assert actions[0] == ("split", False), actions
+    assert actions[1] == ("refine", True), actions
+    assert all(r["cavities"] == 0 for r in rounds)
+    assert gmsh_worst(msh) > 0.0
