@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -166,10 +167,14 @@ CavityOutcome remeshCavities(Mesh& mesh, const std::vector<std::size_t>& cells,
   for (std::size_t c = 0; c < count; ++c)
     if (marked[c] != 0) cavities[root(c)].push_back(c);
 
-  // Each cavity filled again, on a copy: a failure leaves the mesh as it was.
+  // Each cavity filled again, on a copy: a failure leaves the mesh as it was. Gmsh gets a mesh
+  // of the cavity's surface nodes alone, so that a fill (and its copy to and from a child
+  // process, isolated) costs the cavity's size, not the model's; all the fills share
+  // options.timeLimit.
   Mesh work = mesh;
   ElementBlock added;
   added.type = CellType::Tetrahedron;
+  const auto started = std::chrono::steady_clock::now();
   for (const auto& [rootCell, members] : cavities) {
     const int solid = tets.entity[rootCell];
     std::set<Triangle> own;  // the cavity's faces, as keys
@@ -182,17 +187,43 @@ CavityOutcome remeshCavities(Mesh& mesh, const std::vector<std::size_t>& cells,
           longest = std::max(longest, (nodePoint(mesh, v[i]) - nodePoint(mesh, v[j])).norm());
       for (const auto& f : kOutwardFaces) own.insert(sortedKey({v[f[0]], v[f[1]], v[f[2]]}));
     }
+    Mesh local;
+    std::map<std::int64_t, std::int64_t> toLocal;
+    std::vector<std::int64_t> toWork;  // local node -> node of `work`
     std::vector<Triangle> boundary;
-    for (const auto& [key, t] : surface)
-      if (key.first == solid && own.count(key.second) > 0) boundary.push_back(t);
+    for (const auto& [key, t] : surface) {
+      if (key.first != solid || own.count(key.second) == 0) continue;
+      Triangle mapped{};
+      for (int i = 0; i < 3; ++i) {
+        const std::int64_t n = t[static_cast<std::size_t>(i)];
+        auto [it, fresh] = toLocal.emplace(n, static_cast<std::int64_t>(toWork.size()));
+        if (fresh) {
+          const auto k = static_cast<std::size_t>(n);
+          local.addNode(&mesh.xyz[3 * k], mesh.nodeCadDim[k], mesh.nodeCadIndex[k],
+                        mesh.nodeCadParam[2 * k], mesh.nodeCadParam[2 * k + 1]);
+          toWork.push_back(n);
+        }
+        mapped[static_cast<std::size_t>(i)] = it->second;
+      }
+      boundary.push_back(mapped);
+    }
     // Sizes from the surface: no cap below the cavity's longest edge.
     LinearMeshOptions fillOptions = options;
     fillOptions.sizeField = nullptr;
     fillOptions.size = longest;
+    if (options.timeLimit > 0.0) {
+      const double spent =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      fillOptions.timeLimit = std::max(options.timeLimit - spent, 1e-3);
+    }
     const std::string what =
         "a cavity of " + std::to_string(members.size()) + " cells in Solid" + std::to_string(solid);
-    const ElementBlock cavityCells =
-        fillTetrahedra(work, boundary, fillOptions, solid, {what, " (its surface is closed)"});
+    ElementBlock cavityCells =
+        fillTetrahedra(local, boundary, fillOptions, solid, {what, " (its surface is closed)"});
+    for (std::size_t n = toWork.size(); n < local.numNodes(); ++n)
+      toWork.push_back(work.addNode(&local.xyz[3 * n], local.nodeCadDim[n], local.nodeCadIndex[n],
+                                    local.nodeCadParam[2 * n], local.nodeCadParam[2 * n + 1]));
+    for (std::int64_t& n : cavityCells.nodes) n = toWork[static_cast<std::size_t>(n)];
     double filled = 0.0;
     for (std::size_t c = 0; c < cavityCells.count(); ++c) {
       const double v = tetVolume(work, cavityCells.element(c));

@@ -555,8 +555,6 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
   return state;
 }
 
-// The geometry stage (left out once the job's budget is spent: it only measures), then the
-// job's record.
 // The closing note of a mesh with elements not proven valid: how many, where on the CAD, and
 // what was tried on them (the optimiser, the repair rounds and their actions), so that a one-line
 // message names the stage that gave up and the entity. `linearGiven`: the caller gave the linear
@@ -570,8 +568,9 @@ std::string notValidNote(const MeshResult& result, bool linearGiven) {
   const std::string where = notValidLocation(result.mesh, q);
   if (!where.empty()) text += " " + where;
   text += result.options.optimiseIterations == 0
-              ? "; the optimiser did not run (" + parameterText("optimise") +
-                    " 0; optimising may make them valid)"
+              ? std::string(
+                    "; the optimiser did not run (--optimise, Python optimise > 0, "
+                    "FreeCAD OptimiserIterations > 0 may make them valid)")
               : std::string("; after the optimiser");
   if (linearGiven) return text + "; no repair rounds (the linear mesh was given)";
   if (result.rounds.empty())
@@ -593,6 +592,8 @@ std::string notValidNote(const MeshResult& result, bool linearGiven) {
   return text;
 }
 
+// The geometry stage (left out once the job's budget is spent: it only measures), then the
+// job's record.
 void finishJob(MeshResult& result, JobBudget& budget, PipelineObserver* observer,
                bool linearGiven) {
   if (result.quality.invalid + result.quality.undecided > 0)
@@ -700,8 +701,13 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   bool splitFailed = false;   // the last round split and made things worse: refine instead
   bool flipFailed = false;    // the last round flipped and made things worse: refine instead
   bool remeshFailed = false;  // the last round remeshed cavities and made things worse: refine
+  // Flips and remeshes already tried on the best mesh (and not kept): not tried on it again
+  // until a round is kept, so that a failed flip and a failed remesh cannot take turns for
+  // every round (each flag alone only covers the round after it).
+  bool flipTriedOnBest = false, remeshTriedOnBest = false;
   for (int round = 1; round <= options.repairRounds; ++round) {
-    const CurvedState& from = last && !splitFailed && !flipFailed && !remeshFailed ? *last : best;
+    const bool fromBest = !(last && !splitFailed && !flipFailed && !remeshFailed);
+    const CurvedState& from = fromBest ? best : *last;
     const bool poor = from.notValid() == 0;  // only elements below kPoorElement are left
     if (poor && (!(from.quality.scaled.min < kPoorElement) || splitFailed || options.boundaryLayer))
       break;
@@ -737,7 +743,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     // Flagged cells with no edge to split (slivers with vertices inside, which the optimiser
     // could not inflate) are flipped away where a flip makes better cells, judged where the
     // optimiser left the vertices: local, where a refinement remeshes the whole model.
-    if (plan.splits.empty() && !flipFailed && !options.boundaryLayer &&
+    if (plan.splits.empty() && !(fromBest && flipTriedOnBest) && !options.boundaryLayer &&
         options.optimiseIterations > 0 && from.linear.dim == 3) {
       next = from.linear;
       try {
@@ -759,9 +765,10 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     // a cavity's new cells are curved as they come, on the same boundary triangles: only a finer
     // boundary helps there too.
     bool remeshed = false;
-    if (plan.splits.empty() && record.flips == 0 && !remeshFailed && !options.boundaryLayer &&
-        options.optimiseIterations > 0 && from.linear.dim == 3) {
+    if (plan.splits.empty() && record.flips == 0 && !(fromBest && remeshTriedOnBest) &&
+        !options.boundaryLayer && options.optimiseIterations > 0 && from.linear.dim == 3) {
       const std::vector<std::size_t>& cells = plan.unsplit;
+      record.elements = cells.size();
       next = from.linear;
       try {
         LinearMeshOptions o = linearOptions;
@@ -769,7 +776,6 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
         const CavityOutcome cavities = remeshCavities(next, cells, o);
         compactNodes(next);  // the removed cells' inner nodes (reuse matches cells by position)
         record.cavities = cavities.cavities;
-        record.elements = cells.size();
         remeshed = cavities.cavities > 0;
       } catch (const ParameterError& e) {
         result.notes.push_back(name + ": no local remesh (" + e.what() + "); refined instead");
@@ -854,6 +860,12 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     splitFailed = !record.kept && (record.action == "split" || record.action == "split poor");
     flipFailed = !record.kept && record.action == "flip";
     remeshFailed = !record.kept && record.action == "remesh";
+    if (record.kept) {
+      flipTriedOnBest = remeshTriedOnBest = false;
+    } else if (fromBest) {
+      flipTriedOnBest = flipTriedOnBest || record.action == "flip";
+      remeshTriedOnBest = remeshTriedOnBest || record.action == "remesh";
+    }
     if (record.kept) {
       best = std::move(state);
       last.reset();

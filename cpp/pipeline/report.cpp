@@ -70,8 +70,10 @@ std::string notValidLocation(const Mesh& mesh, const QualitySummary& quality,
     if (first.empty())
       for (int e : second) ++count[{1, e}];
     if (first.empty() && second.empty() && f.entity > 0) ++count[{mesh.dim, -f.entity}];
-    classified = classified || !f.cadFaces.empty() || !f.cadCurves.empty();
   }
+  // A mesh made from CAD has classified nodes (a mesh read from a file has none).
+  for (std::size_t n = 0; n < mesh.nodeCadIndex.size() && !classified; ++n)
+    classified = mesh.nodeCadIndex[n] > 0;
   if (!classified) return {};
   std::vector<std::pair<std::pair<int, int>, std::size_t>> order(count.begin(), count.end());
   // Most elements first; then boundary entities of the higher dimension, then inside.
