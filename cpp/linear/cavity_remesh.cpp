@@ -91,10 +91,6 @@ std::set<std::pair<int, std::int64_t>> nonManifoldVertices(
   return bad;
 }
 
-double tetVolume(const Mesh& mesh, const std::int64_t* v) {
-  return simplexVolume(mesh, v);
-}
-
 }  // namespace
 
 CavityOutcome remeshCavities(Mesh& mesh, const std::vector<std::size_t>& cells,
@@ -181,7 +177,7 @@ CavityOutcome remeshCavities(Mesh& mesh, const std::vector<std::size_t>& cells,
     double removed = 0.0, longest = 0.0;
     for (const std::size_t c : members) {
       const std::int64_t* v = tets.element(c);
-      removed += tetVolume(mesh, v);
+      removed += simplexVolume(mesh, v);
       for (int i = 0; i < 4; ++i)
         for (int j = i + 1; j < 4; ++j)
           longest = std::max(longest, (nodePoint(mesh, v[i]) - nodePoint(mesh, v[j])).norm());
@@ -226,7 +222,7 @@ CavityOutcome remeshCavities(Mesh& mesh, const std::vector<std::size_t>& cells,
     for (std::int64_t& n : cavityCells.nodes) n = toWork[static_cast<std::size_t>(n)];
     double filled = 0.0;
     for (std::size_t c = 0; c < cavityCells.count(); ++c) {
-      const double v = tetVolume(work, cavityCells.element(c));
+      const double v = simplexVolume(work, cavityCells.element(c));
       if (!(v > 0.0))
         throw MeshingError("Gmsh's fill of " + what + " has a cell of non-positive volume");
       filled += v;

@@ -338,18 +338,21 @@ constexpr int kPlainSplitAttempts = 3;
 // (the layer's included) a second optimiser run may move.
 constexpr int kLayerReleaseLayers = 4;
 
+// How to set a parameter: "--job-time-limit, Python job_seconds, FreeCAD JobTimeLimit".
+std::string settingsOf(const char* key) {
+  const ParameterDefinition& p = parameterDefinition(key);
+  return std::string(p.option) + ", Python " + p.key + ", FreeCAD " + p.property;
+}
+
 // How messages name a time-limit parameter: "linear meshing time limit: --linear-time-limit,
 // Python linear_seconds, FreeCAD LinearTimeLimit".
 std::string limitName(const char* key) {
-  const ParameterDefinition& p = parameterDefinition(key);
-  return std::string(p.label) + ": " + p.option + ", Python " + p.key + ", FreeCAD " + p.property;
+  return std::string(parameterDefinition(key).label) + ": " + settingsOf(key);
 }
 
 // "repair rounds (--repair-rounds, Python repair_rounds, FreeCAD RepairRounds)".
 std::string parameterText(const char* key) {
-  const ParameterDefinition& p = parameterDefinition(key);
-  return std::string(p.label) + " (" + p.option + ", Python " + p.key + ", FreeCAD " + p.property +
-         ")";
+  return std::string(parameterDefinition(key).label) + " (" + settingsOf(key) + ")";
 }
 
 // Seconds in messages: three digits are enough ("3.19 s").
@@ -366,8 +369,7 @@ std::string jobLimitName(const JobBudget& budget) {
          formatNumber(budget.seconds()) + " s";
 }
 std::string jobLimitSettings() {
-  const ParameterDefinition& p = parameterDefinition("job_seconds");
-  return std::string(p.option) + ", Python " + p.key + ", FreeCAD " + p.property;
+  return settingsOf("job_seconds");
 }
 
 // "the job time limit of 120 s (--job-time-limit, Python job_seconds, FreeCAD JobTimeLimit)".
@@ -756,6 +758,19 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       }
     }
     StageClock clock(name, result.timings, observer);
+    // A Gmsh run of the round failed (or was stopped by the budget): the round is recorded with
+    // why, and the rounds end with the best mesh so far.
+    const auto recordFailedRound = [&](const MeshingError& e) {
+      record.failure = e.what();
+      if (dynamic_cast<const BudgetExceeded*>(&e) != nullptr && gmshByBudget) {
+        budget.cut(name);
+        record.budgetStopped = true;
+      }
+      record.seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      result.rounds.push_back(record);
+      clock.done();
+    };
     // Nothing to split or flip: the cavities around the offenders are meshed again and the rest
     // of the mesh stays; where that fails, or made things worse the last time, the whole model
     // is meshed again, finer around them, instead. A cavity keeps its boundary triangles, so
@@ -782,14 +797,8 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       } catch (const MeshingError& e) {
         if (dynamic_cast<const BudgetExceeded*>(&e) != nullptr && gmshByBudget) {
           // The budget ran out inside Gmsh: the rounds end, the best stays.
-          budget.cut(name);
-          record.budgetStopped = true;
           record.action = "remesh";
-          record.failure = e.what();
-          record.seconds =
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-          result.rounds.push_back(record);
-          clock.done();
+          recordFailedRound(e);
           break;
         }
         result.notes.push_back(name + ": no local remesh (" + e.what() + "); refined instead");
@@ -833,15 +842,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
         next = makeLinear(refined, false, name);
       } catch (const MeshingError& e) {
         // The refined mesh (or its layer) could not be made: the rounds end, the best stays.
-        record.failure = e.what();
-        if (dynamic_cast<const BudgetExceeded*>(&e) != nullptr && gmshByBudget) {
-          budget.cut(name);
-          record.budgetStopped = true;
-        }
-        record.seconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        result.rounds.push_back(record);
-        clock.done();
+        recordFailedRound(e);
         break;
       }
     }
@@ -862,14 +863,13 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     remeshFailed = !record.kept && record.action == "remesh";
     if (record.kept) {
       flipTriedOnBest = remeshTriedOnBest = false;
-    } else if (fromBest) {
-      flipTriedOnBest = flipTriedOnBest || record.action == "flip";
-      remeshTriedOnBest = remeshTriedOnBest || record.action == "remesh";
-    }
-    if (record.kept) {
       best = std::move(state);
       last.reset();
     } else {
+      if (fromBest) {
+        flipTriedOnBest = flipTriedOnBest || record.action == "flip";
+        remeshTriedOnBest = remeshTriedOnBest || record.action == "remesh";
+      }
       last = std::move(state);
     }
     record.seconds =

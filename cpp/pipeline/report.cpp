@@ -128,6 +128,8 @@ void appendQuality(JsonWriter& json, const Mesh& mesh, const QualitySummary& q) 
     json.endObject();
   }
   json.endObject();
+  const std::string where = notValidLocation(mesh, q);
+  if (!where.empty()) json.value("where", where);
   // Where the problems are: element index, type, CAD entity, verdict, and the interval that
   // holds its min J / max J.
   json.beginArray("flagged_elements");

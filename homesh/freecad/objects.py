@@ -369,8 +369,10 @@ def apply_result(obj, mesh, predicted=None, touch=True, values=None, npz_path=No
     obj.MinScaledJacobian = float(quality["min"])
     obj.InvalidElements = int(quality["invalid_elements"])
     obj.UndecidedElements = int(quality["undecided_elements"])
-    notes = job_notes(mesh)
-    obj.Status = summary_text(obj, mesh, quality, predicted, notes)
+    report = job_report(mesh)
+    notes = report.get("notes", [])
+    obj.Status = summary_text(obj, mesh, quality, predicted,
+                              report.get("quality", {}).get("where", ""))
     if not_valid(obj):
         FreeCAD.Console.PrintWarning("HOMesh: %s\n" % obj.Status)
     else:
@@ -388,26 +390,18 @@ def not_valid(obj):
     return obj.InvalidElements > 0 or obj.UndecidedElements > 0
 
 
-def job_notes(mesh):
-    """The notes of the job that made ``mesh`` (its report's), or [] for a mesh without a
-    report (one read back from a document)."""
+def job_report(mesh):
+    """The report of the job that made ``mesh``, or {} for a mesh without one (read back from
+    a document)."""
     try:
-        return list(mesh.report().get("notes", []))
+        return mesh.report()
     except Exception:  # noqa: BLE001 - a mesh without a pipeline result has no report
-        return []
+        return {}
 
 
-def where_not_valid(notes):
-    """From the core's closing note on a mesh not proven valid ("9 elements not proven valid
-    (...) at Face85 (3 elements), Face96 (2); after ..."): the "at ..." part, or ""."""
-    for note in notes:
-        head, _, _ = note.partition(";")
-        if " not proven valid (" in head and ") at " in head:
-            return head[head.index(") at ") + 2:]
-    return ""
-
-
-def summary_text(obj, mesh, quality, predicted=None, notes=()):
+def summary_text(obj, mesh, quality, predicted=None, where=""):
+    """``where``: the report's quality "where" (the CAD faces elements not proven valid
+    touch: "at Face7 (18 elements), Face3 (6)")."""
     text = ("%s: %d nodes, %d elements of order %d, worst scaled Jacobian %.3f"
             % (obj.Label, mesh.num_nodes, mesh.num_elements, mesh.order, quality["min"]))
     if predicted:
@@ -415,7 +409,6 @@ def summary_text(obj, mesh, quality, predicted=None, notes=()):
     if quality["invalid_elements"] or quality["undecided_elements"]:
         text += (": NOT VALID, %d invalid and %d undecided elements (worst %.3g)"
                  % (quality["invalid_elements"], quality["undecided_elements"], quality["min"]))
-        where = where_not_valid(notes)
         if where:
             text += " " + where
     else:

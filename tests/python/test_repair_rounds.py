@@ -51,6 +51,7 @@ def test_no_rounds_exits_4_with_the_mesh_written(homesh_bin, tmp_path):
     assert " at Face%d (%d element" % (min(f for f, n in per_face.items() if n == most), most) \
         in note, note
     assert "FreeCAD RepairRounds) 0" in note, note
+    assert " " + quality["where"] + ";" in note, (quality["where"], note)
     assert "homesh: note: " + note in result.stderr
 
 
