@@ -7,6 +7,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   return homesh::fuzz::readBytes(data, size, ".step", [](const std::string& path) {
     homesh::HealingRecord record;
-    homesh::healModel(homesh::CadModel::fromFile(path), false, record);
+    homesh::healModel(homesh::CadModel::fromFile(path), homesh::HealingOptions{false, false},
+                      record);
   });
 }

@@ -327,7 +327,7 @@ def _cad_source(shape, name):
 
 
 def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_octree=None,
-            name=None, threads=1):
+            name=None, threads=1, heal=True, solids_only=False):
     """The element count the linear mesh of a CAD shape will have, without making it.
 
     Builds the sizing octree (curvature sizes between min_delta and max_delta with sagitta
@@ -337,7 +337,8 @@ def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_o
     "delta": ...}``, ``{"kind": "box", "a": lo, "b": hi, "delta": ...}`` or ``{"kind":
     "curve", "edge": 3, "radius": ..., "delta": ...}``. write_octree: a .vtu path for the
     octree's leaves and sizes. shape may be a NekMesh .mcf path: its CAD (in metres) and,
-    unless given here, its sizes are used (likewise in :func:`mesh`).
+    unless given here, its sizes are used (likewise in :func:`mesh`). heal, solids_only: the
+    CAD check and healing, as for :func:`mesh` (the prediction is of the model meshed).
 
     Returns the report as a dict: "predicted_elements", "dimension" and "sizing" (parameters,
     integrals and octree statistics).
@@ -347,9 +348,10 @@ def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_o
     octree = "" if write_octree is None else os.fspath(write_octree)
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
-        text = _core.predict_brep(value, label, sizing, octree, threads)
+        text = _core.predict_brep(value, label, sizing, octree, threads, bool(heal),
+                                  bool(solids_only))
     else:
-        text = _core.predict_file(value, sizing, octree, threads)
+        text = _core.predict_file(value, sizing, octree, threads, bool(heal), bool(solids_only))
     return json.loads(text)
 
 
@@ -370,7 +372,7 @@ def size_field(shape, min_delta=None, max_delta=None, eps=None, sources=(), name
 def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
          optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=8,
          boundary_layer=None, cancel=None, optimise_seconds=0.0, linear_seconds=600.0,
-         heal=True, job_seconds=0.0):
+         heal=True, job_seconds=0.0, solids_only=False):
     """Meshes a CAD shape with curved elements of the given order.
 
     shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
@@ -416,6 +418,10 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
               sewn into a solid, OCCT-invalid shapes, edges or faces far smaller than the model),
               repair it with OpenCASCADE's shape healing; ``report()["healing"]`` says what was
               found and done (a healed model's faces are numbered afresh). False: check only.
+    solids_only
+              faces in no solid (a loose shell beside solids, shells sewing cannot close) are
+              left out, and ``report()["healing"]["left_out"]`` and a note say which and where;
+              False: such a model is refused (:class:`CadError` naming the faces).
     repair_rounds
               at most this many repair rounds (0..20) while elements are not proven valid:
               each splits the offending linear elements' edges on curved CAD faces (or refines
@@ -452,10 +458,12 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
         core = _core.mesh_brep(value, label, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds, layer, cancel, limits, bool(heal))
+                               sizing, repair_rounds, layer, cancel, limits, bool(heal),
+                               bool(solids_only))
     else:
         core = _core.mesh_file(value, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds, layer, cancel, limits, bool(heal))
+                               sizing, repair_rounds, layer, cancel, limits, bool(heal),
+                               bool(solids_only))
     return HighOrderMesh(core)
 
 

@@ -90,15 +90,17 @@ bool hasNoVolume(const TopoDS_Shape& solid, double diagonal, double& volume) {
   return volume < std::abs(props.Mass()) * kTolerance * diagonal;
 }
 
-// Whether `after` numbers its faces and edges as `before` does: the same counts, and the i-th
-// face (edge) of each has the same centre of mass within `tolerance`.
-bool sameNumbering(const TopoDS_Shape& before, const TopoDS_Shape& after, double tolerance) {
+// Whether `after` numbers its faces and edges as `before` does: the same counts (with
+// `fewer`, the same or fewer: faces and edges left out at the end keep the others' numbers),
+// and the i-th face (edge) of each has the same centre of mass within `tolerance`.
+bool sameNumbering(const TopoDS_Shape& before, const TopoDS_Shape& after, double tolerance,
+                   bool fewer = false) {
   for (const TopAbs_ShapeEnum type : {TopAbs_FACE, TopAbs_EDGE}) {
     TopTools_IndexedMapOfShape a, b;
     TopExp::MapShapes(before, type, a);
     TopExp::MapShapes(after, type, b);
-    if (a.Extent() != b.Extent()) return false;
-    for (int i = 1; i <= a.Extent(); ++i) {
+    if (fewer ? b.Extent() > a.Extent() : a.Extent() != b.Extent()) return false;
+    for (int i = 1; i <= b.Extent(); ++i) {
       GProp_GProps pa, pb;
       if (type == TopAbs_FACE) {
         BRepGProp::SurfaceProperties(a(i), pa);
@@ -113,13 +115,74 @@ bool sameNumbering(const TopoDS_Shape& before, const TopoDS_Shape& after, double
   return true;
 }
 
+// The faces of `shape` that no solid of it bounds, as their indices in its face map (1-based,
+// FaceN), and as a compound.
+struct LooseFaces {
+  std::vector<int> indices;
+  TopoDS_Compound faces;
+};
+
+LooseFaces facesInNoSolid(const TopoDS_Shape& shape) {
+  TopTools_IndexedMapOfShape all, bounding;
+  TopExp::MapShapes(shape, TopAbs_FACE, all);
+  for (TopExp_Explorer s(shape, TopAbs_SOLID); s.More(); s.Next())
+    TopExp::MapShapes(s.Current(), TopAbs_FACE, bounding);
+  LooseFaces loose;
+  BRep_Builder builder;
+  builder.MakeCompound(loose.faces);
+  for (int i = 1; i <= all.Extent(); ++i) {
+    if (bounding.Contains(all(i))) continue;
+    loose.indices.push_back(i);
+    builder.Add(loose.faces, all(i));
+  }
+  return loose;
+}
+
+// The solids of `shape` alone, in a compound (or the solid itself when there is one).
+TopoDS_Shape solidsOf(const TopoDS_Shape& shape) {
+  TopoDS_Compound solids;
+  BRep_Builder builder;
+  builder.MakeCompound(solids);
+  int n = 0;
+  for (TopExp_Explorer s(shape, TopAbs_SOLID); s.More(); s.Next(), ++n)
+    builder.Add(solids, s.Current());
+  return n == 1 ? TopExp_Explorer(shape, TopAbs_SOLID).Current() : TopoDS_Shape(solids);
+}
+
+// "Face3, Face7-Face9": FaceN names of sorted indices, runs joined, at most `max` items.
+std::string faceNames(const std::vector<int>& indices, std::size_t max = 6) {
+  std::string out;
+  std::size_t items = 0;
+  for (std::size_t i = 0; i < indices.size(); ++items) {
+    std::size_t j = i;
+    while (j + 1 < indices.size() && indices[j + 1] == indices[j] + 1) ++j;
+    if (items == max) return out + ", ...";
+    out += (out.empty() ? "" : ", ") + cadEntityName(2, indices[i]) +
+           (j > i ? "-" + cadEntityName(2, indices[j]) : std::string());
+    i = j + 1;
+  }
+  return out;
+}
+
+std::string boxText(const TopoDS_Shape& shape) {
+  Bnd_Box box;
+  BRepBndLib::AddOptimal(shape, box, /*useTriangulation=*/false, /*useShapeTolerance=*/false);
+  double x0 = 0, y0 = 0, z0 = 0, x1 = 0, y1 = 0, z1 = 0;
+  box.Get(x0, y0, z0, x1, y1, z1);
+  const auto range = [](double a, double b) {
+    return "[" + formatNumber(a) + ", " + formatNumber(b) + "]";
+  };
+  return "x " + range(x0, x1) + ", y " + range(y0, y1) + ", z " + range(z0, z1);
+}
+
 struct Findings {
   bool invalid = false, unsewn = false, openSolid = false;
   int smallEdges = 0, smallFaces = 0;
+  int facesInNoSolid = 0;                 // beside solids (a loose shell, a stray face)
   std::vector<TopoDS_Shape> emptySolids;  // solids without a face (an exporter's leftovers)
   bool any() const {
     return invalid || unsewn || openSolid || smallEdges > 0 || smallFaces > 0 ||
-           !emptySolids.empty();
+           facesInNoSolid > 0 || !emptySolids.empty();
   }
 };
 
@@ -145,6 +208,13 @@ Findings inspect(const TopoDS_Shape& shape, double diagonal, bool planar,
   if (solids.Extent() == 0 && faces.Extent() > 1 && !planar) {
     f.unsewn = true;
     problems.push_back("no solid: " + std::to_string(faces.Extent()) + " loose faces");
+  }
+  if (solids.Extent() > 0) {
+    const LooseFaces loose = facesInNoSolid(shape);
+    f.facesInNoSolid = static_cast<int>(loose.indices.size());
+    if (f.facesInNoSolid > 0)
+      problems.push_back(std::to_string(f.facesInNoSolid) + " faces in no solid (" +
+                         faceNames(loose.indices) + ")");
   }
   for (int s = 1; s <= solids.Extent(); ++s) {
     const int edge = firstFreeEdge(solids(s), edges);
@@ -182,36 +252,47 @@ Findings inspect(const TopoDS_Shape& shape, double diagonal, bool planar,
   return f;
 }
 
-// Sews the faces and makes a solid of every closed shell; nullopt when no closed shell results.
+// Sews the faces and makes a solid of every closed shell; nullopt when no closed shell results,
+// or when some face ends up in no solid and `keepOpen` is false. With `keepOpen`, the shells
+// that do not close (and faces in no shell) come back beside the solids, to be left out and
+// named by healModel.
 std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tolerance,
-                                          double diagonal, HealingRecord& record) {
+                                          double diagonal, bool keepOpen, HealingRecord& record) {
   BRepBuilderAPI_Sewing sewing(tolerance);
   sewing.Add(shape);
   sewing.Perform();
   const TopoDS_Shape sewn = sewing.SewedShape();
-  TopoDS_Compound solids;
+  TopoDS_Compound solids, rest;
   BRep_Builder builder;
   builder.MakeCompound(solids);
-  int made = 0, shellCount = 0;
+  builder.MakeCompound(rest);
+  int made = 0, shellCount = 0, restCount = 0;
   for (TopExp_Explorer shells(sewn, TopAbs_SHELL); shells.More(); shells.Next()) {
     ++shellCount;
     const TopoDS_Shell& shell = TopoDS::Shell(shells.Current());
-    if (!BRep_Tool::IsClosed(shell)) continue;
-    ShapeFix_Solid fix;
-    const TopoDS_Solid solid = fix.SolidFromShell(shell);
-    // Two faces on one boundary loop also close: a solid of no volume is no solid.
     double volume = 0.0;
-    if (hasNoVolume(solid, diagonal, volume)) continue;
+    TopoDS_Solid solid;
+    if (BRep_Tool::IsClosed(shell)) {
+      ShapeFix_Solid fix;
+      solid = fix.SolidFromShell(shell);
+    }
+    // Two faces on one boundary loop also close: a solid of no volume is no solid.
+    if (solid.IsNull() || hasNoVolume(solid, diagonal, volume)) {
+      builder.Add(rest, shell);
+      ++restCount;
+      continue;
+    }
     builder.Add(solids, solid);
     ++made;
   }
-  // Only when every face ends up in a solid, and no solid lies inside another (an inner shell
-  // is a void, not material): else the model is refused as it is, naming a free edge.
-  if (made == 0 || count(solids, TopAbs_FACE) < count(shape, TopAbs_FACE)) {
+  for (TopExp_Explorer f(sewn, TopAbs_FACE, TopAbs_SHELL); f.More(); f.Next(), ++restCount)
+    builder.Add(rest, f.Current());
+  // Only when every face ends up in a solid (or keepOpen), and no solid lies inside another (an
+  // inner shell is a void, not material): else the model is refused as it is, naming a free edge.
+  if (made == 0 || restCount > 0)
     record.sewing = "sewing closed " + std::to_string(made) + " of " +
                     std::to_string(std::max(shellCount, made)) + " shells";
-    return std::nullopt;
-  }
+  if (made == 0 || (restCount > 0 && !keepOpen)) return std::nullopt;
   // A solid is inside another when its box is and one of its vertices lies strictly inside the
   // other (a void's vertices all do; solids that merely touch, or whose boxes nest, like a
   // resistor's leads and body, have theirs on or outside it: RLF_12545.igs).
@@ -242,11 +323,15 @@ std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tole
   record.actions.push_back("sewed the faces (tolerance " + formatNumber(tolerance) + ") into " +
                            std::to_string(made) + (made == 1 ? " closed shell" : " closed shells") +
                            " and made " + (made == 1 ? "a solid of it" : "solids of them"));
+  if (restCount > 0) {
+    builder.Add(solids, rest);
+    return TopoDS_Shape(solids);
+  }
   return made == 1 ? TopoDS_Shape(TopExp_Explorer(solids, TopAbs_SOLID).Current())
                    : TopoDS_Shape(solids);
 }
 
-TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal,
+TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal, bool keepOpen,
                   HealingRecord& record) {
   if (!found.emptySolids.empty()) {
     const Handle(BRepTools_ReShape) reshape = new BRepTools_ReShape;
@@ -258,8 +343,21 @@ TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal,
   const double tolerance = kTolerance * diagonal;
   bool sewn = false;
   if (found.unsewn || found.openSolid) {
-    if (auto solids = sewIntoSolids(shape, 10.0 * tolerance, diagonal, record)) {
+    if (auto solids = sewIntoSolids(shape, 10.0 * tolerance, diagonal, keepOpen, record)) {
       shape = *solids;
+      sewn = true;
+    }
+  } else if (found.facesInNoSolid > 0) {
+    // The solids stay as they are; the faces beside them are sewn alone.
+    if (auto more = sewIntoSolids(facesInNoSolid(shape).faces, 10.0 * tolerance, diagonal, keepOpen,
+                                  record)) {
+      TopoDS_Compound both;
+      BRep_Builder builder;
+      builder.MakeCompound(both);
+      for (TopExp_Explorer s(shape, TopAbs_SOLID); s.More(); s.Next())
+        builder.Add(both, s.Current());
+      builder.Add(both, *more);
+      shape = both;
       sewn = true;
     }
   }
@@ -304,8 +402,10 @@ TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal,
 
 }  // namespace
 
-CadModel healModel(CadModel cad, bool enabled, HealingRecord& record) {
+CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& record) {
   const auto start = std::chrono::steady_clock::now();
+  const bool enabled = options.enabled;
+  const TopoDS_Shape original = occtShape(cad);
   record = HealingRecord{};
   record.enabled = enabled;
   const double diagonal = cad.boundingDiagonal();
@@ -332,7 +432,7 @@ CadModel healModel(CadModel cad, bool enabled, HealingRecord& record) {
   }
   if (enabled && found.any()) {
     const TopoDS_Shape healed = withOcctErrors("healing " + cad.sourceName(), [&] {
-      return heal(occtShape(cad), found, diagonal, record);
+      return heal(occtShape(cad), found, diagonal, options.solidsOnly, record);
     });
     if (record.changed()) {
       record.renumbered = !sameNumbering(occtShape(cad), healed, 10.0 * record.tolerance);
@@ -362,12 +462,44 @@ CadModel healModel(CadModel cad, bool enabled, HealingRecord& record) {
                      formatNumber(volume) + " for a bounding-box diagonal of " +
                      formatNumber(diagonal) + "): a zero-thickness solid cannot be meshed");
   }
+  // Some shells closed: the option that meshes them and leaves the others out is worth naming.
+  const bool someClosed = record.sewing.rfind("sewing closed 0 ", 0) != 0;
+  const std::string solidsOnlyOption =
+      "--solids-only (Python solids_only=True, FreeCAD SolidsOnly)";
   if (solids.Extent() == 0 && !planar) {
     const int edge = firstFreeEdge(shape, edges);
     throw CadError(cad.sourceName() + " is not a closed solid: it has no solid, and its " +
                    std::to_string(cad.numFaces()) + " faces do not close" +
                    (edge != 0 ? " (" + cadEntityName(1, edge) + " bounds only one face)" : "") +
-                   healed + "; HOMesh meshes solids, or planar faces in one plane (2D)");
+                   healed + "; HOMesh meshes solids, or planar faces in one plane (2D)" +
+                   (!record.sewing.empty() && someClosed && !options.solidsOnly
+                        ? "; " + solidsOnlyOption + " meshes the closed shells alone"
+                        : std::string()));
+  }
+  // Faces beside the solids would not be meshed: refused, or left out and recorded.
+  const LooseFaces loose = solids.Extent() > 0 ? facesInNoSolid(shape) : LooseFaces{};
+  if (!loose.indices.empty()) {
+    const int edge = firstFreeEdge(loose.faces, edges);
+    // Their FaceN names only while they are the file's own (healing did not renumber).
+    const std::string which = record.changed() ? "" : " (" + faceNames(loose.indices) + ")";
+    const std::string what =
+        std::to_string(loose.indices.size()) + (loose.indices.size() == 1 ? " face" : " faces") +
+        which + " in no solid, within " + boxText(loose.faces) +
+        (edge != 0 ? ": they do not close (" + cadEntityName(1, edge) + " bounds only one face)"
+                   : "");
+    if (!options.solidsOnly)
+      throw CadError(cad.sourceName() + ": " + what +
+                     (enabled
+                          ? "; healing could not make a solid of them" +
+                                (record.sewing.empty() ? std::string() : " (" + record.sewing + ")")
+                          : "; healing is off (it may close them)") +
+                     "; close them in the CAD, or mesh the solids alone: " + solidsOnlyOption);
+    record.leftOut = what;
+    cad = cadModelFromShape(solidsOf(shape), cad.sourceName());
+    record.renumbered =
+        !sameNumbering(original, occtShape(cad), 10.0 * record.tolerance, /*fewer=*/true);
+    record.facesAfter = cad.numFaces();
+    record.solidsAfter = cad.numSolids();
   }
   return cad;
 }

@@ -9,6 +9,10 @@
 // (ShapeFix_FixSmallFace). Tolerances follow the model's size: 1e-6 of its bounding-box
 // diagonal for sewing and fixing, at most 1e-3 of it for what a fix may widen a tolerance to.
 //
+// Faces that end up in no solid (a loose shell beside solids, a shell sewing cannot close) are
+// not meshed: the model is refused naming them, or, with HealingOptions::solidsOnly, left out
+// and recorded (HealingRecord::leftOut), never dropped silently.
+//
 // A model with nothing to heal is returned as it is: its FaceN numbering, which boundary layers
 // and boundary groups refer to, is unchanged. Whether a healed model's numbering changed is
 // measured and recorded (HealingRecord::renumbered).
@@ -21,6 +25,11 @@
 
 namespace homesh {
 
+struct HealingOptions {
+  bool enabled = true;      // sew and fix what the check finds; false: check only
+  bool solidsOnly = false;  // faces in no solid are left out (recorded) instead of refused
+};
+
 struct HealingRecord {
   bool enabled = true;
   double tolerance = 0.0;             // of the fixes (model units)
@@ -29,6 +38,9 @@ struct HealingRecord {
   // Why sewing made no solids of the faces, when it was tried and did not ("closed 3 of 5
   // shells"); the refusal quotes it.
   std::string sewing;
+  // The faces left out because they are in no solid (HealingOptions::solidsOnly), in words:
+  // how many, where, and why ("17 faces in no solid (they do not close: ...), within x ...").
+  std::string leftOut;
   int facesBefore = 0, facesAfter = 0;
   int solidsBefore = 0, solidsAfter = 0;
   double seconds = 0.0;
@@ -39,8 +51,10 @@ struct HealingRecord {
 };
 
 // The model to mesh: `cad` itself when the check finds nothing (or healing is off), else the
-// healed model (same source name). Fills `record`. Throws CadError when the model (healed or
-// not) has a solid whose boundary is open, naming the solid and a free edge.
-CadModel healModel(CadModel cad, bool enabled, HealingRecord& record);
+// healed model (same source name), less the faces in no solid when `options.solidsOnly`.
+// Fills `record`. Throws CadError when the model (healed or not) has a solid whose boundary is
+// open, naming the solid and a free edge, and when faces are in no solid (without
+// solidsOnly), naming them.
+CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& record);
 
 }  // namespace homesh

@@ -44,6 +44,7 @@ struct MeshCommand {
   int repairRounds = 8;            // --repair-rounds N, range and default in core/parameters.hpp
   double timeLimit = 0.0;          // --time-limit S: seconds per optimiser run (0: none)
   bool heal = true;                // --no-heal: the CAD is only checked
+  bool solidsOnly = false;         // --solids-only: faces in no solid are left out
   double linearTimeLimit = 600.0;  // --linear-time-limit S: seconds per Gmsh run (0: none)
   double jobTimeLimit = 0.0;       // --job-time-limit S: seconds for the whole job (0: none)
   // --bl-faces, --bl-thickness, --bl-layers, --bl-progression: a boundary layer (each
@@ -63,6 +64,8 @@ struct QualityCommand {
 struct PredictCommand {
   std::string input;
   SizingFlags sizing;
+  bool heal = true;         // --no-heal, as for mesh
+  bool solidsOnly = false;  // --solids-only, as for mesh
   CommonOptions common;
 };
 

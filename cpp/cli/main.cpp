@@ -151,6 +151,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
   options.linearSeconds = cmd.linearTimeLimit;
   options.jobSeconds = cmd.jobTimeLimit;
   options.heal = cmd.heal;
+  options.solidsOnly = cmd.solidsOnly;
   if (cmd.blFaces || cmd.blThickness || cmd.blLayers || cmd.blProgression) {
     homesh::BoundaryLayerParameters bl =
         options.boundaryLayer.value_or(homesh::BoundaryLayerParameters{});
@@ -247,6 +248,8 @@ int runPredict(const homesh::PredictCommand& cmd) {
   checkOutputs(c, cmd.input);
   homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.sizing, std::nullopt, c.quiet);
   setup.options.threads = c.threads;
+  setup.options.heal = cmd.heal;
+  setup.options.solidsOnly = cmd.solidsOnly;
   const homesh::SizingResult s = homesh::runSizingStage(setup.source, setup.options);
   const bool toStdout = c.report && *c.report == "-";
   if (!c.quiet) {

@@ -99,18 +99,25 @@ void checkRenumbering(const HealingRecord& healing, const MeshingOptions& option
     for (const RefinementSource& s : options.sizing->sources)
       if (s.kind == RefinementSource::Kind::Curve)
         what = "a refinement along CAD curve " + std::to_string(s.edge);
-  if (!what.empty())
-    throw ParameterError("healing changed the CAD (" + healing.actions.front() +
-                         ") and the numbering of its faces and edges, and " + what +
-                         " is given in the original numbering: repair the CAD file, or mesh "
-                         "without healing (--no-heal, heal=False, Heal off)");
+  if (what.empty()) return;
+  if (healing.actions.empty())  // renumbered by leaving faces out alone
+    throw ParameterError(
+        "leaving out the faces in no solid (--solids-only) numbered the CAD's "
+        "faces and edges afresh, and " +
+        what +
+        " is given in the original numbering: make a solid of those faces, or "
+        "remove them, in the CAD file");
+  throw ParameterError("healing changed the CAD (" + healing.actions.front() +
+                       ") and the numbering of its faces and edges, and " + what +
+                       " is given in the original numbering: repair the CAD file, or mesh "
+                       "without healing (--no-heal, heal=False, Heal off)");
 }
 
 }  // namespace
 
 SizingResult runSizingStage(const CadSource& source, const MeshingOptions& options) {
   HealingRecord healing;
-  const CadModel cad = healModel(source.load(), options.heal, healing);
+  const CadModel cad = healModel(source.load(), options.healing(), healing);
   checkRenumbering(healing, options);
   checkMeshDimension(cad, options.expectedDimension);
   SizingResult result = runSizing(cad, resolveSizing(options.sizing, cad), options.threads);
@@ -626,8 +633,10 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   JobBudget budget(options.jobSeconds);  // its clock starts here
   StageClock cad("cad", result.timings, observer);
   result.cad =
-      std::make_shared<const CadModel>(healModel(source.load(), options.heal, result.healing));
+      std::make_shared<const CadModel>(healModel(source.load(), options.healing(), result.healing));
   cad.done();
+  if (!result.healing.leftOut.empty())
+    result.notes.push_back("solids only: left out " + result.healing.leftOut);
   checkRenumbering(result.healing, options);
   checkMeshDimension(*result.cad, options.expectedDimension);
   if (!options.size) options.sizing = resolveSizing(options.sizing, *result.cad);

@@ -67,6 +67,9 @@ struct MeshingOptions {
   std::optional<BoundaryLayerParameters> boundaryLayer;
   // CAD healing after loading (cad/cad_healing.hpp); false: the model is only checked.
   bool heal = true;
+  // Faces in no solid are left out (report: healing "left_out") instead of refusing the model.
+  bool solidsOnly = false;
+  HealingOptions healing() const { return {heal, solidsOnly}; }
 
   // Throws ParameterError naming the offending parameter.
   void validate() const;

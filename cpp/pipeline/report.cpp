@@ -292,6 +292,8 @@ void appendHealing(JsonWriter& json, const HealingRecord& h) {
   json.value("tolerance", h.tolerance);
   appendStrings(json, "problems", h.problems);
   appendStrings(json, "actions", h.actions);
+  // The faces in no solid that were not meshed (solids only), in words; empty: none.
+  json.value("left_out", h.leftOut);
   // Face numbers (boundary layers, groups) are the healed model's when it was renumbered.
   json.value("renumbered", h.renumbered);
   json.value("faces_before", h.facesBefore);

@@ -402,9 +402,10 @@ void applyTimeLimits(MeshingOptions& options, const bp::object& limits) {
 MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity,
                            int optimise, const bp::object& sizing, int repairRounds,
                            const bp::object& boundaryLayer, const bp::object& limits,
-                           bool heal = true) {
+                           bool heal = true, bool solidsOnly = false) {
   MeshingOptions options;
   options.heal = heal;
+  options.solidsOnly = solidsOnly;
   applyTimeLimits(options, limits);
   if (!boundaryLayer.is_none())
     options.boundaryLayer = boundaryLayerFrom(bp::extract<bp::dict>(boundaryLayer));
@@ -421,10 +422,12 @@ MeshingOptions makeOptions(int order, const bp::object& size, int threads, int v
 // The sizing octree and prediction of a CAD source: the JSON report of `homesh predict`,
 // and the octree's leaves written to `octreePath` when it is not empty.
 std::string predict(CaseSetup setup, const bp::object& sizing, const std::string& octreePath,
-                    const std::string& input, int threads) {
+                    const std::string& input, int threads, bool heal, bool solidsOnly) {
   if (!sizing.is_none()) setup.options.sizing = sizingFrom(bp::extract<bp::dict>(sizing));
   setup.options.octreeOutput = octreePath;
   setup.options.threads = threads;
+  setup.options.heal = heal;
+  setup.options.solidsOnly = solidsOnly;
   const ReleaseGil nogil;
   return predictReportJson(runSizingStage(setup.source, setup.options), input);
 }
@@ -466,15 +469,15 @@ bp::dict sizeField(const std::string& text, const std::string& name, const bp::o
 
 // A CAD file or a NekMesh .mcf case (pipeline/case_setup.hpp).
 std::string predictFile(const std::string& path, const bp::object& sizing,
-                        const std::string& octreePath, int threads) {
-  return predict(setupCase(path), sizing, octreePath, path, threads);
+                        const std::string& octreePath, int threads, bool heal, bool solidsOnly) {
+  return predict(setupCase(path), sizing, octreePath, path, threads, heal, solidsOnly);
 }
 
 std::string predictBrep(const std::string& text, const std::string& name, const bp::object& sizing,
-                        const std::string& octreePath, int threads) {
+                        const std::string& octreePath, int threads, bool heal, bool solidsOnly) {
   CaseSetup setup;
   setup.source = CadSource::brepText(text, name);
-  return predict(setup, sizing, octreePath, name, threads);
+  return predict(setup, sizing, octreePath, name, threads, heal, solidsOnly);
 }
 
 // The parameter table (core/parameters.hpp) as a list of dicts: key, property, option, label,
@@ -566,10 +569,10 @@ int defaultRepairRounds() {
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
                 int verbosity, bp::object progress, int optimise, const bp::object& sizing,
                 int repairRounds, const bp::object& boundaryLayer, const bp::object& cancel,
-                const bp::object& limits, bool heal) {
+                const bp::object& limits, bool heal, bool solidsOnly) {
   const CaseSetup setup = setupCase(path);
   MeshingOptions options = makeOptions(order, size, threads, verbosity, optimise, sizing,
-                                       repairRounds, boundaryLayer, limits, heal);
+                                       repairRounds, boundaryLayer, limits, heal, solidsOnly);
   if (!options.size && !options.sizing) options.sizing = setup.options.sizing;
   if (!options.boundaryLayer) options.boundaryLayer = setup.options.boundaryLayer;
   options.expectedDimension = setup.options.expectedDimension;
@@ -579,10 +582,10 @@ PyMesh meshFile(const std::string& path, int order, const bp::object& size, int 
 PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
                 int threads, int verbosity, bp::object progress, int optimise,
                 const bp::object& sizing, int repairRounds, const bp::object& boundaryLayer,
-                const bp::object& cancel, const bp::object& limits, bool heal) {
+                const bp::object& cancel, const bp::object& limits, bool heal, bool solidsOnly) {
   return runPipeline(CadSource::brepText(text, name),
                      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds,
-                                 boundaryLayer, limits, heal),
+                                 boundaryLayer, limits, heal, solidsOnly),
                      std::move(progress), cancel);
 }
 
@@ -772,19 +775,22 @@ BOOST_PYTHON_MODULE(_core) {
       (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"), bp::arg("verbosity"),
        bp::arg("progress"), bp::arg("optimise") = 0, bp::arg("sizing") = bp::object(),
        bp::arg("repair_rounds") = defaultRepairRounds(), bp::arg("boundary_layer") = bp::object(),
-       bp::arg("cancel") = bp::object(), bp::arg("limits") = bp::object(), bp::arg("heal") = true));
-  bp::def("mesh_brep", &meshBrep,
-          (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
-           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
-           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = defaultRepairRounds(),
-           bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object(),
-           bp::arg("limits") = bp::object(), bp::arg("heal") = true));
+       bp::arg("cancel") = bp::object(), bp::arg("limits") = bp::object(), bp::arg("heal") = true,
+       bp::arg("solids_only") = false));
+  bp::def(
+      "mesh_brep", &meshBrep,
+      (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
+       bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
+       bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = defaultRepairRounds(),
+       bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object(),
+       bp::arg("limits") = bp::object(), bp::arg("heal") = true, bp::arg("solids_only") = false));
   bp::def("predict_file", &predictFile,
           (bp::arg("path"), bp::arg("sizing") = bp::object(), bp::arg("octree_path") = "",
-           bp::arg("threads") = 1));
+           bp::arg("threads") = 1, bp::arg("heal") = true, bp::arg("solids_only") = false));
   bp::def("predict_brep", &predictBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
-           bp::arg("octree_path") = "", bp::arg("threads") = 1));
+           bp::arg("octree_path") = "", bp::arg("threads") = 1, bp::arg("heal") = true,
+           bp::arg("solids_only") = false));
   bp::def("parameters", &parameters);
   bp::def("parameter_in_range", &parameterInRange, (bp::arg("key"), bp::arg("value")));
   bp::def(

@@ -132,6 +132,12 @@ class HighOrderMeshProxy(_Proxy, ParameterGuard):
                             "repair it with OpenCASCADE's shape healing before meshing; a "
                             "healed shape's faces are numbered afresh (see the report)")
             obj.Heal = True
+        if "SolidsOnly" not in have:
+            obj.addProperty("App::PropertyBool", "SolidsOnly", "Mesh",
+                            "Mesh the solids and leave out faces in no solid (a loose shell "
+                            "that does not close), named in the report view; off: such a "
+                            "shape is refused, naming those faces")
+            obj.SolidsOnly = False
         add_parameter_property(obj, "repair_rounds", "Mesh")
         add_parameter_property(obj, "threads", "Mesh", " Default: all cores.",
                                default=os.cpu_count() or 1)
@@ -252,6 +258,7 @@ def mesh_arguments(obj, values=None):
                  "linear_seconds": get("LinearTimeLimit"),
                  "job_seconds": get("JobTimeLimit"),
                  "heal": bool(values.get("Heal", getattr(obj, "Heal", True))),
+                 "solids_only": bool(values.get("SolidsOnly", getattr(obj, "SolidsOnly", False))),
                  "repair_rounds": int(get("RepairRounds")), "threads": int(get("Threads"))}
     sizing = values.get("Sizing", getattr(obj, "Sizing", None))
     if arguments["size"] is None and sizing is not None:
@@ -328,7 +335,8 @@ def predicted_elements(obj, job):
     else:
         sizing = {"min_delta": size, "max_delta": size}
     report = homesh.predict(job.brep_text, name=job.name, threads=arguments["threads"],
-                            **sizing)
+                            heal=arguments.get("heal", True),
+                            solids_only=arguments.get("solids_only", False), **sizing)
     return int(report["predicted_elements"])
 
 

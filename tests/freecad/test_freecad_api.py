@@ -48,6 +48,22 @@ class MeshingPartShapes(unittest.TestCase):
         m = homesh.mesh(compound, order=2, size=0.3)
         self.assertEqual(set(m.element_entity.tolist()), {1, 2})
 
+    def test_faces_in_no_solid_are_refused_or_left_out(self):
+        """A solid beside an open shell: refused naming the shell's faces, or, with
+        solids_only, the solid meshed and the faces named in the report and notes."""
+        other = Part.makeBox(1, 1, 1, FreeCAD.Vector(2, 0, 0))
+        compound = Part.makeCompound([Part.makeBox(1, 1, 1), Part.Shell(other.Faces[:5])])
+        with self.assertRaises(homesh.CadError) as refused:
+            homesh.mesh(compound, order=2, size=0.5, name="Compound")
+        self.assertIn("5 faces (Face7-Face11) in no solid", str(refused.exception))
+        self.assertIn("solids_only=True", str(refused.exception))
+        m = homesh.mesh(compound, order=2, size=0.5, solids_only=True)
+        report = m.report()
+        self.assertIn("Face7-Face11", report["healing"]["left_out"])
+        self.assertTrue(any(n.startswith("solids only: left out") for n in report["notes"]))
+        # Only the unit box is meshed (its nodes are within the CAD's 1e-7 of it).
+        self.assertLess(float(m.nodes[:, 0].max()), 1.0 + 1e-6)
+
     def test_planar_face(self):
         m = homesh.mesh(Part.makeCircle(1.0).toShape() if False else Part.Face(
             Part.Wire(Part.makeCircle(1.0))), order=4, size=0.25)

@@ -137,6 +137,24 @@ class HighOrderMeshObject(unittest.TestCase):
         exporter.export([obj], out)
         self.assertFalse(os.path.exists(out))
 
+    def test_faces_in_no_solid_fail_by_name_unless_solids_only(self):
+        import Part
+        other = Part.makeBox(1, 1, 1, FreeCAD.Vector(2, 0, 0))
+        part = self.doc.addObject("Part::Feature", "BoxAndShell")
+        part.Shape = Part.makeCompound([Part.makeBox(1, 1, 1), Part.Shell(other.Faces[:5])])
+        obj = homesh.freecad.make_high_order_mesh(self.doc, part, order=2, size=0.5)
+        self.assertFalse(obj.SolidsOnly)
+        self.doc.recompute()
+        self.assertFalse(obj.isValid())
+        self.assertIn("5 faces (Face7-Face11) in no solid", obj.Status)
+        self.assertIn("FreeCAD SolidsOnly", obj.Status)
+        obj.SolidsOnly = True
+        self.doc.recompute()
+        self.assertTrue(obj.isValid(), obj.Status)
+        mesh = homesh.freecad.get_mesh(obj)
+        self.assertIn("Face7-Face11", mesh.report()["healing"]["left_out"])
+        self.assertLess(float(mesh.nodes[:, 0].max()), 1.0 + 1e-6)
+
     def test_recompute_leaves_no_temporary_folders(self):
         before = set(os.listdir(tempfile.gettempdir()))
         part = box_with_hole(self.doc)

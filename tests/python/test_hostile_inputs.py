@@ -1,7 +1,8 @@
 """Hostile inputs (issue 15): each ends with one clear error line and exit status 1 or 2, or a
 mesh, within its limit; never a crash, a hang or a partial file. The CAD fixtures in
 tests/data/hostile were exported by FreeCAD (Part.makeCone(0.01, 0, 100) for the needle,
-five faces of a box for the open shell, two coincident opposite faces made a solid for the zero
+five faces of a box for the open shell, a unit box with five faces of another beside it at
+x 2..3 for the solid and open shell, two coincident opposite faces made a solid for the zero
 thickness, spheres of radius 1e-6 and 1e6)."""
 
 import json
@@ -70,6 +71,28 @@ def test_closed_shell_without_solid_is_healed_into_one(homesh_bin, tmp_path):
              "--bl-thickness", "0.05"], timeout=120)
     one_line_error(r, 2, "healing changed the CAD", "the boundary layer",
                    "original numbering", "--no-heal")
+
+
+def test_faces_in_no_solid_are_refused_by_name_or_left_out_with_a_note(homesh_bin, tmp_path):
+    out = tmp_path / "m.msh"
+    r = run([homesh_bin, "mesh", cad("solid_and_open_shell.step"), "--order", "2",
+             "--size", "0.25", "-o", out], timeout=120)
+    one_line_error(r, 1, "solid_and_open_shell.step", "5 faces (Face7-Face11) in no solid",
+                   "within x [2, 3]", "bounds only one face", "--solids-only")
+    assert not out.exists()
+    report = tmp_path / "r.json"
+    r = run([homesh_bin, "mesh", cad("solid_and_open_shell.step"), "--order", "2",
+             "--size", "0.25", "--solids-only", "-o", out, "--report", report], timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "homesh: note: solids only: left out 5 faces (Face7-Face11)" in r.stderr, r.stderr
+    healing = json.loads(report.read_text())["healing"]
+    assert "Face7-Face11" in healing["left_out"], healing
+    # The box's faces come first and keep their numbers.
+    assert healing["faces_after"] == 6 and healing["renumbered"] is False, healing
+    import meshio
+    points = meshio.read(out).points
+    # Only the unit box is meshed: its nodes lie on or inside it, to the CAD's tolerance (1e-7).
+    assert points[:, 0].min() > -1e-6 and points[:, 0].max() < 1.0 + 1e-6, points[:, 0].max()
 
 
 def test_a_sound_model_is_left_as_it_is(homesh_bin, data, tmp_path):

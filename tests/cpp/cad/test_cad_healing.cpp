@@ -1,16 +1,18 @@
 // The CAD check and healing: a sound model is left exactly as it is; an empty solid is removed
 // without touching the faces' numbering; faces that close are sewn into a solid; what cannot be
-// closed is refused naming a free edge.
+// closed is refused naming a free edge, or left out by name when only solids are asked for.
 #include <gtest/gtest.h>
 
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRep_Builder.hxx>
 #include <TopExp_Explorer.hxx>
+#include <TopLoc_Location.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
 #include <TopoDS_Shell.hxx>
 #include <TopoDS_Solid.hxx>
+#include <gp_Trsf.hxx>
 #include <string>
 
 #include "cad/cad_healing.hpp"
@@ -48,7 +50,7 @@ TopoDS_Shape looseFacesOf(const TopoDS_Shape& one, const TopoDS_Shape& two) {
 TEST(CadHealing, ASoundModelIsLeftAsItIs) {
   const TopoDS_Shape shape = box();
   HealingRecord record;
-  const CadModel cad = healModel(cadModelFromShape(shape, "box"), true, record);
+  const CadModel cad = healModel(cadModelFromShape(shape, "box"), {}, record);
   EXPECT_TRUE(record.problems.empty());
   EXPECT_FALSE(record.changed());
   EXPECT_FALSE(record.renumbered);
@@ -64,7 +66,7 @@ TEST(CadHealing, AnEmptySolidIsRemovedAndTheFacesKeepTheirNumbers) {
   b.MakeSolid(empty);
   b.Add(c, empty);
   HealingRecord record;
-  const CadModel cad = healModel(cadModelFromShape(c, "model"), true, record);
+  const CadModel cad = healModel(cadModelFromShape(c, "model"), {}, record);
   ASSERT_EQ(record.problems.size(), 1U);
   EXPECT_NE(record.problems[0].find("Solid2 has no face"), std::string::npos);
   EXPECT_EQ(record.solidsBefore, 2);
@@ -75,7 +77,7 @@ TEST(CadHealing, AnEmptySolidIsRemovedAndTheFacesKeepTheirNumbers) {
 
 TEST(CadHealing, FacesThatCloseAreSewnIntoASolid) {
   HealingRecord record;
-  const CadModel cad = healModel(cadModelFromShape(looseFaces(true), "faces"), true, record);
+  const CadModel cad = healModel(cadModelFromShape(looseFaces(true), "faces"), {}, record);
   EXPECT_EQ(record.solidsBefore, 0);
   EXPECT_EQ(cad.numSolids(), 1);
   EXPECT_EQ(cad.numFaces(), 6);
@@ -91,7 +93,7 @@ TEST(CadHealing, AShellInsideAnotherIsRefusedOneInAHoleIsASolid) {
   const TopoDS_Shape small = BRepPrimAPI_MakeBox(gp_Pnt(1, 1, 1), 1.0, 1.0, 1.0).Shape();
   HealingRecord voided;
   try {
-    healModel(cadModelFromShape(looseFacesOf(big, small), "a box with a void"), true, voided);
+    healModel(cadModelFromShape(looseFacesOf(big, small), "a box with a void"), {}, voided);
     FAIL() << "a box with a void was accepted";
   } catch (const CadError& e) {
     EXPECT_NE(std::string(e.what()).find("closed shells one inside another"), std::string::npos)
@@ -102,7 +104,7 @@ TEST(CadHealing, AShellInsideAnotherIsRefusedOneInAHoleIsASolid) {
   const TopoDS_Shape post = BRepPrimAPI_MakeBox(gp_Pnt(1.5, 1.5, 1), 1.0, 1.0, 2.0).Shape();
   HealingRecord record;
   const CadModel cad =
-      healModel(cadModelFromShape(looseFacesOf(frame, post), "a frame and a post"), true, record);
+      healModel(cadModelFromShape(looseFacesOf(frame, post), "a frame and a post"), {}, record);
   EXPECT_EQ(cad.numSolids(), 2);
 }
 
@@ -110,7 +112,8 @@ TEST(CadHealing, WhatCannotBeClosedIsRefusedNamingAFreeEdge) {
   for (const bool heal : {true, false}) {
     HealingRecord record;
     try {
-      healModel(cadModelFromShape(looseFaces(false), "five faces"), heal, record);
+      healModel(cadModelFromShape(looseFaces(false), "five faces"), HealingOptions{heal, false},
+                record);
       FAIL() << "five faces of a box were accepted";
     } catch (const CadError& e) {
       const std::string message = e.what();
@@ -121,6 +124,86 @@ TEST(CadHealing, WhatCannotBeClosedIsRefusedNamingAFreeEdge) {
           << message;
     }
   }
+}
+
+// A solid and, beside it, the faces of a second box (all six, or the first five: open).
+TopoDS_Shape solidAndFaces(bool all) {
+  TopoDS_Compound c;
+  BRep_Builder b;
+  b.MakeCompound(c);
+  b.Add(c, box());
+  int n = 0;
+  const TopoDS_Shape other = BRepPrimAPI_MakeBox(gp_Pnt(5, 0, 0), 1.0, 2.0, 3.0).Shape();
+  for (TopExp_Explorer f(other, TopAbs_FACE); f.More(); f.Next())
+    if (all || ++n < 6) b.Add(c, f.Current());
+  return c;
+}
+
+// Faces beside a solid are not dropped in silence: sewn into a solid of their own when they
+// close, else the model is refused naming them, or (solids only) left out and recorded.
+TEST(CadHealing, FacesBesideASolidAreSewnRefusedOrLeftOutByName) {
+  HealingRecord closed;
+  const CadModel two = healModel(cadModelFromShape(solidAndFaces(true), "two"), {}, closed);
+  EXPECT_EQ(two.numSolids(), 2);
+  EXPECT_EQ(two.numFaces(), 12);
+  EXPECT_TRUE(closed.leftOut.empty()) << closed.leftOut;
+
+  for (const bool heal : {true, false}) {
+    HealingRecord record;
+    try {
+      healModel(cadModelFromShape(solidAndFaces(false), "open"), HealingOptions{heal, false},
+                record);
+      FAIL() << "a solid beside an open shell was accepted";
+    } catch (const CadError& e) {
+      const std::string message = e.what();
+      // The box's six faces come first: the loose ones are Face7 to Face11, at x 5..6.
+      EXPECT_NE(message.find("5 faces (Face7-Face11) in no solid, within x [5, 6]"),
+                std::string::npos)
+          << message;
+      EXPECT_NE(message.find("bounds only one face"), std::string::npos) << message;
+      EXPECT_NE(message.find("--solids-only"), std::string::npos) << message;
+    }
+  }
+
+  HealingRecord record;
+  const CadModel solid = healModel(cadModelFromShape(solidAndFaces(false), "open"),
+                                   HealingOptions{true, true}, record);
+  EXPECT_EQ(solid.numSolids(), 1);
+  EXPECT_EQ(solid.numFaces(), 6);
+  EXPECT_NE(record.leftOut.find("5 faces (Face7-Face11)"), std::string::npos) << record.leftOut;
+  // The solid's faces keep their numbers: only faces after them were left out.
+  EXPECT_FALSE(record.renumbered);
+  EXPECT_EQ(record.facesBefore, 11);
+  EXPECT_EQ(record.facesAfter, 6);
+}
+
+// Loose faces of which only some close: refused with the option named; solids only meshes the
+// closed shell and records the rest.
+TEST(CadHealing, SolidsOnlyKeepsTheShellsThatCloseAndRecordsTheRest) {
+  TopoDS_Compound c;
+  BRep_Builder b;
+  b.MakeCompound(c);
+  for (TopExp_Explorer f(box(), TopAbs_FACE); f.More(); f.Next()) b.Add(c, f.Current());
+  gp_Trsf shift;
+  shift.SetTranslation(gp_Vec(5, 0, 0));
+  for (TopExp_Explorer f(looseFaces(false), TopAbs_FACE); f.More(); f.Next())
+    b.Add(c, f.Current().Moved(TopLoc_Location(shift)));
+  HealingRecord refused;
+  try {
+    healModel(cadModelFromShape(c, "some close"), {}, refused);
+    FAIL() << "a model whose faces do not all close was accepted";
+  } catch (const CadError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("sewing closed 1 of 2 shells"), std::string::npos) << message;
+    EXPECT_NE(message.find("--solids-only"), std::string::npos) << message;
+  }
+  HealingRecord record;
+  const CadModel cad =
+      healModel(cadModelFromShape(c, "some close"), HealingOptions{true, true}, record);
+  EXPECT_EQ(cad.numSolids(), 1);
+  EXPECT_EQ(cad.numFaces(), 6);
+  EXPECT_NE(record.leftOut.find("5 faces in no solid, within x [5, 6]"), std::string::npos)
+      << record.leftOut;
 }
 
 }  // namespace
