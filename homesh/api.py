@@ -356,7 +356,7 @@ def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_o
 
 
 def size_field(shape, min_delta=None, max_delta=None, eps=None, sources=(), name=None,
-               threads=1):
+               threads=1, heal=True, solids_only=False):
     """The sizing octree's leaves inside the model or on its boundary, for drawing the size
     field: a dict of numpy arrays ``centre`` (L, 3), ``half_width`` (L,), ``delta`` (L,), the
     size there, and ``boundary`` (L,) 1 where the model's boundary passes through the leaf,
@@ -366,7 +366,7 @@ def size_field(shape, min_delta=None, max_delta=None, eps=None, sources=(), name
     kind, value, label = _cad_source(shape, name)
     if kind != "brep":
         raise ParameterError("size_field takes a shape or BRep text, not a file path")
-    return dict(_core.size_field(value, label, sizing, threads))
+    return dict(_core.size_field(value, label, sizing, threads, bool(heal), bool(solids_only)))
 
 
 def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,

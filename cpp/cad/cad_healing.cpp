@@ -213,7 +213,8 @@ Findings inspect(const TopoDS_Shape& shape, double diagonal, bool planar,
     const LooseFaces loose = facesInNoSolid(shape);
     f.facesInNoSolid = static_cast<int>(loose.indices.size());
     if (f.facesInNoSolid > 0)
-      problems.push_back(std::to_string(f.facesInNoSolid) + " faces in no solid (" +
+      problems.push_back(std::to_string(f.facesInNoSolid) +
+                         (f.facesInNoSolid == 1 ? " face" : " faces") + " in no solid (" +
                          faceNames(loose.indices) + ")");
   }
   for (int s = 1; s <= solids.Extent(); ++s) {
@@ -253,11 +254,13 @@ Findings inspect(const TopoDS_Shape& shape, double diagonal, bool planar,
 }
 
 // Sews the faces and makes a solid of every closed shell; nullopt when no closed shell results,
-// or when some face ends up in no solid and `keepOpen` is false. With `keepOpen`, the shells
-// that do not close (and faces in no shell) come back beside the solids, to be left out and
-// named by healModel.
+// when some face ends up in no solid and `keepOpen` is false, or when a new solid lies inside
+// another or in one of `existing` (the model's solids the faces were sewn beside), or
+// duplicates one of those. With `keepOpen`, the shells that do not close (and faces in no
+// shell) come back beside the solids, to be left out and named by healModel.
 std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tolerance,
-                                          double diagonal, bool keepOpen, HealingRecord& record) {
+                                          double diagonal, bool keepOpen,
+                                          const TopoDS_Shape& existing, HealingRecord& record) {
   BRepBuilderAPI_Sewing sewing(tolerance);
   sewing.Add(shape);
   sewing.Perform();
@@ -285,18 +288,49 @@ std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tole
     builder.Add(solids, solid);
     ++made;
   }
-  for (TopExp_Explorer f(sewn, TopAbs_FACE, TopAbs_SHELL); f.More(); f.Next(), ++restCount)
+  int strayFaces = 0;
+  for (TopExp_Explorer f(sewn, TopAbs_FACE, TopAbs_SHELL); f.More(); f.Next(), ++strayFaces)
     builder.Add(rest, f.Current());
-  // Only when every face ends up in a solid (or keepOpen), and no solid lies inside another (an
-  // inner shell is a void, not material): else the model is refused as it is, naming a free edge.
-  if (made == 0 || restCount > 0)
+  restCount += strayFaces;
+  // Only when every face ends up in a solid (or keepOpen), none was lost on the way, and no
+  // solid lies inside another (an inner shell is a void, not material): else the model is
+  // refused as it is, naming a free edge.
+  const int lost =
+      count(shape, TopAbs_FACE) - count(solids, TopAbs_FACE) - count(rest, TopAbs_FACE);
+  if (made == 0 || restCount > 0 || lost > 0)
     record.sewing = "sewing closed " + std::to_string(made) + " of " +
-                    std::to_string(std::max(shellCount, made)) + " shells";
-  if (made == 0 || (restCount > 0 && !keepOpen)) return std::nullopt;
+                    std::to_string(std::max(shellCount, made)) +
+                    (shellCount == 1 ? " shell" : " shells") +
+                    (strayFaces > 0 ? ", " + std::to_string(strayFaces) +
+                                          (strayFaces == 1 ? " face" : " faces") + " in no shell"
+                                    : std::string()) +
+                    (lost > 0 ? ", " + std::to_string(lost) + " faces lost" : std::string());
+  // (What --solids-only could keep: the closed shells, unless faces were lost.)
+  record.sewnSolids = lost > 0 ? 0 : made;
+  if (made == 0 || lost > 0 || (restCount > 0 && !keepOpen)) return std::nullopt;
   // A solid is inside another when its box is and one of its vertices lies strictly inside the
   // other (a void's vertices all do; solids that merely touch, or whose boxes nest, like a
   // resistor's leads and body, have theirs on or outside it: RLF_12545.igs).
+  const auto boxOf = [](const TopoDS_Shape& solid) {
+    Bnd_Box box;
+    BRepBndLib::Add(solid, box);
+    return box;
+  };
   std::vector<std::pair<TopoDS_Shape, Bnd_Box>> seen;
+  if (!existing.IsNull())
+    for (TopExp_Explorer s(existing, TopAbs_SOLID); s.More(); s.Next())
+      seen.emplace_back(s.Current(), boxOf(s.Current()));
+  const std::size_t existingCount = seen.size();
+  // A copy of a solid (a surface model exported beside the body) has its vertices on the
+  // other's boundary, not inside: the same box and volume, to the sewing tolerance.
+  const auto duplicate = [&](const TopoDS_Shape& a, const Bnd_Box& aBox, const TopoDS_Shape& b,
+                             const Bnd_Box& bBox) {
+    if (aBox.CornerMin().Distance(bBox.CornerMin()) > 10.0 * tolerance ||
+        aBox.CornerMax().Distance(bBox.CornerMax()) > 10.0 * tolerance)
+      return false;
+    const double va = volumeOf(a), vb = volumeOf(b);
+    return std::abs(va - vb) <= 1e-6 * std::max(va, vb);
+  };
   const auto nested = [](const TopoDS_Shape& inner, const Bnd_Box& innerBox,
                          const TopoDS_Shape& outer, const Bnd_Box& outerBox) {
     if (outerBox.IsOut(innerBox.CornerMin()) || outerBox.IsOut(innerBox.CornerMax())) return false;
@@ -309,15 +343,24 @@ std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tole
     return false;
   };
   for (TopExp_Explorer s(solids, TopAbs_SOLID); s.More(); s.Next()) {
-    Bnd_Box box;
-    BRepBndLib::Add(s.Current(), box);
-    for (const auto& [other, otherBox] : seen)
-      if (nested(other, otherBox, s.Current(), box) || nested(s.Current(), box, other, otherBox)) {
-        record.sewing =
-            "sewing gave closed shells one inside another: a void, and which side is material "
-            "is not known";
+    const Bnd_Box box = boxOf(s.Current());
+    for (std::size_t k = 0; k < seen.size(); ++k) {
+      const auto& [other, otherBox] = seen[k];
+      const std::string where =
+          k < existingCount ? "a closed shell and " + cadEntityName(3, static_cast<int>(k) + 1)
+                            : std::string("closed shells");
+      if (duplicate(s.Current(), box, other, otherBox)) {
+        record.sewing = "sewing gave " + where + " that are copies of each other";
+        record.sewnSolids = 0;
         return std::nullopt;
       }
+      if (nested(other, otherBox, s.Current(), box) || nested(s.Current(), box, other, otherBox)) {
+        record.sewing = "sewing gave " + where +
+                        " one inside the other: a void, and which side is material is not known";
+        record.sewnSolids = 0;
+        return std::nullopt;
+      }
+    }
     seen.emplace_back(s.Current(), box);
   }
   record.actions.push_back("sewed the faces (tolerance " + formatNumber(tolerance) + ") into " +
@@ -343,19 +386,21 @@ TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal, bo
   const double tolerance = kTolerance * diagonal;
   bool sewn = false;
   if (found.unsewn || found.openSolid) {
-    if (auto solids = sewIntoSolids(shape, 10.0 * tolerance, diagonal, keepOpen, record)) {
+    // An open solid stays refused by name: solids only leaves out faces that were in no solid.
+    if (auto solids = sewIntoSolids(shape, 10.0 * tolerance, diagonal, keepOpen && !found.openSolid,
+                                    TopoDS_Shape(), record)) {
       shape = *solids;
       sewn = true;
     }
   } else if (found.facesInNoSolid > 0) {
     // The solids stay as they are; the faces beside them are sewn alone.
+    const TopoDS_Shape solids = solidsOf(shape);
     if (auto more = sewIntoSolids(facesInNoSolid(shape).faces, 10.0 * tolerance, diagonal, keepOpen,
-                                  record)) {
+                                  solids, record)) {
       TopoDS_Compound both;
       BRep_Builder builder;
       builder.MakeCompound(both);
-      for (TopExp_Explorer s(shape, TopAbs_SOLID); s.More(); s.Next())
-        builder.Add(both, s.Current());
+      builder.Add(both, solids);
       builder.Add(both, *more);
       shape = both;
       sewn = true;
@@ -462,40 +507,45 @@ CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& r
                      formatNumber(volume) + " for a bounding-box diagonal of " +
                      formatNumber(diagonal) + "): a zero-thickness solid cannot be meshed");
   }
-  // Some shells closed: the option that meshes them and leaves the others out is worth naming.
-  const bool someClosed = record.sewing.rfind("sewing closed 0 ", 0) != 0;
   const std::string solidsOnlyOption =
       "--solids-only (Python solids_only=True, FreeCAD SolidsOnly)";
   if (solids.Extent() == 0 && !planar) {
     const int edge = firstFreeEdge(shape, edges);
+    // Some shells closed: the option that meshes them and leaves the others out is worth naming.
     throw CadError(cad.sourceName() + " is not a closed solid: it has no solid, and its " +
                    std::to_string(cad.numFaces()) + " faces do not close" +
                    (edge != 0 ? " (" + cadEntityName(1, edge) + " bounds only one face)" : "") +
                    healed + "; HOMesh meshes solids, or planar faces in one plane (2D)" +
-                   (!record.sewing.empty() && someClosed && !options.solidsOnly
+                   (record.sewnSolids > 0 && !options.solidsOnly
                         ? "; " + solidsOnlyOption + " meshes the closed shells alone"
                         : std::string()));
   }
   // Faces beside the solids would not be meshed: refused, or left out and recorded.
   const LooseFaces loose = solids.Extent() > 0 ? facesInNoSolid(shape) : LooseFaces{};
   if (!loose.indices.empty()) {
-    const int edge = firstFreeEdge(loose.faces, edges);
-    // Their FaceN names only while they are the file's own (healing did not renumber).
-    const std::string which = record.changed() ? "" : " (" + faceNames(loose.indices) + ")";
+    const TopoDS_Shape kept = solidsOf(shape);
+    const bool one = loose.indices.size() == 1;
+    // Face and edge names only while they are the file's own (healing changed nothing).
+    const bool ownNumbers = !record.changed();
+    const int edge = ownNumbers ? firstFreeEdge(loose.faces, edges) : 0;
     const std::string what =
-        std::to_string(loose.indices.size()) + (loose.indices.size() == 1 ? " face" : " faces") +
-        which + " in no solid, within " + boxText(loose.faces) +
-        (edge != 0 ? ": they do not close (" + cadEntityName(1, edge) + " bounds only one face)"
+        std::to_string(loose.indices.size()) + (one ? " face" : " faces") +
+        (ownNumbers ? " (" + faceNames(loose.indices) + ")" : std::string()) +
+        " in no solid, within " + boxText(loose.faces) +
+        (edge != 0 ? (one ? ": it does not close (" : ": they do not close (") +
+                         cadEntityName(1, edge) + " bounds only one face)"
                    : "");
-    if (!options.solidsOnly)
+    if (!options.solidsOnly || count(kept, TopAbs_FACE) == 0)
       throw CadError(cad.sourceName() + ": " + what +
-                     (enabled
-                          ? "; healing could not make a solid of them" +
-                                (record.sewing.empty() ? std::string() : " (" + record.sewing + ")")
-                          : "; healing is off (it may close them)") +
-                     "; close them in the CAD, or mesh the solids alone: " + solidsOnlyOption);
-    record.leftOut = what;
-    cad = cadModelFromShape(solidsOf(shape), cad.sourceName());
+                     (!enabled ? "; healing is off (it may close them)"
+                      : record.sewing.empty()
+                          ? std::string()
+                          : "; healing could not make a solid of them (" + record.sewing + ")") +
+                     (options.solidsOnly ? "; and no solid has a face"
+                                         : "; close them in the CAD, or mesh the solids alone: " +
+                                               solidsOnlyOption));
+    record.leftOut = what + (record.sewing.empty() ? std::string() : " (" + record.sewing + ")");
+    cad = cadModelFromShape(kept, cad.sourceName());
     record.renumbered =
         !sameNumbering(original, occtShape(cad), 10.0 * record.tolerance, /*fewer=*/true);
     record.facesAfter = cad.numFaces();

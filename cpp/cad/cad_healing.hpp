@@ -38,6 +38,9 @@ struct HealingRecord {
   // Why sewing made no solids of the faces, when it was tried and did not ("closed 3 of 5
   // shells"); the refusal quotes it.
   std::string sewing;
+  // Solids sewing made (or could make, when the model was refused for faces left over): what
+  // HealingOptions::solidsOnly would keep; 0 when sewing was not tried or found a void.
+  int sewnSolids = 0;
   // The faces left out because they are in no solid (HealingOptions::solidsOnly), in words:
   // how many, where, and why ("17 faces in no solid (they do not close: ...), within x ...").
   std::string leftOut;

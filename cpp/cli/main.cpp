@@ -253,6 +253,8 @@ int runPredict(const homesh::PredictCommand& cmd) {
   const homesh::SizingResult s = homesh::runSizingStage(setup.source, setup.options);
   const bool toStdout = c.report && *c.report == "-";
   if (!c.quiet) {
+    if (!s.healing.leftOut.empty())
+      std::fprintf(stderr, "homesh: note: solids only: left out %s\n", s.healing.leftOut.c_str());
     printPrediction(s, s.octree->dim());
     if (cmd.sizing.writeOctree)
       std::fprintf(stderr, "homesh: wrote %s\n", cmd.sizing.writeOctree->c_str());

@@ -121,6 +121,7 @@ SizingResult runSizingStage(const CadSource& source, const MeshingOptions& optio
   checkRenumbering(healing, options);
   checkMeshDimension(cad, options.expectedDimension);
   SizingResult result = runSizing(cad, resolveSizing(options.sizing, cad), options.threads);
+  result.healing = std::move(healing);
   if (!options.octreeOutput.empty()) writeOctree(*result.octree, options.octreeOutput);
   return result;
 }

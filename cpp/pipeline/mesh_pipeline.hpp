@@ -98,7 +98,8 @@ void checkMeshDimension(const CadModel& cad, std::optional<int> expected);
 struct SizingResult {
   std::shared_ptr<const SizingOctree> octree;
   ElementCountPrediction prediction;
-  double seconds = 0.0;  // octree and prediction
+  double seconds = 0.0;   // octree and prediction
+  HealingRecord healing;  // runSizingStage: what the CAD check found and healing did
 };
 
 // Throws ParameterError (bad parameters, or a prediction above kMaxPredictedElements: sizes

@@ -36,6 +36,42 @@ void appendMeasure(JsonWriter& json, const std::string& key, const MeasureSummar
   json.endObject();
 }
 
+void appendStrings(JsonWriter& json, const std::string& key, const std::vector<std::string>& v) {
+  json.beginArray(key);
+  for (const std::string& text : v) json.value("", text);
+  json.endArray();
+}
+
+void appendHealing(JsonWriter& json, const HealingRecord& h) {
+  json.beginObject("healing");
+  json.value("enabled", h.enabled);
+  json.value("tolerance", h.tolerance);
+  appendStrings(json, "problems", h.problems);
+  appendStrings(json, "actions", h.actions);
+  // The faces in no solid that were not meshed (solids only), in words; empty: none.
+  json.value("left_out", h.leftOut);
+  // Face numbers (boundary layers, groups) are the healed model's when it was renumbered.
+  json.value("renumbered", h.renumbered);
+  json.value("faces_before", h.facesBefore);
+  json.value("faces_after", h.facesAfter);
+  json.value("solids_before", h.solidsBefore);
+  json.value("solids_after", h.solidsAfter);
+  json.value("seconds", h.seconds);
+  json.endObject();
+}
+
+// "job": the time budget, the wall time, and what the budget stopped early or left out.
+void appendJob(JsonWriter& json, const JobRecord& job) {
+  json.beginObject("job");
+  json.value("time_limit", job.timeLimit);
+  json.value("seconds", job.seconds);
+  json.value("reserved", job.reserved);
+  json.value("stopped", std::string(job.stopped() ? "time budget" : "finished"));
+  appendStrings(json, "cut", job.cut);
+  appendStrings(json, "skipped", job.skipped);
+  json.endObject();
+}
+
 }  // namespace
 
 void appendCounts(JsonWriter& json, const Mesh& mesh) {
@@ -218,6 +254,7 @@ std::string predictReportJson(const SizingResult& sizing, const std::string& inp
   json.value("predicted_elements",
              static_cast<std::size_t>(std::llround(sizing.prediction.elements)));
   appendSizing(json, sizing);
+  appendHealing(json, sizing.healing);
   json.endObject();
   return json.str();
 }
@@ -277,46 +314,6 @@ void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
   json.value("seconds", r.seconds);
   json.endObject();
 }
-
-namespace {
-
-void appendStrings(JsonWriter& json, const std::string& key, const std::vector<std::string>& v) {
-  json.beginArray(key);
-  for (const std::string& text : v) json.value("", text);
-  json.endArray();
-}
-
-void appendHealing(JsonWriter& json, const HealingRecord& h) {
-  json.beginObject("healing");
-  json.value("enabled", h.enabled);
-  json.value("tolerance", h.tolerance);
-  appendStrings(json, "problems", h.problems);
-  appendStrings(json, "actions", h.actions);
-  // The faces in no solid that were not meshed (solids only), in words; empty: none.
-  json.value("left_out", h.leftOut);
-  // Face numbers (boundary layers, groups) are the healed model's when it was renumbered.
-  json.value("renumbered", h.renumbered);
-  json.value("faces_before", h.facesBefore);
-  json.value("faces_after", h.facesAfter);
-  json.value("solids_before", h.solidsBefore);
-  json.value("solids_after", h.solidsAfter);
-  json.value("seconds", h.seconds);
-  json.endObject();
-}
-
-// "job": the time budget, the wall time, and what the budget stopped early or left out.
-void appendJob(JsonWriter& json, const JobRecord& job) {
-  json.beginObject("job");
-  json.value("time_limit", job.timeLimit);
-  json.value("seconds", job.seconds);
-  json.value("reserved", job.reserved);
-  json.value("stopped", std::string(job.stopped() ? "time budget" : "finished"));
-  appendStrings(json, "cut", job.cut);
-  appendStrings(json, "skipped", job.skipped);
-  json.endObject();
-}
-
-}  // namespace
 
 std::string meshReportJson(const MeshResult& result, const std::string& input) {
   JsonWriter json;

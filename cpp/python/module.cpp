@@ -436,11 +436,13 @@ std::string predict(CaseSetup setup, const bp::object& sizing, const std::string
 // "half_width" (L,), "delta" (L,) and "boundary" (L,) uint8 (1: the boundary passes through the
 // leaf), with "predicted_elements". For drawing the size field.
 bp::dict sizeField(const std::string& text, const std::string& name, const bp::object& sizing,
-                   int threads) {
+                   int threads, bool heal, bool solidsOnly) {
   CaseSetup setup;
   setup.source = CadSource::brepText(text, name);
   if (!sizing.is_none()) setup.options.sizing = sizingFrom(bp::extract<bp::dict>(sizing));
   setup.options.threads = threads;
+  setup.options.heal = heal;
+  setup.options.solidsOnly = solidsOnly;
   std::vector<double> centre, half, delta;
   std::vector<std::uint8_t> boundary;
   double predicted = 0.0;
@@ -802,9 +804,9 @@ BOOST_PYTHON_MODULE(_core) {
           (bp::arg("path"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("order"),
            bp::arg("threads"), bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise"),
            bp::arg("cancel") = bp::object(), bp::arg("limits") = bp::object()));
-  bp::def(
-      "size_field", &sizeField,
-      (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(), bp::arg("threads") = 1));
+  bp::def("size_field", &sizeField,
+          (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
+           bp::arg("threads") = 1, bp::arg("heal") = true, bp::arg("solids_only") = false));
   bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("threads") = 1));
   bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
   bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));

@@ -549,7 +549,10 @@ class SizingProxy(_Proxy, ParameterGuard):
             shape = getattr(obj.Part, "Shape", None)
             if shape is None or shape.isNull():
                 raise ValueError("%s: %s has no shape" % (obj.Label, obj.Part.Label))
-            report = homesh.predict(shape, name=obj.Part.Label, **sizing_arguments(obj))
+            # Sizes of the solids (faces in no solid left out): a mesh object without
+            # SolidsOnly refuses such a shape and says why; the sizing stays drawable.
+            report = homesh.predict(shape, name=obj.Part.Label, solids_only=True,
+                                    **sizing_arguments(obj))
         except (ValueError, homesh.HOMeshError) as e:
             obj.PredictedElements = 0
             obj.OctreeLeaves = 0

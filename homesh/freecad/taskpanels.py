@@ -408,6 +408,7 @@ class TaskPanelSizing:
                   "max_delta": values["MaxDelta"] or None, "eps": values["Eps"]}
         try:
             report = homesh.predict(self.obj.Part.Shape, name=self.obj.Part.Label,
+                                    solids_only=True,  # as the Sizing object's recompute
                                     **dict(objects.sizing_arguments(self.obj), **sizing))
         except (ValueError, homesh.HOMeshError) as e:
             self.result.setText("Cannot predict: %s" % e)

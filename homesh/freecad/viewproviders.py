@@ -326,7 +326,7 @@ class ViewProviderSizing(_Stateless, _EditsWithTaskPanel):
         import homesh
         from .objects import sizing_arguments
         try:
-            field = homesh.size_field(obj.Part.Shape, name=obj.Part.Label,
+            field = homesh.size_field(obj.Part.Shape, name=obj.Part.Label, solids_only=True,
                                       **sizing_arguments(obj))
         except (ValueError, homesh.HOMeshError):
             return  # the object's recompute reports it

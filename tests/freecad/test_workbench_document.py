@@ -154,6 +154,12 @@ class HighOrderMeshObject(unittest.TestCase):
         mesh = homesh.freecad.get_mesh(obj)
         self.assertIn("Face7-Face11", mesh.report()["healing"]["left_out"])
         self.assertLess(float(mesh.nodes[:, 0].max()), 1.0 + 1e-6)
+        # A Sizing object of the same shape sizes its solids (as before faces in no solid were
+        # refused): it stays drawable whichever way its meshes are set.
+        sizing = homesh.freecad.make_sizing(self.doc, part, max_delta=0.5)
+        self.doc.recompute()
+        self.assertTrue(sizing.isValid(), sizing.Status)
+        self.assertGreater(sizing.PredictedElements, 0)
 
     def test_recompute_leaves_no_temporary_folders(self):
         before = set(os.listdir(tempfile.gettempdir()))

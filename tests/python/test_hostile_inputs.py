@@ -93,6 +93,14 @@ def test_faces_in_no_solid_are_refused_by_name_or_left_out_with_a_note(homesh_bi
     points = meshio.read(out).points
     # Only the unit box is meshed: its nodes lie on or inside it, to the CAD's tolerance (1e-7).
     assert points[:, 0].min() > -1e-6 and points[:, 0].max() < 1.0 + 1e-6, points[:, 0].max()
+    # The prediction is of the same model: refused the same way, or of the solids alone.
+    r = run([homesh_bin, "predict", cad("solid_and_open_shell.step")], timeout=120)
+    one_line_error(r, 1, "5 faces (Face7-Face11) in no solid", "--solids-only")
+    r = run([homesh_bin, "predict", cad("solid_and_open_shell.step"), "--solids-only",
+             "--report", report], timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert "homesh: note: solids only: left out 5 faces (Face7-Face11)" in r.stderr, r.stderr
+    assert "Face7-Face11" in json.loads(report.read_text())["healing"]["left_out"]
 
 
 def test_a_sound_model_is_left_as_it_is(homesh_bin, data, tmp_path):

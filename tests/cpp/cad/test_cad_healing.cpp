@@ -96,7 +96,7 @@ TEST(CadHealing, AShellInsideAnotherIsRefusedOneInAHoleIsASolid) {
     healModel(cadModelFromShape(looseFacesOf(big, small), "a box with a void"), {}, voided);
     FAIL() << "a box with a void was accepted";
   } catch (const CadError& e) {
-    EXPECT_NE(std::string(e.what()).find("closed shells one inside another"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("closed shells one inside the other"), std::string::npos)
         << e.what();
   }
   const TopoDS_Shape frame =
@@ -177,17 +177,25 @@ TEST(CadHealing, FacesBesideASolidAreSewnRefusedOrLeftOutByName) {
   EXPECT_EQ(record.facesAfter, 6);
 }
 
+// The faces of `shape`, moved by (dx, 0, 0), all or all but the last, added to `c` loose.
+void addFaces(TopoDS_Compound& c, const TopoDS_Shape& shape, double dx, bool all) {
+  BRep_Builder b;
+  gp_Trsf shift;
+  shift.SetTranslation(gp_Vec(dx, 0, 0));
+  int k = 0, total = 0;
+  for (TopExp_Explorer f(shape, TopAbs_FACE); f.More(); f.Next()) ++total;
+  for (TopExp_Explorer f(shape, TopAbs_FACE); f.More(); f.Next())
+    if (all || ++k < total) b.Add(c, f.Current().Moved(TopLoc_Location(shift)));
+}
+
 // Loose faces of which only some close: refused with the option named; solids only meshes the
 // closed shell and records the rest.
 TEST(CadHealing, SolidsOnlyKeepsTheShellsThatCloseAndRecordsTheRest) {
   TopoDS_Compound c;
   BRep_Builder b;
   b.MakeCompound(c);
-  for (TopExp_Explorer f(box(), TopAbs_FACE); f.More(); f.Next()) b.Add(c, f.Current());
-  gp_Trsf shift;
-  shift.SetTranslation(gp_Vec(5, 0, 0));
-  for (TopExp_Explorer f(looseFaces(false), TopAbs_FACE); f.More(); f.Next())
-    b.Add(c, f.Current().Moved(TopLoc_Location(shift)));
+  addFaces(c, box(), 0.0, true);
+  addFaces(c, box(), 5.0, false);
   HealingRecord refused;
   try {
     healModel(cadModelFromShape(c, "some close"), {}, refused);
@@ -204,6 +212,80 @@ TEST(CadHealing, SolidsOnlyKeepsTheShellsThatCloseAndRecordsTheRest) {
   EXPECT_EQ(cad.numFaces(), 6);
   EXPECT_NE(record.leftOut.find("5 faces in no solid, within x [5, 6]"), std::string::npos)
       << record.leftOut;
+}
+
+// A solid, a loose shell that closes and one that does not: the closed one becomes a solid,
+// the open one is refused, or left out (solids only) with where it is.
+TEST(CadHealing, SolidsOnlySewsWhatClosesBesideSolidsAndLeavesOutTheRest) {
+  TopoDS_Compound c;
+  BRep_Builder b;
+  b.MakeCompound(c);
+  b.Add(c, box());
+  addFaces(c, box(), 5.0, true);    // closes
+  addFaces(c, box(), 10.0, false);  // open
+  HealingRecord refused;
+  try {
+    healModel(cadModelFromShape(c, "three"), {}, refused);
+    FAIL() << "an open shell beside solids was accepted";
+  } catch (const CadError& e) {
+    EXPECT_NE(std::string(e.what()).find("sewing closed 1 of 2 shells"), std::string::npos)
+        << e.what();
+  }
+  HealingRecord record;
+  const CadModel cad = healModel(cadModelFromShape(c, "three"), HealingOptions{true, true}, record);
+  EXPECT_EQ(cad.numSolids(), 2);
+  EXPECT_EQ(cad.numFaces(), 12);
+  EXPECT_NE(record.leftOut.find("5 faces in no solid, within x [10, 11]"), std::string::npos)
+      << record.leftOut;
+}
+
+// A loose shell that closes inside a solid (a void exported on its own) or on it (a surface
+// copy of the body) is no second solid: the model is refused, not meshed twice; solids only
+// meshes the solid and leaves the shell out, saying why.
+TEST(CadHealing, AClosedLooseShellInsideOrCopyingASolidIsRefused) {
+  const TopoDS_Shape big = BRepPrimAPI_MakeBox(4.0, 4.0, 4.0).Shape();
+  const TopoDS_Shape small = BRepPrimAPI_MakeBox(gp_Pnt(1, 1, 1), 1.0, 1.0, 1.0).Shape();
+  for (const bool copy : {false, true}) {
+    TopoDS_Compound c;
+    BRep_Builder b;
+    b.MakeCompound(c);
+    b.Add(c, big);
+    addFaces(c, copy ? big : small, 0.0, true);
+    const std::string why = copy ? "a closed shell and Solid1 that are copies of each other"
+                                 : "a closed shell and Solid1 one inside the other";
+    HealingRecord refused;
+    try {
+      healModel(cadModelFromShape(c, "body"), {}, refused);
+      FAIL() << "a closed shell " << (copy ? "copying" : "inside") << " a solid was accepted";
+    } catch (const CadError& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+    HealingRecord record;
+    const CadModel cad =
+        healModel(cadModelFromShape(c, "body"), HealingOptions{true, true}, record);
+    EXPECT_EQ(cad.numSolids(), 1);
+    EXPECT_EQ(cad.numFaces(), 6);
+    EXPECT_NE(record.leftOut.find(why), std::string::npos) << record.leftOut;
+  }
+}
+
+// Healing off: nothing is sewn, and solids only still leaves the faces out by name; faces
+// before the solid in the file's order renumber the solid's faces, which the record says.
+TEST(CadHealing, SolidsOnlyWithoutHealingAndTheNumberingItChanges) {
+  TopoDS_Compound c;
+  BRep_Builder b;
+  b.MakeCompound(c);
+  addFaces(c, box(), 5.0, true);  // would close, but healing is off
+  b.Add(c, box());
+  HealingRecord record;
+  const CadModel cad = healModel(cadModelFromShape(c, "off"), HealingOptions{false, true}, record);
+  EXPECT_TRUE(record.actions.empty());
+  EXPECT_EQ(cad.numSolids(), 1);
+  EXPECT_EQ(cad.numFaces(), 6);
+  EXPECT_NE(record.leftOut.find("6 faces (Face1-Face6) in no solid, within x [5, 6]"),
+            std::string::npos)
+      << record.leftOut;
+  EXPECT_TRUE(record.renumbered);
 }
 
 }  // namespace
