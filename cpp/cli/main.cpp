@@ -230,8 +230,9 @@ int runMesh(const homesh::MeshCommand& cmd) {
   // The mesh is written either way; status 4 tells scripts it is not proven valid.
   if (result.quality.invalid + result.quality.undecided > 0) {
     if (!c.quiet)
-      std::fprintf(stderr, "homesh: %zu elements invalid, %zu undecided (exit status 4)\n",
-                   result.quality.invalid, result.quality.undecided);
+      std::fprintf(stderr, "homesh: %zu %s invalid, %zu undecided (exit status 4)\n",
+                   result.quality.invalid, result.quality.invalid == 1 ? "element" : "elements",
+                   result.quality.undecided);
     return kNotProvenValid;
   }
   if (nektarNotValid > 0) {
