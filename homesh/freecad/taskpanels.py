@@ -24,6 +24,8 @@ from .properties import definition, value_of
 _MESH_PARAMETERS = ("Order", "Size", "OptimiserIterations", "OptimiserTimeLimit",
                     "LinearTimeLimit", "JobTimeLimit", "RepairRounds", "Threads")
 _SIZING_PARAMETERS = ("MinDelta", "MaxDelta", "Eps")
+# The CAD check's switches (boolean properties): check boxes under the parameters.
+_MESH_FLAGS = (("Heal", "Heal the CAD"), ("SolidsOnly", "Solids only"))
 
 
 _LAST = []
@@ -112,6 +114,14 @@ class TaskPanelHighOrderMesh:
 
         box, self.widgets = parameter_box(obj, "Parameters", _MESH_PARAMETERS)
         layout.addWidget(box)
+        self.flags = {}
+        for prop, text in _MESH_FLAGS:
+            if prop in obj.PropertiesList:  # an older document may lack one
+                flag = QtWidgets.QCheckBox(text)
+                flag.setChecked(bool(getattr(obj, prop)))
+                flag.setToolTip(obj.getDocumentationOfProperty(prop))
+                box.layout().addRow(flag)
+                self.flags[prop] = flag
 
         buttons = QtWidgets.QGridLayout()
         self.mesh_button = QtWidgets.QPushButton("Mesh")
@@ -200,7 +210,9 @@ class TaskPanelHighOrderMesh:
 
     # Actions ------------------------------------------------------------------------------------
     def values(self):
-        return {prop: w.value() for prop, w in self.widgets.items()}
+        values = {prop: w.value() for prop, w in self.widgets.items()}
+        values.update((prop, flag.isChecked()) for prop, flag in self.flags.items())
+        return values
 
     def apply(self):
         """Writes the panel's parameters to the object (one undoable step; the object is then
@@ -209,7 +221,10 @@ class TaskPanelHighOrderMesh:
         doc.openTransaction("HOMesh parameters")
         try:
             for prop, value in self.values().items():
-                if abs(value_of(self.obj, prop) - value) > 0:
+                if prop in self.flags:
+                    if bool(getattr(self.obj, prop)) != value:
+                        setattr(self.obj, prop, value)
+                elif abs(value_of(self.obj, prop) - value) > 0:
                     setattr(self.obj, prop, value)
         finally:
             doc.commitTransaction()
@@ -237,7 +252,7 @@ class TaskPanelHighOrderMesh:
         self.progress_values = []
         self.log.clear()
         self._log("Meshing %s: %s" % (self.obj.Part.Label, ", ".join(
-            "%s %g" % (k, v) for k, v in values.items())))
+            ("%s %s" if isinstance(v, bool) else "%s %g") % (k, v) for k, v in values.items())))
         if self.predicted is not None:
             self._log("About %d linear elements predicted." % self.predicted)
         self.mesh_button.setEnabled(False)

@@ -213,6 +213,11 @@ try:
     print("HOMesh GUI: Escape ended the job in %.3f s" % (time.monotonic() - t0))
     assert isinstance(job.error, homesh.CancelledError), job.error
     assert state(mesh) == before, "cancelling with Escape changed the object"
+    # The CAD check's switches are check boxes whose values reach the job's arguments.
+    assert panel.flags["Heal"].isChecked() and not panel.flags["SolidsOnly"].isChecked()
+    panel.flags["SolidsOnly"].setChecked(True)
+    assert objects.mesh_arguments(mesh, panel.values())["solids_only"] is True
+    panel.flags["SolidsOnly"].setChecked(False)
     FreeCADGui.Control.closeDialog()
     settle()
 
