@@ -866,6 +866,12 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     record.undecidedAfter = state.quality.undecided;
     record.worstAfter = state.quality.scaled.min;
     record.meshElements = state.mesh.numElements();
+    if (state.optimiser) {
+      record.optimiserRegion = state.optimiser->regionElements;
+      record.optimiserSweeps = state.optimiser->iterations;
+      record.optimiserStopped = state.optimiser->stopReason;
+      record.optimiserSeconds = state.optimiser->seconds;
+    }
     record.kept = state.betterThan(best);
     // (A "split poor" round not kept ends the rounds: see the loop's start.)
     splitFailed = !record.kept && (record.action == "split" || record.action == "split poor");

@@ -46,6 +46,12 @@ struct RepairRound {
   std::size_t reused = 0;  // of those, elements whose curved nodes came from the round before
   bool kept = false;       // the round's mesh is no worse than the best before it and was kept
   double seconds = 0.0;
+  // The round's optimiser run (the last one, at the final order): its region, sweeps, why it
+  // stopped and its time; where a round's seconds go.
+  std::size_t optimiserRegion = 0;
+  int optimiserSweeps = 0;
+  std::string optimiserStopped;
+  double optimiserSeconds = 0.0;
   std::string failure;  // why the round's mesh could not be made (the rounds then stop)
   // The job's time budget stopped a stage of the round early or left it out (its Gmsh run,
   // then `failure` says so, or its optimiser run).

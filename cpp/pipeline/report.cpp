@@ -456,6 +456,14 @@ void appendRepairRounds(JsonWriter& json, const std::vector<RepairRound>& rounds
     json.value("kept", r.kept);
     if (!r.failure.empty()) json.value("failure", r.failure);
     if (r.budgetStopped) json.value("stopped", std::string("time budget"));
+    if (!r.optimiserStopped.empty()) {
+      json.beginObject("optimiser");
+      json.value("region_elements", r.optimiserRegion);
+      json.value("sweeps", static_cast<std::size_t>(r.optimiserSweeps));
+      json.value("stopped", r.optimiserStopped);
+      json.value("seconds", r.optimiserSeconds);
+      json.endObject();
+    }
     json.value("seconds", r.seconds);
     json.endObject();
   }

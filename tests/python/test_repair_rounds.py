@@ -186,4 +186,9 @@ def test_a_failed_split_is_followed_by_a_whole_refine_not_a_cavity_remesh(homesh
     assert actions[0] == ("split", False), actions
     assert actions[1] == ("refine", True), actions
     assert all(r["cavities"] == 0 for r in rounds)
+    # Each round's optimiser run is reported: it works on a region around what changed.
+    for r in rounds:
+        run_ = r["optimiser"]
+        assert 0 < run_["region_elements"] <= r["mesh_elements"], r
+        assert run_["sweeps"] >= 0 and 0 < run_["seconds"] <= r["seconds"], r
     assert gmsh_worst(msh) > 0.0
