@@ -569,6 +569,9 @@ class SizingProxy(_Proxy, ParameterGuard):
         obj.Status = ("%d elements predicted (sizes %.4g to %.4g, %d octree leaves)"
                       % (obj.PredictedElements, sizing["min_delta"], sizing["max_delta"],
                          obj.OctreeLeaves))
+        left_out = report.get("healing", {}).get("left_out")
+        if left_out:  # said, not hidden: the sizes are of the solids alone
+            obj.Status += "; of the solids alone: left out %s" % left_out
         FreeCAD.Console.PrintMessage("HOMesh: %s: %s\n" % (obj.Label, obj.Status))
 
 

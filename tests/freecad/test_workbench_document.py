@@ -160,6 +160,7 @@ class HighOrderMeshObject(unittest.TestCase):
         self.doc.recompute()
         self.assertTrue(sizing.isValid(), sizing.Status)
         self.assertGreater(sizing.PredictedElements, 0)
+        self.assertIn("of the solids alone: left out 5 faces (Face7-Face11)", sizing.Status)
 
     def test_recompute_leaves_no_temporary_folders(self):
         before = set(os.listdir(tempfile.gettempdir()))
