@@ -175,6 +175,61 @@ std::string boxText(const TopoDS_Shape& shape) {
   return "x " + range(x0, x1) + ", y " + range(y0, y1) + ", z " + range(z0, z1);
 }
 
+// Faces of different solids that lie on each other without being one shared face (the same
+// box, area and centre of mass, to `tolerance`): each solid's mesh gets its own triangles and
+// nodes there, so the mesh does not conform across them. As "Face7 on Face8" (FaceN in the
+// shape's numbering), with the two solids' SolidN.
+struct CoincidentFaces {
+  int solidA = 0, solidB = 0, faceA = 0, faceB = 0;
+};
+
+std::vector<CoincidentFaces> coincidentFaces(const TopoDS_Shape& shape, double tolerance) {
+  TopTools_IndexedMapOfShape faces, solids;
+  TopExp::MapShapes(shape, TopAbs_FACE, faces);
+  TopExp::MapShapes(shape, TopAbs_SOLID, solids);
+  std::vector<int> owner(static_cast<std::size_t>(faces.Extent()) + 1, 0);  // 0: none, -1: two
+  for (int s = 1; s <= solids.Extent(); ++s)
+    for (TopExp_Explorer f(solids(s), TopAbs_FACE); f.More(); f.Next()) {
+      int& o = owner[static_cast<std::size_t>(faces.FindIndex(f.Current()))];
+      o = (o == 0 || o == s) ? s : -1;
+    }
+  struct Candidate {
+    int face = 0, solid = 0;
+    Bnd_Box box;
+    double area = 0.0;
+    gp_Pnt centre;
+  };
+  std::vector<Candidate> candidates;
+  for (int i = 1; i <= faces.Extent(); ++i) {
+    const int solid = owner[static_cast<std::size_t>(i)];
+    if (solid <= 0) continue;
+    Candidate c;
+    c.face = i;
+    c.solid = solid;
+    BRepBndLib::AddOptimal(faces(i), c.box, /*useTriangulation=*/false,
+                           /*useShapeTolerance=*/false);
+    GProp_GProps props;
+    BRepGProp::SurfaceProperties(faces(i), props);
+    c.area = props.Mass();
+    c.centre = props.CentreOfMass();
+    candidates.push_back(c);
+  }
+  std::vector<CoincidentFaces> found;
+  for (std::size_t a = 0; a < candidates.size(); ++a)
+    for (std::size_t b = a + 1; b < candidates.size(); ++b) {
+      const Candidate& p = candidates[a];
+      const Candidate& q = candidates[b];
+      if (p.solid == q.solid) continue;
+      if (p.box.CornerMin().Distance(q.box.CornerMin()) > tolerance ||
+          p.box.CornerMax().Distance(q.box.CornerMax()) > tolerance ||
+          std::abs(p.area - q.area) > 1e-6 * std::max(p.area, q.area) ||
+          p.centre.Distance(q.centre) > tolerance)
+        continue;
+      found.push_back({p.solid, q.solid, p.face, q.face});
+    }
+  return found;
+}
+
 struct Findings {
   bool invalid = false, unsewn = false, openSolid = false;
   int smallEdges = 0, smallFaces = 0;
@@ -550,6 +605,24 @@ CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& r
         !sameNumbering(original, occtShape(cad), 10.0 * record.tolerance, /*fewer=*/true);
     record.facesAfter = cad.numFaces();
     record.solidsAfter = cad.numSolids();
+  }
+  // Solids that touch on faces of their own (not one shared face) are meshed apart there.
+  if (cad.numSolids() > 1) {
+    const std::vector<CoincidentFaces> pairs = withOcctErrors("checking " + cad.sourceName(), [&] {
+      return coincidentFaces(occtShape(cad), 10.0 * record.tolerance);
+    });
+    std::string where;
+    for (std::size_t k = 0; k < pairs.size() && k < 3; ++k)
+      where += (k == 0 ? "" : ", ") + cadEntityName(3, pairs[k].solidA) + " and " +
+               cadEntityName(3, pairs[k].solidB) + " (" + cadEntityName(2, pairs[k].faceA) +
+               " on " + cadEntityName(2, pairs[k].faceB) + ")";
+    if (pairs.size() > 3) where += " and " + std::to_string(pairs.size() - 3) + " more pairs";
+    if (!pairs.empty())
+      record.warnings.push_back(
+          "solids lie against each other on faces they do not share: " + where +
+          "; each is meshed with its own nodes there, so the mesh does not conform across "
+          "them (fuse them first for one conforming mesh: FreeCAD Part > Boolean > Boolean "
+          "fragments)");
   }
   return cad;
 }

@@ -44,6 +44,9 @@ struct HealingRecord {
   // The faces left out because they are in no solid (HealingOptions::solidsOnly), in words:
   // how many, where, and why ("17 faces in no solid (they do not close: ...), within x ...").
   std::string leftOut;
+  // What the mesh user must know that healing does not change: solids that lie against each
+  // other on faces of their own (coincident, not shared), whose meshes do not conform there.
+  std::vector<std::string> warnings;
   int facesBefore = 0, facesAfter = 0;
   int solidsBefore = 0, solidsAfter = 0;
   double seconds = 0.0;

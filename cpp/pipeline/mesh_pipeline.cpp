@@ -638,6 +638,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   cad.done();
   if (!result.healing.leftOut.empty())
     result.notes.push_back("solids only: left out " + result.healing.leftOut);
+  for (const std::string& warning : result.healing.warnings) result.notes.push_back(warning);
   checkRenumbering(result.healing, options);
   checkMeshDimension(*result.cad, options.expectedDimension);
   if (!options.size) options.sizing = resolveSizing(options.sizing, *result.cad);

@@ -48,6 +48,7 @@ void appendHealing(JsonWriter& json, const HealingRecord& h) {
   json.value("tolerance", h.tolerance);
   appendStrings(json, "problems", h.problems);
   appendStrings(json, "actions", h.actions);
+  appendStrings(json, "warnings", h.warnings);
   // The faces in no solid that were not meshed (solids only), in words; empty: none.
   json.value("left_out", h.leftOut);
   // Face numbers (boundary layers, groups) are the healed model's when it was renumbered.

@@ -103,6 +103,23 @@ def test_faces_in_no_solid_are_refused_by_name_or_left_out_with_a_note(homesh_bi
     assert "Face7-Face11" in json.loads(report.read_text())["healing"]["left_out"]
 
 
+def test_solids_on_faces_they_do_not_share_are_named(homesh_bin, tmp_path):
+    """examples/sphere_box.step holds a sphere and a box with a spherical hole, each with its own
+    sphere face: meshed apart there, which the note and the report's healing warnings say."""
+    sphere_box = os.path.join(os.path.dirname(__file__), "..", "..", "examples", "sphere_box.step")
+    report = tmp_path / "r.json"
+    r = run([homesh_bin, "mesh", sphere_box, "--order", "2", "--size", "1.2",
+             "--report", report], timeout=300)
+    assert r.returncode == 0, r.stderr
+    note = ("homesh: note: solids lie against each other on faces they do not share: Solid1 "
+            "and Solid2 (Face1 on Face8)")
+    assert note in r.stderr, r.stderr
+    [warning] = json.loads(report.read_text())["healing"]["warnings"]
+    assert "does not conform" in warning, warning
+    r = run([homesh_bin, "predict", sphere_box], timeout=120)
+    assert r.returncode == 0 and note in r.stderr, r.stderr
+
+
 def test_a_sound_model_is_left_as_it_is(homesh_bin, data, tmp_path):
     report = tmp_path / "r.json"
     r = run([homesh_bin, "mesh", data / "sphere.brep", "--order", "2", "--size", "0.5",

@@ -3,6 +3,7 @@
 // closed is refused naming a free edge, or left out by name when only solids are asked for.
 #include <gtest/gtest.h>
 
+#include <BRepAlgoAPI_BuilderAlgo.hxx>
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRep_Builder.hxx>
@@ -286,6 +287,42 @@ TEST(CadHealing, SolidsOnlyWithoutHealingAndTheNumberingItChanges) {
             std::string::npos)
       << record.leftOut;
   EXPECT_TRUE(record.renumbered);
+}
+
+// Two boxes side by side, each with its own face at x = 1 (as Gmsh's STEP export writes
+// fragments): the mesh would not conform there, and the record says which solids and faces.
+// Fused so that they share that face (OpenCASCADE's general fuse, FreeCAD's Boolean
+// fragments): nothing to say.
+TEST(CadHealing, SolidsOnFacesTheyDoNotShareAreNamed) {
+  const TopoDS_Shape left = BRepPrimAPI_MakeBox(1.0, 1.0, 1.0).Shape();
+  const TopoDS_Shape right = BRepPrimAPI_MakeBox(gp_Pnt(1, 0, 0), 1.0, 1.0, 1.0).Shape();
+  TopoDS_Compound apart;
+  BRep_Builder b;
+  b.MakeCompound(apart);
+  b.Add(apart, left);
+  b.Add(apart, right);
+  HealingRecord record;
+  const CadModel cad = healModel(cadModelFromShape(apart, "apart"), {}, record);
+  EXPECT_EQ(cad.numSolids(), 2);
+  EXPECT_EQ(cad.numFaces(), 12);
+  ASSERT_EQ(record.warnings.size(), 1U);
+  // The left box's face at x = 1 is its second (OpenCASCADE's box: x = 0, x = 1, ...), the
+  // right box's at x = 1 its first: Face2 and Face7.
+  EXPECT_NE(record.warnings[0].find("Solid1 and Solid2 (Face2 on Face7)"), std::string::npos)
+      << record.warnings[0];
+
+  TopTools_ListOfShape arguments;
+  arguments.Append(left);
+  arguments.Append(right);
+  BRepAlgoAPI_BuilderAlgo fuse;
+  fuse.SetArguments(arguments);
+  fuse.Build();
+  ASSERT_TRUE(fuse.IsDone());
+  HealingRecord shared;
+  const CadModel fused = healModel(cadModelFromShape(fuse.Shape(), "fused"), {}, shared);
+  EXPECT_EQ(fused.numSolids(), 2);
+  EXPECT_EQ(fused.numFaces(), 11);  // the face at x = 1 is one face of both
+  EXPECT_TRUE(shared.warnings.empty()) << shared.warnings[0];
 }
 
 }  // namespace
