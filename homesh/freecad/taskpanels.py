@@ -120,6 +120,10 @@ class TaskPanelHighOrderMesh:
                 flag = QtWidgets.QCheckBox(text)
                 flag.setChecked(bool(getattr(obj, prop)))
                 flag.setToolTip(obj.getDocumentationOfProperty(prop))
+                if getattr(obj, "FemMesh", None) is not None:  # curving a FEM mesh: no CAD check
+                    flag.setEnabled(False)
+                    flag.setToolTip("Not used: the mesh curves the FEM mesh %s"
+                                    % obj.FemMesh.Label)
                 box.layout().addRow(flag)
                 self.flags[prop] = flag
 

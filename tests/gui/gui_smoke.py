@@ -310,6 +310,8 @@ try:
         print("HOMesh GUI: curved FEM mesh: %s" % curved.Status)
         assert job.error is None and curved.InvalidElements == 0 and curved.UndecidedElements == 0
         assert curved.NumElements == femmesh.FemMesh.VolumeCount
+        # Curving a FEM mesh runs no CAD check: its switches are shown greyed out.
+        assert not any(flag.isEnabled() for flag in panel.flags.values()), panel.flags
         FreeCADGui.Control.closeDialog()
         settle()
         FreeCADGui.Selection.clearSelection()
