@@ -175,6 +175,13 @@ std::string boxText(const TopoDS_Shape& shape) {
   return "x " + range(x0, x1) + ", y " + range(y0, y1) + ", z " + range(z0, z1);
 }
 
+// Whether two boxes have the same corners, to `tolerance`: the first test of two shapes being
+// one (a copied solid, coincident faces), before their volumes or areas are measured.
+bool sameBox(const Bnd_Box& a, const Bnd_Box& b, double tolerance) {
+  return a.CornerMin().Distance(b.CornerMin()) <= tolerance &&
+         a.CornerMax().Distance(b.CornerMax()) <= tolerance;
+}
+
 // Faces of different solids that lie on each other without being one shared face (the same
 // box, area and centre of mass, to `tolerance`): each solid's mesh gets its own triangles and
 // nodes there, so the mesh does not conform across them. As "Face7 on Face8" (FaceN in the
@@ -196,8 +203,7 @@ std::vector<CoincidentFaces> coincidentFaces(const TopoDS_Shape& shape, double t
   struct Candidate {
     int face = 0, solid = 0;
     Bnd_Box box;
-    double area = 0.0;
-    gp_Pnt centre;
+    std::optional<GProp_GProps> props;  // area and centre, measured once a box matches
   };
   std::vector<Candidate> candidates;
   for (int i = 1; i <= faces.Extent(); ++i) {
@@ -208,22 +214,25 @@ std::vector<CoincidentFaces> coincidentFaces(const TopoDS_Shape& shape, double t
     c.solid = solid;
     BRepBndLib::AddOptimal(faces(i), c.box, /*useTriangulation=*/false,
                            /*useShapeTolerance=*/false);
-    GProp_GProps props;
-    BRepGProp::SurfaceProperties(faces(i), props);
-    c.area = props.Mass();
-    c.centre = props.CentreOfMass();
     candidates.push_back(c);
   }
+  const auto props = [&](Candidate& c) -> const GProp_GProps& {
+    if (!c.props) {
+      c.props.emplace();
+      BRepGProp::SurfaceProperties(faces(c.face), *c.props);
+    }
+    return *c.props;
+  };
   std::vector<CoincidentFaces> found;
   for (std::size_t a = 0; a < candidates.size(); ++a)
     for (std::size_t b = a + 1; b < candidates.size(); ++b) {
-      const Candidate& p = candidates[a];
-      const Candidate& q = candidates[b];
-      if (p.solid == q.solid) continue;
-      if (p.box.CornerMin().Distance(q.box.CornerMin()) > tolerance ||
-          p.box.CornerMax().Distance(q.box.CornerMax()) > tolerance ||
-          std::abs(p.area - q.area) > 1e-6 * std::max(p.area, q.area) ||
-          p.centre.Distance(q.centre) > tolerance)
+      Candidate& p = candidates[a];
+      Candidate& q = candidates[b];
+      if (p.solid == q.solid || !sameBox(p.box, q.box, tolerance)) continue;
+      const GProp_GProps& pp = props(p);
+      const GProp_GProps& qp = props(q);
+      if (std::abs(pp.Mass() - qp.Mass()) > 1e-6 * std::max(pp.Mass(), qp.Mass()) ||
+          pp.CentreOfMass().Distance(qp.CentreOfMass()) > tolerance)
         continue;
       found.push_back({p.solid, q.solid, p.face, q.face});
     }
@@ -380,9 +389,7 @@ std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tole
   // other's boundary, not inside: the same box and volume, to the sewing tolerance.
   const auto duplicate = [&](const TopoDS_Shape& a, const Bnd_Box& aBox, const TopoDS_Shape& b,
                              const Bnd_Box& bBox) {
-    if (aBox.CornerMin().Distance(bBox.CornerMin()) > 10.0 * tolerance ||
-        aBox.CornerMax().Distance(bBox.CornerMax()) > 10.0 * tolerance)
-      return false;
+    if (!sameBox(aBox, bBox, 10.0 * tolerance)) return false;
     const double va = volumeOf(a), vb = volumeOf(b);
     return std::abs(va - vb) <= 1e-6 * std::max(va, vb);
   };
@@ -425,8 +432,7 @@ std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tole
     builder.Add(solids, rest);
     return TopoDS_Shape(solids);
   }
-  return made == 1 ? TopoDS_Shape(TopExp_Explorer(solids, TopAbs_SOLID).Current())
-                   : TopoDS_Shape(solids);
+  return solidsOf(solids);
 }
 
 TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal, bool keepOpen,

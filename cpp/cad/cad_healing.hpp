@@ -54,6 +54,14 @@ struct HealingRecord {
   // whose centre of mass moved); a fix of tolerances alone keeps the numbering.
   bool renumbered = false;
   bool changed() const { return !actions.empty(); }
+  // What a user must read about the model meshed, one line each: the faces left out (solids
+  // only) and the warnings. The pipeline's notes and `homesh predict` print these.
+  std::vector<std::string> notes() const {
+    std::vector<std::string> lines;
+    if (!leftOut.empty()) lines.push_back("solids only: left out " + leftOut);
+    lines.insert(lines.end(), warnings.begin(), warnings.end());
+    return lines;
+  }
 };
 
 // The model to mesh: `cad` itself when the check finds nothing (or healing is off), else the

@@ -254,10 +254,8 @@ int runPredict(const homesh::PredictCommand& cmd) {
   const homesh::SizingResult s = homesh::runSizingStage(setup.source, setup.options);
   const bool toStdout = c.report && *c.report == "-";
   if (!c.quiet) {
-    if (!s.healing.leftOut.empty())
-      std::fprintf(stderr, "homesh: note: solids only: left out %s\n", s.healing.leftOut.c_str());
-    for (const std::string& warning : s.healing.warnings)
-      std::fprintf(stderr, "homesh: note: %s\n", warning.c_str());
+    for (const std::string& note : s.healing.notes())
+      std::fprintf(stderr, "homesh: note: %s\n", note.c_str());
     printPrediction(s, s.octree->dim());
     if (cmd.sizing.writeOctree)
       std::fprintf(stderr, "homesh: wrote %s\n", cmd.sizing.writeOctree->c_str());

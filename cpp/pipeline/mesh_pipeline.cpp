@@ -636,9 +636,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   result.cad =
       std::make_shared<const CadModel>(healModel(source.load(), options.healing(), result.healing));
   cad.done();
-  if (!result.healing.leftOut.empty())
-    result.notes.push_back("solids only: left out " + result.healing.leftOut);
-  for (const std::string& warning : result.healing.warnings) result.notes.push_back(warning);
+  for (const std::string& note : result.healing.notes()) result.notes.push_back(note);
   checkRenumbering(result.healing, options);
   checkMeshDimension(*result.cad, options.expectedDimension);
   if (!options.size) options.sizing = resolveSizing(options.sizing, *result.cad);
