@@ -128,10 +128,10 @@ void printPrediction(const homesh::SizingResult& s, int dim) {
   std::fprintf(stderr,
                "homesh: sizing octree: MinDelta %g, MaxDelta %g, EPS %g, %zu sources; %zu leaves "
                "(%zu inside, %zu boundary), depth %d, %zu boundary samples (%zu curved, %zu on "
-               "thin walls), smallest size %g, %.3f s\n",
+               "thin walls, %zu on curves of narrow faces), smallest size %g, %.3f s\n",
                p.minDelta, p.maxDelta, p.eps, p.sources.size(), st.leaves, st.insideLeaves,
                st.boundaryLeaves, st.maxLevel, st.boundarySamples, st.sizedSamples,
-               st.thinWallSamples, st.smallestDelta, s.seconds);
+               st.thinWallSamples, st.narrowFaceSamples, st.smallestDelta, s.seconds);
   std::fprintf(stderr, "homesh: predicted %.0f %s (%s %g)\n", s.prediction.elements,
                dim == 3 ? "tetrahedra" : "triangles", dim == 3 ? "domain volume" : "domain area",
                s.prediction.domainMeasure);

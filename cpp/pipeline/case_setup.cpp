@@ -54,6 +54,7 @@ CaseSetup setupCase(const std::string& input) {
     p.maxDelta = *mcf.maxDelta;
     p.eps = *mcf.eps;
     p.thinWall = 0.0;  // NekMesh's sizing has no thin-wall bound: its parameters, its sizes
+    p.narrowFace = 0.0;
     for (const RefinementLine& line : mcf.refinementLines)
       p.sources.push_back(RefinementSource::segment(line.x1, line.x2, line.radius, line.delta));
     setup.options.sizing = p;

@@ -224,6 +224,7 @@ void appendSizing(JsonWriter& json, const SizingResult& sizing) {
   json.value("eps", p.eps);
   json.value("gradation", p.gradation);
   json.value("thin_wall", p.thinWall);
+  json.value("narrow_face", p.narrowFace);
   json.beginArray("sources");
   for (const RefinementSource& src : p.sources) json.value("", src.describe());
   json.endArray();
@@ -241,6 +242,7 @@ void appendSizing(JsonWriter& json, const SizingResult& sizing) {
   json.value("boundary_samples", s.boundarySamples);
   json.value("curvature_samples", s.sizedSamples);
   json.value("thin_wall_samples", s.thinWallSamples);
+  json.value("narrow_face_samples", s.narrowFaceSamples);
   json.value("smallest_delta", s.smallestDelta);
   json.endObject();
   json.value("seconds", sizing.seconds);

@@ -10,12 +10,14 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
 
 #include <Eigen/Geometry>
 
 #include "cad/cad_model.hpp"
 #include "cad/occt_access.hpp"
 #include "core/error.hpp"
+#include "sizing/narrow_face.hpp"
 #include "sizing/sizing_parameters.hpp"
 
 namespace homesh {
@@ -243,8 +245,10 @@ std::vector<std::pair<double, double>> curveIntervals(const CadModel& cad, int e
 }
 
 // Samples of a curve; with `normal` (2D: the face's oriented normal) they bound the domain.
+// In 3D, `narrow` (when given) bounds the size where the curve's faces are narrow.
 void sampleCurve(const CadModel& cad, int edge, bool reversed, const Eigen::Vector3d* normal,
-                 bool internal, const SizingParameters& params, std::vector<BoundarySample>& out) {
+                 bool internal, const SizingParameters& params, const NarrowFaces* narrow,
+                 std::vector<BoundarySample>& out) {
   const ParameterRange r = cad.edgeRange(edge);
   const double length = curveLength(cad, edge, r);
   // A sample stands for at most kSpacing times the size its curvature asks for: along a
@@ -271,8 +275,19 @@ void sampleCurve(const CadModel& cad, int edge, bool reversed, const Eigen::Vect
         const Eigen::Vector3d tangent = (reversed ? -d.d1 : d.d1) / speed;
         s.outward = tangent.cross(*normal).normalized();
         s.weight = speed * dt;
-      } else if (s.delta <= 0.0) {
-        continue;  // a 3D curve only contributes sizes
+      } else {
+        if (narrow != nullptr && s.curvature > 0.0) {
+          const double radius = 1.0 / s.curvature;
+          const double current = s.delta > 0.0 ? s.delta : params.maxDelta;
+          const double width =
+              narrow->width(edge, s.x, NarrowFaces::reach(radius, current, params));
+          const double bounded = NarrowFaces::size(radius, width, current, params);
+          if (bounded < current) {
+            s.delta = bounded;
+            s.narrowFace = true;
+          }
+        }
+        if (s.delta <= 0.0) continue;  // a 3D curve only contributes sizes
       }
       found.push_back(s);
     }
@@ -301,8 +316,11 @@ std::vector<BoundarySample> sampleBoundary(const CadModel& cad, int dim,
         for (const int f : cad.subShapeIndices(3, s, 2)) ++solidsOfFace[f];
       for (int f = 1; f <= cad.numFaces(); ++f)
         sampleFace(cad, f, solidsOfFace[f] != 1, params, samples);
+      std::optional<NarrowFaces> narrow;
+      if (params.narrowFace > 0.0) narrow.emplace(cad);
       for (int e = 1; e <= cad.numEdges(); ++e)
-        if (!cad.isDegenerated(e)) sampleCurve(cad, e, false, nullptr, false, params, samples);
+        if (!cad.isDegenerated(e))
+          sampleCurve(cad, e, false, nullptr, false, params, narrow ? &*narrow : nullptr, samples);
       return;
     }
     std::map<int, int> facesOfEdge;
@@ -321,7 +339,7 @@ std::vector<BoundarySample> sampleBoundary(const CadModel& cad, int dim,
             // An internal curve is sampled once, from its first face.
             if (internal && facesOfEdge[e] < 0) break;
             sampleCurve(cad, e, edge.Orientation() == TopAbs_REVERSED, &normal, internal, params,
-                        samples);
+                        nullptr, samples);
             if (internal) facesOfEdge[e] = -1;
             break;
           }

@@ -112,6 +112,7 @@ class OctreeBuilder {
       if (t_.dim_ == 2) local.x.z() = 0.0;
       samples_.push_back(local);
       if (s.delta > 0.0) ++t_.stats_.sizedSamples;
+      if (s.narrowFace) ++t_.stats_.narrowFaceSamples;
     }
     t_.stats_.boundarySamples = samples_.size();
   }

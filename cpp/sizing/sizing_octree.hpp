@@ -31,8 +31,9 @@ struct OctreeStatistics {
   std::size_t leaves = 0, insideLeaves = 0, boundaryLeaves = 0, outsideLeaves = 0;
   int maxLevel = 0;
   std::size_t boundarySamples = 0, sizedSamples = 0;
-  std::size_t thinWallSamples = 0;  // samples whose size the thin-wall bound made smaller
-  double smallestDelta = 0.0;       // over leaves that are not outside
+  std::size_t thinWallSamples = 0;    // samples whose size the thin-wall bound made smaller
+  std::size_t narrowFaceSamples = 0;  // curve samples whose size a narrow face made smaller
+  double smallestDelta = 0.0;         // over leaves that are not outside
 };
 
 class SizingOctree {

@@ -27,6 +27,9 @@ void SizingParameters::validate() const {
   if (!(thinWall >= 0.0 && thinWall <= 1.0))
     throw ParameterError("the thin-wall sagitta ratio must lie in [0, 1], got " +
                          formatNumber(thinWall));
+  if (!(narrowFace >= 0.0 && narrowFace <= 1.0))
+    throw ParameterError("the narrow-face sagitta ratio must lie in [0, 1], got " +
+                         formatNumber(narrowFace));
   if (!positive(gradation))
     throw ParameterError("the gradation must be a positive number, got " + formatNumber(gradation));
   for (std::size_t i = 0; i < sources.size(); ++i)

@@ -25,6 +25,11 @@ struct SizingParameters {
   // with fillets of radius 2.5 mm) the curvature size alone left six elements spanning the
   // wall folded after curving and repair; with the bound none (bench/results/corpus.md).
   double thinWall = 0.1;
+  // Sagitta at most this fraction of the width of the faces a curved edge bounds, in [0, 1]; 0:
+  // no such bound (a .mcf case keeps NekMesh's sizing). On OpenCASCADE's Motor-c, a ledge 0.05
+  // wide along a circle of radius 20 held 71 of the 168 invalid elements left after 3 optimiser
+  // sweeps with the curvature size alone, and 2 of 94 with the bound (sizing/narrow_face.hpp).
+  double narrowFace = 0.25;
   std::vector<RefinementSource> sources;
 
   // Throws ParameterError naming the offending parameter.

@@ -566,13 +566,22 @@ class SizingProxy(_Proxy, ParameterGuard):
         obj.OctreeLeaves = int(octree["leaves"])
         obj.SmallestSize = float(octree["smallest_delta"])
         obj.Gradation = float(sizing.get("gradation", SizingProxy.GRADATION))
-        obj.Status = ("%d elements predicted (sizes %.4g to %.4g, %d octree leaves)"
-                      % (obj.PredictedElements, sizing["min_delta"], sizing["max_delta"],
-                         obj.OctreeLeaves))
-        left_out = report.get("healing", {}).get("left_out")
-        if left_out:  # said, not hidden: the sizes are of the solids alone
-            obj.Status += "; of the solids alone: left out %s" % left_out
+        obj.Status = prediction_summary(report)
         FreeCAD.Console.PrintMessage("HOMesh: %s: %s\n" % (obj.Label, obj.Status))
+
+
+def prediction_summary(report):
+    """One line for a ``homesh.predict`` report: the element count, the sizes and leaves, and
+    the faces left out (the prediction is then of the solids alone: said, not hidden). The
+    Sizing object's Status and its task panel's Predict both show it."""
+    sizing = report["sizing"]
+    text = ("%d elements predicted (sizes %.4g to %.4g, %d octree leaves)"
+            % (int(report["predicted_elements"]), sizing["min_delta"], sizing["max_delta"],
+               int(sizing["octree"]["leaves"])))
+    left_out = report.get("healing", {}).get("left_out")
+    if left_out:
+        text += "; of the solids alone: left out %s" % left_out
+    return text
 
 
 def make_boundary_layer(doc, part, faces, thickness, layers=2, progression=2.0,

@@ -432,9 +432,8 @@ class TaskPanelSizing:
         except (ValueError, homesh.HOMeshError) as e:
             self.result.setText("Cannot predict: %s" % e)
             return None
-        count = int(report["predicted_elements"])
-        self.result.setText("%d elements predicted" % count)
-        return count
+        self.result.setText(objects.prediction_summary(report))
+        return int(report["predicted_elements"])
 
     def apply(self):
         doc = self.obj.Document

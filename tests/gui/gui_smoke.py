@@ -232,6 +232,8 @@ try:
     print("HOMesh GUI: sizing panel: %d predicted with MaxDelta 0.2 (object: %d)"
           % (finer, default_count))
     assert finer > 2 * default_count and sizing.PredictedElements == default_count
+    assert sizing_panel.result.text().startswith("%d elements predicted (sizes " % finer), \
+        sizing_panel.result.text()
     sizing_panel.apply()
     assert sizing.MaxDelta.Value == 0.2 and sizing.PredictedElements == finer
     FreeCADGui.Control.closeDialog()

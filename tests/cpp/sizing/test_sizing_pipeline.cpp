@@ -179,6 +179,9 @@ TEST(SizingPipeline, McfSetupReadsTheCaseInMetres) {
   EXPECT_DOUBLE_EQ(s.options.sizing->maxDelta, 0.2);
   EXPECT_DOUBLE_EQ(s.options.sizing->eps, 0.02);
   EXPECT_DOUBLE_EQ(s.source.scale, 0.001);
+  // NekMesh's sizes are kept as NekMesh computes them: no bound of ours on top.
+  EXPECT_EQ(s.options.sizing->thinWall, 0.0);
+  EXPECT_EQ(s.options.sizing->narrowFace, 0.0);
   const CadModel cad = s.source.load();
   // OCCT's optimal box finds the sphere's extremes to its precision (1e-7 mm, 1e-10 m here).
   EXPECT_NEAR(cad.boundingDiagonal(), std::sqrt(16.0 + 4.0 + 0.75 * 0.75), 1e-6);
