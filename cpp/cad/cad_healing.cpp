@@ -30,6 +30,7 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <set>
 
 #include "cad/model_dimension.hpp"
 #include "cad/occt_access.hpp"
@@ -185,7 +186,8 @@ bool sameBox(const Bnd_Box& a, const Bnd_Box& b, double tolerance) {
 // Faces of different solids that lie on each other without being one shared face (the same
 // box, area and centre of mass, to `tolerance`): each solid's mesh gets its own triangles and
 // nodes there, so the mesh does not conform across them. As "Face7 on Face8" (FaceN in the
-// shape's numbering), with the two solids' SolidN.
+// shape's numbering), with the two solids' SolidN. A face in no solid counts as one of solid
+// 0: a pair with solidB 0 is a loose face (faceB) lying on a solid's face (faceA), a copy.
 struct CoincidentFaces {
   int solidA = 0, solidB = 0, faceA = 0, faceB = 0;
 };
@@ -208,7 +210,7 @@ std::vector<CoincidentFaces> coincidentFaces(const TopoDS_Shape& shape, double t
   std::vector<Candidate> candidates;
   for (int i = 1; i <= faces.Extent(); ++i) {
     const int solid = owner[static_cast<std::size_t>(i)];
-    if (solid <= 0) continue;
+    if (solid < 0) continue;
     Candidate c;
     c.face = i;
     c.solid = solid;
@@ -226,15 +228,16 @@ std::vector<CoincidentFaces> coincidentFaces(const TopoDS_Shape& shape, double t
   std::vector<CoincidentFaces> found;
   for (std::size_t a = 0; a < candidates.size(); ++a)
     for (std::size_t b = a + 1; b < candidates.size(); ++b) {
-      Candidate& p = candidates[a];
-      Candidate& q = candidates[b];
-      if (p.solid == q.solid || !sameBox(p.box, q.box, tolerance)) continue;
-      const GProp_GProps& pp = props(p);
-      const GProp_GProps& qp = props(q);
+      Candidate* p = &candidates[a];
+      Candidate* q = &candidates[b];
+      if (p->solid == q->solid || !sameBox(p->box, q->box, tolerance)) continue;
+      if (p->solid == 0) std::swap(p, q);  // the loose face second
+      const GProp_GProps& pp = props(*p);
+      const GProp_GProps& qp = props(*q);
       if (std::abs(pp.Mass() - qp.Mass()) > 1e-6 * std::max(pp.Mass(), qp.Mass()) ||
           pp.CentreOfMass().Distance(qp.CentreOfMass()) > tolerance)
         continue;
-      found.push_back({p.solid, q.solid, p.face, q.face});
+      found.push_back({p->solid, q->solid, p->face, q->face});
     }
   return found;
 }
@@ -589,14 +592,26 @@ CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& r
     // Face and edge names only while they are the file's own (healing changed nothing).
     const bool ownNumbers = !record.changed();
     const int edge = ownNumbers ? firstFreeEdge(loose.faces, edges) : 0;
+    const std::string which = std::to_string(loose.indices.size()) + (one ? " face" : " faces") +
+                              (ownNumbers ? " (" + faceNames(loose.indices) + ")" : std::string()) +
+                              " in no solid, within " + boxText(loose.faces);
     const std::string what =
-        std::to_string(loose.indices.size()) + (one ? " face" : " faces") +
-        (ownNumbers ? " (" + faceNames(loose.indices) + ")" : std::string()) +
-        " in no solid, within " + boxText(loose.faces) +
-        (edge != 0 ? (one ? ": it does not close (" : ": they do not close (") +
-                         cadEntityName(1, edge) + " bounds only one face)"
-                   : "");
-    if (!options.solidsOnly || count(kept, TopAbs_FACE) == 0)
+        which + (edge != 0 ? (one ? ": it does not close (" : ": they do not close (") +
+                                 cadEntityName(1, edge) + " bounds only one face)"
+                           : "");
+    // Loose faces that all lie on faces of the solids (a surface model exported beside its
+    // body, as Gmsh's shell_sewing demo writes it) are copies: leaving them out loses nothing.
+    std::vector<int> copied;  // the solids' faces they copy
+    if (ownNumbers) {
+      std::set<int> copies;
+      for (const CoincidentFaces& c : withOcctErrors("checking " + cad.sourceName(), [&] {
+             return coincidentFaces(shape, 10.0 * record.tolerance);
+           }))
+        if (c.solidB == 0 && copies.insert(c.faceB).second) copied.push_back(c.faceA);
+      if (copies.size() != loose.indices.size()) copied.clear();
+      std::sort(copied.begin(), copied.end());
+    }
+    if ((!options.solidsOnly && copied.empty()) || count(kept, TopAbs_FACE) == 0)
       throw CadError(cad.sourceName() + ": " + what +
                      (!enabled ? "; healing is off (it may close them)"
                       : record.sewing.empty()
@@ -606,6 +621,11 @@ CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& r
                                          : "; close them in the CAD, or mesh the solids alone: " +
                                                solidsOnlyOption));
     record.leftOut = what + (record.sewing.empty() ? std::string() : " (" + record.sewing + ")");
+    if (!copied.empty()) {
+      record.leftOut = which + ": " + (one ? "a copy of " : "copies of ") + faceNames(copied) +
+                       " of the solids; nothing of the model is lost";
+      record.leftOutCopies = true;
+    }
     cad = cadModelFromShape(kept, cad.sourceName());
     record.renumbered =
         !sameNumbering(original, occtShape(cad), 10.0 * record.tolerance, /*fewer=*/true);
@@ -614,9 +634,12 @@ CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& r
   }
   // Solids that touch on faces of their own (not one shared face) are meshed apart there.
   if (cad.numSolids() > 1) {
-    const std::vector<CoincidentFaces> pairs = withOcctErrors("checking " + cad.sourceName(), [&] {
+    std::vector<CoincidentFaces> pairs = withOcctErrors("checking " + cad.sourceName(), [&] {
       return coincidentFaces(occtShape(cad), 10.0 * record.tolerance);
     });
+    pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
+                               [](const CoincidentFaces& c) { return c.solidB == 0; }),
+                pairs.end());
     std::string where;
     for (std::size_t k = 0; k < pairs.size() && k < 3; ++k)
       where += (k == 0 ? "" : ", ") + cadEntityName(3, pairs[k].solidA) + " and " +

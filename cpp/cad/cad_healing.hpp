@@ -11,7 +11,8 @@
 //
 // Faces that end up in no solid (a loose shell beside solids, a shell sewing cannot close) are
 // not meshed: the model is refused naming them, or, with HealingOptions::solidsOnly, left out
-// and recorded (HealingRecord::leftOut), never dropped silently.
+// and recorded (HealingRecord::leftOut), never dropped silently. Loose faces that all copy faces
+// of the solids are left out and recorded without solidsOnly: nothing is lost.
 //
 // A model with nothing to heal is returned as it is: its FaceN numbering, which boundary layers
 // and boundary groups refer to, is unchanged. Whether a healed model's numbering changed is
@@ -44,6 +45,9 @@ struct HealingRecord {
   // The faces left out because they are in no solid (HealingOptions::solidsOnly), in words:
   // how many, where, and why ("17 faces in no solid (they do not close: ...), within x ...").
   std::string leftOut;
+  // Those faces all copy faces of the solids (the same box, area and centre): left out without
+  // HealingOptions::solidsOnly, since nothing is lost.
+  bool leftOutCopies = false;
   // What the mesh user must know that healing does not change: solids that lie against each
   // other on faces of their own (coincident, not shared), whose meshes do not conform there.
   std::vector<std::string> warnings;
@@ -58,7 +62,8 @@ struct HealingRecord {
   // only) and the warnings. The pipeline's notes and `homesh predict` print these.
   std::vector<std::string> notes() const {
     std::vector<std::string> lines;
-    if (!leftOut.empty()) lines.push_back("solids only: left out " + leftOut);
+    if (!leftOut.empty())
+      lines.push_back(std::string(leftOutCopies ? "" : "solids only: ") + "left out " + leftOut);
     lines.insert(lines.end(), warnings.begin(), warnings.end());
     return lines;
   }

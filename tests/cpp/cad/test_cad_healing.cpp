@@ -243,30 +243,74 @@ TEST(CadHealing, SolidsOnlySewsWhatClosesBesideSolidsAndLeavesOutTheRest) {
 // A loose shell that closes inside a solid (a void exported on its own) or on it (a surface
 // copy of the body) is no second solid: the model is refused, not meshed twice; solids only
 // meshes the solid and leaves the shell out, saying why.
-TEST(CadHealing, AClosedLooseShellInsideOrCopyingASolidIsRefused) {
+TEST(CadHealing, AClosedLooseShellInsideASolidIsRefused) {
   const TopoDS_Shape big = BRepPrimAPI_MakeBox(4.0, 4.0, 4.0).Shape();
   const TopoDS_Shape small = BRepPrimAPI_MakeBox(gp_Pnt(1, 1, 1), 1.0, 1.0, 1.0).Shape();
-  for (const bool copy : {false, true}) {
+  TopoDS_Compound c;
+  BRep_Builder b;
+  b.MakeCompound(c);
+  b.Add(c, big);
+  addFaces(c, small, 0.0, true);
+  const std::string why = "a closed shell and Solid1 one inside the other";
+  HealingRecord refused;
+  try {
+    healModel(cadModelFromShape(c, "body"), {}, refused);
+    FAIL() << "a closed shell inside a solid was accepted";
+  } catch (const CadError& e) {
+    EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+  }
+  HealingRecord record;
+  const CadModel cad = healModel(cadModelFromShape(c, "body"), HealingOptions{true, true}, record);
+  EXPECT_EQ(cad.numSolids(), 1);
+  EXPECT_EQ(cad.numFaces(), 6);
+  EXPECT_NE(record.leftOut.find(why), std::string::npos) << record.leftOut;
+  EXPECT_FALSE(record.leftOutCopies);
+}
+
+// Loose faces that all copy faces of a solid (a surface model written beside its body, as
+// Gmsh's shell_sewing demo does) are left out without solids only: nothing is lost, and the
+// record says so. One loose face that copies nothing is enough to refuse the model as before.
+TEST(CadHealing, LooseCopiesOfASolidsFacesAreLeftOutAndSaidSo) {
+  const TopoDS_Shape big = BRepPrimAPI_MakeBox(4.0, 4.0, 4.0).Shape();
+  for (const bool shell : {true, false}) {  // a closed copy, or two faces of it
     TopoDS_Compound c;
     BRep_Builder b;
     b.MakeCompound(c);
     b.Add(c, big);
-    addFaces(c, copy ? big : small, 0.0, true);
-    const std::string why = copy ? "a closed shell and Solid1 that are copies of each other"
-                                 : "a closed shell and Solid1 one inside the other";
-    HealingRecord refused;
-    try {
-      healModel(cadModelFromShape(c, "body"), {}, refused);
-      FAIL() << "a closed shell " << (copy ? "copying" : "inside") << " a solid was accepted";
-    } catch (const CadError& e) {
-      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
-    }
+    int n = 0;
+    for (TopExp_Explorer f(big, TopAbs_FACE); f.More(); f.Next())
+      if (shell || ++n <= 2) b.Add(c, f.Current().Moved(TopLoc_Location(gp_Trsf())));
     HealingRecord record;
-    const CadModel cad =
-        healModel(cadModelFromShape(c, "body"), HealingOptions{true, true}, record);
+    const CadModel cad = healModel(cadModelFromShape(c, "copies"), {}, record);
     EXPECT_EQ(cad.numSolids(), 1);
     EXPECT_EQ(cad.numFaces(), 6);
-    EXPECT_NE(record.leftOut.find(why), std::string::npos) << record.leftOut;
+    EXPECT_TRUE(record.leftOutCopies);
+    const std::string names = shell ? "6 faces (Face7-Face12)" : "2 faces (Face7-Face8)";
+    EXPECT_EQ(record.leftOut.rfind(names + " in no solid", 0), 0u) << record.leftOut;
+    EXPECT_NE(
+        record.leftOut.find(std::string("copies of ") + (shell ? "Face1-Face6" : "Face1-Face2") +
+                            " of the solids; nothing of the model is lost"),
+        std::string::npos)
+        << record.leftOut;
+    ASSERT_EQ(record.notes().size(), 1u);
+    EXPECT_EQ(record.notes()[0].rfind("left out " + names, 0), 0u) << record.notes()[0];
+  }
+  // Two copies and a face elsewhere: refused, naming all three.
+  TopoDS_Compound c;
+  BRep_Builder b;
+  b.MakeCompound(c);
+  b.Add(c, big);
+  int n = 0;
+  for (TopExp_Explorer f(big, TopAbs_FACE); f.More(); f.Next())
+    if (++n <= 2) b.Add(c, f.Current().Moved(TopLoc_Location(gp_Trsf())));
+  addFaces(c, box(), 10.0, false);  // 5 faces of another box, apart
+  HealingRecord refused;
+  try {
+    healModel(cadModelFromShape(c, "mixed"), {}, refused);
+    FAIL() << "loose faces that copy nothing were accepted";
+  } catch (const CadError& e) {
+    EXPECT_NE(std::string(e.what()).find("7 faces (Face7-Face13) in no solid"), std::string::npos)
+        << e.what();
   }
 }
 
