@@ -189,6 +189,17 @@ void addFaces(TopoDS_Compound& c, const TopoDS_Shape& shape, double dx, bool all
     if (all || ++k < total) b.Add(c, f.Current().Moved(TopLoc_Location(shift)));
 }
 
+// healModel with healing on and without solids only refuses `shape`, saying `why`.
+void expectRefused(const TopoDS_Shape& shape, const std::string& name, const std::string& why) {
+  HealingRecord record;
+  try {
+    healModel(cadModelFromShape(shape, name), {}, record);
+    ADD_FAILURE() << name << " was accepted";
+  } catch (const CadError& e) {
+    EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+  }
+}
+
 // Loose faces of which only some close: refused with the option named; solids only meshes the
 // closed shell and records the rest.
 TEST(CadHealing, SolidsOnlyKeepsTheShellsThatCloseAndRecordsTheRest) {
@@ -224,14 +235,7 @@ TEST(CadHealing, SolidsOnlySewsWhatClosesBesideSolidsAndLeavesOutTheRest) {
   b.Add(c, box());
   addFaces(c, box(), 5.0, true);    // closes
   addFaces(c, box(), 10.0, false);  // open
-  HealingRecord refused;
-  try {
-    healModel(cadModelFromShape(c, "three"), {}, refused);
-    FAIL() << "an open shell beside solids was accepted";
-  } catch (const CadError& e) {
-    EXPECT_NE(std::string(e.what()).find("sewing closed 1 of 2 shells"), std::string::npos)
-        << e.what();
-  }
+  expectRefused(c, "three", "sewing closed 1 of 2 shells");
   HealingRecord record;
   const CadModel cad = healModel(cadModelFromShape(c, "three"), HealingOptions{true, true}, record);
   EXPECT_EQ(cad.numSolids(), 2);
@@ -252,13 +256,7 @@ TEST(CadHealing, AClosedLooseShellInsideASolidIsRefused) {
   b.Add(c, big);
   addFaces(c, small, 0.0, true);
   const std::string why = "a closed shell and Solid1 one inside the other";
-  HealingRecord refused;
-  try {
-    healModel(cadModelFromShape(c, "body"), {}, refused);
-    FAIL() << "a closed shell inside a solid was accepted";
-  } catch (const CadError& e) {
-    EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
-  }
+  expectRefused(c, "body", why);
   HealingRecord record;
   const CadModel cad = healModel(cadModelFromShape(c, "body"), HealingOptions{true, true}, record);
   EXPECT_EQ(cad.numSolids(), 1);
@@ -272,14 +270,19 @@ TEST(CadHealing, AClosedLooseShellInsideASolidIsRefused) {
 // record says so. One loose face that copies nothing is enough to refuse the model as before.
 TEST(CadHealing, LooseCopiesOfASolidsFacesAreLeftOutAndSaidSo) {
   const TopoDS_Shape big = BRepPrimAPI_MakeBox(4.0, 4.0, 4.0).Shape();
-  for (const bool shell : {true, false}) {  // a closed copy, or two faces of it
+  // The box, then copies of its first `faces` faces, loose.
+  const auto withCopies = [&big](int faces) {
     TopoDS_Compound c;
     BRep_Builder b;
     b.MakeCompound(c);
     b.Add(c, big);
     int n = 0;
     for (TopExp_Explorer f(big, TopAbs_FACE); f.More(); f.Next())
-      if (shell || ++n <= 2) b.Add(c, f.Current().Moved(TopLoc_Location(gp_Trsf())));
+      if (++n <= faces) b.Add(c, f.Current().Moved(TopLoc_Location(gp_Trsf())));
+    return c;
+  };
+  for (const bool shell : {true, false}) {  // a closed copy, or two faces of it
+    const TopoDS_Compound c = withCopies(shell ? 6 : 2);
     HealingRecord record;
     const CadModel cad = healModel(cadModelFromShape(c, "copies"), {}, record);
     EXPECT_EQ(cad.numSolids(), 1);
@@ -295,23 +298,10 @@ TEST(CadHealing, LooseCopiesOfASolidsFacesAreLeftOutAndSaidSo) {
     ASSERT_EQ(record.notes().size(), 1u);
     EXPECT_EQ(record.notes()[0].rfind("left out " + names, 0), 0u) << record.notes()[0];
   }
-  // Two copies and a face elsewhere: refused, naming all three.
-  TopoDS_Compound c;
-  BRep_Builder b;
-  b.MakeCompound(c);
-  b.Add(c, big);
-  int n = 0;
-  for (TopExp_Explorer f(big, TopAbs_FACE); f.More(); f.Next())
-    if (++n <= 2) b.Add(c, f.Current().Moved(TopLoc_Location(gp_Trsf())));
+  // Two copies and faces elsewhere: refused, naming all seven.
+  TopoDS_Compound c = withCopies(2);
   addFaces(c, box(), 10.0, false);  // 5 faces of another box, apart
-  HealingRecord refused;
-  try {
-    healModel(cadModelFromShape(c, "mixed"), {}, refused);
-    FAIL() << "loose faces that copy nothing were accepted";
-  } catch (const CadError& e) {
-    EXPECT_NE(std::string(e.what()).find("7 faces (Face7-Face13) in no solid"), std::string::npos)
-        << e.what();
-  }
+  expectRefused(c, "mixed", "7 faces (Face7-Face13) in no solid");
 }
 
 // Healing off: nothing is sewn, and solids only still leaves the faces out by name; faces
