@@ -689,15 +689,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     Mesh mesh = generateLinearMesh(*result.cad, o);
     if (!options.boundaryLayer) {
       // Cells that curving would make flat at a vertex, whatever follows: split now.
-      for (const CurvedFaceEdge& ear : tangentEarSplits(mesh, *result.cad)) {
-        try {
-          result.tangentEars += applySplits(mesh, {ear}, *result.cad);
-        } catch (const MeshingError& e) {  // (not seen: a midpoint keeps positive cells so)
-          result.notes.push_back(std::string("a tangent ear was left as it is: ") + e.what());
-        } catch (const CadError& e) {  // OCCT could not project its midpoint onto the face
-          result.notes.push_back(std::string("a tangent ear was left as it is: ") + e.what());
-        }
-      }
+      result.tangentEars += applySplits(mesh, tangentEarSplits(mesh, *result.cad), *result.cad);
       if (clocked) clock->done();
       return mesh;
     }
