@@ -2,11 +2,6 @@
 // the pipeline on the sphere in a box, which curving alone leaves invalid.
 #include <gtest/gtest.h>
 
-#include <BRepBuilderAPI_MakeEdge.hxx>
-#include <BRepBuilderAPI_MakeFace.hxx>
-#include <BRepBuilderAPI_MakeWire.hxx>
-#include <gp_Circ.hxx>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -133,52 +128,6 @@ TEST(TangentEars, TheOctahedronsAxisIsItsOnlyEarAndSplittingItLeavesNone) {
   o.size = 0.5;
   const Mesh boxMesh = generateLinearMesh(box, o);
   EXPECT_TRUE(tangentEarSplits(boxMesh, box).empty());
-}
-
-TEST(TangentEars, AHexagonInADiskHasThreeEarsIn2D) {
-  const gp_Circ circle(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 1.0);
-  const CadModel cad = test::toModel(
-      BRepBuilderAPI_MakeFace(BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(circle))).Face());
-  ASSERT_EQ(cad.numEdges(), 1);
-  // The hexagon inscribed in the unit circle, cut into three ears (two sides on the circle
-  // each) around the triangle of every other vertex.
-  Mesh mesh;
-  mesh.dim = 2;
-  mesh.planeNormal = {0.0, 0.0, 1.0};
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (int k = 0; k < 6; ++k) {
-    const double a = k * M_PI / 3.0;
-    const double x[3] = {std::cos(a), std::sin(a), 0.0};
-    mesh.addNode(x, 1, 1, a, nan);
-  }
-  ElementBlock tris, lines;
-  tris.type = CellType::Triangle;
-  lines.type = CellType::Line;
-  for (const std::int64_t k : {0, 2, 4}) {
-    tris.nodes.insert(tris.nodes.end(), {k, k + 1, (k + 2) % 6});
-    tris.entity.push_back(1);
-  }
-  tris.nodes.insert(tris.nodes.end(), {0, 2, 4});
-  tris.entity.push_back(1);
-  for (std::int64_t k = 0; k < 6; ++k) {
-    lines.nodes.insert(lines.nodes.end(), {k, (k + 1) % 6});
-    lines.entity.push_back(1);
-  }
-  mesh.blocks = {tris, lines};
-  mesh.checkConsistency();
-  const std::vector<CurvedFaceEdge> ears = tangentEarSplits(mesh, cad);
-  std::set<MeshEdge> edges;
-  for (const CurvedFaceEdge& e : ears) edges.insert(e.edge);
-  EXPECT_EQ(edges, (std::set<MeshEdge>{meshEdge(0, 2), meshEdge(2, 4), meshEdge(0, 4)}));
-  EXPECT_EQ(applySplits(mesh, ears, cad), 3u);
-  EXPECT_TRUE(tangentEarSplits(mesh, cad).empty());
-  for (const ElementBlock& b : mesh.blocks) {
-    if (b.type != CellType::Triangle) continue;
-    EXPECT_EQ(b.count(), 10u);  // each split halves its ear and the middle triangle around it
-    for (std::size_t e = 0; e < b.count(); ++e) {
-      EXPECT_GT(simplexVolume(mesh, b.element(e)), 0.0);
-    }
-  }
 }
 
 TEST(EdgeSplit, MidpointHalvesEveryCellAroundTheEdge) {
