@@ -687,13 +687,8 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     if (clocked) clock.emplace("linear", result.timings, observer);
     limitGmsh(o, stage);
     Mesh mesh = generateLinearMesh(*result.cad, o);
-    if (!options.boundaryLayer) {
-      // Cells that curving would make flat at a vertex, whatever follows: split now.
-      result.tangentEars += applySplits(mesh, tangentEarSplits(mesh, *result.cad), *result.cad);
-      if (clocked) clock->done();
-      return mesh;
-    }
     if (clocked) clock->done();
+    if (!options.boundaryLayer) return mesh;
     if (clocked) clock.emplace("boundary_layer", result.timings, observer);
     layer.emplace();
     limitGmsh(o, clocked ? std::string("boundary_layer") : stage);

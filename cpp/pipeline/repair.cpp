@@ -2,7 +2,6 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <iterator>
 #include <limits>
@@ -106,16 +105,6 @@ std::optional<CurvedFaceEdge> longestEdge(const Mesh& mesh, const std::int64_t* 
       }
     }
   return found;
-}
-
-// A boundary facet's key: its vertices sorted (a line's third -1).
-std::array<std::int64_t, 3> facetKey(std::int64_t a, std::int64_t b, std::int64_t c) {
-  if (a > b) std::swap(a, b);
-  if (c >= 0) {
-    if (b > c) std::swap(b, c);
-    if (a > b) std::swap(a, b);
-  }
-  return {a, b, c};
 }
 
 }  // namespace
@@ -255,53 +244,6 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
     plan.unsplit.push_back(c);
   }
   return plan;
-}
-
-std::vector<CurvedFaceEdge> tangentEarSplits(const Mesh& linear, const CadModel& cad) {
-  const int d = linear.dim;
-  for (const ElementBlock& block : linear.blocks)  // simplices only (no layer's prisms)
-    if (cellDimension(block.type) == d &&
-        (block.order != 1 || cellNumVertices(block.type) != d + 1))
-      return {};
-  // Boundary facets by their sorted vertices (the third -1 in 2D), with their curved entity.
-  std::map<std::array<std::int64_t, 3>, int> facets;
-  std::map<int, bool> curved;
-  for (const ElementBlock& block : linear.blocks) {
-    if (cellDimension(block.type) != d - 1 || block.order != 1 || cellNumVertices(block.type) != d)
-      continue;
-    for (std::size_t e = 0; e < block.count(); ++e) {
-      const int entity = block.entity[e];
-      if (entity <= 0) continue;
-      auto it = curved.find(entity);
-      if (it == curved.end()) it = curved.emplace(entity, d == 2 || !cad.isPlanar(entity)).first;
-      if (!it->second) continue;
-      const std::int64_t* f = block.element(e);
-      facets.emplace(facetKey(f[0], f[1], d == 3 ? f[2] : -1), entity);
-    }
-  }
-  const std::set<MeshEdge> boundary = boundaryEdges(linear);
-  std::vector<CurvedFaceEdge> splits;
-  std::set<MeshEdge> planned;
-  for (const std::int64_t* v : cellsOf(linear)) {
-    std::array<int, 4> entity{0, 0, 0, 0};  // of the facet opposite vertex i
-    for (int i = 0; i <= d; ++i) {
-      std::array<std::int64_t, 3> rest{-1, -1, -1};  // the vertices but i
-      for (int k = 0, n = 0; k <= d; ++k)
-        if (k != i) rest[static_cast<std::size_t>(n++)] = v[k];
-      const auto it = facets.find(facetKey(rest[0], rest[1], rest[2]));
-      if (it != facets.end()) entity[static_cast<std::size_t>(i)] = it->second;
-    }
-    for (int i = 0; i <= d; ++i)
-      for (int j = i + 1; j <= d; ++j) {
-        const int face = entity[static_cast<std::size_t>(i)];
-        if (face == 0 || face != entity[static_cast<std::size_t>(j)]) continue;
-        // The facets opposite i and j share every vertex but i and j: the ear's far edge.
-        const MeshEdge edge = meshEdge(v[i], v[j]);
-        if (boundary.count(edge) == 0 && planned.insert(edge).second)
-          splits.push_back({edge, face, false});
-      }
-  }
-  return splits;
 }
 
 std::vector<double> curvedVertexPositions(const Mesh& linear, const Mesh& curved) {

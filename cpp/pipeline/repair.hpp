@@ -119,15 +119,6 @@ struct RepairPlan {
 RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
                       const CadModel& cad, bool optimised);
 
-// Tangent ears of a linear simplex mesh: cells with two boundary facets (3D: triangles, 2D:
-// lines) on one curved CAD face (2D: curve). Curving puts both facets on that face, so at each
-// end of the edge they share (2D: at the vertex) every edge of the cell is tangent to the face
-// and the Jacobian vanishes there, whatever the interior nodes do: such a cell is never proven
-// valid (on OpenCASCADE's Motor-c, 80 of the 94 elements left invalid after the optimiser). The
-// edge joining the two facets' far vertices, to split before curving (applySplits: a new
-// interior vertex, its node off the face); none where that edge is on the boundary itself.
-std::vector<CurvedFaceEdge> tangentEarSplits(const Mesh& linear, const CadModel& cad);
-
 // Splits the plan's edges in turn (linear/edge_split.hpp) and returns how many it split. A
 // chord between different entities (entity 0) is split at its midpoint. An interior edge's new
 // node goes at its midpoint when that lies on the solid's side of the curved face (the side of the

@@ -107,29 +107,6 @@ TEST(EdgeSplit, SplittingTheChordsOfABallKeepsVolumesAndLeavesNoChord) {
   mesh.checkConsistency();
 }
 
-TEST(TangentEars, TheOctahedronsAxisIsItsOnlyEarAndSplittingItLeavesNone) {
-  const CadModel cad = test::toModel(test::sphere(1.0));
-  Mesh mesh = octahedronAroundItsAxis();
-  // Each tetrahedron has two faces on the sphere, sharing its equator edge: the far edge of
-  // all four is the axis (poles 0 and 1).
-  const std::vector<CurvedFaceEdge> ears = tangentEarSplits(mesh, cad);
-  ASSERT_EQ(ears.size(), 1u);
-  EXPECT_EQ(ears[0].edge, meshEdge(0, 1));
-  EXPECT_EQ(ears[0].entity, 1);
-  EXPECT_FALSE(ears[0].boundary);
-  EXPECT_EQ(applySplits(mesh, ears, cad), 1u);
-  EXPECT_TRUE(tangentEarSplits(mesh, cad).empty());  // each half has one face on the sphere
-  EXPECT_EQ(cellVolumes(mesh).size(), 8u);
-
-  // On a plane two faces of a cell cannot share an edge without the cell being flat: a box's
-  // cells have no ear, and a mesh with cells other than simplices gets none either.
-  const CadModel box = test::toModel(test::box(1, 1, 1));
-  LinearMeshOptions o;
-  o.size = 0.5;
-  const Mesh boxMesh = generateLinearMesh(box, o);
-  EXPECT_TRUE(tangentEarSplits(boxMesh, box).empty());
-}
-
 TEST(EdgeSplit, MidpointHalvesEveryCellAroundTheEdge) {
   const CadModel cad = test::toModel(test::box(1, 1, 1));
   Mesh mesh = generateLinearMesh(cad, LinearMeshOptions::uniform(0.4));
