@@ -42,8 +42,8 @@ struct HealingRecord {
   // Solids sewing made (or could make, when the model was refused for faces left over): what
   // HealingOptions::solidsOnly would keep; 0 when sewing was not tried or found a void.
   int sewnSolids = 0;
-  // The faces left out because they are in no solid (HealingOptions::solidsOnly), in words:
-  // how many, where, and why ("17 faces in no solid (they do not close: ...), within x ...").
+  // The faces left out because they are in no solid (HealingOptions::solidsOnly, or copies of
+  // the solids' faces: leftOutCopies), in words: how many, where, and why ("17 faces in no solid (they do not close: ...), within x ...").
   std::string leftOut;
   // Those faces all copy faces of the solids (the same box, area and centre): left out without
   // HealingOptions::solidsOnly, since nothing is lost.
@@ -59,7 +59,7 @@ struct HealingRecord {
   bool renumbered = false;
   bool changed() const { return !actions.empty(); }
   // What a user must read about the model meshed, one line each: the faces left out (solids
-  // only) and the warnings. The pipeline's notes and `homesh predict` print these.
+  // only, or copies) and the warnings. The pipeline's notes and `homesh predict` print these.
   std::vector<std::string> notes() const {
     std::vector<std::string> lines;
     if (!leftOut.empty())

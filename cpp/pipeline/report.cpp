@@ -49,7 +49,8 @@ void appendHealing(JsonWriter& json, const HealingRecord& h) {
   appendStrings(json, "problems", h.problems);
   appendStrings(json, "actions", h.actions);
   appendStrings(json, "warnings", h.warnings);
-  // The faces in no solid that were not meshed (solids only), in words; empty: none.
+  // The faces in no solid that were not meshed (solids only, or copies of the solids' faces),
+  // in words; empty: none.
   json.value("left_out", h.leftOut);
   // Face numbers (boundary layers, groups) are the healed model's when it was renumbered.
   json.value("renumbered", h.renumbered);

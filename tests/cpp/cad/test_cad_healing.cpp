@@ -244,9 +244,9 @@ TEST(CadHealing, SolidsOnlySewsWhatClosesBesideSolidsAndLeavesOutTheRest) {
       << record.leftOut;
 }
 
-// A loose shell that closes inside a solid (a void exported on its own) or on it (a surface
-// copy of the body) is no second solid: the model is refused, not meshed twice; solids only
-// meshes the solid and leaves the shell out, saying why.
+// A loose shell that closes inside a solid (a void exported on its own) is no second solid:
+// the model is refused, not meshed as two solids; solids only meshes the solid and leaves the
+// shell out, saying why. (A shell on it, a surface copy of the body: the test below.)
 TEST(CadHealing, AClosedLooseShellInsideASolidIsRefused) {
   const TopoDS_Shape big = BRepPrimAPI_MakeBox(4.0, 4.0, 4.0).Shape();
   const TopoDS_Shape small = BRepPrimAPI_MakeBox(gp_Pnt(1, 1, 1), 1.0, 1.0, 1.0).Shape();
