@@ -43,7 +43,8 @@ struct HealingRecord {
   // HealingOptions::solidsOnly would keep; 0 when sewing was not tried or found a void.
   int sewnSolids = 0;
   // The faces left out because they are in no solid (HealingOptions::solidsOnly, or copies of
-  // the solids' faces: leftOutCopies), in words: how many, where, and why ("17 faces in no solid (they do not close: ...), within x ...").
+  // the solids' faces: leftOutCopies), in words: how many, where, and why ("17 faces in no
+  // solid (they do not close: ...), within x ...").
   std::string leftOut;
   // Those faces all copy faces of the solids (the same box, area and centre): left out without
   // HealingOptions::solidsOnly, since nothing is lost.
