@@ -103,8 +103,9 @@ TEST(NarrowFaces, BoundTheSizesAlongTheLedgeAndNowhereElse) {
     const double radius = std::hypot(s.x.x(), s.x.y());
     EXPECT_NEAR(s.x.z(), 5.0, 1e-9);  // only the ledge's circles
     // width 0.05 (to the projection's precision) and R = 1 / curvature = the circle's radius
-    // (to rounding): the size changes with sqrt(width) and sqrt(R).
-    EXPECT_NEAR(s.delta, chordSize(radius, 0.25 * 0.05 / radius), 1e-6 * s.delta)
+    // (to rounding): the size changes with sqrt(width), so by half the width's relative error.
+    const double relative = 0.5 * precision(cad) / 0.05 + 1e-12;
+    EXPECT_NEAR(s.delta, chordSize(radius, 0.25 * 0.05 / radius), relative * s.delta)
         << s.x.transpose();
   }
   EXPECT_GT(narrowed, 80u);  // both circles, at least 40 samples each
