@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 
+#include "cad/face_cusps.hpp"
 #include "cad/model_dimension.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
@@ -297,8 +298,9 @@ constexpr int kPipelineStuckWindow = 5;
 
 // Once every element is proven valid, repair rounds go on for elements whose certified scaled
 // Jacobian is below this: slivers lying flat on a curved face and chords of one curved face, the
-// same configurations as the invalid ones, milder. Those rounds only split (a refinement remeshes
-// the whole model and brings new offenders elsewhere) and are kept only when the worst element
+// same configurations as the invalid ones, milder. Those rounds only act locally (split, then
+// flip, then remesh their cavities, each tried once on the best mesh; a refinement remeshes the
+// whole model and brings new offenders elsewhere) and are kept only when the worst element
 // improves with every element still valid. (OpenCASCADE's linkrods.step: 3 elements at 0.043 to
 // 0.086, all four vertices on one cylinder.)
 constexpr double kPoorElement = 0.1;
@@ -565,6 +567,46 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
   return state;
 }
 
+// The cusps of the CAD, none where OCCT fails a query on the way (they only explain).
+std::vector<FaceCusp> cadCusps(const CadModel& cad) {
+  try {
+    return findFaceCusps(cad);
+  } catch (const CadError&) {
+    return {};
+  }
+}
+
+// The cusps of the CAD at which elements not proven valid have a corner, and how many such
+// elements (elementsAtCusps): the CAD, not the mesher, keeps those from being proven valid.
+// Empty when there are none.
+std::string cuspText(const MeshResult& result) {
+  if (!result.cad) return {};
+  const std::vector<FaceCusp> cusps = cadCusps(*result.cad);
+  const CuspElements at = elementsAtCusps(result.mesh, result.quality, cusps);
+  if (at.elements.empty()) return {};
+  const std::size_t n = at.elements.size();
+  std::string text = "; " + std::to_string(n) + " of them " + (n == 1 ? "has" : "have") +
+                     " a corner at a cusp of the CAD (";
+  int listed = 0;
+  for (std::size_t c = 0; c < cusps.size(); ++c) {
+    if (at.perCusp[c] == 0) continue;
+    if (listed == 3) {
+      text += ", ...";
+      break;
+    }
+    const FaceCusp& cusp = cusps[c];
+    text += std::string(listed++ == 0 ? "" : ", ") + "Face" + std::to_string(cusp.face) +
+            " at Vertex" + std::to_string(cusp.vertex) + ", where Edge" +
+            std::to_string(cusp.edgeA) + " and Edge" + std::to_string(cusp.edgeB) +
+            " leave it in the same direction";
+  }
+  // (A Jacobian positive there rests on the edges' polynomials missing the CAD's tangents on
+  // the right side: FreeCAD's I22 inductors end valid with some builds and not with others.)
+  return text +
+         "): a mesh that follows the CAD has a zero Jacobian there, and such an element is proven "
+         "valid only where its polynomial edges miss the CAD's tangents on the right side";
+}
+
 // The closing note of a mesh with elements not proven valid: how many, where on the CAD, and
 // what was tried on them (the optimiser, the repair rounds and their actions), so that a one-line
 // message names the stage that gave up and the entity. `linearGiven`: the caller gave the linear
@@ -577,6 +619,7 @@ std::string notValidNote(const MeshResult& result, bool linearGiven) {
                      std::to_string(q.undecided) + " undecided)";
   const std::string where = notValidLocation(result.mesh, q);
   if (!where.empty()) text += " " + where;
+  text += cuspText(result);
   text += result.options.optimiseIterations == 0
               ? std::string(
                     "; the optimiser did not run (--optimise, Python optimise > 0, "
@@ -687,8 +730,21 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     if (clocked) clock.emplace("linear", result.timings, observer);
     limitGmsh(o, stage);
     Mesh mesh = generateLinearMesh(*result.cad, o);
+    if (!options.boundaryLayer) {
+      // Cells that curving would make flat at a vertex, whatever follows: split now.
+      for (const CurvedFaceEdge& ear : tangentEarSplits(mesh, *result.cad)) {
+        try {
+          result.tangentEars += applySplits(mesh, {ear}, *result.cad);
+        } catch (const MeshingError& e) {  // (not seen: a midpoint keeps positive cells so)
+          result.notes.push_back(std::string("a tangent ear was left as it is: ") + e.what());
+        } catch (const CadError& e) {  // OCCT could not project its midpoint onto the face
+          result.notes.push_back(std::string("a tangent ear was left as it is: ") + e.what());
+        }
+      }
+      if (clocked) clock->done();
+      return mesh;
+    }
     if (clocked) clock->done();
-    if (!options.boundaryLayer) return mesh;
     if (clocked) clock.emplace("boundary_layer", result.timings, observer);
     layer.emplace();
     limitGmsh(o, clocked ? std::string("boundary_layer") : stage);
@@ -716,12 +772,24 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   // until a round is kept, so that a failed flip and a failed remesh cannot take turns for
   // every round (each flag alone only covers the round after it).
   bool flipTriedOnBest = false, remeshTriedOnBest = false;
+  // Rounds for poor elements (every element valid) never refine: they try a split, a flip and a
+  // remesh of the best mesh in turn, each once, and end when none is kept.
+  bool splitTriedOnBest = false;
+  // The last round split poor elements and left some invalid (not kept): the next round splits
+  // those from its mesh, as a first round would after curving (the sphere in a box at size 1.2,
+  // order 4: a poor split left 1 invalid, the split after it ended valid at 0.193, from 0.083;
+  // OpenCASCADE's linkrods.step: 0.0106 -> 0.217 the same way).
+  bool poorSplitLeftInvalid = false;
   for (int round = 1; round <= options.repairRounds; ++round) {
-    const bool fromBest = !(last && !splitFailed && !flipFailed && !remeshFailed);
+    bool follow = poorSplitLeftInvalid && last && !options.boundaryLayer;
+    if (follow)  // (only where there is something to split: no refinement after poor rounds)
+      follow = !planRepair(last->linear, last->quality.validity, *result.cad,
+                           options.optimiseIterations > 0)
+                    .splits.empty();
+    const bool fromBest = !(last && (follow || (!splitFailed && !flipFailed && !remeshFailed)));
     const CurvedState& from = fromBest ? best : *last;
     const bool poor = from.notValid() == 0;  // only elements below kPoorElement are left
-    if (poor && (!(from.quality.scaled.min < kPoorElement) || splitFailed || options.boundaryLayer))
-      break;
+    if (poor && (!(from.quality.scaled.min < kPoorElement) || options.boundaryLayer)) break;
     const std::string name = "repair " + std::to_string(round);
     if (budget.limited() && budget.available() < lastSeconds) {
       budget.skip(name);
@@ -744,28 +812,36 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     const RepairPlan plan = planRepair(from.linear, repairTargets(from.quality, poor), *result.cad,
                                        options.optimiseIterations > 0);
     Mesh next;
-    if (!plan.splits.empty() && !splitFailed && !options.boundaryLayer) {
+    if (!plan.splits.empty() && (!splitFailed || follow) && !(poor && splitTriedOnBest) &&
+        !options.boundaryLayer) {
       // Local: only the cells around the split edges change; the rest wait for the next round.
       next = from.linear;
       record.edgesSplit = applySplits(next, plan.splits, *result.cad);
     }
-    // A poor element is not worth a remesh: without a split there is no round (nor its stage).
-    if (poor && record.edgesSplit == 0) break;
     // Flagged cells with no edge to split (slivers with vertices inside, which the optimiser
     // could not inflate) are flipped away where a flip makes better cells, judged where the
-    // optimiser left the vertices: local, where a refinement remeshes the whole model.
-    if (plan.splits.empty() && !(fromBest && flipTriedOnBest) && !options.boundaryLayer &&
+    // optimiser left the vertices: local, where a refinement remeshes the whole model. Poor
+    // elements whose split was not kept are flipped the same way (all of them).
+    const bool local = plan.splits.empty() || (poor && record.edgesSplit == 0);
+    const std::vector<std::size_t>& localCells = poor ? plan.flagged : plan.unsplit;
+    const bool mayRemesh = local && !(fromBest && remeshTriedOnBest) && !options.boundaryLayer &&
+                           options.optimiseIterations > 0 && from.linear.dim == 3;
+    if (local && !(fromBest && flipTriedOnBest) && !options.boundaryLayer &&
         options.optimiseIterations > 0 && from.linear.dim == 3) {
       next = from.linear;
       try {
         const FlipOutcome flipped =
-            flipAwayCells(next, plan.unsplit, curvedVertexPositions(from.linear, from.mesh));
+            flipAwayCells(next, localCells, curvedVertexPositions(from.linear, from.mesh));
         record.flips = flipped.flips;
         record.elements = flipped.cellsFlipped;
       } catch (const ParameterError& e) {  // a mesh the flips do not handle: refine instead
         result.notes.push_back(name + ": no flips (" + e.what() + "); refined instead");
       }
+      if (record.flips == 0) flipTriedOnBest = flipTriedOnBest || fromBest;
     }
+    // A poor element is not worth a refinement (it remeshes the whole model and brings new
+    // offenders elsewhere): with nothing local left to try there is no round (nor its stage).
+    if (poor && record.edgesSplit == 0 && record.flips == 0 && !mayRemesh) break;
     StageClock clock(name, result.timings, observer);
     // A Gmsh run of the round failed (or was stopped by the budget): the round is recorded with
     // why, and the rounds end with the best mesh so far.
@@ -789,9 +865,8 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     // a cavity's new cells are curved as they come, on the same boundary triangles: only a finer
     // boundary helps there too.
     bool remeshed = false;
-    if (plan.splits.empty() && record.flips == 0 && !(fromBest && remeshTriedOnBest) &&
-        !options.boundaryLayer && options.optimiseIterations > 0 && from.linear.dim == 3) {
-      const std::vector<std::size_t>& cells = plan.unsplit;
+    if (mayRemesh && record.edgesSplit == 0 && record.flips == 0) {
+      const std::vector<std::size_t>& cells = localCells;
       record.elements = cells.size();
       next = from.linear;
       try {
@@ -813,14 +888,19 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
         result.notes.push_back(name + ": no local remesh (" + e.what() + "); refined instead");
       }
       if (!remeshed) next = Mesh();
+      if (!remeshed) remeshTriedOnBest = remeshTriedOnBest || fromBest;
+    }
+    if (poor && record.edgesSplit == 0 && record.flips == 0 && !remeshed) {
+      clock.done();  // (no refinement for poor elements: see above)
+      break;
     }
     if (record.edgesSplit > 0) {
       record.action = poor ? "split poor" : "split";
       record.elements = plan.splitCells;
     } else if (record.flips > 0) {
-      record.action = "flip";
+      record.action = poor ? "flip poor" : "flip";
     } else if (remeshed) {
-      record.action = "remesh";
+      record.action = poor ? "remesh poor" : "remesh";
     } else {
       // Nothing to split (or no split kept its cells positive): refine around every offender.
       std::vector<RefinementSource> added =
@@ -872,18 +952,19 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       record.optimiserSeconds = state.optimiser->seconds;
     }
     record.kept = state.betterThan(best);
-    // (A "split poor" round not kept ends the rounds: see the loop's start.)
     splitFailed = !record.kept && (record.action == "split" || record.action == "split poor");
-    flipFailed = !record.kept && record.action == "flip";
-    remeshFailed = !record.kept && record.action == "remesh";
+    poorSplitLeftInvalid = !record.kept && record.action == "split poor" && state.notValid() > 0;
+    flipFailed = !record.kept && (record.action == "flip" || record.action == "flip poor");
+    remeshFailed = !record.kept && (record.action == "remesh" || record.action == "remesh poor");
     if (record.kept) {
-      flipTriedOnBest = remeshTriedOnBest = false;
+      flipTriedOnBest = remeshTriedOnBest = splitTriedOnBest = false;
       best = std::move(state);
       last.reset();
     } else {
       if (fromBest) {
-        flipTriedOnBest = flipTriedOnBest || record.action == "flip";
-        remeshTriedOnBest = remeshTriedOnBest || record.action == "remesh";
+        flipTriedOnBest = flipTriedOnBest || flipFailed;
+        remeshTriedOnBest = remeshTriedOnBest || remeshFailed;
+        splitTriedOnBest = splitTriedOnBest || record.action == "split poor";
       }
       last = std::move(state);
     }

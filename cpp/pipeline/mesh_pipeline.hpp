@@ -198,6 +198,9 @@ struct MeshResult {
   std::optional<SizingResult> sizing;        // when the sizes came from the octree
   std::optional<GeometryAccuracy> geometry;  // boundary against the CAD (a mesh made from CAD)
   std::vector<RepairRound> rounds;           // the repair rounds run, in order
+  // Tangent ears split in the linear meshes Gmsh made, before curving (tangentEarSplits in
+  // pipeline/repair.hpp), over the first mesh and the refine rounds' meshes.
+  std::size_t tangentEars = 0;
   // With a boundary layer: how the macro layer of the kept mesh was grown, the certified
   // quality of its macro (unsplit) mesh, and how it was split.
   std::optional<BoundaryLayerRecord> boundaryLayer;

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iterator>
 #include <limits>
@@ -107,6 +108,16 @@ std::optional<CurvedFaceEdge> longestEdge(const Mesh& mesh, const std::int64_t* 
   return found;
 }
 
+// A boundary facet's key: its vertices sorted (a line's third -1).
+std::array<std::int64_t, 3> facetKey(std::int64_t a, std::int64_t b, std::int64_t c) {
+  if (a > b) std::swap(a, b);
+  if (c >= 0) {
+    if (b > c) std::swap(b, c);
+    if (a > b) std::swap(a, b);
+  }
+  return {a, b, c};
+}
+
 }  // namespace
 
 CurvedFaceEdges::CurvedFaceEdges(const Mesh& linear, const CadModel& cad)
@@ -209,6 +220,7 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
   std::set<MeshEdge> planned;
   for (std::size_t c = 0; c < cells.size(); ++c) {
     if (validity[c] == Validity::Valid) continue;
+    plan.flagged.push_back(c);
     const int nv = vertexCount[c];
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     double longest = 0.0, total = 0.0;
@@ -244,6 +256,76 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
     plan.unsplit.push_back(c);
   }
   return plan;
+}
+
+std::vector<CurvedFaceEdge> tangentEarSplits(const Mesh& linear, const CadModel& cad) {
+  const int d = linear.dim;
+  for (const ElementBlock& block : linear.blocks)  // simplices only (no layer's prisms)
+    if (cellDimension(block.type) == d &&
+        (block.order != 1 || cellNumVertices(block.type) != d + 1))
+      return {};
+  // Boundary facets by their sorted vertices (the third -1 in 2D), with their curved entity.
+  std::map<std::array<std::int64_t, 3>, int> facets;
+  std::map<int, bool> curved;
+  for (const ElementBlock& block : linear.blocks) {
+    if (cellDimension(block.type) != d - 1 || block.order != 1 || cellNumVertices(block.type) != d)
+      continue;
+    for (std::size_t e = 0; e < block.count(); ++e) {
+      const int entity = block.entity[e];
+      if (entity <= 0) continue;
+      auto it = curved.find(entity);
+      if (it == curved.end()) it = curved.emplace(entity, d == 2 || !cad.isPlanar(entity)).first;
+      if (!it->second) continue;
+      const std::int64_t* f = block.element(e);
+      facets.emplace(facetKey(f[0], f[1], d == 3 ? f[2] : -1), entity);
+    }
+  }
+  const std::set<MeshEdge> boundary = boundaryEdges(linear);
+  std::vector<CurvedFaceEdge> splits;
+  std::set<MeshEdge> planned;
+  for (const std::int64_t* v : cellsOf(linear)) {
+    std::array<int, 4> entity{0, 0, 0, 0};  // of the facet opposite vertex i
+    for (int i = 0; i <= d; ++i) {
+      std::array<std::int64_t, 3> rest{-1, -1, -1};  // the vertices but i
+      for (int k = 0, n = 0; k <= d; ++k)
+        if (k != i) rest[static_cast<std::size_t>(n++)] = v[k];
+      const auto it = facets.find(facetKey(rest[0], rest[1], rest[2]));
+      if (it != facets.end()) entity[static_cast<std::size_t>(i)] = it->second;
+    }
+    for (int i = 0; i <= d; ++i)
+      for (int j = i + 1; j <= d; ++j) {
+        const int face = entity[static_cast<std::size_t>(i)];
+        if (face == 0 || face != entity[static_cast<std::size_t>(j)]) continue;
+        // The facets opposite i and j share every vertex but i and j: the ear's far edge.
+        const MeshEdge edge = meshEdge(v[i], v[j]);
+        if (boundary.count(edge) == 0 && planned.insert(edge).second)
+          splits.push_back({edge, face, false});
+      }
+  }
+  return splits;
+}
+
+CuspElements elementsAtCusps(const Mesh& mesh, const QualitySummary& quality,
+                             const std::vector<FaceCusp>& cusps) {
+  CuspElements out;
+  out.perCusp.assign(cusps.size(), 0);
+  if (cusps.empty()) return out;
+  const auto has = [](const std::vector<int>& list, int x) {
+    return std::binary_search(list.begin(), list.end(), x);
+  };
+  for (const FlaggedElement& f :
+       flaggedElements(mesh, quality, quality.invalid + quality.undecided)) {
+    bool any = false;
+    for (std::size_t c = 0; c < cusps.size(); ++c) {
+      const FaceCusp& cusp = cusps[c];
+      if (!has(f.cadVertices, cusp.vertex)) continue;
+      if (!has(f.cadCurves, cusp.edgeA) && !has(f.cadCurves, cusp.edgeB)) continue;
+      ++out.perCusp[c];
+      any = true;
+    }
+    if (any) out.elements.push_back(f.index);
+  }
+  return out;
 }
 
 std::vector<double> curvedVertexPositions(const Mesh& linear, const Mesh& curved) {

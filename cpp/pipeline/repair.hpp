@@ -20,10 +20,12 @@
 #include <vector>
 
 #include "cad/cad_model.hpp"
+#include "cad/face_cusps.hpp"
 #include "core/mesh.hpp"
 #include "linear/edge_split.hpp"
 #include "linear/linear_mesher.hpp"
 #include "quality/bezier_jacobian.hpp"
+#include "quality/mesh_quality.hpp"
 #include "sizing/refinement_source.hpp"
 
 namespace homesh {
@@ -33,8 +35,9 @@ struct RepairRound {
   std::size_t invalid = 0, undecided = 0;  // elements not proven valid that the round found
   double worst = 0.0, worstAfter = 0.0;    // certified scaled Jacobian before and after
   // "split", "flip", "remesh" (cavities around the flagged cells filled again), "refine" (the
-  // whole model meshed again, finer around them), or "split poor" (every element was valid; the
-  // round split the cells of those below the pipeline's poor-element threshold)
+  // whole model meshed again, finer around them), or "split poor", "flip poor", "remesh poor"
+  // (every element was valid; the round split, flipped or remeshed around the cells of those
+  // below the pipeline's poor-element threshold)
   std::string action;
   std::size_t elements = 0;                          // linear cells it acted on
   std::size_t edgesSplit = 0;                        // edges bisected ("split")
@@ -104,6 +107,7 @@ struct RepairPlan {
   std::vector<RefinementSource> allSources;  // spheres around every flagged cell
   std::size_t splitCells = 0, refineCells = 0;
   std::vector<std::size_t> unsplit;  // the flagged cells without an edge to split (`sources`)
+  std::vector<std::size_t> flagged;  // every flagged cell
 };
 
 // Locates the elements whose verdict is not Valid (`validity` per element of the curved mesh,
@@ -118,6 +122,25 @@ struct RepairPlan {
 // the linear mesh's cell count.
 RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
                       const CadModel& cad, bool optimised);
+
+// Tangent ears of a linear simplex mesh: cells with two boundary facets (3D: triangles, 2D:
+// lines) on one curved CAD face (2D: curve). Curving puts both facets on that face, so at each
+// end of the edge they share (2D: at the vertex) every edge of the cell is tangent to the face
+// and the Jacobian vanishes there, whatever the interior nodes do: such a cell is never proven
+// valid (on OpenCASCADE's Motor-c, 80 of the 94 elements left invalid after the optimiser). The
+// edge joining the two facets' far vertices, to split before curving (applySplits: a new
+// interior vertex, its node off the face); none where that edge is on the boundary itself.
+std::vector<CurvedFaceEdge> tangentEarSplits(const Mesh& linear, const CadModel& cad);
+
+// The elements not proven valid that have a corner at a cusp of the CAD (cad/face_cusps.hpp: a
+// node at the cusp's vertex and nodes on one of its two edges): their Jacobian is zero at that
+// vertex whatever the mesh, so no repair round mends them. `perCusp[c]`: how many touch cusps[c].
+struct CuspElements {
+  std::vector<std::size_t> elements;  // indices among the cells of dimension mesh.dim
+  std::vector<std::size_t> perCusp;
+};
+CuspElements elementsAtCusps(const Mesh& mesh, const QualitySummary& quality,
+                             const std::vector<FaceCusp>& cusps);
 
 // Splits the plan's edges in turn (linear/edge_split.hpp) and returns how many it split. A
 // chord between different entities (entity 0) is split at its midpoint. An interior edge's new

@@ -338,6 +338,7 @@ std::string meshReportJson(const MeshResult& result, const std::string& input) {
   json.value("size", result.options.size.value_or(0.0));
   json.value("nodes", result.mesh.numNodes());
   appendCounts(json, result.mesh);
+  json.value("tangent_ears_split", result.tangentEars);
   if (result.sizing) {
     json.value("predicted_elements",
                static_cast<std::size_t>(std::llround(result.sizing->prediction.elements)));

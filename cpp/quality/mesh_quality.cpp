@@ -166,8 +166,9 @@ std::vector<FlaggedElement> flaggedElements(const Mesh& mesh, const QualitySumma
         if (n >= mesh.nodeCadIndex.size() || mesh.nodeCadIndex[n] <= 0) continue;
         if (mesh.nodeCadDim[n] == 2) f.cadFaces.push_back(mesh.nodeCadIndex[n]);
         if (mesh.nodeCadDim[n] == 1) f.cadCurves.push_back(mesh.nodeCadIndex[n]);
+        if (mesh.nodeCadDim[n] == 0) f.cadVertices.push_back(mesh.nodeCadIndex[n]);
       }
-      for (std::vector<int>* list : {&f.cadFaces, &f.cadCurves}) {
+      for (std::vector<int>* list : {&f.cadFaces, &f.cadCurves, &f.cadVertices}) {
         std::sort(list->begin(), list->end());
         list->erase(std::unique(list->begin(), list->end()), list->end());
       }

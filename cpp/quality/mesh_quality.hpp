@@ -72,7 +72,7 @@ struct FlaggedElement {
   double lower = 0.0, upper = 0.0;
   // The CAD faces and curves its nodes lie on (1-based indices, sorted; from the mesh's node
   // classification, empty for a mesh without CAD): where the problem sits on the model.
-  std::vector<int> cadFaces, cadCurves;
+  std::vector<int> cadFaces, cadCurves, cadVertices;
 };
 
 // The invalid and undecided elements, at most `limit` of them, in element order.

@@ -3,18 +3,22 @@
 
 #include <BOPAlgo_Builder.hxx>
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakeSolid.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
 #include <BRepBuilderAPI_NurbsConvert.hxx>
 #include <BRepBuilderAPI_Transform.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
+#include <BRepPrimAPI_MakePrism.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
 #include <BRepPrimAPI_MakeTorus.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
 #include <Eigen/Geometry>
+#include <GC_MakeArcOfCircle.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <Precision.hxx>
 #include <ShapeFix_Solid.hxx>
@@ -22,6 +26,7 @@
 #include <TopoDS.hxx>
 #include <TopoDS_Shape.hxx>
 #include <TopoDS_Shell.hxx>
+#include <cmath>
 #include <filesystem>
 #include <random>
 #include <sstream>
@@ -80,6 +85,23 @@ inline TopoDS_Shape nurbsTorus(double major, double minor) {
   fix.Perform();
   return fix.Solid();
 }
+// The prism of height 1 over the region bounded by the segment (0,0)-(2,0), the segment
+// (2,0)-(1,h) and an arc from (1,h) back to the origin through `through`. With the defaults the
+// arc is a quarter of the circle of radius 1 centred at (0,1): it leaves the origin along +x,
+// like the segment, so the bottom and top faces have a cusp there (and the side faces meet
+// tangentially along the vertical edge through it).
+inline TopoDS_Shape cuspPrism(const gp_Pnt& through = gp_Pnt(std::sqrt(0.5), 1.0 - std::sqrt(0.5),
+                                                             0),
+                              double h = 1.0) {
+  const gp_Pnt o(0, 0, 0), a(2, 0, 0), b(1, h, 0);
+  const Handle(Geom_TrimmedCurve) arc = GC_MakeArcOfCircle(b, through, o).Value();
+  BRepBuilderAPI_MakeWire wire(BRepBuilderAPI_MakeEdge(o, a).Edge(),
+                               BRepBuilderAPI_MakeEdge(a, b).Edge(),
+                               BRepBuilderAPI_MakeEdge(arc).Edge());
+  const TopoDS_Face face = BRepBuilderAPI_MakeFace(wire.Wire(), true).Face();
+  return BRepPrimAPI_MakePrism(face, gp_Vec(0, 0, 1)).Shape();
+}
+
 inline TopoDS_Shape box(double x, double y, double z) {
   return BRepPrimAPI_MakeBox(x, y, z).Shape();
 }

@@ -2,6 +2,11 @@
 // the pipeline on the sphere in a box, which curving alone leaves invalid.
 #include <gtest/gtest.h>
 
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
+#include <gp_Circ.hxx>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -105,6 +110,75 @@ TEST(EdgeSplit, SplittingTheChordsOfABallKeepsVolumesAndLeavesNoChord) {
   EXPECT_EQ(countTriangles(mesh), triangles);  // interior splits leave the boundary alone
   EXPECT_TRUE(allChords(mesh, cad).empty());
   mesh.checkConsistency();
+}
+
+TEST(TangentEars, TheOctahedronsAxisIsItsOnlyEarAndSplittingItLeavesNone) {
+  const CadModel cad = test::toModel(test::sphere(1.0));
+  Mesh mesh = octahedronAroundItsAxis();
+  // Each tetrahedron has two faces on the sphere, sharing its equator edge: the far edge of
+  // all four is the axis (poles 0 and 1).
+  const std::vector<CurvedFaceEdge> ears = tangentEarSplits(mesh, cad);
+  ASSERT_EQ(ears.size(), 1u);
+  EXPECT_EQ(ears[0].edge, meshEdge(0, 1));
+  EXPECT_EQ(ears[0].entity, 1);
+  EXPECT_FALSE(ears[0].boundary);
+  EXPECT_EQ(applySplits(mesh, ears, cad), 1u);
+  EXPECT_TRUE(tangentEarSplits(mesh, cad).empty());  // each half has one face on the sphere
+  EXPECT_EQ(cellVolumes(mesh).size(), 8u);
+
+  // On a plane two faces of a cell cannot share an edge without the cell being flat: a box's
+  // cells have no ear, and a mesh with cells other than simplices gets none either.
+  const CadModel box = test::toModel(test::box(1, 1, 1));
+  LinearMeshOptions o;
+  o.size = 0.5;
+  const Mesh boxMesh = generateLinearMesh(box, o);
+  EXPECT_TRUE(tangentEarSplits(boxMesh, box).empty());
+}
+
+TEST(TangentEars, AHexagonInADiskHasThreeEarsIn2D) {
+  const gp_Circ circle(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 1.0);
+  const CadModel cad = test::toModel(
+      BRepBuilderAPI_MakeFace(BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(circle))).Face());
+  ASSERT_EQ(cad.numEdges(), 1);
+  // The hexagon inscribed in the unit circle, cut into three ears (two sides on the circle
+  // each) around the triangle of every other vertex.
+  Mesh mesh;
+  mesh.dim = 2;
+  mesh.planeNormal = {0.0, 0.0, 1.0};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int k = 0; k < 6; ++k) {
+    const double a = k * M_PI / 3.0;
+    const double x[3] = {std::cos(a), std::sin(a), 0.0};
+    mesh.addNode(x, 1, 1, a, nan);
+  }
+  ElementBlock tris, lines;
+  tris.type = CellType::Triangle;
+  lines.type = CellType::Line;
+  for (const std::int64_t k : {0, 2, 4}) {
+    tris.nodes.insert(tris.nodes.end(), {k, k + 1, (k + 2) % 6});
+    tris.entity.push_back(1);
+  }
+  tris.nodes.insert(tris.nodes.end(), {0, 2, 4});
+  tris.entity.push_back(1);
+  for (std::int64_t k = 0; k < 6; ++k) {
+    lines.nodes.insert(lines.nodes.end(), {k, (k + 1) % 6});
+    lines.entity.push_back(1);
+  }
+  mesh.blocks = {tris, lines};
+  mesh.checkConsistency();
+  const std::vector<CurvedFaceEdge> ears = tangentEarSplits(mesh, cad);
+  std::set<MeshEdge> edges;
+  for (const CurvedFaceEdge& e : ears) edges.insert(e.edge);
+  EXPECT_EQ(edges, (std::set<MeshEdge>{meshEdge(0, 2), meshEdge(2, 4), meshEdge(0, 4)}));
+  EXPECT_EQ(applySplits(mesh, ears, cad), 3u);
+  EXPECT_TRUE(tangentEarSplits(mesh, cad).empty());
+  for (const ElementBlock& b : mesh.blocks) {
+    if (b.type != CellType::Triangle) continue;
+    EXPECT_EQ(b.count(), 10u);  // each split halves its ear and the middle triangle around it
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      EXPECT_GT(simplexVolume(mesh, b.element(e)), 0.0);
+    }
+  }
 }
 
 TEST(EdgeSplit, MidpointHalvesEveryCellAroundTheEdge) {
@@ -540,6 +614,60 @@ TEST(RepairRounds, RoundsAreValidated) {
   EXPECT_THROW(options.validate(), ParameterError);
   options.repairRounds = 0;
   EXPECT_NO_THROW(options.validate());
+}
+
+}  // namespace
+}  // namespace homesh
+
+namespace homesh {
+namespace {
+
+// The prism over a region with a cusp (test::cuspPrism) at order 3, curved without the
+// optimiser: at the cusp the arc's curved edge leaves the vertex along the segment, while the
+// straight edges the bottom and top faces' triangles have inside the corner leave it at an
+// angle, so the triangle between such an edge and the arc is inverted next to the vertex. The
+// elements that have that corner are found at each cusp, and the closing note names the cusps.
+TEST(CuspElements, TheElementsWithACornerAtACuspAreFoundAndNamed) {
+  MeshingOptions options;
+  options.order = 3;
+  options.repairRounds = 0;  // what curving leaves is under test
+  const MeshResult r =
+      runMeshPipeline(CadSource::brepText(test::brepText(test::cuspPrism())), options);
+  const std::vector<FaceCusp> cusps = findFaceCusps(*r.cad);
+  ASSERT_EQ(cusps.size(), 2u);
+  const CuspElements at = elementsAtCusps(r.mesh, r.quality, cusps);
+  ASSERT_EQ(at.perCusp.size(), 2u);
+  EXPECT_GE(at.perCusp[0], 1u);
+  EXPECT_GE(at.perCusp[1], 1u);
+  // Each is flagged and has a node at a cusp's vertex.
+  const std::vector<FlaggedElement> flagged =
+      flaggedElements(r.mesh, r.quality, r.quality.invalid + r.quality.undecided);
+  for (const std::size_t e : at.elements) {
+    const auto f = std::find_if(flagged.begin(), flagged.end(),
+                                [e](const FlaggedElement& x) { return x.index == e; });
+    ASSERT_NE(f, flagged.end()) << e;
+    EXPECT_TRUE(std::any_of(cusps.begin(), cusps.end(), [&](const FaceCusp& c) {
+      return std::binary_search(f->cadVertices.begin(), f->cadVertices.end(), c.vertex);
+    })) << e;
+  }
+  // The closing note says how many and where.
+  const auto note = std::find_if(r.notes.begin(), r.notes.end(), [](const std::string& n) {
+    return n.find("not proven valid") != std::string::npos;
+  });
+  ASSERT_NE(note, r.notes.end());
+  EXPECT_NE(
+      note->find("; " + std::to_string(at.elements.size()) +
+                 " of them have a corner at a "
+                 "cusp of the CAD (Face" +
+                 std::to_string(cusps[0].face) + " at Vertex" + std::to_string(cusps[0].vertex) +
+                 ", where Edge" + std::to_string(cusps[0].edgeA) + " and Edge" +
+                 std::to_string(cusps[0].edgeB) + " leave it in the same direction"),
+      std::string::npos)
+      << *note;
+  // Without a flagged element at a cusp the note says nothing of cusps: a box.
+  const MeshResult box =
+      runMeshPipeline(CadSource::brepText(test::brepText(test::box(1, 1, 1))), options);
+  for (const std::string& n : box.notes) EXPECT_EQ(n.find("cusp"), std::string::npos) << n;
 }
 
 }  // namespace
