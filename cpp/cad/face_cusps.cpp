@@ -33,7 +33,7 @@ std::optional<Leaving> leaving(const CadModel& cad, int edge, int vertex) {
   l.length =
       (cad.evaluateCurve(edge, range.last).point - cad.evaluateCurve(edge, range.first).point)
           .norm();
-  if (!(l.length > 0.0)) l.length = std::abs(l.step) * d1.norm();  // a closed edge
+  if (!(l.length > 0.0)) return std::nullopt;  // (closed edges are skipped before)
   return l;
 }
 
@@ -62,13 +62,16 @@ double wrapped(const CadModel& cad, int face, double x, int axis) {
 
 std::vector<FaceCusp> findFaceCusps(const CadModel& cad, double maxAngleDeg) {
   std::vector<FaceCusp> cusps;
-  const double cosMax = std::cos(maxAngleDeg * kPi / 180.0);
+  const double maxAngle = maxAngleDeg * kPi / 180.0;
+  std::vector<std::vector<int>> endsOf(static_cast<std::size_t>(cad.numEdges()) + 1);
+  for (int edge = 1; edge <= cad.numEdges(); ++edge)
+    endsOf[static_cast<std::size_t>(edge)] = cad.subShapeIndices(1, edge, 0);
   for (int face = 1; face <= cad.numFaces(); ++face) {
     const std::vector<int> edges = cad.subShapeIndices(2, face, 1);
     for (const int vertex : cad.subShapeIndices(2, face, 0)) {
       std::vector<Leaving> around;
       for (const int edge : edges) {
-        const std::vector<int> ends = cad.subShapeIndices(1, edge, 0);
+        const std::vector<int>& ends = endsOf[static_cast<std::size_t>(edge)];
         if (std::find(ends.begin(), ends.end(), vertex) == ends.end()) continue;
         if (ends.size() == 1) continue;  // a closed edge meets itself: no corner
         if (const auto l = leaving(cad, edge, vertex)) around.push_back(*l);
@@ -77,8 +80,10 @@ std::vector<FaceCusp> findFaceCusps(const CadModel& cad, double maxAngleDeg) {
         for (std::size_t j = i + 1; j < around.size(); ++j) {
           const Leaving& a = around[i];
           const Leaving& b = around[j];
-          const double c = a.direction.dot(b.direction);
-          if (c < cosMax) continue;
+          // (atan2 keeps the precision of small angles, which acos of the cosine loses.)
+          const double angle =
+              std::atan2(a.direction.cross(b.direction).norm(), a.direction.dot(b.direction));
+          if (angle > maxAngle) continue;
           // The face between them near the vertex (a cusp), or all around (a slit)?
           const double reach = 0.05 * std::min(a.length, b.length);
           const Eigen::Vector3d mid = 0.5 * (pointAt(cad, a, reach) + pointAt(cad, b, reach));
@@ -90,7 +95,7 @@ std::vector<FaceCusp> findFaceCusps(const CadModel& cad, double maxAngleDeg) {
           cusp.vertex = vertex;
           cusp.edgeA = std::min(a.edge, b.edge);
           cusp.edgeB = std::max(a.edge, b.edge);
-          cusp.angleDeg = std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / kPi;
+          cusp.angleDeg = angle * 180.0 / kPi;
           cusps.push_back(cusp);
         }
     }

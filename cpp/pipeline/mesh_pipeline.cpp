@@ -586,7 +586,8 @@ std::string cuspText(const MeshResult& result) {
   if (at.elements.empty()) return {};
   const std::size_t n = at.elements.size();
   std::string text = "; " + std::to_string(n) + " of them " + (n == 1 ? "has" : "have") +
-                     " a corner at a cusp of the CAD (";
+                     " a corner at a cusp of the CAD, where two edges of a face leave a vertex in "
+                     "the same direction (";
   int listed = 0;
   for (std::size_t c = 0; c < cusps.size(); ++c) {
     if (at.perCusp[c] == 0) continue;
@@ -596,9 +597,8 @@ std::string cuspText(const MeshResult& result) {
     }
     const FaceCusp& cusp = cusps[c];
     text += std::string(listed++ == 0 ? "" : ", ") + "Face" + std::to_string(cusp.face) +
-            " at Vertex" + std::to_string(cusp.vertex) + ", where Edge" +
-            std::to_string(cusp.edgeA) + " and Edge" + std::to_string(cusp.edgeB) +
-            " leave it in the same direction";
+            " at Vertex" + std::to_string(cusp.vertex) + " between Edge" +
+            std::to_string(cusp.edgeA) + " and Edge" + std::to_string(cusp.edgeB);
   }
   // (A Jacobian positive there rests on the edges' polynomials missing the CAD's tangents on
   // the right side: FreeCAD's I22 inductors end valid with some builds and not with others.)
@@ -818,6 +818,10 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       next = from.linear;
       record.edgesSplit = applySplits(next, plan.splits, *result.cad);
     }
+    // A follow-up round whose splits all failed their checks: nothing else is tried from a mesh
+    // that was not kept (a refine from it would remesh the model while the best is valid).
+    if (follow && record.edgesSplit == 0) break;
+    const char* const instead = poor ? "" : "; refined instead";
     // Flagged cells with no edge to split (slivers with vertices inside, which the optimiser
     // could not inflate) are flipped away where a flip makes better cells, judged where the
     // optimiser left the vertices: local, where a refinement remeshes the whole model. Poor
@@ -835,7 +839,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
         record.flips = flipped.flips;
         record.elements = flipped.cellsFlipped;
       } catch (const ParameterError& e) {  // a mesh the flips do not handle: refine instead
-        result.notes.push_back(name + ": no flips (" + e.what() + "); refined instead");
+        result.notes.push_back(name + ": no flips (" + e.what() + ")" + instead);
       }
       if (record.flips == 0) flipTriedOnBest = flipTriedOnBest || fromBest;
     }
@@ -877,21 +881,28 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
         record.cavities = cavities.cavities;
         remeshed = cavities.cavities > 0;
       } catch (const ParameterError& e) {
-        result.notes.push_back(name + ": no local remesh (" + e.what() + "); refined instead");
+        result.notes.push_back(name + ": no local remesh (" + e.what() + ")" + instead);
       } catch (const MeshingError& e) {
         if (dynamic_cast<const BudgetExceeded*>(&e) != nullptr && gmshByBudget) {
           // The budget ran out inside Gmsh: the rounds end, the best stays.
-          record.action = "remesh";
+          record.action = poor ? "remesh poor" : "remesh";
           recordFailedRound(e);
           break;
         }
-        result.notes.push_back(name + ": no local remesh (" + e.what() + "); refined instead");
+        result.notes.push_back(name + ": no local remesh (" + e.what() + ")" + instead);
       }
       if (!remeshed) next = Mesh();
       if (!remeshed) remeshTriedOnBest = remeshTriedOnBest || fromBest;
     }
     if (poor && record.edgesSplit == 0 && record.flips == 0 && !remeshed) {
-      clock.done();  // (no refinement for poor elements: see above)
+      // The remesh was tried and made no cavity: recorded, and the rounds end (no refinement
+      // for poor elements: see above).
+      record.action = "remesh poor";
+      record.failure = "no cavity around the poor elements could be meshed again";
+      record.seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      result.rounds.push_back(record);
+      clock.done();
       break;
     }
     if (record.edgesSplit > 0) {
@@ -901,6 +912,9 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       record.action = poor ? "flip poor" : "flip";
     } else if (remeshed) {
       record.action = poor ? "remesh poor" : "remesh";
+    } else if (best.notValid() == 0) {
+      clock.done();  // (defensive: once the best is valid the rounds never refine)
+      break;
     } else {
       // Nothing to split (or no split kept its cells positive): refine around every offender.
       std::vector<RefinementSource> added =

@@ -319,7 +319,10 @@ CuspElements elementsAtCusps(const Mesh& mesh, const QualitySummary& quality,
     for (std::size_t c = 0; c < cusps.size(); ++c) {
       const FaceCusp& cusp = cusps[c];
       if (!has(f.cadVertices, cusp.vertex)) continue;
-      if (!has(f.cadCurves, cusp.edgeA) && !has(f.cadCurves, cusp.edgeB)) continue;
+      // Nodes on both edges, or on one of them and on the face: the corner itself (not an
+      // element on the edge's other face).
+      const bool a = has(f.cadCurves, cusp.edgeA), b = has(f.cadCurves, cusp.edgeB);
+      if (!(a && b) && !((a || b) && has(f.cadFaces, cusp.face))) continue;
       ++out.perCusp[c];
       any = true;
     }

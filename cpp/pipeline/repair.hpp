@@ -133,8 +133,9 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
 std::vector<CurvedFaceEdge> tangentEarSplits(const Mesh& linear, const CadModel& cad);
 
 // The elements not proven valid that have a corner at a cusp of the CAD (cad/face_cusps.hpp: a
-// node at the cusp's vertex and nodes on one of its two edges): their Jacobian is zero at that
-// vertex whatever the mesh, so no repair round mends them. `perCusp[c]`: how many touch cusps[c].
+// node at the cusp's vertex, and nodes on both its edges or on one of them and on its face): their
+// Jacobian is zero at that vertex whatever the mesh, so no repair round mends them. `perCusp[c]`:
+// how many touch cusps[c].
 struct CuspElements {
   std::vector<std::size_t> elements;  // indices among the cells of dimension mesh.dim
   std::vector<std::size_t> perCusp;

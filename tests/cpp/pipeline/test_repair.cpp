@@ -655,19 +655,20 @@ TEST(CuspElements, TheElementsWithACornerAtACuspAreFoundAndNamed) {
     return n.find("not proven valid") != std::string::npos;
   });
   ASSERT_NE(note, r.notes.end());
+  const std::size_t n = at.elements.size();
   EXPECT_NE(
-      note->find("; " + std::to_string(at.elements.size()) +
-                 " of them have a corner at a "
-                 "cusp of the CAD (Face" +
+      note->find("; " + std::to_string(n) + " of them " + (n == 1 ? "has" : "have") +
+                 " a corner at a cusp of the CAD, where two edges of a face leave a vertex "
+                 "in the same direction (Face" +
                  std::to_string(cusps[0].face) + " at Vertex" + std::to_string(cusps[0].vertex) +
-                 ", where Edge" + std::to_string(cusps[0].edgeA) + " and Edge" +
-                 std::to_string(cusps[0].edgeB) + " leave it in the same direction"),
+                 " between Edge" + std::to_string(cusps[0].edgeA) + " and Edge" +
+                 std::to_string(cusps[0].edgeB)),
       std::string::npos)
       << *note;
   // Without a flagged element at a cusp the note says nothing of cusps: a box.
   const MeshResult box =
       runMeshPipeline(CadSource::brepText(test::brepText(test::box(1, 1, 1))), options);
-  for (const std::string& n : box.notes) EXPECT_EQ(n.find("cusp"), std::string::npos) << n;
+  for (const std::string& line : box.notes) EXPECT_EQ(line.find("cusp"), std::string::npos) << line;
 }
 
 }  // namespace
