@@ -585,9 +585,14 @@ std::string cuspText(const MeshResult& result) {
   const CuspElements at = elementsAtCusps(result.mesh, result.quality, cusps);
   if (at.elements.empty()) return {};
   const std::size_t n = at.elements.size();
-  std::string text = "; " + std::to_string(n) + " of them " + (n == 1 ? "has" : "have") +
-                     " a corner at a cusp of the CAD, where two edges of a face leave a vertex in "
-                     "the same direction (";
+  const std::size_t all = result.quality.invalid + result.quality.undecided;
+  // "it has" for the one element, "all 8 have" for every one, "3 of them have" for some.
+  std::string text =
+      n == all ? (n == 1 ? std::string("; it has") : "; all " + std::to_string(n) + " have")
+               : "; " + std::to_string(n) + " of them " + (n == 1 ? "has" : "have");
+  text +=
+      " a corner at a cusp of the CAD, where two edges of a face leave a vertex in the same "
+      "direction (";
   int listed = 0;
   for (std::size_t c = 0; c < cusps.size(); ++c) {
     if (at.perCusp[c] == 0) continue;
