@@ -529,6 +529,14 @@ std::array<double, 2> CadModel::facePeriods(int face) const {
   return impl_->facePeriods(face).period;
 }
 
+double CadModel::wrapIntoPeriod(int face, double x, int axis) const {
+  const double period = facePeriods(face)[axis];
+  if (period <= 0.0) return x;
+  const SurfaceBounds b = faceBounds(face);
+  const double lo = axis == 0 ? b.uMin : b.vMin;
+  return lo + std::fmod(std::fmod(x - lo, period) + period, period);
+}
+
 bool CadModel::faceContains(int face, double u, double v) const {
   BRepTopAdaptor_FClass2d& classifier = impl_->classifier(face);
   return withOcctErrors(cadEntityName(2, face), [&] {

@@ -129,6 +129,10 @@ class CadModel {
   // range as its period, and evaluateSurface, curvature and projectOnSurface's guess wrap into
   // that range, so such a seam behaves as a periodic one.
   std::array<double, 2> facePeriods(int face) const;
+  // A parameter of the face (axis 0: u, 1: v) moved by whole periods into [min, min + period)
+  // of its bounds where that direction is periodic (facePeriods), else as it is: what
+  // faceContains expects.
+  double wrapIntoPeriod(int face, double x, int axis) const;
   // Whether (u, v) lies on the face: inside its trimming loops or on them within the face's
   // tolerance (classified in the face's own parameter range; wrap periodic values first).
   bool faceContains(int face, double u, double v) const;

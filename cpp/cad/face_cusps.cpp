@@ -49,15 +49,6 @@ Eigen::Vector3d pointAt(const CadModel& cad, const Leaving& l, double distance) 
   return cad.evaluateCurve(l.edge, l.t + std::copysign(dt, l.step)).point;
 }
 
-// A periodic face's parameter moved into its bounds' period, as faceContains expects.
-double wrapped(const CadModel& cad, int face, double x, int axis) {
-  const double period = cad.facePeriods(face)[axis];
-  if (period <= 0.0) return x;
-  const SurfaceBounds b = cad.faceBounds(face);
-  const double lo = axis == 0 ? b.uMin : b.vMin;
-  return lo + std::fmod(std::fmod(x - lo, period) + period, period);
-}
-
 }  // namespace
 
 std::vector<FaceCusp> findFaceCusps(const CadModel& cad, double maxAngleDeg) {
@@ -88,7 +79,8 @@ std::vector<FaceCusp> findFaceCusps(const CadModel& cad, double maxAngleDeg) {
           const double reach = 0.05 * std::min(a.length, b.length);
           const Eigen::Vector3d mid = 0.5 * (pointAt(cad, a, reach) + pointAt(cad, b, reach));
           const SurfaceProjection foot = cad.projectOnSurface(face, mid);
-          if (!cad.faceContains(face, wrapped(cad, face, foot.u, 0), wrapped(cad, face, foot.v, 1)))
+          if (!cad.faceContains(face, cad.wrapIntoPeriod(face, foot.u, 0),
+                                cad.wrapIntoPeriod(face, foot.v, 1)))
             continue;
           FaceCusp cusp;
           cusp.face = face;

@@ -101,7 +101,8 @@ class Classifier {
       const SurfaceProjection s = cad_.projectOnSurface(f, p);
       if (s.distance < nearestFace.second) nearestFace = {f, s.distance};
       if (s.distance > tol_ + cad_.tolerance(2, f)) continue;
-      if (!cad_.faceContains(f, wrapped(f, s.u, 0), wrapped(f, s.v, 1))) continue;
+      if (!cad_.faceContains(f, cad_.wrapIntoPeriod(f, s.u, 0), cad_.wrapIntoPeriod(f, s.v, 1)))
+        continue;
       if (best.dim < 0 || s.distance < best.distance)
         best = Place{2, f, s.u, s.v, s.point, s.distance};
     }
@@ -128,15 +129,6 @@ class Classifier {
   }
 
  private:
-  // A periodic face's parameter moved into its bounds' period, as faceContains expects.
-  double wrapped(int face, double x, int axis) const {
-    const double period = cad_.facePeriods(face)[axis];
-    if (period <= 0.0) return x;
-    const SurfaceBounds b = cad_.faceBounds(face);
-    const double lo = axis == 0 ? b.uMin : b.vMin;
-    return lo + std::fmod(std::fmod(x - lo, period) + period, period);
-  }
-
   const CadModel& cad_;
   double tol_;
   std::vector<Box> edgeBoxes_, faceBoxes_;

@@ -786,11 +786,14 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   // OpenCASCADE's linkrods.step: 0.0106 -> 0.217 the same way).
   bool poorSplitLeftInvalid = false;
   for (int round = 1; round <= options.repairRounds; ++round) {
-    bool follow = poorSplitLeftInvalid && last && !options.boundaryLayer;
-    if (follow)  // (only where there is something to split: no refinement after poor rounds)
-      follow = !planRepair(last->linear, last->quality.validity, *result.cad,
-                           options.optimiseIterations > 0)
-                    .splits.empty();
+    // (Only where there is something to split: no refinement after poor rounds.)
+    std::optional<RepairPlan> followPlan;
+    if (poorSplitLeftInvalid && last && !options.boundaryLayer) {
+      followPlan = planRepair(last->linear, last->quality.validity, *result.cad,
+                              options.optimiseIterations > 0);
+      if (followPlan->splits.empty()) followPlan.reset();
+    }
+    const bool follow = followPlan.has_value();
     const bool fromBest = !(last && (follow || (!splitFailed && !flipFailed && !remeshFailed)));
     const CurvedState& from = fromBest ? best : *last;
     const bool poor = from.notValid() == 0;  // only elements below kPoorElement are left
@@ -814,8 +817,10 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
     record.undecided = from.quality.undecided;
     record.worst = from.quality.scaled.min;
     // Every flagged cell gets edges to split or a refinement sphere: the plan is never empty.
-    const RepairPlan plan = planRepair(from.linear, repairTargets(from.quality, poor), *result.cad,
-                                       options.optimiseIterations > 0);
+    // (A follow-up round starts from a mesh with invalid elements: its plan is the one above.)
+    const RepairPlan plan = follow ? std::move(*followPlan)
+                                   : planRepair(from.linear, repairTargets(from.quality, poor),
+                                                *result.cad, options.optimiseIterations > 0);
     Mesh next;
     if (!plan.splits.empty() && (!splitFailed || follow) && !(poor && splitTriedOnBest) &&
         !options.boundaryLayer) {
