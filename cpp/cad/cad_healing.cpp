@@ -55,12 +55,11 @@ bool bounding(TopAbs_Orientation o) {
   return o == TopAbs_FORWARD || o == TopAbs_REVERSED;
 }
 
-// The first free edge of `solid` (an edge used once by its bounding faces: not a seam, which a
-// face uses twice, not degenerated, and not an internal or external edge imprinted on a face),
-// as its index in `edges`; 0 when its boundary is closed.
-int firstFreeEdge(const TopoDS_Shape& solid, const TopTools_IndexedMapOfShape& edges) {
-  TopTools_IndexedDataMapOfShapeListOfShape uses;  // edge -> the faces using it (repeats kept)
-  for (TopExp_Explorer f(solid, TopAbs_FACE); f.More(); f.Next()) {
+// Edge -> the faces of `shape` using it, repeats kept (a seam edge is used twice by its face);
+// internal and external faces and edges (not on the boundary) left out.
+TopTools_IndexedDataMapOfShapeListOfShape edgeUses(const TopoDS_Shape& shape) {
+  TopTools_IndexedDataMapOfShapeListOfShape uses;
+  for (TopExp_Explorer f(shape, TopAbs_FACE); f.More(); f.Next()) {
     if (!bounding(f.Current().Orientation())) continue;
     for (TopExp_Explorer e(f.Current(), TopAbs_EDGE); e.More(); e.Next()) {
       if (!bounding(e.Current().Orientation())) continue;
@@ -68,11 +67,45 @@ int firstFreeEdge(const TopoDS_Shape& solid, const TopTools_IndexedMapOfShape& e
       uses.ChangeFromKey(e.Current()).Append(f.Current());
     }
   }
+  return uses;
+}
+
+// The first free edge of `solid` (an edge used once by its bounding faces: not a seam, which a
+// face uses twice, not degenerated, and not an internal or external edge imprinted on a face),
+// as its index in `edges`; 0 when its boundary is closed.
+int firstFreeEdge(const TopoDS_Shape& solid, const TopTools_IndexedMapOfShape& edges) {
+  const TopTools_IndexedDataMapOfShapeListOfShape uses = edgeUses(solid);
   for (int i = 1; i <= uses.Extent(); ++i) {
     const TopoDS_Edge& edge = TopoDS::Edge(uses.FindKey(i));
     if (uses(i).Extent() == 1 && !BRep_Tool::Degenerated(edge)) return edges.FindIndex(edge);
   }
   return 0;
+}
+
+// How many edges of `shape` are free, as firstFreeEdge judges them.
+int freeEdgeCount(const TopoDS_Shape& shape) {
+  const TopTools_IndexedDataMapOfShapeListOfShape uses = edgeUses(shape);
+  int free = 0;
+  for (int i = 1; i <= uses.Extent(); ++i)
+    if (uses(i).Extent() == 1 && !BRep_Tool::Degenerated(TopoDS::Edge(uses.FindKey(i)))) ++free;
+  return free;
+}
+
+// The faces of a model kept for a surface mesh, sewn into shells where sewing joins faces that
+// meet without sharing their edges (a conforming mesh across them) and loses none; else as
+// they are.
+TopoDS_Shape sewSurface(const TopoDS_Shape& shape, double tolerance, HealingRecord& record) {
+  BRepBuilderAPI_Sewing sewing(tolerance);
+  sewing.Add(shape);
+  sewing.Perform();
+  const TopoDS_Shape sewn = sewing.SewedShape();
+  if (sewn.IsNull() || count(sewn, TopAbs_FACE) != count(shape, TopAbs_FACE)) return shape;
+  const int before = freeEdgeCount(shape), after = freeEdgeCount(sewn);
+  if (after >= before) return shape;
+  record.actions.push_back("sewed the faces (tolerance " + formatNumber(tolerance) +
+                           ") for the surface mesh: " + std::to_string(before) + " -> " +
+                           std::to_string(after) + " edges bounding one face");
+  return sewn;
 }
 
 double volumeOf(const TopoDS_Shape& solid) {
@@ -521,20 +554,29 @@ CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& r
   record.tolerance = kTolerance * diagonal;
   record.facesBefore = record.facesAfter = cad.numFaces();
   record.solidsBefore = record.solidsAfter = cad.numSolids();
+  if (options.surface && cad.numSolids() > 0)
+    throw CadError(cad.sourceName() + " has " + std::to_string(cad.numSolids()) +
+                   (cad.numSolids() == 1 ? " solid" : " solids") +
+                   ": a surface mesh (--surface, Python surface=True, FreeCAD Surface) is for a "
+                   "model of faces alone; without it the solids get a volume mesh");
+  // Faces not meant to be sewn into a solid: planar ones in one plane (a 2D case), or any when
+  // a surface mesh is asked for.
   bool planar = false;
-  if (cad.numSolids() == 0) {
+  if (cad.numSolids() == 0 && cad.numFaces() > 0) {
     try {
       Eigen::Vector3d normal;
-      planar = modelMeshDimension(cad, normal) == 2;
-    } catch (const CadError&) {  // neither a solid nor planar: reported below
+      modelMeshDimension(cad, normal);
+      planar = !normal.isZero();
+    } catch (const CadError&) {  // (OCCT could not give a face's plane: reported below)
     }
   }
+  const bool faces = planar || (options.surface && cad.numSolids() == 0);
   // A check that fails (OCCT cannot measure an edge, say) is recorded, not fatal: the model is
   // then meshed as it is, and a stage that cannot handle it says so.
   Findings found;
   try {
     found = withOcctErrors("checking " + cad.sourceName(), [&] {
-      return inspect(occtShape(cad), diagonal, planar, record.problems);
+      return inspect(occtShape(cad), diagonal, faces, record.problems);
     });
   } catch (const CadError& e) {
     record.problems.push_back(std::string("the check failed: ") + e.what());
@@ -573,16 +615,45 @@ CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& r
   }
   const std::string solidsOnlyOption =
       "--solids-only (Python solids_only=True, FreeCAD SolidsOnly)";
+  if (solids.Extent() == 0 && faces && !planar) {
+    if (cad.numFaces() == 0)
+      throw CadError(cad.sourceName() + " has no face: nothing for a surface mesh");
+    if (enabled && cad.numFaces() > 1) {
+      const TopoDS_Shape sewn = withOcctErrors("sewing " + cad.sourceName(), [&] {
+        return sewSurface(shape, 10.0 * record.tolerance, record);
+      });
+      if (!sewn.IsSame(shape)) {
+        cad = cadModelFromShape(sewn, cad.sourceName());
+        record.renumbered = !sameNumbering(original, sewn, 10.0 * record.tolerance);
+        record.facesAfter = cad.numFaces();
+      }
+    }
+    const int open = freeEdgeCount(occtShape(cad));
+    record.surface =
+        "a surface mesh of its " + std::to_string(cad.numFaces()) +
+        (cad.numFaces() == 1 ? " face" : " faces") +
+        " (no solid: triangles on the faces, no volume" +
+        (open > 0 ? "; " + std::to_string(open) + (open == 1 ? " edge bounds" : " edges bound") +
+                        " only one face"
+                  : std::string("; the faces close")) +
+        ")";
+    record.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return cad;
+  }
   if (solids.Extent() == 0 && !planar) {
     const int edge = firstFreeEdge(shape, edges);
     // Some shells closed: the option that meshes them and leaves the others out is worth naming.
-    throw CadError(cad.sourceName() + " is not a closed solid: it has no solid, and its " +
-                   std::to_string(cad.numFaces()) + " faces do not close" +
-                   (edge != 0 ? " (" + cadEntityName(1, edge) + " bounds only one face)" : "") +
-                   healed + "; HOMesh meshes solids, or planar faces in one plane (2D)" +
-                   (record.sewnSolids > 0 && !options.solidsOnly
-                        ? "; " + solidsOnlyOption + " meshes the closed shells alone"
-                        : std::string()));
+    throw CadError(
+        cad.sourceName() + " is not a closed solid: it has no solid, and " +
+        (cad.numFaces() == 1 ? std::string("its one face does not close")
+                             : "its " + std::to_string(cad.numFaces()) + " faces do not close") +
+        (edge != 0 ? " (" + cadEntityName(1, edge) + " bounds only one face)" : "") + healed +
+        "; HOMesh meshes solids, planar faces in one plane (2D), or the faces alone "
+        "as a surface mesh: --surface (Python surface=True, FreeCAD Surface)" +
+        (record.sewnSolids > 0 && !options.solidsOnly
+             ? "; " + solidsOnlyOption + " meshes the closed shells alone"
+             : std::string()));
   }
   // Faces beside the solids would not be meshed: refused, or left out and recorded.
   const LooseFaces loose = solids.Extent() > 0 ? facesInNoSolid(shape) : LooseFaces{};

@@ -29,6 +29,9 @@ namespace homesh {
 struct HealingOptions {
   bool enabled = true;      // sew and fix what the check finds; false: check only
   bool solidsOnly = false;  // faces in no solid are left out (recorded) instead of refused
+  // A model without solids whose faces do not close is kept as faces (a surface mesh), sewn
+  // into shells where that joins them, instead of refused.
+  bool surface = false;
 };
 
 struct HealingRecord {
@@ -49,6 +52,9 @@ struct HealingRecord {
   // Those faces all copy faces of the solids (the same box, area and centre): left out without
   // HealingOptions::solidsOnly, since nothing is lost.
   bool leftOutCopies = false;
+  // The model is kept as faces for a surface mesh (HealingOptions::surface): in words, how
+  // many faces and shells, and whether sewing joined them.
+  std::string surface;
   // What the mesh user must know that healing does not change: solids that lie against each
   // other on faces of their own (coincident, not shared), whose meshes do not conform there.
   std::vector<std::string> warnings;
@@ -63,6 +69,7 @@ struct HealingRecord {
   // only, or copies) and the warnings. The pipeline's notes and `homesh predict` print these.
   std::vector<std::string> notes() const {
     std::vector<std::string> lines;
+    if (!surface.empty()) lines.push_back(surface);
     if (!leftOut.empty())
       lines.push_back(std::string(leftOutCopies ? "" : "solids only: ") + "left out " + leftOut);
     lines.insert(lines.end(), warnings.begin(), warnings.end());
@@ -71,10 +78,12 @@ struct HealingRecord {
 };
 
 // The model to mesh: `cad` itself when the check finds nothing (or healing is off), else the
-// healed model (same source name), less the faces in no solid when `options.solidsOnly`.
-// Fills `record`. Throws CadError when the model (healed or not) has a solid whose boundary is
-// open, naming the solid and a free edge, and when faces are in no solid (without
-// solidsOnly), naming them.
+// healed model (same source name), less the faces in no solid when `options.solidsOnly`; with
+// `options.surface`, a model without solids that healing cannot close stays faces (sewn into
+// shells where sewing joins them without losing a face). Fills `record`. Throws CadError when
+// the model (healed or not) has a solid whose boundary is open, naming the solid and a free
+// edge, when faces are in no solid (without solidsOnly), naming them, when it has no solid and
+// no face, and when `options.surface` is asked of a model with solids.
 CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& record);
 
 }  // namespace homesh

@@ -210,6 +210,7 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   table.flag({"--optimise", "--optimize"}, [&optimise] { optimise = true; });
   table.flag({"--no-heal"}, [&cmd] { cmd.heal = false; });
   table.flag({"--solids-only"}, [&cmd] { cmd.solidsOnly = true; });
+  table.flag({"--surface"}, [&cmd] { cmd.surface = true; });
   table.value({"--maxiter", "-n"}, [&maxiter](const std::string& o, const std::string& v) {
     maxiter = parseInteger(o, v);
     if (*maxiter < 1) throw UsageError{"--maxiter must be >= 1, got " + v};
@@ -257,6 +258,7 @@ PredictCommand parsePredict(const std::vector<std::string>& args) {
   addSizing(table, cmd.sizing);
   table.flag({"--no-heal"}, [&cmd] { cmd.heal = false; });
   table.flag({"--solids-only"}, [&cmd] { cmd.solidsOnly = true; });
+  table.flag({"--surface"}, [&cmd] { cmd.surface = true; });
   cmd.input = onlyInput(table.parse(args, 1, "predict"), "predict", "an INPUT CAD or .mcf file");
   return cmd;
 }
@@ -407,6 +409,9 @@ options:
       --solids-only   mesh the solids and leave out faces in no solid (a loose shell that
                       does not close), naming them in a note; without it such a model is
                       refused, naming those faces
+      --surface       for a model without solids (a shell, faces that do not close): a
+                      surface mesh of its faces, triangles curved on the CAD, sewn where
+                      faces meet; no volume, no optimiser, no boundary layer
       --linear-time-limit S  Gmsh's linear meshing (in a process of its own) is stopped after
                       S seconds and the run fails (default 600; 0: no limit)
       --job-time-limit S  the whole job's wall time: Gmsh and the optimiser get at most what
@@ -443,7 +448,7 @@ options:
       --max-delta D, --min-delta D, --eps E, --refine-line ..., --refine-sphere ...,
       --refine-box ..., --refine-curve ...   as for 'homesh mesh'
       --write-octree FILE.vtu   the octree's leaves with their sizes (ParaView)
-      --no-heal, --solids-only   as for 'homesh mesh'
+      --no-heal, --solids-only, --surface   as for 'homesh mesh'
       --report FILE   write the JSON report ("-" for standard output)
   -j, --threads N     threads (default 1)
   -q, --quiet         print nothing but errors

@@ -152,6 +152,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
   options.jobSeconds = cmd.jobTimeLimit;
   options.heal = cmd.heal;
   options.solidsOnly = cmd.solidsOnly;
+  options.surface = cmd.surface;
   if (cmd.blFaces || cmd.blThickness || cmd.blLayers || cmd.blProgression) {
     homesh::BoundaryLayerParameters bl =
         options.boundaryLayer.value_or(homesh::BoundaryLayerParameters{});
@@ -251,6 +252,7 @@ int runPredict(const homesh::PredictCommand& cmd) {
   setup.options.threads = c.threads;
   setup.options.heal = cmd.heal;
   setup.options.solidsOnly = cmd.solidsOnly;
+  setup.options.surface = cmd.surface;
   const homesh::SizingResult s = homesh::runSizingStage(setup.source, setup.options);
   const bool toStdout = c.report && *c.report == "-";
   if (!c.quiet) {

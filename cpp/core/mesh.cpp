@@ -1,5 +1,8 @@
 #include "core/mesh.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include "core/error.hpp"
@@ -22,6 +25,66 @@ std::size_t Mesh::numElements() const {
   for (const auto& block : blocks)
     if (cellDimension(block.type) == dim) n += block.count();
   return n;
+}
+
+std::array<double, 3> Mesh::cellNormal(const std::int64_t* cell) const {
+  if (!isSurface()) return planeNormal;
+  double a[3], b[3];
+  for (int c = 0; c < 3; ++c) {
+    a[c] = xyz[3 * cell[1] + c] - xyz[3 * cell[0] + c];
+    b[c] = xyz[3 * cell[2] + c] - xyz[3 * cell[0] + c];
+  }
+  std::array<double, 3> n{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                          a[0] * b[1] - a[1] * b[0]};
+  const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (!(length > 0.0)) return {0.0, 0.0, 0.0};
+  for (double& v : n) v /= length;
+  return n;
+}
+
+std::array<double, 3> votedPlaneNormal(const Mesh& mesh) {
+  std::array<double, 3> sum{0.0, 0.0, 0.0};
+  for (const ElementBlock& b : mesh.blocks) {
+    if (cellDimension(b.type) != 2) continue;
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      const std::int64_t* v = b.element(e);
+      double a[3], c[3];
+      for (int k = 0; k < 3; ++k) {
+        a[k] = mesh.xyz[3 * v[1] + k] - mesh.xyz[3 * v[0] + k];
+        c[k] = mesh.xyz[3 * v[2] + k] - mesh.xyz[3 * v[0] + k];
+      }
+      const double n[3] = {a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2],
+                           a[0] * c[1] - a[1] * c[0]};
+      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      if (length > 0.0)
+        for (int k = 0; k < 3; ++k) sum[k] += n[k] / length;
+    }
+  }
+  const double length = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+  if (!(length > 0.0)) return {0.0, 0.0, 0.0};
+  for (double& x : sum) x /= length;
+  return sum;
+}
+
+bool nodesInPlane(const Mesh& mesh, const std::array<double, 3>& normal, double tolerance) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double lo = kInf, hi = -kInf;
+  std::array<double, 3> boxLo{kInf, kInf, kInf}, boxHi{-kInf, -kInf, -kInf};
+  for (std::size_t i = 0; i < mesh.numNodes(); ++i) {
+    double h = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double x = mesh.xyz[3 * i + k];
+      h += normal[k] * x;
+      boxLo[k] = std::min(boxLo[k], x);
+      boxHi[k] = std::max(boxHi[k], x);
+    }
+    lo = std::min(lo, h);
+    hi = std::max(hi, h);
+  }
+  if (mesh.numNodes() == 0) return true;
+  double diagonal = 0.0;
+  for (int k = 0; k < 3; ++k) diagonal += (boxHi[k] - boxLo[k]) * (boxHi[k] - boxLo[k]);
+  return hi - lo <= tolerance * std::sqrt(diagonal);
 }
 
 void Mesh::checkConsistency() const {

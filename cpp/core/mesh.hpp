@@ -36,10 +36,13 @@ struct ElementBlock {
 };
 
 struct Mesh {
-  int dim = 3;    // 3: volume mesh; 2: planar mesh (its elements are triangles in a plane)
+  // 3: volume mesh; 2: its elements are triangles (or quadrilaterals), in a plane or, for a
+  // surface mesh, on the curved faces of a model without solids.
+  int dim = 3;
   int order = 1;  // polynomial order of every block
   // For dim == 2: the unit normal of the mesh plane; 2D elements are oriented counter-clockwise
-  // around it (positive Jacobian).
+  // around it (positive Jacobian). Zero for a surface mesh (no plane): there each element's
+  // Jacobian is measured along the normal of its own straight cell (cellNormal).
   std::array<double, 3> planeNormal{0.0, 0.0, 1.0};
 
   std::vector<double> xyz;
@@ -59,9 +62,27 @@ struct Mesh {
   // Number of cells of dimension `dim` (the elements the report counts).
   std::size_t numElements() const;
 
+  // A 2D mesh whose elements lie on curved faces in 3D (planeNormal zero), not in one plane.
+  bool isSurface() const {
+    return dim == 2 && planeNormal[0] == 0.0 && planeNormal[1] == 0.0 && planeNormal[2] == 0.0;
+  }
+
+  // For dim == 2: the unit vector a 2D cell's Jacobian x_xi1 x x_xi2 is measured along: the
+  // plane's normal, or in a surface mesh the unit normal of the straight cell through its
+  // first three vertices (zero when they are collinear). `cell`: its node ids, Gmsh order.
+  std::array<double, 3> cellNormal(const std::int64_t* cell) const;
+
   // Throws Error if array sizes disagree or a connectivity entry is out of range.
   void checkConsistency() const;
 };
+
+// For a 2D mesh read from a file: the unit normal most of its 2D cells agree with (the sum of
+// their straight cells' unit normals, normalised); zero when no cell spans a plane.
+std::array<double, 3> votedPlaneNormal(const Mesh& mesh);
+
+// Whether every node lies within `tolerance` times the mesh's bounding-box diagonal of one plane
+// with unit normal `normal` (else the mesh is a surface mesh: Mesh::isSurface).
+bool nodesInPlane(const Mesh& mesh, const std::array<double, 3>& normal, double tolerance);
 
 // Drops the nodes no element uses (a source's high-order nodes after an order change, a macro
 // layer's inner nodes after its split) and renumbers the rest in their original order.

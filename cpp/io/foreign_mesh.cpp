@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <utility>
 
 #include "core/error.hpp"
@@ -38,10 +37,6 @@ NodeCoordinates gather(const Mesh& mesh, const std::int64_t* nodes, int n) {
   return x;
 }
 
-std::string nodeName(const ForeignMesh& raw, std::int64_t id) {
-  return std::to_string(raw.labels.empty() ? id : raw.labels[static_cast<std::size_t>(id)]);
-}
-
 // Reverses the handedness of every cell of a block whose cells all have negative volume.
 void orientSolids(Mesh& mesh, const std::string& path, std::vector<std::string>* notes) {
   for (ElementBlock& block : mesh.blocks) {
@@ -67,43 +62,15 @@ void orientSolids(Mesh& mesh, const std::string& path, std::vector<std::string>*
   }
 }
 
-// The plane normal most 2D elements agree with; throws when the 2D cells' nodes leave the plane.
-void setPlane(Mesh& mesh, const ForeignMesh& raw, const std::string& path) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::AlignedBox3d box;
-  for (const ElementBlock& b : mesh.blocks) {
-    if (cellDimension(b.type) != 2) continue;
-    for (std::size_t e = 0; e < b.count(); ++e) {
-      const std::int64_t* v = b.element(e);
-      const Eigen::Vector3d normal = (point(mesh.xyz, v[1]) - point(mesh.xyz, v[0]))
-                                         .cross(point(mesh.xyz, v[2]) - point(mesh.xyz, v[0]));
-      if (normal.norm() > 0.0) sum += normal.normalized();
-      for (int k = 0; k < b.nodesPerElement(); ++k) box.extend(point(mesh.xyz, v[k]));
-    }
-  }
-  if (sum.norm() == 0.0)
+// The plane normal most 2D elements agree with; zero (a surface mesh) when the 2D cells' nodes
+// leave that plane.
+void setPlane(Mesh& mesh, const std::string& path) {
+  const std::array<double, 3> normal = votedPlaneNormal(mesh);
+  if (normal == std::array<double, 3>{0.0, 0.0, 0.0})
     throw IoError("'" + path + "': its 2D elements are degenerate (no element spans a plane)");
-  const Eigen::Vector3d n3 = sum.normalized();
-  mesh.planeNormal = {n3.x(), n3.y(), n3.z()};
   // Files of single-precision coordinates (FreeCAD's VTK) carry 7 digits.
-  const double tolerance = 1e-5 * box.diagonal().norm();
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  std::int64_t lowest = 0, highest = 0;
-  for (const ElementBlock& b : mesh.blocks)
-    for (const std::int64_t id : b.nodes) {
-      const double h = n3.dot(point(mesh.xyz, id));
-      if (h < lo) lo = h, lowest = id;
-      if (h > hi) hi = h, highest = id;
-    }
-  if (hi - lo > tolerance) {
-    std::ostringstream os;
-    os.precision(3);
-    os << "'" << path << "': its 2D elements do not lie in one plane (nodes "
-       << nodeName(raw, lowest) << " and " << nodeName(raw, highest) << " are " << hi - lo
-       << " apart along its mean normal, the mesh " << box.diagonal().norm()
-       << " across): HOMesh checks volume meshes and planar 2D meshes, not shells";
-    throw IoError(os.str());
-  }
+  mesh.planeNormal =
+      nodesInPlane(mesh, normal, 1e-5) ? normal : std::array<double, 3>{0.0, 0.0, 0.0};
 }
 
 }  // namespace
@@ -171,7 +138,7 @@ Mesh assembleForeignMesh(ForeignMesh raw, const std::string& path,
   if (dim == 3)
     orientSolids(mesh, path, notes);
   else
-    setPlane(mesh, raw, path);
+    setPlane(mesh, path);
   return mesh;
 }
 

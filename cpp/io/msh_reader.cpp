@@ -306,24 +306,12 @@ Mesh assemble(RawMesh& raw, const std::string& path) {
         }
     }
   }
-  if (dim == 2) {  // the plane normal most elements agree with
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (const ElementBlock& b : mesh.blocks) {
-      if (cellDimension(b.type) != 2) continue;
-      for (std::size_t e = 0; e < b.count(); ++e) {
-        const std::int64_t* v = b.element(e);
-        const auto p = [&](int k) {
-          return Eigen::Vector3d(mesh.xyz[3 * v[k]], mesh.xyz[3 * v[k] + 1],
-                                 mesh.xyz[3 * v[k] + 2]);
-        };
-        const Eigen::Vector3d normal = (p(1) - p(0)).cross(p(2) - p(0));
-        if (normal.norm() > 0.0) sum += normal.normalized();
-      }
-    }
-    if (sum.norm() > 0.0) {
-      const Eigen::Vector3d n3 = sum.normalized();
-      mesh.planeNormal = {n3.x(), n3.y(), n3.z()};
-    }
+  if (dim == 2) {  // the plane most elements agree with; none (a surface mesh) off it
+    const std::array<double, 3> normal = votedPlaneNormal(mesh);
+    // (1e-7 of the mesh's size: far above what 17-digit coordinates round to.)
+    if (normal != std::array<double, 3>{0.0, 0.0, 0.0})
+      mesh.planeNormal =
+          nodesInPlane(mesh, normal, 1e-7) ? normal : std::array<double, 3>{0.0, 0.0, 0.0};
   }
   mesh.checkConsistency();
   return mesh;

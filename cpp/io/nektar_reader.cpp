@@ -873,6 +873,13 @@ Mesh Reader::read() {
     if (b->count() > 0) mesh_.blocks.push_back(std::move(*b));
   for (const bool k : known_)
     if (!k) fail("some nodes could not be placed");
+  // A 2D mesh off one plane (a manifold in SPACE 3) is a surface mesh; a planar one keeps the
+  // counter-clockwise convention around +z that Nektar++'s 2D elements follow.
+  if (dim_ == 2) {
+    const std::array<double, 3> normal = votedPlaneNormal(mesh_);
+    if (normal != std::array<double, 3>{0.0, 0.0, 0.0} && !nodesInPlane(mesh_, normal, 1e-7))
+      mesh_.planeNormal = {0.0, 0.0, 0.0};
+  }
   mesh_.checkConsistency();
   return std::move(mesh_);
 }

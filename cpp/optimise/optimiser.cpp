@@ -1351,6 +1351,10 @@ OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
                              OptimiserObserver* observer, const CadModel* cad) {
   options.validate();
   mesh.checkConsistency();
+  if (mesh.isSurface())
+    throw ParameterError(
+        "the optimiser handles volume meshes and planar 2D meshes, not a surface mesh "
+        "(triangles on curved faces in 3D)");
   if (mesh.dim == 3) return Optimiser<3>(mesh, options, observer, cad).run();
   if (mesh.dim == 2) return Optimiser<2>(mesh, options, observer, cad).run();
   throw ParameterError("the optimiser needs a 2D or 3D mesh, got dimension " +
@@ -1443,7 +1447,6 @@ NodeEnergy NodeEnergyProbe::evaluate(std::int64_t node, const Eigen::VectorXd& c
 }
 
 double nodalScaledJacobian(const Mesh& mesh, int threads) {
-  const Eigen::Vector3d normal(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
   double worst = 1.0;
   for (const ElementBlock& block : mesh.blocks) {
     if (cellDimension(block.type) != mesh.dim || block.count() == 0) continue;
@@ -1460,6 +1463,8 @@ double nodalScaledJacobian(const Mesh& mesh, int threads) {
         for (int i = 0; i < n; ++i)
           for (int c = 0; c < 3; ++c) x(i, c) = mesh.xyz[3 * v[i] + c];
         Eigen::VectorXd j;
+        const std::array<double, 3> n3 = mesh.cellNormal(v);
+        const Eigen::Vector3d normal(n3[0], n3[1], n3[2]);
         sampler.jacobians(x, mesh.dim == 2 ? &normal : nullptr, j);
         const double hi = j.maxCoeff();
         blockWorst = std::min(blockWorst, hi > 0.0 ? j.minCoeff() / hi : -1.0);

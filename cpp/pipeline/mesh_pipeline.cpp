@@ -38,6 +38,14 @@ void MeshingOptions::validate() const {
   checkParameter("job_seconds", jobSeconds);
   checkParameter("repair_rounds", repairRounds);
   if (boundaryLayer) boundaryLayer->validate();
+  if (surface && boundaryLayer)
+    throw ParameterError(
+        "a boundary layer needs a volume or planar mesh, not a surface mesh "
+        "(--surface)");
+  if (surface && solidsOnly)
+    throw ParameterError(
+        "--surface meshes a model without solids and --solids-only its solids "
+        "alone: give one of them");
   if (size && !octreeOutput.empty())
     throw ParameterError("writing the sizing octree needs octree sizing, not a uniform size");
   if (size && sizing)
@@ -134,7 +142,9 @@ void checkMeshDimension(const CadModel& cad, std::optional<int> expected) {
   if (dim != *expected)
     throw ParameterError("MeshType asks for a " + std::to_string(*expected) + "D mesh but " +
                          cad.sourceName() +
-                         (dim == 3 ? " has solids (a 3D mesh)" : " is planar faces (a 2D mesh)"));
+                         (dim == 3              ? " has solids (a 3D mesh)"
+                          : isSurfaceModel(cad) ? " is faces without a solid (a surface mesh)"
+                                                : " is planar faces (a 2D mesh)"));
 }
 
 SizingResult runSizing(const CadModel& cad, const SizingParameters& params, int threads) {
@@ -625,11 +635,14 @@ std::string notValidNote(const MeshResult& result, bool linearGiven) {
   const std::string where = notValidLocation(result.mesh, q);
   if (!where.empty()) text += " " + where;
   text += cuspText(result);
-  text += result.options.optimiseIterations == 0
-              ? std::string(
-                    "; the optimiser did not run (--optimise, Python optimise > 0, "
-                    "FreeCAD OptimiserIterations > 0 may make them valid)")
-              : std::string("; after the optimiser");
+  if (result.mesh.isSurface())
+    text += "; a surface mesh (no optimiser: its nodes are where curving put them on the faces)";
+  else
+    text += result.options.optimiseIterations == 0
+                ? std::string(
+                      "; the optimiser did not run (--optimise, Python optimise > 0, "
+                      "FreeCAD OptimiserIterations > 0 may make them valid)")
+                : std::string("; after the optimiser");
   if (linearGiven) return text + "; no repair rounds (the linear mesh was given)";
   if (result.rounds.empty())
     return text + (result.options.repairRounds == 0
@@ -688,6 +701,12 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   checkRenumbering(result.healing, options);
   checkMeshDimension(*result.cad, options.expectedDimension);
   if (!options.size) options.sizing = resolveSizing(options.sizing, *result.cad);
+  if (isSurfaceModel(*result.cad) && options.optimiseIterations > 0) {
+    options.optimiseIterations = 0;
+    result.notes.emplace_back(
+        "the optimiser does not run on a surface mesh: every node lies on the CAD, where "
+        "curving placed it");
+  }
   result.options = options;
 
   Eigen::Vector3d normal;  // (the plane of a 2D model)

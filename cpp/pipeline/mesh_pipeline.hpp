@@ -69,7 +69,10 @@ struct MeshingOptions {
   bool heal = true;
   // Faces in no solid are left out (report: healing "left_out") instead of refusing the model.
   bool solidsOnly = false;
-  HealingOptions healing() const { return {heal, solidsOnly}; }
+  // A model without solids gets a surface mesh of its faces (triangles on the CAD, no volume;
+  // the optimiser and boundary layers do not apply) instead of being refused.
+  bool surface = false;
+  HealingOptions healing() const { return {heal, solidsOnly, surface}; }
 
   // Throws ParameterError naming the offending parameter.
   void validate() const;

@@ -214,8 +214,10 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
     throw ParameterError("repair: " + std::to_string(validity.size()) +
                          " verdicts for a linear mesh of " + std::to_string(cells.size()) +
                          " cells");
+  // Splits only where their cells' areas can be checked: not in a surface mesh, which has no
+  // plane to measure them in (its offenders get refinement spheres).
   std::optional<CurvedFaceEdges> finder;
-  if (simplex) finder.emplace(linear, cad);
+  if (simplex && !linear.isSurface()) finder.emplace(linear, cad);
   RepairPlan plan;
   std::set<MeshEdge> planned;
   for (std::size_t c = 0; c < cells.size(); ++c) {
@@ -260,6 +262,8 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
 
 std::vector<CurvedFaceEdge> tangentEarSplits(const Mesh& linear, const CadModel& cad) {
   const int d = linear.dim;
+  // (A surface mesh has no plane to check a split's areas in: its rounds refine instead.)
+  if (linear.isSurface()) return {};
   for (const ElementBlock& block : linear.blocks)  // simplices only (no layer's prisms)
     if (cellDimension(block.type) == d &&
         (block.order != 1 || cellNumVertices(block.type) != d + 1))

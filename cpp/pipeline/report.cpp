@@ -52,6 +52,8 @@ void appendHealing(JsonWriter& json, const HealingRecord& h) {
   // The faces in no solid that were not meshed (solids only, or copies of the solids' faces),
   // in words; empty: none.
   json.value("left_out", h.leftOut);
+  // The model was kept as faces for a surface mesh (--surface), in words; empty: it was not.
+  json.value("surface", h.surface);
   // Face numbers (boundary layers, groups) are the healed model's when it was renumbered.
   json.value("renumbered", h.renumbered);
   json.value("faces_before", h.facesBefore);

@@ -402,10 +402,11 @@ void applyTimeLimits(MeshingOptions& options, const bp::object& limits) {
 MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity,
                            int optimise, const bp::object& sizing, int repairRounds,
                            const bp::object& boundaryLayer, const bp::object& limits,
-                           bool heal = true, bool solidsOnly = false) {
+                           bool heal = true, bool solidsOnly = false, bool surface = false) {
   MeshingOptions options;
   options.heal = heal;
   options.solidsOnly = solidsOnly;
+  options.surface = surface;
   applyTimeLimits(options, limits);
   if (!boundaryLayer.is_none())
     options.boundaryLayer = boundaryLayerFrom(bp::extract<bp::dict>(boundaryLayer));
@@ -422,12 +423,14 @@ MeshingOptions makeOptions(int order, const bp::object& size, int threads, int v
 // The sizing octree and prediction of a CAD source: the JSON report of `homesh predict`,
 // and the octree's leaves written to `octreePath` when it is not empty.
 std::string predict(CaseSetup setup, const bp::object& sizing, const std::string& octreePath,
-                    const std::string& input, int threads, bool heal, bool solidsOnly) {
+                    const std::string& input, int threads, bool heal, bool solidsOnly,
+                    bool surface) {
   if (!sizing.is_none()) setup.options.sizing = sizingFrom(bp::extract<bp::dict>(sizing));
   setup.options.octreeOutput = octreePath;
   setup.options.threads = threads;
   setup.options.heal = heal;
   setup.options.solidsOnly = solidsOnly;
+  setup.options.surface = surface;
   const ReleaseGil nogil;
   return predictReportJson(runSizingStage(setup.source, setup.options), input);
 }
@@ -436,13 +439,14 @@ std::string predict(CaseSetup setup, const bp::object& sizing, const std::string
 // "half_width" (L,), "delta" (L,) and "boundary" (L,) uint8 (1: the boundary passes through the
 // leaf), with "predicted_elements". For drawing the size field.
 bp::dict sizeField(const std::string& text, const std::string& name, const bp::object& sizing,
-                   int threads, bool heal, bool solidsOnly) {
+                   int threads, bool heal, bool solidsOnly, bool surface) {
   CaseSetup setup;
   setup.source = CadSource::brepText(text, name);
   if (!sizing.is_none()) setup.options.sizing = sizingFrom(bp::extract<bp::dict>(sizing));
   setup.options.threads = threads;
   setup.options.heal = heal;
   setup.options.solidsOnly = solidsOnly;
+  setup.options.surface = surface;
   std::vector<double> centre, half, delta;
   std::vector<std::uint8_t> boundary;
   double predicted = 0.0;
@@ -471,15 +475,17 @@ bp::dict sizeField(const std::string& text, const std::string& name, const bp::o
 
 // A CAD file or a NekMesh .mcf case (pipeline/case_setup.hpp).
 std::string predictFile(const std::string& path, const bp::object& sizing,
-                        const std::string& octreePath, int threads, bool heal, bool solidsOnly) {
-  return predict(setupCase(path), sizing, octreePath, path, threads, heal, solidsOnly);
+                        const std::string& octreePath, int threads, bool heal, bool solidsOnly,
+                        bool surface) {
+  return predict(setupCase(path), sizing, octreePath, path, threads, heal, solidsOnly, surface);
 }
 
 std::string predictBrep(const std::string& text, const std::string& name, const bp::object& sizing,
-                        const std::string& octreePath, int threads, bool heal, bool solidsOnly) {
+                        const std::string& octreePath, int threads, bool heal, bool solidsOnly,
+                        bool surface) {
   CaseSetup setup;
   setup.source = CadSource::brepText(text, name);
-  return predict(setup, sizing, octreePath, name, threads, heal, solidsOnly);
+  return predict(setup, sizing, octreePath, name, threads, heal, solidsOnly, surface);
 }
 
 // The parameter table (core/parameters.hpp) as a list of dicts: key, property, option, label,
@@ -571,10 +577,11 @@ int defaultRepairRounds() {
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
                 int verbosity, bp::object progress, int optimise, const bp::object& sizing,
                 int repairRounds, const bp::object& boundaryLayer, const bp::object& cancel,
-                const bp::object& limits, bool heal, bool solidsOnly) {
+                const bp::object& limits, bool heal, bool solidsOnly, bool surface) {
   const CaseSetup setup = setupCase(path);
-  MeshingOptions options = makeOptions(order, size, threads, verbosity, optimise, sizing,
-                                       repairRounds, boundaryLayer, limits, heal, solidsOnly);
+  MeshingOptions options =
+      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds, boundaryLayer,
+                  limits, heal, solidsOnly, surface);
   if (!options.size && !options.sizing) options.sizing = setup.options.sizing;
   if (!options.boundaryLayer) options.boundaryLayer = setup.options.boundaryLayer;
   options.expectedDimension = setup.options.expectedDimension;
@@ -584,10 +591,11 @@ PyMesh meshFile(const std::string& path, int order, const bp::object& size, int 
 PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
                 int threads, int verbosity, bp::object progress, int optimise,
                 const bp::object& sizing, int repairRounds, const bp::object& boundaryLayer,
-                const bp::object& cancel, const bp::object& limits, bool heal, bool solidsOnly) {
+                const bp::object& cancel, const bp::object& limits, bool heal, bool solidsOnly,
+                bool surface) {
   return runPipeline(CadSource::brepText(text, name),
                      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds,
-                                 boundaryLayer, limits, heal, solidsOnly),
+                                 boundaryLayer, limits, heal, solidsOnly, surface),
                      std::move(progress), cancel);
 }
 
@@ -778,21 +786,22 @@ BOOST_PYTHON_MODULE(_core) {
        bp::arg("progress"), bp::arg("optimise") = 0, bp::arg("sizing") = bp::object(),
        bp::arg("repair_rounds") = defaultRepairRounds(), bp::arg("boundary_layer") = bp::object(),
        bp::arg("cancel") = bp::object(), bp::arg("limits") = bp::object(), bp::arg("heal") = true,
-       bp::arg("solids_only") = false));
-  bp::def(
-      "mesh_brep", &meshBrep,
-      (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
-       bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
-       bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = defaultRepairRounds(),
-       bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object(),
-       bp::arg("limits") = bp::object(), bp::arg("heal") = true, bp::arg("solids_only") = false));
+       bp::arg("solids_only") = false, bp::arg("surface") = false));
+  bp::def("mesh_brep", &meshBrep,
+          (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
+           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
+           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = defaultRepairRounds(),
+           bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object(),
+           bp::arg("limits") = bp::object(), bp::arg("heal") = true, bp::arg("solids_only") = false,
+           bp::arg("surface") = false));
   bp::def("predict_file", &predictFile,
           (bp::arg("path"), bp::arg("sizing") = bp::object(), bp::arg("octree_path") = "",
-           bp::arg("threads") = 1, bp::arg("heal") = true, bp::arg("solids_only") = false));
+           bp::arg("threads") = 1, bp::arg("heal") = true, bp::arg("solids_only") = false,
+           bp::arg("surface") = false));
   bp::def("predict_brep", &predictBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
            bp::arg("octree_path") = "", bp::arg("threads") = 1, bp::arg("heal") = true,
-           bp::arg("solids_only") = false));
+           bp::arg("solids_only") = false, bp::arg("surface") = false));
   bp::def("parameters", &parameters);
   bp::def("parameter_in_range", &parameterInRange, (bp::arg("key"), bp::arg("value")));
   bp::def(
@@ -804,9 +813,10 @@ BOOST_PYTHON_MODULE(_core) {
           (bp::arg("path"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("order"),
            bp::arg("threads"), bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise"),
            bp::arg("cancel") = bp::object(), bp::arg("limits") = bp::object()));
-  bp::def("size_field", &sizeField,
-          (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
-           bp::arg("threads") = 1, bp::arg("heal") = true, bp::arg("solids_only") = false));
+  bp::def(
+      "size_field", &sizeField,
+      (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(), bp::arg("threads") = 1,
+       bp::arg("heal") = true, bp::arg("solids_only") = false, bp::arg("surface") = false));
   bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("threads") = 1));
   bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
   bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));

@@ -5,6 +5,7 @@
 #include <mutex>
 
 #include "element/quadrature.hpp"
+#include "quality/mesh_quality.hpp"
 
 namespace homesh {
 namespace {
@@ -62,7 +63,6 @@ double elementMeasure(CellType type, int order, const NodeCoordinates& x,
 
 std::vector<double> elementMeasures(const Mesh& mesh) {
   std::vector<double> out;
-  const Eigen::Vector3d normal(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
   for (const ElementBlock& b : mesh.blocks) {
     if (cellDimension(b.type) != mesh.dim) continue;
     const int n = b.nodesPerElement();
@@ -70,6 +70,7 @@ std::vector<double> elementMeasures(const Mesh& mesh) {
     for (std::size_t e = 0; e < b.count(); ++e) {
       for (int i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c) x(i, c) = mesh.xyz[3 * b.element(e)[i] + c];
+      const Eigen::Vector3d normal = cellNormal(mesh, b.element(e));
       out.push_back(elementMeasure(b.type, b.order, x, mesh.dim == 2 ? &normal : nullptr));
     }
   }

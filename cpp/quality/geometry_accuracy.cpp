@@ -190,7 +190,8 @@ CellRecord sampleCell(const Mesh& mesh, const std::int64_t* nodes, int n, const 
     }
   } else {
     const auto guess = curveGuesses(mesh, nodes, n, entity, cad);
-    const bool angle = mesh.dim == 2;  // in 3D curves only bound faces: distance only
+    // In 3D (and on a surface mesh) curves only bound faces: distance only.
+    const bool angle = mesh.dim == 2 && !mesh.isSurface();
     for (int q = 0; q < samples; ++q) {
       const Eigen::Vector3d p = (s.values.row(q) * x).transpose();
       const CurveProjection proj = cad.projectOnCurve(entity, p, nearestGuess(s.nearest[q], guess));
@@ -225,7 +226,10 @@ GeometryAccuracy measureGeometryAccuracy(const Mesh& mesh, const CadModel& cad, 
   result.maxDistance = -1.0;
   for (const ElementBlock& block : mesh.blocks) {
     const int cellDim = cellDimension(block.type);
-    if (cellDim == 0 || cellDim >= mesh.dim || block.count() == 0) continue;
+    // A surface mesh's elements are themselves on CAD faces: measured like a volume's
+    // boundary triangles.
+    const bool onFaces = mesh.isSurface() && cellDim == 2;
+    if (cellDim == 0 || (cellDim >= mesh.dim && !onFaces) || block.count() == 0) continue;
     const int entityDim = cellDim;  // faces carry faces, lines carry curves
     const int entities = entityDim == 2 ? cad.numFaces() : cad.numEdges();
     for (const std::int32_t entity : block.entity)
@@ -235,7 +239,7 @@ GeometryAccuracy measureGeometryAccuracy(const Mesh& mesh, const CadModel& cad, 
                     std::to_string(entities) + (entityDim == 2 ? " faces" : " edges"));
     const Sampling sampling = makeSampling(block.type, block.order);
     std::vector<double> speeds(static_cast<std::size_t>(entities) + 1, 0.0);
-    if (entityDim == 1 && mesh.dim == 2)  // the tangent angle needs them
+    if (entityDim == 1 && mesh.dim == 2 && !mesh.isSurface())  // the tangent angle needs them
       for (const std::int32_t entity : block.entity)
         if (speeds[static_cast<std::size_t>(entity)] == 0.0 && !cad.isDegenerated(entity))
           speeds[static_cast<std::size_t>(entity)] = typicalSpeed(cad, entity);

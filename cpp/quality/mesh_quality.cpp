@@ -68,7 +68,7 @@ JacobianSampler boundarySampler(CellType type, int order) {
 
 JacobianBounds elementJacobianBounds(const Mesh& mesh, const ElementBlock& block, std::size_t e,
                                      double tolerance) {
-  const Eigen::Vector3d normal(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
+  const Eigen::Vector3d normal = cellNormal(mesh, block.element(e));
   return boundJacobian(block.type, block.order,
                        gather(mesh, block.element(e), block.nodesPerElement()),
                        mesh.dim == 2 ? &normal : nullptr, tolerance);
@@ -76,7 +76,6 @@ JacobianBounds elementJacobianBounds(const Mesh& mesh, const ElementBlock& block
 
 QualitySummary evaluateQuality(const Mesh& mesh, int threads) {
   QualitySummary summary;
-  const Eigen::Vector3d normal(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
   for (const ElementBlock& block : mesh.blocks) {
     const int n = block.nodesPerElement();
     if (block.count() == 0) continue;
@@ -95,11 +94,14 @@ QualitySummary evaluateQuality(const Mesh& mesh, int threads) {
     std::vector<JacobianBounds> bounds(block.count());
     std::vector<double> distortion(block.count());
     // Warm the shared tables once before the threads need them.
+    const Eigen::Vector3d first = cellNormal(mesh, block.element(0));
     boundJacobian(block.type, block.order, gather(mesh, block.element(0), n),
-                  mesh.dim == 2 ? &normal : nullptr);
+                  mesh.dim == 2 ? &first : nullptr);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
     for (std::int64_t e = 0; e < count; ++e) {
-      const NodeCoordinates x = gather(mesh, block.element(static_cast<std::size_t>(e)), n);
+      const std::int64_t* cell = block.element(static_cast<std::size_t>(e));
+      const NodeCoordinates x = gather(mesh, cell, n);
+      const Eigen::Vector3d normal = cellNormal(mesh, cell);
       bounds[e] = boundJacobian(block.type, block.order, x, mesh.dim == 2 ? &normal : nullptr);
       distortion[e] = elementDistortion(block.type, block.order, x);
     }

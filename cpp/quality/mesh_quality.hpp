@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <vector>
 
@@ -78,6 +79,12 @@ struct FlaggedElement {
 // The invalid and undecided elements, at most `limit` of them, in element order.
 std::vector<FlaggedElement> flaggedElements(const Mesh& mesh, const QualitySummary& quality,
                                             std::size_t limit);
+
+// Mesh::cellNormal as a vector: what the Jacobian of 2D cell `cell` is measured along.
+inline Eigen::Vector3d cellNormal(const Mesh& mesh, const std::int64_t* cell) {
+  const std::array<double, 3> n = mesh.cellNormal(cell);
+  return {n[0], n[1], n[2]};
+}
 
 // Certified Jacobian bounds of one element of `block` (of dimension mesh.dim), computed on its
 // node coordinates moved to the origin and scaled to unit size (every measure here is invariant

@@ -28,9 +28,28 @@ constexpr double kAreaDensity2 = 2.309;
 constexpr double kBoundaryDensity2 = 0.465;
 constexpr double kGradientDensity2 = 1.41;
 
+// A surface mesh's triangles: the 2D area density over the faces, integrated with the face
+// samples' areas (the faces are the domain; no volume, and no boundary term fitted for it).
+ElementCountPrediction predictSurfaceTriangles(const SizingOctree& tree) {
+  ElementCountPrediction out;
+  out.dim = 2;
+  double area = 0.0, integral = 0.0;
+  for (const BoundarySample& s : tree.samples()) {
+    if (s.outward.isZero()) continue;  // a curve's size-only sample
+    const double h = tree.delta(s.x);
+    area += s.weight;
+    integral += s.weight / (h * h);
+  }
+  out.domainMeasure = area;
+  out.volumeIntegral = integral;
+  out.elements = kAreaDensity2 * integral;
+  return out;
+}
+
 }  // namespace
 
 ElementCountPrediction predictElementCount(const SizingOctree& tree, int threads) {
+  if (tree.surface()) return predictSurfaceTriangles(tree);
   ElementCountPrediction out;
   out.dim = tree.dim();
   const int d = out.dim;

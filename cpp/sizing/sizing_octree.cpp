@@ -90,6 +90,10 @@ class OctreeBuilder {
   void prepareFrame() {
     Eigen::Vector3d normal(0.0, 0.0, 1.0);
     t_.dim_ = modelMeshDimension(cad_, normal);
+    if (t_.dim_ == 2 && normal.isZero()) {  // a surface mesh: faces in 3D
+      t_.dim_ = 3;
+      t_.surface_ = true;
+    }
     if (t_.dim_ == 2) {
       t_.origin_ = cad_.plane(1).first;
       const Eigen::Vector3d n = normal.normalized();

@@ -56,7 +56,11 @@ class SizingOctree {
   // The size at x (model coordinates). Thread-safe.
   double delta(const Eigen::Vector3d& x) const;
 
+  // 3 for a volume (and for a surface mesh, whose sizes live in 3D too), 2 for a planar model.
   int dim() const { return dim_; }
+  // Built for a surface mesh (a model of faces, no solid, not in one plane): the sizes follow
+  // its faces; which leaves lie inside means nothing there.
+  bool surface() const { return surface_; }
   const SizingParameters& parameters() const { return params_; }
   const OctreeStatistics& statistics() const { return stats_; }
   std::size_t numLeaves() const { return leaves_.size(); }
@@ -119,6 +123,7 @@ class SizingOctree {
   friend class OctreeBuilder;
 
   int dim_ = 3;
+  bool surface_ = false;
   SizingParameters params_;
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
   Eigen::Matrix3d axes_ = Eigen::Matrix3d::Identity();  // columns: local x, y, z (normal in 2D)

@@ -138,6 +138,13 @@ class HighOrderMeshProxy(_Proxy, ParameterGuard):
                             "that does not close), named in the report view; off: such a "
                             "shape is refused, naming those faces")
             obj.SolidsOnly = False
+        if "Surface" not in have:
+            obj.addProperty("App::PropertyBool", "Surface", "Mesh",
+                            "For a shape without solids (a shell, faces that do not close): a "
+                            "surface mesh of its faces, triangles curved on the CAD, sewn where "
+                            "faces meet (no volume, no optimiser, no boundary layer); off: such "
+                            "a shape is refused, naming a free edge")
+            obj.Surface = False
         add_parameter_property(obj, "repair_rounds", "Mesh")
         add_parameter_property(obj, "threads", "Mesh", " Default: all cores.",
                                default=os.cpu_count() or 1)
@@ -259,6 +266,7 @@ def mesh_arguments(obj, values=None):
                  "job_seconds": get("JobTimeLimit"),
                  "heal": bool(values.get("Heal", getattr(obj, "Heal", True))),
                  "solids_only": bool(values.get("SolidsOnly", getattr(obj, "SolidsOnly", False))),
+                 "surface": bool(values.get("Surface", getattr(obj, "Surface", False))),
                  "repair_rounds": int(get("RepairRounds")), "threads": int(get("Threads"))}
     sizing = values.get("Sizing", getattr(obj, "Sizing", None))
     if arguments["size"] is None and sizing is not None:
@@ -336,7 +344,8 @@ def predicted_elements(obj, job):
         sizing = {"min_delta": size, "max_delta": size}
     report = homesh.predict(job.brep_text, name=job.name, threads=arguments["threads"],
                             heal=arguments.get("heal", True),
-                            solids_only=arguments.get("solids_only", False), **sizing)
+                            solids_only=arguments.get("solids_only", False),
+                            surface=arguments.get("surface", False), **sizing)
     return int(report["predicted_elements"])
 
 

@@ -25,7 +25,8 @@ _MESH_PARAMETERS = ("Order", "Size", "OptimiserIterations", "OptimiserTimeLimit"
                     "LinearTimeLimit", "JobTimeLimit", "RepairRounds", "Threads")
 _SIZING_PARAMETERS = ("MinDelta", "MaxDelta", "Eps")
 # The CAD check's switches (boolean properties): check boxes under the parameters.
-_MESH_FLAGS = (("Heal", "Heal the CAD"), ("SolidsOnly", "Solids only"))
+_MESH_FLAGS = (("Heal", "Heal the CAD"), ("SolidsOnly", "Solids only"),
+               ("Surface", "Surface mesh (no solid)"))
 
 
 _LAST = []

@@ -162,6 +162,28 @@ class HighOrderMeshObject(unittest.TestCase):
         self.assertGreater(sizing.PredictedElements, 0)
         self.assertIn("of the solids alone: left out 5 faces (Face7-Face11)", sizing.Status)
 
+    def test_a_shell_is_refused_by_name_unless_a_surface_mesh_is_asked_for(self):
+        import Part
+        tube = [f for f in Part.makeCylinder(1, 2).Faces
+                if f.Surface.TypeId == "Part::GeomCylinder"][0]
+        part = self.doc.addObject("Part::Feature", "Tube")
+        part.Shape = Part.Shell([tube])
+        obj = homesh.freecad.make_high_order_mesh(self.doc, part, order=3, size=0.5)
+        self.assertFalse(obj.Surface)
+        self.doc.recompute()
+        self.assertFalse(obj.isValid())
+        self.assertIn("FreeCAD Surface", obj.Status)
+        obj.Surface = True
+        self.doc.recompute()
+        self.assertTrue(obj.isValid(), obj.Status)
+        mesh = homesh.freecad.get_mesh(obj)
+        self.assertEqual(mesh.dim, 2)
+        self.assertEqual(tuple(mesh.plane_normal), (0.0, 0.0, 0.0))
+        self.assertEqual(mesh.quality()["invalid_elements"], 0)
+        self.assertIn("a surface mesh of its 1 face", mesh.report()["healing"]["surface"])
+        radial = (mesh.nodes[:, 0] ** 2 + mesh.nodes[:, 1] ** 2) ** 0.5
+        self.assertLess(float(abs(radial - 1.0).max()), 1e-9)
+
     def test_recompute_leaves_no_temporary_folders(self):
         before = set(os.listdir(tempfile.gettempdir()))
         part = box_with_hole(self.doc)

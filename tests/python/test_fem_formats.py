@@ -329,10 +329,23 @@ UNV_SHELL = """    -1
 """
 
 
+def test_a_shell_is_read_as_a_surface_mesh(homesh_bin, tmp_path):
+    # Two triangles folded along their shared edge (node 4 lifted by 0.5): no plane holds them,
+    # so each is judged along its own normal, both straight and valid.
+    path = tmp_path / "shell.unv"
+    path.write_text(UNV_SHELL)
+    m = homesh.read(path)
+    assert m.dim == 2 and m.num_elements == 2
+    assert tuple(m.plane_normal) == (0.0, 0.0, 0.0)
+    q = m.quality()
+    assert q["invalid_elements"] == 0 and q["min"] == pytest.approx(1.0)
+    r = run([homesh_bin, "quality", path])
+    assert r.returncode == 0, r.stderr
+
+
 @pytest.mark.parametrize("text, phrases", [
     (UNV_QUAD8, ["line 10: element 7 (FE descriptor 45, a quadrilateral) has 8 nodes",
                  "serendipity"]),
-    (UNV_SHELL, ["do not lie in one plane (nodes", "not shells"]),
     (UNV_SHELL.replace("  2412", "  2413"), ["it has no elements (dataset 2412)"]),
     (UNV_SHELL.replace("   1.0  1.0  0.5\n", ""), ["line 9: node 4 has no coordinate line"]),
     (UNV_SHELL.replace("         2         4         3\n    -1\n", ""),

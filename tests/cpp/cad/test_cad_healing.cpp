@@ -1,10 +1,12 @@
 // The CAD check and healing: a sound model is left exactly as it is; an empty solid is removed
 // without touching the faces' numbering; faces that close are sewn into a solid; what cannot be
-// closed is refused naming a free edge, or left out by name when only solids are asked for.
+// closed is refused naming a free edge, or left out by name when only solids are asked for, or
+// kept as faces (sewn where they meet) for a surface mesh.
 #include <gtest/gtest.h>
 
 #include <BRepAlgoAPI_BuilderAlgo.hxx>
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepBuilderAPI_Copy.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRep_Builder.hxx>
 #include <TopExp_Explorer.hxx>
@@ -123,7 +125,56 @@ TEST(CadHealing, WhatCannotBeClosedIsRefusedNamingAFreeEdge) {
       EXPECT_NE(message.find(heal ? "healing could not close it" : "healing is off"),
                 std::string::npos)
           << message;
+      EXPECT_NE(message.find("as a surface mesh: --surface"), std::string::npos) << message;
     }
+  }
+}
+
+// Five faces of a box, each copied on its own (no edge shared): a surface mesh keeps them as
+// faces, no solid, and sewing joins them along the 8 edges they meet at, leaving the open
+// top's 4 edges free. Asked of a model with a solid, it is refused naming the solid.
+TEST(CadHealing, ASurfaceMeshKeepsTheFacesSewnWhereTheyMeet) {
+  TopoDS_Compound apart;
+  BRep_Builder builder;
+  builder.MakeCompound(apart);
+  int n = 0;
+  for (TopExp_Explorer f(box(), TopAbs_FACE); f.More() && n < 5; f.Next(), ++n)
+    builder.Add(apart, BRepBuilderAPI_Copy(f.Current()).Shape());
+  HealingOptions surface;
+  surface.surface = true;
+  HealingRecord record;
+  const CadModel cad = healModel(cadModelFromShape(apart, "five faces"), surface, record);
+  EXPECT_EQ(cad.numSolids(), 0);
+  EXPECT_EQ(cad.numFaces(), 5);
+  ASSERT_EQ(record.actions.size(), 1U);
+  EXPECT_NE(record.actions[0].find("20 -> 4 edges bounding one face"), std::string::npos)
+      << record.actions[0];
+  EXPECT_NE(record.surface.find("a surface mesh of its 5 faces"), std::string::npos)
+      << record.surface;
+  EXPECT_NE(record.surface.find("4 edges bound only one face"), std::string::npos)
+      << record.surface;
+  ASSERT_FALSE(record.notes().empty());
+  EXPECT_EQ(record.notes().front(), record.surface);
+  // Without healing the faces stay apart: 20 free edges, nothing sewn.
+  surface.enabled = false;
+  const CadModel unsewn = healModel(cadModelFromShape(apart, "five faces"), surface, record);
+  EXPECT_EQ(unsewn.numFaces(), 5);
+  EXPECT_TRUE(record.actions.empty());
+  EXPECT_NE(record.surface.find("20 edges bound only one face"), std::string::npos)
+      << record.surface;
+  // All six faces close, yet stay faces: no solid is made when a surface mesh is asked for.
+  surface.enabled = true;
+  const CadModel closed =
+      healModel(cadModelFromShape(looseFaces(true), "six faces"), surface, record);
+  EXPECT_EQ(closed.numSolids(), 0);
+  EXPECT_NE(record.surface.find("the faces close"), std::string::npos) << record.surface;
+  try {
+    healModel(cadModelFromShape(box(), "a box"), surface, record);
+    FAIL() << "a surface mesh of a solid was accepted";
+  } catch (const CadError& e) {
+    EXPECT_NE(std::string(e.what()).find("a box has 1 solid: a surface mesh (--surface"),
+              std::string::npos)
+        << e.what();
   }
 }
 

@@ -12,6 +12,7 @@
 #include <TopTools_ListOfShape.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
+#include <cmath>
 #include <gp_Pln.hxx>
 #include <map>
 #include <set>
@@ -171,8 +172,10 @@ TEST(LinearMesher, PlanarFaceGivesOrientedTriangles) {
   expectParametersReproduceNodes(mesh, cad, 1e-9);
 }
 
-TEST(LinearMesher, RejectsWhatItCannotMesh) {
-  // A lone cylindrical face: not planar and in no solid.
+// A lone cylindrical face (not planar, in no solid) gets a surface mesh: triangles on the face
+// in 3D with no plane (Mesh::isSurface), their nodes on the cylinder with the parameters that
+// reproduce them.
+TEST(LinearMesher, ALoneCurvedFaceGetsASurfaceMesh) {
   TopTools_IndexedMapOfShape faces;
   TopExp::MapShapes(test::cylinder(1, 2), TopAbs_FACE, faces);
   int lateral = 0;
@@ -182,12 +185,21 @@ TEST(LinearMesher, RejectsWhatItCannotMesh) {
   }
   ASSERT_GT(lateral, 0);
   const CadModel curved = test::toModel(faces(lateral));
-  try {
-    generateLinearMesh(curved, LinearMeshOptions::uniform(0.5));
-    FAIL();
-  } catch (const CadError& e) {
-    EXPECT_NE(std::string(e.what()).find("Face1"), std::string::npos);
-  }
+  const Mesh mesh = generateLinearMesh(curved, LinearMeshOptions::uniform(0.5));
+  EXPECT_EQ(mesh.dim, 2);
+  EXPECT_TRUE(mesh.isSurface());
+  ASSERT_EQ(mesh.blocks.size(), 2U);
+  EXPECT_EQ(mesh.blocks[0].type, CellType::Triangle);
+  EXPECT_EQ(mesh.blocks[1].type, CellType::Line);
+  // The tube's area 4 pi over triangles of side 0.5 (0.108 each): about 116.
+  EXPECT_GT(mesh.numElements(), 60U);
+  EXPECT_LT(mesh.numElements(), 240U);
+  for (std::size_t i = 0; i < mesh.numNodes(); ++i)  // |(x, y)| = 1 to OCCT's rounding
+    ASSERT_NEAR(std::hypot(mesh.xyz[3 * i], mesh.xyz[3 * i + 1]), 1.0, 1e-12) << i;
+  expectParametersReproduceNodes(mesh, curved, 1e-9);
+}
+
+TEST(LinearMesher, RejectsWhatItCannotMesh) {
   const CadModel cube = test::toModel(test::box(1, 1, 1));
   EXPECT_THROW(generateLinearMesh(cube, LinearMeshOptions::uniform(0.0)), ParameterError);
   EXPECT_THROW(generateLinearMesh(cube, LinearMeshOptions::uniform(-1.0)), ParameterError);

@@ -2,6 +2,11 @@
 #include <gtest/gtest.h>
 
 #include <BRepTools.hxx>
+#include <BRep_Builder.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS_Compound.hxx>
+#include <algorithm>
+#include <cmath>
 #include <tuple>
 
 #include "core/error.hpp"
@@ -153,6 +158,66 @@ TEST(MeshPipeline, StagesReportProgressAndCancelWithinTheOptimiser) {
     EXPECT_EQ(observer.sweeps, 0);  // stopped inside sweep 1, which never finished
     EXPECT_EQ(observer.askedWhileOptimising, 2);
   }
+}
+
+// A model of faces and no solid (the tube of a cylinder and the sphere's face beside it, kept
+// apart) with `surface`: a surface mesh at order 4 whose every node lies on its CAD entity,
+// certified valid, its triangles measured against the faces; the optimiser is left out and
+// said so. Without `surface` the same model is refused, naming the option.
+TEST(MeshPipeline, FacesWithoutASolidGetACertifiedSurfaceMesh) {
+  TopoDS_Compound faces;
+  BRep_Builder builder;
+  builder.MakeCompound(faces);
+  for (TopExp_Explorer f(test::cylinder(1.0, 2.0), TopAbs_FACE); f.More(); f.Next())
+    if (!test::toModel(f.Current()).isPlanar(1)) builder.Add(faces, f.Current());
+  for (TopExp_Explorer f(test::sphere(0.5), TopAbs_FACE); f.More(); f.Next())
+    builder.Add(faces, f.Current());
+  const std::string text = test::brepText(faces);
+  MeshingOptions options;
+  options.order = 4;
+  options.size = 0.4;
+  options.optimiseIterations = 5;
+  EXPECT_THROW(runMeshPipeline(CadSource::brepText(text), options), CadError);
+  options.surface = true;
+  const MeshResult r = runMeshPipeline(CadSource::brepText(text), options);
+  ASSERT_TRUE(r.mesh.isSurface());
+  EXPECT_EQ(r.mesh.order, 4);
+  EXPECT_FALSE(r.optimiser.has_value());
+  const auto noted = [&r](const std::string& phrase) {
+    return std::any_of(r.notes.begin(), r.notes.end(), [&phrase](const std::string& note) {
+      return note.find(phrase) != std::string::npos;
+    });
+  };
+  EXPECT_TRUE(noted("a surface mesh of its 2 faces")) << r.notes.front();
+  EXPECT_TRUE(noted("the optimiser does not run on a surface mesh"));
+  // Every element proven valid, its Jacobian measured along its straight triangle's normal.
+  EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
+  EXPECT_GT(r.quality.scaled.min, 0.0);
+  EXPECT_EQ(r.quality.scaledJacobian.size(), r.mesh.numElements());
+  // Nodes on the CAD: evaluated there, so |(x, y)| = 1 on the tube and |x| = 0.5 on the sphere
+  // up to rounding (1e-15); 1e-9 leaves room for OCCT's projection of the few nodes placement
+  // hands to it.
+  std::size_t onTube = 0, onSphere = 0;
+  for (std::size_t i = 0; i < r.mesh.numNodes(); ++i) {
+    const Eigen::Vector3d x = test::nodePoint(r.mesh, static_cast<std::int64_t>(i));
+    if (std::abs(x.norm() - 0.5) < 1e-9) {
+      ++onSphere;
+    } else {
+      ASSERT_NEAR(std::hypot(x.x(), x.y()), 1.0, 1e-9) << "node " << i;
+      ++onTube;
+    }
+  }
+  EXPECT_GT(onTube, 500U);
+  EXPECT_GT(onSphere, 100U);
+  // Between the nodes the order-4 triangles follow the faces to interpolation accuracy: on the
+  // sphere of radius 0.5, chords of about 0.4 (0.8 rad of arc) miss it by about
+  // r (h/r)^5 / (4^4 5!) = 5e-6, 1.5e-6 of the diagonal (3.5); as for the torus above, 1e-4
+  // leaves room for the triangles distorted at the poles, and a triangle off its face would
+  // be off by a chord's sagitta, 0.04 (1e-2 of the diagonal).
+  ASSERT_TRUE(r.geometry.has_value());
+  EXPECT_GT(r.geometry->samples, 10000U);
+  EXPECT_LT(r.geometry->maxDistanceRelative(), 1e-4) << r.geometry->worstEntity;
+  EXPECT_LT(r.geometry->maxAngleDeg, 5.0);
 }
 
 }  // namespace
