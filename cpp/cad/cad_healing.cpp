@@ -554,23 +554,26 @@ CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& r
   record.tolerance = kTolerance * diagonal;
   record.facesBefore = record.facesAfter = cad.numFaces();
   record.solidsBefore = record.solidsAfter = cad.numSolids();
-  if (options.surface && cad.numSolids() > 0)
-    throw CadError(cad.sourceName() + " has " + std::to_string(cad.numSolids()) +
-                   (cad.numSolids() == 1 ? " solid" : " solids") +
+  // (Solids without a face are removed below: they do not count.)
+  int solidsWithFaces = 0;
+  for (int s = 1; s <= cad.numSolids(); ++s)
+    if (count(occtSolid(cad, s), TopAbs_FACE) > 0) ++solidsWithFaces;
+  if (options.surface && solidsWithFaces > 0)
+    throw CadError(cad.sourceName() + " has " + std::to_string(solidsWithFaces) +
+                   (solidsWithFaces == 1 ? " solid" : " solids") +
                    ": a surface mesh (--surface, Python surface=True, FreeCAD Surface) is for a "
                    "model of faces alone; without it the solids get a volume mesh");
   // Faces not meant to be sewn into a solid: planar ones in one plane (a 2D case), or any when
   // a surface mesh is asked for.
   bool planar = false;
-  if (cad.numSolids() == 0 && cad.numFaces() > 0) {
+  if (solidsWithFaces == 0 && cad.numFaces() > 0) {
     try {
-      Eigen::Vector3d normal;
-      modelMeshDimension(cad, normal);
-      planar = !normal.isZero();
+      Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+      planar = modelMeshDimension(cad, normal) == 2 && !normal.isZero();
     } catch (const CadError&) {  // (OCCT could not give a face's plane: reported below)
     }
   }
-  const bool faces = planar || (options.surface && cad.numSolids() == 0);
+  const bool faces = planar || (options.surface && solidsWithFaces == 0);
   // A check that fails (OCCT cannot measure an edge, say) is recorded, not fatal: the model is
   // then meshed as it is, and a stage that cannot handle it says so.
   Findings found;

@@ -258,7 +258,7 @@ int runPredict(const homesh::PredictCommand& cmd) {
   if (!c.quiet) {
     for (const std::string& note : s.healing.notes())
       std::fprintf(stderr, "homesh: note: %s\n", note.c_str());
-    printPrediction(s, s.octree->dim());
+    printPrediction(s, s.prediction.dim);  // (2 for a surface mesh, whose octree is 3D)
     if (cmd.sizing.writeOctree)
       std::fprintf(stderr, "homesh: wrote %s\n", cmd.sizing.writeOctree->c_str());
   }

@@ -42,49 +42,70 @@ std::array<double, 3> Mesh::cellNormal(const std::int64_t* cell) const {
   return n;
 }
 
-std::array<double, 3> votedPlaneNormal(const Mesh& mesh) {
-  std::array<double, 3> sum{0.0, 0.0, 0.0};
-  for (const ElementBlock& b : mesh.blocks) {
-    if (cellDimension(b.type) != 2) continue;
-    for (std::size_t e = 0; e < b.count(); ++e) {
-      const std::int64_t* v = b.element(e);
-      double a[3], c[3];
-      for (int k = 0; k < 3; ++k) {
-        a[k] = mesh.xyz[3 * v[1] + k] - mesh.xyz[3 * v[0] + k];
-        c[k] = mesh.xyz[3 * v[2] + k] - mesh.xyz[3 * v[0] + k];
-      }
-      const double n[3] = {a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2],
-                           a[0] * c[1] - a[1] * c[0]};
-      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-      if (length > 0.0)
-        for (int k = 0; k < 3; ++k) sum[k] += n[k] / length;
-    }
+namespace {
+
+std::array<double, 3> unitNormal(const Mesh& mesh, const std::int64_t* v) {
+  double a[3], c[3];
+  for (int k = 0; k < 3; ++k) {
+    a[k] = mesh.xyz[3 * v[1] + k] - mesh.xyz[3 * v[0] + k];
+    c[k] = mesh.xyz[3 * v[2] + k] - mesh.xyz[3 * v[0] + k];
   }
-  const double length = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+  std::array<double, 3> n{a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2],
+                          a[0] * c[1] - a[1] * c[0]};
+  const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   if (!(length > 0.0)) return {0.0, 0.0, 0.0};
-  for (double& x : sum) x /= length;
-  return sum;
+  for (double& x : n) x /= length;
+  return n;
 }
 
+bool isZero(const std::array<double, 3>& n) {
+  return n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0;
+}
+
+// Whether every node of a cell lies within `tolerance` times their bounding-box diagonal of one
+// plane with unit normal `normal` (nodes no cell uses do not count).
 bool nodesInPlane(const Mesh& mesh, const std::array<double, 3>& normal, double tolerance) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   double lo = kInf, hi = -kInf;
   std::array<double, 3> boxLo{kInf, kInf, kInf}, boxHi{-kInf, -kInf, -kInf};
-  for (std::size_t i = 0; i < mesh.numNodes(); ++i) {
-    double h = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      const double x = mesh.xyz[3 * i + k];
-      h += normal[k] * x;
-      boxLo[k] = std::min(boxLo[k], x);
-      boxHi[k] = std::max(boxHi[k], x);
+  for (const ElementBlock& b : mesh.blocks)
+    for (const std::int64_t i : b.nodes) {
+      double h = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const double x = mesh.xyz[3 * i + k];
+        h += normal[k] * x;
+        boxLo[k] = std::min(boxLo[k], x);
+        boxHi[k] = std::max(boxHi[k], x);
+      }
+      lo = std::min(lo, h);
+      hi = std::max(hi, h);
     }
-    lo = std::min(lo, h);
-    hi = std::max(hi, h);
-  }
-  if (mesh.numNodes() == 0) return true;
+  if (!(hi >= lo)) return true;  // no cell
   double diagonal = 0.0;
   for (int k = 0; k < 3; ++k) diagonal += (boxHi[k] - boxLo[k]) * (boxHi[k] - boxLo[k]);
   return hi - lo <= tolerance * std::sqrt(diagonal);
+}
+
+}  // namespace
+
+std::optional<std::array<double, 3>> planeOfCells(const Mesh& mesh, double tolerance) {
+  std::array<double, 3> sum{0.0, 0.0, 0.0}, first{0.0, 0.0, 0.0};
+  for (const ElementBlock& b : mesh.blocks) {
+    if (cellDimension(b.type) != 2) continue;
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      const std::array<double, 3> n = unitNormal(mesh, b.element(e));
+      if (isZero(first)) first = n;
+      for (int k = 0; k < 3; ++k) sum[k] += n[k];
+    }
+  }
+  if (isZero(first)) return std::nullopt;
+  const double length = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+  // (A sum far below one cell's: the cells face both ways, a closed shell perhaps.)
+  std::array<double, 3> normal = first;
+  if (length > 1e-6)
+    for (int k = 0; k < 3; ++k) normal[k] = sum[k] / length;
+  if (nodesInPlane(mesh, normal, tolerance)) return normal;
+  return std::array<double, 3>{0.0, 0.0, 0.0};
 }
 
 void Mesh::checkConsistency() const {

@@ -16,6 +16,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/cell_type.hpp"
@@ -76,13 +77,12 @@ struct Mesh {
   void checkConsistency() const;
 };
 
-// For a 2D mesh read from a file: the unit normal most of its 2D cells agree with (the sum of
-// their straight cells' unit normals, normalised); zero when no cell spans a plane.
-std::array<double, 3> votedPlaneNormal(const Mesh& mesh);
-
-// Whether every node lies within `tolerance` times the mesh's bounding-box diagonal of one plane
-// with unit normal `normal` (else the mesh is a surface mesh: Mesh::isSurface).
-bool nodesInPlane(const Mesh& mesh, const std::array<double, 3>& normal, double tolerance);
+// The plane of a 2D mesh read from a file, for Mesh::planeNormal: when every node lies within
+// `tolerance` times the mesh's bounding-box diagonal of one plane, its unit normal, oriented as
+// most 2D cells' straight normals (their unit normals summed; a cell's own where they cancel,
+// as on a closed shell); zero when the nodes leave every such plane (a surface mesh); nullopt
+// when no 2D cell spans a plane.
+std::optional<std::array<double, 3>> planeOfCells(const Mesh& mesh, double tolerance);
 
 // Drops the nodes no element uses (a source's high-order nodes after an order change, a macro
 // layer's inner nodes after its split) and renumbers the rest in their original order.

@@ -65,12 +65,11 @@ void orientSolids(Mesh& mesh, const std::string& path, std::vector<std::string>*
 // The plane normal most 2D elements agree with; zero (a surface mesh) when the 2D cells' nodes
 // leave that plane.
 void setPlane(Mesh& mesh, const std::string& path) {
-  const std::array<double, 3> normal = votedPlaneNormal(mesh);
-  if (normal == std::array<double, 3>{0.0, 0.0, 0.0})
-    throw IoError("'" + path + "': its 2D elements are degenerate (no element spans a plane)");
   // Files of single-precision coordinates (FreeCAD's VTK) carry 7 digits.
-  mesh.planeNormal =
-      nodesInPlane(mesh, normal, 1e-5) ? normal : std::array<double, 3>{0.0, 0.0, 0.0};
+  const auto normal = planeOfCells(mesh, 1e-5);
+  if (!normal)
+    throw IoError("'" + path + "': its 2D elements are degenerate (no element spans a plane)");
+  mesh.planeNormal = *normal;
 }
 
 }  // namespace

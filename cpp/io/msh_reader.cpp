@@ -307,11 +307,9 @@ Mesh assemble(RawMesh& raw, const std::string& path) {
     }
   }
   if (dim == 2) {  // the plane most elements agree with; none (a surface mesh) off it
-    const std::array<double, 3> normal = votedPlaneNormal(mesh);
-    // (1e-7 of the mesh's size: far above what 17-digit coordinates round to.)
-    if (normal != std::array<double, 3>{0.0, 0.0, 0.0})
-      mesh.planeNormal =
-          nodesInPlane(mesh, normal, 1e-7) ? normal : std::array<double, 3>{0.0, 0.0, 0.0};
+    // (1e-5 of the mesh's size, as for FreeCAD's files: other tools write 7 digits, and a shell
+    // flatter than that is measured along its plane as well as along its cells' own normals.)
+    if (const auto normal = planeOfCells(mesh, 1e-5)) mesh.planeNormal = *normal;
   }
   mesh.checkConsistency();
   return mesh;

@@ -873,13 +873,12 @@ Mesh Reader::read() {
     if (b->count() > 0) mesh_.blocks.push_back(std::move(*b));
   for (const bool k : known_)
     if (!k) fail("some nodes could not be placed");
-  // A 2D mesh off one plane (a manifold in SPACE 3) is a surface mesh; a planar one keeps the
+  // A 2D mesh off one plane (a manifold in SPACE 3) is a surface mesh; one in a plane other than
+  // z = const is measured along that plane's normal; one in such a plane keeps the
   // counter-clockwise convention around +z that Nektar++'s 2D elements follow.
-  if (dim_ == 2) {
-    const std::array<double, 3> normal = votedPlaneNormal(mesh_);
-    if (normal != std::array<double, 3>{0.0, 0.0, 0.0} && !nodesInPlane(mesh_, normal, 1e-7))
-      mesh_.planeNormal = {0.0, 0.0, 0.0};
-  }
+  if (dim_ == 2)
+    if (const auto normal = planeOfCells(mesh_, 1e-5))  // (as for MSH files)
+      if (std::abs((*normal)[2]) < 1.0 - 1e-12) mesh_.planeNormal = *normal;
   mesh_.checkConsistency();
   return std::move(mesh_);
 }

@@ -103,11 +103,14 @@ class Matcher {
         if (cad_.isDegenerated(c)) {
           // Gmsh evaluates the face along the edge's curve on it, which may miss the vertex by
           // up to the tolerance the CAD gives the vertex (OpenCASCADE's shell1.brep: 7e-6 on
-          // a model 83 across, where tol_ is 8.3e-6 and the vertex's tolerance 3.2e-5).
+          // a model 83 across, where tol_ is 8.3e-6 and the vertex's tolerance 3.2e-5). Only
+          // for a Gmsh curve that is itself closed on one point, so that a short edge between
+          // two vertices there never takes the degenerated one's place.
           const std::vector<int> v = cad_.subShapeIndices(1, c, 0);
-          if (v.empty() || (cad_.vertexPoint(v[0]) - g.probe).norm() >
-                               std::max(tol_, 2.0 * cad_.tolerance(0, v[0])))
-            return std::nullopt;
+          const double within = g.boundary.size() <= 1 && !v.empty()
+                                    ? std::max(tol_, 2.0 * cad_.tolerance(0, v[0]))
+                                    : tol_;
+          if (v.empty() || (cad_.vertexPoint(v[0]) - g.probe).norm() > within) return std::nullopt;
           return 0.0;
         }
         const double tm = 0.5 * (g.lo.at(0) + g.hi.at(0));

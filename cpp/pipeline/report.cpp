@@ -256,7 +256,7 @@ std::string predictReportJson(const SizingResult& sizing, const std::string& inp
   JsonWriter json;
   json.beginObject();
   json.value("input", input);
-  json.value("dimension", sizing.octree->dim());
+  json.value("dimension", sizing.prediction.dim);  // of the mesh: 2 for a surface mesh
   json.value("predicted_elements",
              static_cast<std::size_t>(std::llround(sizing.prediction.elements)));
   appendSizing(json, sizing);

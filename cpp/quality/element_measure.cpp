@@ -70,8 +70,10 @@ std::vector<double> elementMeasures(const Mesh& mesh) {
     for (std::size_t e = 0; e < b.count(); ++e) {
       for (int i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c) x(i, c) = mesh.xyz[3 * b.element(e)[i] + c];
+      // A surface mesh's cells: their curved area (|x_xi1 x x_xi2|), not its projection.
       const Eigen::Vector3d normal = cellNormal(mesh, b.element(e));
-      out.push_back(elementMeasure(b.type, b.order, x, mesh.dim == 2 ? &normal : nullptr));
+      out.push_back(elementMeasure(b.type, b.order, x,
+                                   mesh.dim == 2 && !mesh.isSurface() ? &normal : nullptr));
     }
   }
   return out;

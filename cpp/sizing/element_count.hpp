@@ -30,6 +30,8 @@ struct ElementCountPrediction {
   double gradientIntegral = 0.0;  // integral of |grad delta| delta^-d over the domain
   double domainMeasure = 0.0;     // volume (area) the octree classified inside
   double elements = 0.0;          // the predicted number of tetrahedra (triangles in 2D)
+  // A surface mesh's (SizingOctree::surface): dim 2, elements its triangles, domainMeasure the
+  // faces' area and volumeIntegral the integral of delta^-2 over them.
 };
 
 // Uses up to `threads` threads.

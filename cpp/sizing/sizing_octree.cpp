@@ -358,6 +358,22 @@ class OctreeBuilder {
 
   void classify() {
     const std::size_t nLeaves = t_.leaves_.size();
+    if (t_.surface_) {
+      // A surface mesh has no inside: the leaves its faces pass through are its domain (the
+      // ones drawn and written), whole, and the rest is outside.
+      const int s = t_.subdivisions();
+      for (SizingOctree::LeafData& leaf : t_.leaves_) {
+        const Content& c = content_[leaf.node];
+        const bool onFaces = std::any_of(c.samples.begin(), c.samples.end(), [&](std::int32_t k) {
+          return samples_[k].weight > 0.0 && !samples_[k].outward.isZero();
+        });
+        leaf.location =
+            onFaces ? SizingOctree::Location::Boundary : SizingOctree::Location::Outside;
+        leaf.insideFraction = onFaces ? 1.0f : 0.0f;
+        if (onFaces) leaf.insideMask.assign(static_cast<std::size_t>(s) * s * s, 1);
+      }
+      return;
+    }
     std::vector<bool> boundary(nLeaves, false);
     for (std::size_t i = 0; i < nLeaves; ++i)
       boundary[i] = onDomainBoundary(content_[t_.leaves_[i].node]);

@@ -458,6 +458,13 @@ def is_sizing(obj):
     return getattr(getattr(obj, "Proxy", None), "Type", None) == TYPE_SIZING
 
 
+def cad_modes(shape):
+    """How a Sizing object sizes `shape`: its solids (faces in no solid left out), or, for a
+    shape without solids, its faces as a surface mesh."""
+    surface = len(shape.Solids) == 0
+    return {"solids_only": not surface, "surface": surface}
+
+
 def sizing_arguments(obj):
     """The keyword arguments of :func:`homesh.predict` / :func:`homesh.mesh` that a Sizing
     object stands for: min_delta, max_delta (None when automatic), eps and sources.
@@ -559,8 +566,9 @@ class SizingProxy(_Proxy, ParameterGuard):
             if shape is None or shape.isNull():
                 raise ValueError("%s: %s has no shape" % (obj.Label, obj.Part.Label))
             # Sizes of the solids (faces in no solid left out): a mesh object without
-            # SolidsOnly refuses such a shape and says why; the sizing stays drawable.
-            report = homesh.predict(shape, name=obj.Part.Label, solids_only=True,
+            # SolidsOnly refuses such a shape and says why; the sizing stays drawable. A shape
+            # without solids is sized as a surface mesh of its faces (the mesh object's Surface).
+            report = homesh.predict(shape, name=obj.Part.Label, **cad_modes(shape),
                                     **sizing_arguments(obj))
         except (ValueError, homesh.HOMeshError) as e:
             obj.PredictedElements = 0

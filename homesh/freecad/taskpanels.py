@@ -427,8 +427,9 @@ class TaskPanelSizing:
         sizing = {"min_delta": values["MinDelta"] or None,
                   "max_delta": values["MaxDelta"] or None, "eps": values["Eps"]}
         try:
-            report = homesh.predict(self.obj.Part.Shape, name=self.obj.Part.Label,
-                                    solids_only=True,  # as the Sizing object's recompute
+            shape = self.obj.Part.Shape
+            report = homesh.predict(shape, name=self.obj.Part.Label,
+                                    **objects.cad_modes(shape),  # as the Sizing object's recompute
                                     **dict(objects.sizing_arguments(self.obj), **sizing))
         except (ValueError, homesh.HOMeshError) as e:
             self.result.setText("Cannot predict: %s" % e)

@@ -324,9 +324,10 @@ class ViewProviderSizing(_Stateless, _EditsWithTaskPanel):
         if vobj is None or not vobj.ShowSizeField or obj.PredictedElements <= 0:
             return
         import homesh
-        from .objects import sizing_arguments
+        from .objects import cad_modes, sizing_arguments
         try:
-            field = homesh.size_field(obj.Part.Shape, name=obj.Part.Label, solids_only=True,
+            shape = obj.Part.Shape
+            field = homesh.size_field(shape, name=obj.Part.Label, **cad_modes(shape),
                                       **sizing_arguments(obj))
         except (ValueError, homesh.HOMeshError):
             return  # the object's recompute reports it

@@ -183,6 +183,14 @@ class HighOrderMeshObject(unittest.TestCase):
         self.assertIn("a surface mesh of its 1 face", mesh.report()["healing"]["surface"])
         radial = (mesh.nodes[:, 0] ** 2 + mesh.nodes[:, 1] ** 2) ** 0.5
         self.assertLess(float(abs(radial - 1.0).max()), 1e-9)
+        # A Sizing object sizes the shell as a surface mesh: its triangles, from the tube's area
+        # 4 pi over triangles of side 0.5 (about 116), and leaves on the tube to draw.
+        sizing = homesh.freecad.make_sizing(self.doc, part, max_delta=0.5)
+        self.doc.recompute()
+        self.assertTrue(sizing.isValid(), sizing.Status)
+        self.assertGreater(sizing.PredictedElements, 60)
+        self.assertLess(sizing.PredictedElements, 240)
+        self.assertGreater(sizing.OctreeLeaves, 0)
 
     def test_recompute_leaves_no_temporary_folders(self):
         before = set(os.listdir(tempfile.gettempdir()))

@@ -5,6 +5,7 @@ judged as a surface; what a surface mesh cannot be is refused by name."""
 
 import json
 import math
+import re
 import subprocess
 
 import meshio
@@ -22,17 +23,27 @@ import FreeCAD, Part
 tube = [f for f in Part.makeCylinder(1, 2).Faces if f.Surface.TypeId == 'Part::GeomCylinder'][0]
 cap = [f for f in Part.makeSphere(1, FreeCAD.Vector(0, 0, 2), FreeCAD.Vector(0, 0, 1), 0, 90).Faces
        if f.Surface.TypeId == 'Part::GeomSphere'][0]
-Part.makeCompound([tube, cap]).exportStep(%r)
+both = Part.makeCompound([tube, cap])
+both.exportStep(%r)
+both.exportBrep(%r)
+# The six faces of a unit box made one shell: closed, consistently oriented, no solid.
+Part.Shell(Part.makeBox(1, 1, 1).Faces).exportBrep(%r)
 """
 
 
 @pytest.fixture(scope="module")
-def shell(tmp_path_factory):
-    path = tmp_path_factory.mktemp("shell") / "tube_and_cap.step"
-    subprocess.run(["freecadcmd", "-c", MAKE_SHELL % str(path)], check=True,
+def shapes(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("shell")
+    paths = [folder / "tube_and_cap.step", folder / "tube_and_cap.brep", folder / "box_shell.brep"]
+    subprocess.run(["freecadcmd", "-c", MAKE_SHELL % tuple(str(p) for p in paths)], check=True,
                    capture_output=True, timeout=120)
-    assert path.exists()
-    return path
+    assert all(p.exists() for p in paths)
+    return paths
+
+
+@pytest.fixture(scope="module")
+def shell(shapes):
+    return shapes[0]
 
 
 def on_shell(points):
@@ -120,6 +131,7 @@ def test_predict_counts_the_surface_triangles(shell):
     p = homesh.predict(str(shell), min_delta=0.2, max_delta=0.2, eps=0.1, surface=True)
     # Tube 4 pi and cap 2 pi: 6 pi of area over triangles of side 0.2 (sqrt(3)/4 0.04 each).
     expected = 6.0 * math.pi / (math.sqrt(3.0) / 4.0 * 0.04)
+    assert p["dimension"] == 2
     assert p["predicted_elements"] == pytest.approx(expected, rel=0.1)
     m = homesh.mesh(str(shell), order=1, min_delta=0.2, max_delta=0.2, eps=0.1, surface=True)
     assert m.num_elements == pytest.approx(p["predicted_elements"], rel=0.2)
@@ -137,6 +149,37 @@ def test_a_shell_with_degenerated_edges_off_their_vertex(homesh_bin, tmp_path):
     r = run([homesh_bin, "mesh", SHELL1, "--surface", "--order", "3", "--size", "4", "-o", out],
             timeout=300)
     assert r.returncode == 0, r.stderr
-    assert "0 invalid" in r.stderr, r.stderr
+    assert re.search(r"; 0 invalid$", r.stderr, re.M), r.stderr
     if GMSH_VERDICT.exists():
         assert gmsh_worst(out, 2) > 0.0
+
+
+@pytest.mark.parametrize("suffix", [".msh", ".vtu", ".xml"])
+def test_a_closed_box_shell_reads_back_as_a_surface(homesh_bin, shapes, tmp_path, suffix):
+    """A closed shell's triangles face every way, their normals summing to zero: read back, it
+    is still a surface mesh (not a plane at z = const, nor degenerate)."""
+    out = tmp_path / ("box" + suffix)
+    r = run([homesh_bin, "mesh", shapes[2], "--surface", "--order", "2", "--size", "0.5", "-o",
+             out], timeout=300)
+    assert r.returncode == 0, r.stderr
+    m = homesh.read(str(out))
+    assert m.dim == 2 and tuple(m.plane_normal) == (0.0, 0.0, 0.0)
+    assert m.quality()["invalid_elements"] == 0
+    q = run([homesh_bin, "quality", out])
+    assert q.returncode == 0 and "invalid elements 0, undecided 0" in q.stdout, q.stdout + q.stderr
+
+
+def test_the_size_field_of_a_surface_lies_on_its_faces(shapes):
+    text = shapes[1].read_text()
+    field = homesh.size_field(text, name="tube and cap", min_delta=0.05, max_delta=0.4,
+                              eps=0.01, surface=True)
+    centres = field["centre"]
+    assert len(centres) > 50
+    assert (field["boundary"] == 1).all()
+    # Every leaf drawn holds a sample of the faces, taken within its box widened by half the
+    # samples' spacing (at most MaxDelta / 2): its centre is within its half-diagonal and
+    # MaxDelta / 4 of the tube or cap.
+    assert (on_shell(centres) <= np.sqrt(3.0) * field["half_width"] + 0.1 + 1e-12).all()
+    # The curvature sizes reach the leaves: the cap (radius 1, sagitta 0.01) asks for less than
+    # MaxDelta.
+    assert field["delta"].min() < 0.4

@@ -168,6 +168,15 @@ TEST(CadHealing, ASurfaceMeshKeepsTheFacesSewnWhereTheyMeet) {
       healModel(cadModelFromShape(looseFaces(true), "six faces"), surface, record);
   EXPECT_EQ(closed.numSolids(), 0);
   EXPECT_NE(record.surface.find("the faces close"), std::string::npos) << record.surface;
+  // A solid without a face beside them is removed by healing, not counted as a solid.
+  TopoDS_Solid empty;
+  builder.MakeSolid(empty);
+  builder.Add(apart, empty);
+  const CadModel withEmpty = healModel(cadModelFromShape(apart, "five faces"), surface, record);
+  EXPECT_EQ(withEmpty.numSolids(), 0);
+  EXPECT_EQ(withEmpty.numFaces(), 5);
+  EXPECT_NE(record.actions.front().find("removed 1 empty solid"), std::string::npos)
+      << record.actions.front();
   try {
     healModel(cadModelFromShape(box(), "a box"), surface, record);
     FAIL() << "a surface mesh of a solid was accepted";

@@ -492,5 +492,55 @@ TEST(PeerMeshes, WorstScaledJacobianAgreesWithGmsh) {
   }
 }
 
+// The plane a 2D mesh read from a file is measured in: the cells' summed normal where they
+// agree, a cell's own where they cancel; none (a surface mesh) where the nodes leave it.
+TEST(PlaneOfCells, PlanesShellsAndDegenerateCells) {
+  // The 12 triangles of the unit cube's surface, all facing out: their normals sum to zero.
+  Mesh cube;
+  cube.dim = 2;
+  for (int i = 0; i < 8; ++i) {
+    const double p[3] = {double(i & 1), double((i >> 1) & 1), double((i >> 2) & 1)};
+    cube.addNode(p, 2, 0, 0.0, 0.0);
+  }
+  ElementBlock tris;
+  tris.type = CellType::Triangle;
+  for (const std::array<std::int64_t, 3> t : std::vector<std::array<std::int64_t, 3>>{{0, 2, 1},
+                                                                                      {1, 2, 3},
+                                                                                      {4, 5, 6},
+                                                                                      {5, 7, 6},
+                                                                                      {0, 1, 4},
+                                                                                      {1, 5, 4},
+                                                                                      {2, 6, 3},
+                                                                                      {3, 6, 7},
+                                                                                      {0, 4, 2},
+                                                                                      {2, 4, 6},
+                                                                                      {1, 3, 5},
+                                                                                      {3, 7, 5}}) {
+    tris.nodes.insert(tris.nodes.end(), t.begin(), t.end());
+    tris.entity.push_back(1);
+  }
+  cube.blocks = {tris};
+  const auto shell = planeOfCells(cube, 1e-7);
+  ASSERT_TRUE(shell.has_value());
+  EXPECT_EQ(*shell, (std::array<double, 3>{0.0, 0.0, 0.0}));
+  // Its bottom face alone (z = 0, both triangles facing -z) lies in a plane.
+  Mesh bottom = cube;
+  bottom.blocks[0].nodes.resize(6);
+  bottom.blocks[0].entity.resize(2);
+  const auto plane = planeOfCells(bottom, 1e-7);
+  ASSERT_TRUE(plane.has_value());
+  EXPECT_EQ(*plane, (std::array<double, 3>{0.0, 0.0, -1.0}));
+  // The same two triangles facing opposite ways cancel: the first one's normal is the plane's.
+  std::swap(bottom.blocks[0].nodes[4], bottom.blocks[0].nodes[5]);
+  const auto cancelled = planeOfCells(bottom, 1e-7);
+  ASSERT_TRUE(cancelled.has_value());
+  EXPECT_EQ(*cancelled, (std::array<double, 3>{0.0, 0.0, -1.0}));
+  // Collinear cells span no plane.
+  Mesh line = bottom;
+  line.blocks[0].nodes = {0, 1, 1};
+  line.blocks[0].entity = {1};
+  EXPECT_FALSE(planeOfCells(line, 1e-7).has_value());
+}
+
 }  // namespace
 }  // namespace homesh
