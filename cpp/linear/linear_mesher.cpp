@@ -2,6 +2,9 @@
 
 #include <gmsh.h>
 
+#include <BRepGProp.hxx>
+#include <GProp_GProps.hxx>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
@@ -32,11 +35,20 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kGmshLine = 1, kGmshTriangle = 2, kGmshTetrahedron = 4, kGmshPoint = 15;
 
 // An upper estimate of the elements a uniform `size` makes in the model's bounding box (a
-// cube's worth of regular tetrahedra, or a square's of triangles for dim 2).
+// cube's worth of regular tetrahedra, or a square's of triangles for dim 2); for a surface
+// mesh, whose faces can hold far more than a square of the box (a box's shell: 4x), the
+// triangles of its faces' area.
 double estimatedElementCount(const CadModel& cad, double size, int dim) {
   const double d = cad.boundingDiagonal();
-  return dim == 3 ? 8.5 * std::pow(d / std::sqrt(3.0) / size, 3)
-                  : 2.3 * std::pow(d / std::sqrt(2.0) / size, 2);
+  if (dim == 3) return 8.5 * std::pow(d / std::sqrt(3.0) / size, 3);
+  double area = 0.5 * d * d;
+  if (isSurfaceModel(cad))
+    area = withOcctErrors("measuring the faces of " + cad.sourceName(), [&] {
+      GProp_GProps props;
+      BRepGProp::SurfaceProperties(occtShape(cad), props);
+      return std::abs(props.Mass());
+    });
+  return 2.3 * area / (size * size);
 }
 
 void checkUniformSize(const CadModel& cad, double size, int dim) {

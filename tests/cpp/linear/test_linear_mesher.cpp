@@ -197,6 +197,10 @@ TEST(LinearMesher, ALoneCurvedFaceGetsASurfaceMesh) {
   for (std::size_t i = 0; i < mesh.numNodes(); ++i)  // |(x, y)| = 1 to OCCT's rounding
     ASSERT_NEAR(std::hypot(mesh.xyz[3 * i], mesh.xyz[3 * i + 1]), 1.0, 1e-12) << i;
   expectParametersReproduceNodes(mesh, curved, 1e-9);
+  // A uniform size is checked against the faces' area (4 pi), twice the square of half the
+  // box's diagonal (sqrt(12)) that bounds a planar model: at 6.5e-4, 2.3 x 4 pi / 6.5e-4^2 =
+  // 6.8e7 triangles exceed the 5e7 allowed, where the planar bound would give 3.3e7.
+  EXPECT_THROW(generateLinearMesh(curved, LinearMeshOptions::uniform(6.5e-4)), ParameterError);
 }
 
 TEST(LinearMesher, RejectsWhatItCannotMesh) {
