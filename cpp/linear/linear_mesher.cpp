@@ -63,9 +63,13 @@ void checkUniformSize(const CadModel& cad, double size, int dim) {
   const double estimate = estimatedElementCount(cad, size, dim);
   if (estimate > kMaxEstimatedElements) {
     std::ostringstream msg;
-    msg << "mesh size " << size << " is too small for " << cad.sourceName()
-        << " (bounding-box diagonal " << d << "): it could make about " << std::scientific
-        << std::setprecision(1) << estimate << " elements";
+    msg << "mesh size " << size << " is too small for " << cad.sourceName() << " (";
+    if (dim == 2 && isSurfaceModel(cad))  // (the estimate's own measure: the faces' area)
+      msg << "faces' area " << estimate * size * size / 2.3;
+    else
+      msg << "bounding-box diagonal " << d;
+    msg << "): it could make about " << std::scientific << std::setprecision(1) << estimate
+        << " elements";
     throw ParameterError(msg.str());
   }
 }
