@@ -9,6 +9,33 @@
 
 namespace homesh {
 
+namespace {
+
+// The unit normal of the straight triangle through the cell's first three nodes, zero when they
+// are collinear. The edges are scaled to unit size first: coordinates near the largest double
+// would overflow the cross product.
+std::array<double, 3> unitNormal(const Mesh& mesh, const std::int64_t* v) {
+  double a[3], c[3], scale = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    a[k] = mesh.xyz[3 * v[1] + k] - mesh.xyz[3 * v[0] + k];
+    c[k] = mesh.xyz[3 * v[2] + k] - mesh.xyz[3 * v[0] + k];
+    scale = std::max({scale, std::abs(a[k]), std::abs(c[k])});
+  }
+  if (!(scale > 0.0) || !std::isfinite(scale)) return {0.0, 0.0, 0.0};
+  for (int k = 0; k < 3; ++k) {
+    a[k] /= scale;
+    c[k] /= scale;
+  }
+  std::array<double, 3> n{a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2],
+                          a[0] * c[1] - a[1] * c[0]};
+  const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (!(length > 0.0)) return {0.0, 0.0, 0.0};
+  for (double& x : n) x /= length;
+  return n;
+}
+
+}  // namespace
+
 std::int64_t Mesh::addNode(const double p[3], int cadDim, int cadIndex, double param0,
                            double param1) {
   const auto id = static_cast<std::int64_t>(numNodes());
@@ -29,34 +56,10 @@ std::size_t Mesh::numElements() const {
 
 std::array<double, 3> Mesh::cellNormal(const std::int64_t* cell) const {
   if (!isSurface()) return planeNormal;
-  double a[3], b[3];
-  for (int c = 0; c < 3; ++c) {
-    a[c] = xyz[3 * cell[1] + c] - xyz[3 * cell[0] + c];
-    b[c] = xyz[3 * cell[2] + c] - xyz[3 * cell[0] + c];
-  }
-  std::array<double, 3> n{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
-                          a[0] * b[1] - a[1] * b[0]};
-  const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-  if (!(length > 0.0)) return {0.0, 0.0, 0.0};
-  for (double& v : n) v /= length;
-  return n;
+  return unitNormal(*this, cell);
 }
 
 namespace {
-
-std::array<double, 3> unitNormal(const Mesh& mesh, const std::int64_t* v) {
-  double a[3], c[3];
-  for (int k = 0; k < 3; ++k) {
-    a[k] = mesh.xyz[3 * v[1] + k] - mesh.xyz[3 * v[0] + k];
-    c[k] = mesh.xyz[3 * v[2] + k] - mesh.xyz[3 * v[0] + k];
-  }
-  std::array<double, 3> n{a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2],
-                          a[0] * c[1] - a[1] * c[0]};
-  const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-  if (!(length > 0.0)) return {0.0, 0.0, 0.0};
-  for (double& x : n) x /= length;
-  return n;
-}
 
 bool isZero(const std::array<double, 3>& n) {
   return n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0;
