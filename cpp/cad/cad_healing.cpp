@@ -31,6 +31,7 @@
 #include <cmath>
 #include <optional>
 #include <set>
+#include <vector>
 
 #include "cad/model_dimension.hpp"
 #include "cad/occt_access.hpp"
@@ -73,22 +74,26 @@ TopTools_IndexedDataMapOfShapeListOfShape edgeUses(const TopoDS_Shape& shape) {
 // The first free edge of `solid` (an edge used once by its bounding faces: not a seam, which a
 // face uses twice, not degenerated, and not an internal or external edge imprinted on a face),
 // as its index in `edges`; 0 when its boundary is closed.
-int firstFreeEdge(const TopoDS_Shape& solid, const TopTools_IndexedMapOfShape& edges) {
-  const TopTools_IndexedDataMapOfShapeListOfShape uses = edgeUses(solid);
+// The free edges of `shape` (used once by its bounding faces: not a seam, which a face uses
+// twice, not degenerated, and not an internal or external edge imprinted on a face).
+std::vector<TopoDS_Edge> freeEdges(const TopoDS_Shape& shape) {
+  const TopTools_IndexedDataMapOfShapeListOfShape uses = edgeUses(shape);
+  std::vector<TopoDS_Edge> free;
   for (int i = 1; i <= uses.Extent(); ++i) {
     const TopoDS_Edge& edge = TopoDS::Edge(uses.FindKey(i));
-    if (uses(i).Extent() == 1 && !BRep_Tool::Degenerated(edge)) return edges.FindIndex(edge);
+    if (uses(i).Extent() == 1 && !BRep_Tool::Degenerated(edge)) free.push_back(edge);
   }
-  return 0;
+  return free;
 }
 
-// How many edges of `shape` are free, as firstFreeEdge judges them.
+// The first free edge of `solid` as its index in `edges`; 0 when its boundary is closed.
+int firstFreeEdge(const TopoDS_Shape& solid, const TopTools_IndexedMapOfShape& edges) {
+  const std::vector<TopoDS_Edge> free = freeEdges(solid);
+  return free.empty() ? 0 : edges.FindIndex(free.front());
+}
+
 int freeEdgeCount(const TopoDS_Shape& shape) {
-  const TopTools_IndexedDataMapOfShapeListOfShape uses = edgeUses(shape);
-  int free = 0;
-  for (int i = 1; i <= uses.Extent(); ++i)
-    if (uses(i).Extent() == 1 && !BRep_Tool::Degenerated(TopoDS::Edge(uses.FindKey(i)))) ++free;
-  return free;
+  return static_cast<int>(freeEdges(shape).size());
 }
 
 // The faces of a model kept for a surface mesh, sewn into shells where sewing joins faces that

@@ -1,6 +1,5 @@
 #include "io/msh_reader.hpp"
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <cerrno>
 #include <cmath>

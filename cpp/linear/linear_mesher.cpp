@@ -34,21 +34,16 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Gmsh element type codes of the linear cells we request.
 constexpr int kGmshLine = 1, kGmshTriangle = 2, kGmshTetrahedron = 4, kGmshPoint = 15;
 
-// An upper estimate of the elements a uniform `size` makes in the model's bounding box (a
-// cube's worth of regular tetrahedra, or a square's of triangles for dim 2); for a surface
-// mesh, whose faces can hold far more than a square of the box (a box's shell: 4x), the
-// triangles of its faces' area.
-double estimatedElementCount(const CadModel& cad, double size, int dim) {
-  const double d = cad.boundingDiagonal();
-  if (dim == 3) return 8.5 * std::pow(d / std::sqrt(3.0) / size, 3);
-  double area = 0.5 * d * d;
-  if (isSurfaceModel(cad))
-    area = withOcctErrors("measuring the faces of " + cad.sourceName(), [&] {
-      GProp_GProps props;
-      BRepGProp::SurfaceProperties(occtShape(cad), props);
-      return std::abs(props.Mass());
-    });
-  return 2.3 * area / (size * size);
+// The area a uniform size's triangles cover, for an upper estimate of their count: a square of
+// the bounding box's half diagonal for a planar model; the faces' area for a surface mesh,
+// whose faces can hold far more (a box's shell: 4x).
+double triangleArea(const CadModel& cad) {
+  if (!isSurfaceModel(cad)) return 0.5 * std::pow(cad.boundingDiagonal(), 2);
+  return withOcctErrors("measuring the faces of " + cad.sourceName(), [&] {
+    GProp_GProps props;
+    BRepGProp::SurfaceProperties(occtShape(cad), props);
+    return std::abs(props.Mass());
+  });
 }
 
 void checkUniformSize(const CadModel& cad, double size, int dim) {
@@ -60,12 +55,15 @@ void checkUniformSize(const CadModel& cad, double size, int dim) {
     throw ParameterError("mesh size " + formatNumber(size) + " is not smaller than " +
                          cad.sourceName() + " itself (bounding-box diagonal " + formatNumber(d) +
                          ")");
-  const double estimate = estimatedElementCount(cad, size, dim);
+  // A cube's worth of regular tetrahedra, or the area's worth of regular triangles.
+  const double area = dim == 2 ? triangleArea(cad) : 0.0;
+  const double estimate =
+      dim == 3 ? 8.5 * std::pow(d / std::sqrt(3.0) / size, 3) : 2.3 * area / (size * size);
   if (estimate > kMaxEstimatedElements) {
     std::ostringstream msg;
     msg << "mesh size " << size << " is too small for " << cad.sourceName() << " (";
-    if (dim == 2 && isSurfaceModel(cad))  // (the estimate's own measure: the faces' area)
-      msg << "faces' area " << estimate * size * size / 2.3;
+    if (dim == 2 && isSurfaceModel(cad))  // (the estimate's own measure)
+      msg << "faces' area " << area;
     else
       msg << "bounding-box diagonal " << d;
     msg << "): it could make about " << std::scientific << std::setprecision(1) << estimate

@@ -1463,8 +1463,7 @@ double nodalScaledJacobian(const Mesh& mesh, int threads) {
         for (int i = 0; i < n; ++i)
           for (int c = 0; c < 3; ++c) x(i, c) = mesh.xyz[3 * v[i] + c];
         Eigen::VectorXd j;
-        const std::array<double, 3> n3 = mesh.cellNormal(v);
-        const Eigen::Vector3d normal(n3[0], n3[1], n3[2]);
+        const Eigen::Vector3d normal = cellNormal(mesh, v);
         sampler.jacobians(x, mesh.dim == 2 ? &normal : nullptr, j);
         const double hi = j.maxCoeff();
         blockWorst = std::min(blockWorst, hi > 0.0 ? j.minCoeff() / hi : -1.0);
