@@ -132,7 +132,13 @@ def test_predict_counts_the_surface_triangles(shell):
     # Tube 4 pi and cap 2 pi: 6 pi of area over triangles of side 0.2 (sqrt(3)/4 0.04 each).
     expected = 6.0 * math.pi / (math.sqrt(3.0) / 4.0 * 0.04)
     assert p["dimension"] == 2
-    assert p["predicted_elements"] == pytest.approx(expected, rel=0.1)
+    # The size is 0.2 everywhere, so the prediction is the faces' area as its samples integrate
+    # it (a grid of at least 40 per direction: error O(spacing^2), measured 2e-5) times the
+    # regular triangle's density: 1 % is room for that.
+    assert p["predicted_elements"] == pytest.approx(expected, rel=0.01)
+    # Gmsh's count scatters about the fitted density by a few per cent (element_count.cpp: 0.98 to
+    # 1.02 on planar cases), and the surface prediction leaves out the boundary term (the free
+    # circle at the tube's foot: about 15 triangles here); measured 1 138 against 1 088 (+4.6 %).
     m = homesh.mesh(str(shell), order=1, min_delta=0.2, max_delta=0.2, eps=0.1, surface=True)
     assert m.num_elements == pytest.approx(p["predicted_elements"], rel=0.2)
 
