@@ -159,11 +159,12 @@ class Optimiser {
   using Vec = Eigen::Matrix<double, D, 1>;
 
   Optimiser(Mesh& mesh, const OptimiserOptions& options, OptimiserObserver* observer,
-            const CadModel* cad)
+            const CadModel* cad, const QualitySummary* startQuality = nullptr)
       : mesh_(mesh),
         options_(options),
         observer_(observer),
         cad_(cad),
+        startQuality_(startQuality),
         converting_(cad == nullptr && !options.regionThreshold && options.regionSeed.empty()) {}
 
   OptimiserResult run() {
@@ -184,7 +185,7 @@ class Optimiser {
     for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
     // Build the shared Bezier tables once before the threads need them.
     for (const Block<D>& b : blocks_) elementJacobianBounds(mesh_, *b.cells, 0);
-    evaluate(all);
+    if (!takeStartQuality()) evaluate(all);
     const IterationRecord before = summarise(0, 0.0, t0);
     result_.worstBefore = before.worst;
     result_.invalidBefore = before.invalid;
@@ -350,7 +351,8 @@ class Optimiser {
     if (options_.timeLimit > 0.0 && since(runStart_) >= options_.timeLimit) budgetSpent_ = true;
     return budgetSpent_;
   }
-  const CadModel* cad_;  // null: boundary nodes stay fixed
+  const CadModel* cad_;                 // null: boundary nodes stay fixed
+  const QualitySummary* startQuality_;  // the input's quality, from the caller (may be null)
   // Without CAD the optimiser moves the nodes of the well-conditioned set (kWorkingSet). With
   // CAD it moves the mesh's own (equispaced) nodes, the ones that lie on the CAD, and so it does
   // with a region, where a fixed node of an element at the region's edge would otherwise change
@@ -1239,6 +1241,21 @@ class Optimiser {
     }
   }
 
+  // The caller's quality of the input (evaluateQuality's, bounded to kJacobianBoundTolerance:
+  // every element as tight as evaluate() makes the ones it refines), when it fits; false to
+  // measure it here. (In the working set's coordinates the input is another mesh.)
+  bool takeStartQuality() {
+    const QualitySummary* q = startQuality_;
+    if (q == nullptr || converting_ || q->scaledJacobian.size() != totalElements_ ||
+        q->scaledJacobianUpper.size() != totalElements_ || q->validity.size() != totalElements_)
+      return false;
+    scaled_ = q->scaledJacobian;
+    estimate_ = q->scaledJacobianUpper;
+    validity_ = q->validity;
+    tight_.assign(totalElements_, 1);
+    return true;
+  }
+
   // Certified quality of the given elements (global indices) into scaled_ and validity_.
   //
   // Bounds to kJacobianBoundTolerance cost subdivisions that only the elements near the worst
@@ -1348,15 +1365,16 @@ class Optimiser {
 }  // namespace
 
 OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
-                             OptimiserObserver* observer, const CadModel* cad) {
+                             OptimiserObserver* observer, const CadModel* cad,
+                             const QualitySummary* startQuality) {
   options.validate();
   mesh.checkConsistency();
   if (mesh.isSurface())
     throw ParameterError(
         "the optimiser handles volume meshes and planar 2D meshes, not a surface mesh "
         "(triangles on curved faces in 3D)");
-  if (mesh.dim == 3) return Optimiser<3>(mesh, options, observer, cad).run();
-  if (mesh.dim == 2) return Optimiser<2>(mesh, options, observer, cad).run();
+  if (mesh.dim == 3) return Optimiser<3>(mesh, options, observer, cad, startQuality).run();
+  if (mesh.dim == 2) return Optimiser<2>(mesh, options, observer, cad, startQuality).run();
   throw ParameterError("the optimiser needs a 2D or 3D mesh, got dimension " +
                        std::to_string(mesh.dim));
 }

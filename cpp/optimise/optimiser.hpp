@@ -37,6 +37,7 @@
 
 #include "core/mesh.hpp"
 #include "optimise/functional.hpp"
+#include "quality/mesh_quality.hpp"
 
 namespace homesh {
 
@@ -166,9 +167,13 @@ class OptimiserObserver {
 // prisms and hexahedra (dim 3) of orders 1..10. With `cad` (the model the mesh's node records
 // refer to), nodes on a CAD curve slide along it in t and, in 3D, nodes on a CAD face slide on
 // it in (u, v), staying exactly on the CAD (their parameters are updated); CAD vertices stay.
+// `startQuality`, when the caller has it: evaluateQuality of `mesh` as given (a repair round
+// has it for all but its new elements); the set-up then takes the elements' certified quality
+// from it instead of measuring the whole mesh. Ignored where its size does not match.
 // Throws ParameterError for bad options or unsupported cells.
 OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
-                             OptimiserObserver* observer = nullptr, const CadModel* cad = nullptr);
+                             OptimiserObserver* observer = nullptr, const CadModel* cad = nullptr,
+                             const QualitySummary* startQuality = nullptr);
 
 // The optimiser's energy around one node as a function of that node's own coordinates, for the
 // derivative tests: the same setup, patch assembly, regularisation and chain rule through the

@@ -60,6 +60,7 @@ CurvedReuse reuseCurvedNodes(const Mesh& oldLinear, const Mesh& oldCurved, const
 
   CurvedReuse result;
   result.fresh.assign(newCells.size(), 1);
+  result.source.assign(newCells.size(), -1);
   for (std::size_t i = 0; i < newCells.size(); ++i) {
     const auto found = where.find(cellKey(newLinear, *newCells[i].first, newCells[i].second));
     if (found == where.end()) continue;
@@ -80,6 +81,7 @@ CurvedReuse reuseCurvedNodes(const Mesh& oldLinear, const Mesh& oldCurved, const
         newCurved.nodeCadParam[2 * to[k] + c] = oldCurved.nodeCadParam[2 * from[k] + c];
     }
     result.fresh[i] = 0;
+    result.source[i] = static_cast<std::int64_t>(found->second);
     ++result.reused;
   }
   return result;

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "core/mesh.hpp"
@@ -18,7 +19,10 @@ namespace homesh {
 
 struct CurvedReuse {
   std::vector<char> fresh;  // per element of the new mesh (block order): 1 when its cell is new
-  std::size_t reused = 0;   // elements that took their old curved nodes
+  // Per element of the new mesh: the index (block order) of the old element whose nodes it
+  // took, -1 for a new cell (KnownQuality's source: its quality need not be measured again).
+  std::vector<std::int64_t> source;
+  std::size_t reused = 0;  // elements that took their old curved nodes
 };
 
 // `oldLinear` and `oldCurved` are a linear mesh and its elevation (elements in the same order,

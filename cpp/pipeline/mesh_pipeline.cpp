@@ -325,8 +325,17 @@ std::vector<Validity> repairTargets(const QualitySummary& quality, bool poor) {
   return flagged;
 }
 
-// Layers of neighbours around a repair round's new elements that the optimiser moves too.
-constexpr int kRepairRegionLayers = 4;
+// Layers of neighbours around a repair round's new elements that the optimiser moves too. One
+// layer (every element sharing a node) already frees the nodes around a new element. Four made
+// regions of 79,000 to 106,000 of Motor-c.brep's 200,000 order-4 elements around some 400
+// seeds, so that each round's optimiser ran into its 40 s limit after one or two sweeps and the
+// job's 360 s ended after 4 rounds with 39 invalid. With one layer the regions had 400 to 9,400
+// elements and took 8 to 60 sweeps; on the 23 corpus files that took over 60 s or were not
+// valid (bench/results/corpus.md, 2026-11-25 seventh session) every valid file stayed valid,
+// most 5 to 55 % faster, and those not valid kept fewer invalid elements (Motor-c 39 -> 1,
+// Bottom 27 -> 2, Top 27 -> 7, MODERN_Sink_1 111 -> 8), except I22_2_5_16 (1 -> 3, all at
+// cusps of the CAD).
+constexpr int kRepairRegionLayers = 1;
 // Poor elements below this certified scaled Jacobian join the region too.
 constexpr double kRepairRegionThreshold = 0.2;
 
@@ -440,12 +449,24 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
   // For `mesh`, just elevated to `order`: takes the curved nodes of unchanged cells from
   // `before` (previous's mesh of that order, if any) and optimises the whole mesh, or only
   // around what changed.
+  // At the final order in a repair round: the mesh's quality as the optimiser gets it (measured
+  // only on the new elements, the others' taken from `previous`) and its coordinates then, from
+  // which the closing check takes the elements the optimiser left alone.
+  std::optional<QualitySummary> startQuality;
+  std::vector<double> startXyz;
   const auto curveAt = [&](int order, Mesh& mesh, const Mesh* before, const char* stage) {
     std::vector<char> fresh;  // the optimiser's region seed: empty for the whole mesh
     if (before != nullptr) {
       CurvedReuse reuse = reuseCurvedNodes(previous->linear, *before, state.linear, mesh);
       if (order == options.order) state.reused = reuse.reused;
-      if (reuse.reused > 0) fresh = std::move(reuse.fresh);
+      if (reuse.reused > 0) {
+        fresh = std::move(reuse.fresh);
+        if (order == options.order) {
+          const KnownQuality known{before, nullptr, &previous->quality, std::move(reuse.source)};
+          startQuality = evaluateQuality(mesh, options.threads, &known);
+          startXyz = mesh.xyz;
+        }
+      }
     }
     if (options.optimiseIterations <= 0) return std::optional<OptimiserResult>();
     const std::string where = round.empty() ? std::string(stage) : round + " " + stage;
@@ -473,7 +494,8 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
     // released, around them, and its inner nodes blended again afterwards.
     if (layered) o.fixedNodes = layerNodes(mesh);
     OptimiserProgress cancel(observer, stage, o.maxIterations);
-    std::optional<OptimiserResult> r = optimiseMesh(mesh, o, &cancel, &cad);
+    std::optional<OptimiserResult> r = optimiseMesh(
+        mesh, o, &cancel, &cad, order == options.order && startQuality ? &*startQuality : nullptr);
     if (r->cancelled) throw CancelledError("cancelled during optimise");
     cut = capped && r->stopReason == "time budget";
     // Released in steps, each only if elements are still not valid: the layer's top slides
@@ -572,7 +594,12 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
                             previous != nullptr ? &previous->mesh : nullptr, "optimise");
 
   if (clocked) clock.emplace("quality", timings, observer);
-  state.quality = evaluateQuality(state.mesh, options.threads);
+  if (startQuality) {
+    const KnownQuality known{&state.mesh, &startXyz, &*startQuality, {}};
+    state.quality = evaluateQuality(state.mesh, options.threads, &known);
+  } else {
+    state.quality = evaluateQuality(state.mesh, options.threads);
+  }
   if (clocked) clock->done();
   return state;
 }

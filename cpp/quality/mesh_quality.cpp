@@ -64,6 +64,55 @@ JacobianSampler boundarySampler(CellType type, int order) {
   return {ref, points};
 }
 
+// The elements (cells of dimension mesh.dim) of a mesh in block order.
+std::vector<std::pair<const ElementBlock*, std::size_t>> elementList(const Mesh& mesh) {
+  std::vector<std::pair<const ElementBlock*, std::size_t>> list;
+  for (const ElementBlock& b : mesh.blocks)
+    if (cellDimension(b.type) == mesh.dim)
+      for (std::size_t e = 0; e < b.count(); ++e) list.emplace_back(&b, e);
+  return list;
+}
+
+// Where evaluateQuality may take an element's values from `known`: the source element of each
+// element of `mesh` (global index, block order) when the two have the same type, order and
+// node coordinates, and its values are finite; -1 otherwise.
+std::vector<std::int64_t> unchangedSources(const Mesh& mesh, const KnownQuality& known) {
+  const auto elements = elementList(mesh);
+  std::vector<std::int64_t> out(elements.size(), -1);
+  if (known.mesh == nullptr || known.quality == nullptr) return out;
+  const auto earlier = elementList(*known.mesh);
+  const QualitySummary& q = *known.quality;
+  if (q.scaledJacobian.size() != earlier.size() || q.validity.size() != earlier.size() ||
+      q.scaledJacobianUpper.size() != earlier.size() || q.distortion.size() != earlier.size())
+    return out;
+  if (!known.source.empty() && known.source.size() != elements.size()) return out;
+  if (known.mesh->dim != mesh.dim) return out;
+  const std::vector<double>& before = known.xyz != nullptr ? *known.xyz : known.mesh->xyz;
+  if (before.size() != known.mesh->xyz.size()) return out;
+  for (std::size_t g = 0; g < elements.size(); ++g) {
+    const std::int64_t s = known.source.empty() ? static_cast<std::int64_t>(g) : known.source[g];
+    if (s < 0 || static_cast<std::size_t>(s) >= earlier.size()) continue;
+    const auto [b, e] = elements[g];
+    const auto [sb, se] = earlier[static_cast<std::size_t>(s)];
+    if (b->type != sb->type || b->order != sb->order) continue;
+    const auto k = static_cast<std::size_t>(s);
+    if (!std::isfinite(q.scaledJacobian[k]) || !std::isfinite(q.scaledJacobianUpper[k]) ||
+        !std::isfinite(q.distortion[k]))
+      continue;
+    const std::int64_t* a = b->element(e);
+    const std::int64_t* c = sb->element(se);
+    // (Finite coordinates: the earlier bounds were certified; NaN input is measured again.)
+    bool same = true;
+    for (int i = 0; i < b->nodesPerElement() && same; ++i) {
+      const double* x = &mesh.xyz[3 * a[i]];
+      const double* y = &before[3 * c[i]];
+      for (int d = 0; d < 3 && same; ++d) same = std::isfinite(x[d]) && x[d] == y[d];
+    }
+    if (same) out[g] = s;
+  }
+  return out;
+}
+
 }  // namespace
 
 JacobianBounds elementJacobianBounds(const Mesh& mesh, const ElementBlock& block, std::size_t e,
@@ -74,8 +123,12 @@ JacobianBounds elementJacobianBounds(const Mesh& mesh, const ElementBlock& block
                        mesh.dim == 2 ? &normal : nullptr, tolerance);
 }
 
-QualitySummary evaluateQuality(const Mesh& mesh, int threads) {
+QualitySummary evaluateQuality(const Mesh& mesh, int threads, const KnownQuality* known) {
   QualitySummary summary;
+  const std::vector<std::int64_t> from =
+      known != nullptr ? unchangedSources(mesh, *known) : std::vector<std::int64_t>();
+  const QualitySummary* earlier = known != nullptr ? known->quality : nullptr;
+  std::size_t offset = 0;  // global index of the block's first element
   for (const ElementBlock& block : mesh.blocks) {
     const int n = block.nodesPerElement();
     if (block.count() == 0) continue;
@@ -91,33 +144,48 @@ QualitySummary evaluateQuality(const Mesh& mesh, int threads) {
     }
     // Elements are independent: evaluate them in parallel, then summarise in order.
     const auto count = static_cast<std::int64_t>(block.count());
-    std::vector<JacobianBounds> bounds(block.count());
-    std::vector<double> distortion(block.count());
+    std::vector<double> scaled(block.count()), upper(block.count()), distortion(block.count());
+    std::vector<Validity> validity(block.count());
+    std::vector<char> certified(block.count(), 1);
     // Warm the shared tables once before the threads need them.
     const Eigen::Vector3d first = cellNormal(mesh, block.element(0));
     boundJacobian(block.type, block.order, gather(mesh, block.element(0), n),
                   mesh.dim == 2 ? &first : nullptr);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
     for (std::int64_t e = 0; e < count; ++e) {
+      const std::int64_t source = from.empty() ? -1 : from[offset + static_cast<std::size_t>(e)];
+      if (source >= 0 && earlier != nullptr) {  // unchanged: the values measured before
+        const auto s = static_cast<std::size_t>(source);
+        scaled[e] = earlier->scaledJacobian[s];
+        upper[e] = earlier->scaledJacobianUpper[s];
+        validity[e] = earlier->validity[s];
+        distortion[e] = earlier->distortion[s];
+        continue;
+      }
       const std::int64_t* cell = block.element(static_cast<std::size_t>(e));
       const NodeCoordinates x = gather(mesh, cell, n);
       const Eigen::Vector3d normal = cellNormal(mesh, cell);
-      bounds[e] = boundJacobian(block.type, block.order, x, mesh.dim == 2 ? &normal : nullptr);
+      const JacobianBounds bounds =
+          boundJacobian(block.type, block.order, x, mesh.dim == 2 ? &normal : nullptr);
+      scaled[e] = bounds.scaledJacobian();
+      upper[e] = bounds.scaledJacobianEstimate();
+      validity[e] = bounds.validity;
+      certified[e] = bounds.certified ? 1 : 0;
       distortion[e] = elementDistortion(block.type, block.order, x);
     }
+    offset += block.count();
     TypeQuality& type = summary.byType[block.type];
     for (std::size_t e = 0; e < block.count(); ++e) {
-      const double scaled = bounds[e].scaledJacobian();
-      summary.scaledJacobian.push_back(scaled);
-      summary.scaledJacobianUpper.push_back(bounds[e].scaledJacobianEstimate());
+      summary.scaledJacobian.push_back(scaled[e]);
+      summary.scaledJacobianUpper.push_back(upper[e]);
       summary.distortion.push_back(distortion[e]);
-      summary.validity.push_back(bounds[e].validity);
+      summary.validity.push_back(validity[e]);
       ++type.count;
-      accumulate(type.scaledJacobian, scaled);
+      accumulate(type.scaledJacobian, scaled[e]);
       accumulate(type.distortion, distortion[e]);
-      if (bounds[e].validity == Validity::Invalid) ++type.invalid;
-      if (bounds[e].validity == Validity::Undecided) ++type.undecided;
-      if (!bounds[e].certified) summary.certified = false;
+      if (validity[e] == Validity::Invalid) ++type.invalid;
+      if (validity[e] == Validity::Undecided) ++type.undecided;
+      if (certified[e] == 0) summary.certified = false;
     }
   }
   if (summary.scaledJacobian.empty()) throw Error("quality: the mesh has no elements");

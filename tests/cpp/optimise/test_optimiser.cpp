@@ -318,6 +318,40 @@ TEST(Optimiser, RegionRestrictsTheMovingNodes) {
   EXPECT_GT(optimiseMesh(all, options).freeNodes, r.freeNodes);
 }
 
+// A caller's quality of the input (a repair round's, measured only where the mesh changed) stands
+// in for the set-up's own measurement: the same region, the same sweeps, the same nodes. A
+// quality summary of another mesh (wrong size) is ignored.
+TEST(Optimiser, TheCallersQualityOfTheInputGivesTheSameRun) {
+  const Mesh input = readMesh(peer("varopti_cube_sphere.msh"));
+  OptimiserOptions options;
+  options.maxIterations = 3;
+  options.regionThreshold = 0.5;
+  options.regionLayers = 1;
+  Mesh measured = input, given = input, other = input;
+  const OptimiserResult a = optimiseMesh(measured, options);
+  const QualitySummary quality = evaluateQuality(input);
+  const OptimiserResult b = optimiseMesh(given, options, nullptr, nullptr, &quality);
+  EXPECT_EQ(measured.xyz, given.xyz);
+  EXPECT_NE(given.xyz, input.xyz);
+  EXPECT_EQ(a.regionElements, b.regionElements);
+  EXPECT_EQ(a.visits, b.visits);
+  EXPECT_EQ(a.worstBefore, quality.scaled.min);
+  EXPECT_EQ(b.worstBefore, quality.scaled.min);
+  EXPECT_EQ(a.worstAfter, b.worstAfter);
+  // It is what the set-up uses: every element marked below the region threshold puts every
+  // element in the region.
+  QualitySummary poor = quality;
+  poor.scaledJacobian.assign(poor.scaledJacobian.size(), 0.1);
+  Mesh copy = input;
+  EXPECT_EQ(optimiseMesh(copy, options, nullptr, nullptr, &poor).regionElements,
+            input.numElements());
+  EXPECT_LT(a.regionElements, input.numElements());
+  QualitySummary wrong = quality;
+  wrong.scaledJacobian.pop_back();
+  optimiseMesh(other, options, nullptr, nullptr, &wrong);
+  EXPECT_EQ(other.xyz, measured.xyz);
+}
+
 // A boundary layer's top released around invalid elements slides parallel to its wall: a node
 // with a locked direction moves only perpendicular to it (to rounding), the rest as before.
 TEST(Optimiser, LockedNodesMoveOnlyPerpendicularToTheirDirection) {

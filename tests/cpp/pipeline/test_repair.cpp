@@ -449,6 +449,17 @@ TEST(RepairRounds, SphereInBoxEndsProvenValid) {
   EXPECT_EQ(result.quality.undecided, 0u);
   EXPECT_GT(result.quality.scaled.min, 0.0);
   EXPECT_EQ(result.rounds.front().invalid, without.quality.invalid);
+  // A round measures only the elements it changed and takes the others' values from the round
+  // before (KnownQuality): exactly what measuring the whole mesh gives.
+  std::size_t reused = 0;
+  for (const RepairRound& r : result.rounds) reused += r.reused;
+  EXPECT_GT(reused, 0u);
+  const QualitySummary whole = evaluateQuality(result.mesh);
+  EXPECT_EQ(result.quality.scaledJacobian, whole.scaledJacobian);
+  EXPECT_EQ(result.quality.scaledJacobianUpper, whole.scaledJacobianUpper);
+  EXPECT_EQ(result.quality.distortion, whole.distortion);
+  EXPECT_EQ(result.quality.validity, whole.validity);
+  EXPECT_EQ(result.quality.scaled.min, whole.scaled.min);
   // Splits add a few elements; a refinement round regenerates the mesh with smaller sizes
   // around the offending elements (397 -> 644 tetrahedra measured): bounded, not a blow-up.
   EXPECT_LT(result.mesh.numElements(), without.mesh.numElements() * 2);

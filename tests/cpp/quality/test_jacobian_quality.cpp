@@ -248,6 +248,66 @@ TEST(Quality, FoldedElementIsCertifiedInvalid) {
   EXPECT_EQ(folded.scaled.histogram.below, 1u);
 }
 
+// Two order-2 tetrahedra, the second a copy of the first shifted by `offset` along x, with node
+// 4 of the second pulled by `pull` towards the inside (folding it when large).
+Mesh twoTetrahedra(double offset, double pull) {
+  NodeCoordinates x = affineElement(CellType::Tetrahedron, 2);
+  Mesh mesh = singleElementMesh(CellType::Tetrahedron, 2, x);
+  x.col(0).array() += offset;
+  x.row(4) += pull * Eigen::RowVector3d(0.0, 0.5, 0.3);
+  const Mesh second = singleElementMesh(CellType::Tetrahedron, 2, x);
+  ElementBlock& block = mesh.blocks[0];
+  for (const std::int64_t id : second.blocks[0].nodes) {
+    const double* p = &second.xyz[3 * id];
+    block.nodes.push_back(mesh.addNode(p, 3, 1, NAN, NAN));
+  }
+  block.entity.push_back(1);
+  return mesh;
+}
+
+TEST(Quality, KnownValuesAreTakenOnlyForElementsWhoseNodesAreUnchanged) {
+  const Mesh before = twoTetrahedra(5.0, 0.1);
+  QualitySummary known = evaluateQuality(before);
+  // Marked values: where they come back, evaluateQuality took them instead of measuring.
+  known.scaledJacobian = {0.25, 0.5};
+  known.scaledJacobianUpper = {0.26, 0.51};
+  known.distortion = {0.125, 0.375};
+
+  // The second element folded: the first is unchanged and takes its known values; the second
+  // is measured (and found invalid) although its source has values too.
+  const Mesh after = twoTetrahedra(5.0, 3.0);
+  const KnownQuality same{&before, nullptr, &known, {}};
+  const QualitySummary q = evaluateQuality(after, 1, &same);
+  const QualitySummary measured = evaluateQuality(after);
+  EXPECT_EQ(q.scaledJacobian[0], 0.25);
+  EXPECT_EQ(q.distortion[0], 0.125);
+  EXPECT_EQ(q.scaledJacobian[1], measured.scaledJacobian[1]);
+  EXPECT_EQ(q.validity[1], Validity::Invalid);
+  EXPECT_EQ(q.invalid, 1u);
+  EXPECT_EQ(q.scaled.min, measured.scaled.min);
+
+  // A source map: the elements of `after` listed the other way round in `before`'s order, so
+  // the unchanged first element of `after` is element 1 there; -1 measures.
+  const KnownQuality swapped{&before, nullptr, &known, {1, 0}};
+  EXPECT_EQ(evaluateQuality(before, 1, &swapped).scaledJacobian[0],
+            evaluateQuality(before).scaledJacobian[0]);  // coordinates differ: measured
+  const Mesh copy = before;
+  const KnownQuality none{&before, nullptr, &known, {-1, 1}};
+  const QualitySummary partly = evaluateQuality(copy, 1, &none);
+  EXPECT_NE(partly.scaledJacobian[0], 0.25);
+  EXPECT_EQ(partly.scaledJacobian[1], 0.5);
+
+  // Coordinates given apart (the mesh's own have moved since): compared with those.
+  Mesh moved = before;
+  const std::vector<double> then = moved.xyz;
+  moved.xyz[3 * moved.blocks[0].nodes[14] + 1] += 0.05;  // node 4 of the second element
+  const KnownQuality earlier{&moved, &then, &known, {}};
+  const QualitySummary r = evaluateQuality(moved, 1, &earlier);
+  EXPECT_EQ(r.scaledJacobian[0], 0.25);
+  EXPECT_NE(r.scaledJacobian[1], 0.5);
+  EXPECT_EQ(r.scaledJacobian[1], evaluateQuality(moved).scaledJacobian[1]);
+}
+
 TEST(Quality, PlanarTrianglesAreSignedAgainstThePlaneNormal) {
   Mesh mesh;
   mesh.dim = 2;
