@@ -127,6 +127,14 @@ void Mesh::checkConsistency() const {
   }
 }
 
+std::vector<std::pair<const ElementBlock*, std::size_t>> elementsOf(const Mesh& mesh) {
+  std::vector<std::pair<const ElementBlock*, std::size_t>> list;
+  for (const ElementBlock& b : mesh.blocks)
+    if (cellDimension(b.type) == mesh.dim)
+      for (std::size_t e = 0; e < b.count(); ++e) list.emplace_back(&b, e);
+  return list;
+}
+
 void compactNodes(Mesh& mesh) {
   std::vector<std::int64_t> newId(mesh.numNodes(), -1);
   for (const ElementBlock& block : mesh.blocks)

@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/cell_type.hpp"
@@ -83,6 +84,10 @@ struct Mesh {
 // as on a closed shell); zero when the nodes leave every such plane (a surface mesh); nullopt
 // when no 2D cell spans a plane.
 std::optional<std::array<double, 3>> planeOfCells(const Mesh& mesh, double tolerance);
+
+// The elements (cells of dimension mesh.dim) in block order, as (block, index in it): what
+// per-element arrays (quality verdicts, region seeds) are indexed by.
+std::vector<std::pair<const ElementBlock*, std::size_t>> elementsOf(const Mesh& mesh);
 
 // Drops the nodes no element uses (a source's high-order nodes after an order change, a macro
 // layer's inner nodes after its split) and renumbers the rest in their original order.

@@ -11,15 +11,6 @@
 namespace homesh {
 namespace {
 
-// The elements (cells of dimension mesh.dim) of a mesh in block order: (block, index).
-std::vector<std::pair<const ElementBlock*, std::size_t>> elementsOf(const Mesh& mesh) {
-  std::vector<std::pair<const ElementBlock*, std::size_t>> list;
-  for (const ElementBlock& b : mesh.blocks)
-    if (cellDimension(b.type) == mesh.dim)
-      for (std::size_t e = 0; e < b.count(); ++e) list.emplace_back(&b, e);
-  return list;
-}
-
 // A cell's type and its vertex coordinates in order, as raw bytes: equal keys mean the same
 // cell at the same place, bit for bit.
 std::string cellKey(const Mesh& mesh, const ElementBlock& b, std::size_t e) {

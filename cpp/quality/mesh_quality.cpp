@@ -64,23 +64,14 @@ JacobianSampler boundarySampler(CellType type, int order) {
   return {ref, points};
 }
 
-// The elements (cells of dimension mesh.dim) of a mesh in block order.
-std::vector<std::pair<const ElementBlock*, std::size_t>> elementList(const Mesh& mesh) {
-  std::vector<std::pair<const ElementBlock*, std::size_t>> list;
-  for (const ElementBlock& b : mesh.blocks)
-    if (cellDimension(b.type) == mesh.dim)
-      for (std::size_t e = 0; e < b.count(); ++e) list.emplace_back(&b, e);
-  return list;
-}
-
 // Where evaluateQuality may take an element's values from `known`: the source element of each
 // element of `mesh` (global index, block order) when the two have the same type, order and
 // node coordinates, and its values are finite; -1 otherwise.
 std::vector<std::int64_t> unchangedSources(const Mesh& mesh, const KnownQuality& known) {
-  const auto elements = elementList(mesh);
+  const auto elements = elementsOf(mesh);
   std::vector<std::int64_t> out(elements.size(), -1);
   if (known.mesh == nullptr || known.quality == nullptr) return out;
-  const auto earlier = elementList(*known.mesh);
+  const auto earlier = elementsOf(*known.mesh);
   const QualitySummary& q = *known.quality;
   if (q.scaledJacobian.size() != earlier.size() || q.validity.size() != earlier.size() ||
       q.scaledJacobianUpper.size() != earlier.size() || q.distortion.size() != earlier.size())
