@@ -77,7 +77,8 @@ std::vector<std::int64_t> unchangedSources(const Mesh& mesh, const KnownQuality&
       q.scaledJacobianUpper.size() != earlier.size() || q.distortion.size() != earlier.size())
     return out;
   if (!known.source.empty() && known.source.size() != elements.size()) return out;
-  if (known.mesh->dim != mesh.dim) return out;
+  // (A 2D cell's Jacobian is measured along the plane's normal, or its own on a surface.)
+  if (known.mesh->dim != mesh.dim || known.mesh->planeNormal != mesh.planeNormal) return out;
   const std::vector<double>& before = known.xyz != nullptr ? *known.xyz : known.mesh->xyz;
   if (before.size() != known.mesh->xyz.size()) return out;
   for (std::size_t g = 0; g < elements.size(); ++g) {
@@ -164,6 +165,8 @@ QualitySummary evaluateQuality(const Mesh& mesh, int threads, const KnownQuality
       certified[e] = bounds.certified ? 1 : 0;
       distortion[e] = elementDistortion(block.type, block.order, x);
     }
+    for (std::size_t e = 0; e < block.count(); ++e)
+      if (!from.empty() && from[offset + e] >= 0) ++summary.known;
     offset += block.count();
     TypeQuality& type = summary.byType[block.type];
     for (std::size_t e = 0; e < block.count(); ++e) {

@@ -59,6 +59,7 @@ struct QualitySummary {
   std::size_t invalid = 0;    // certified invalid (a value of J <= 0 was found)
   std::size_t undecided = 0;  // neither proven valid nor invalid
   bool certified = true;      // every element's verdict is certain and Bezier-certified
+  std::size_t known = 0;      // elements whose values were taken from a KnownQuality
   MeasureSummary scaled, distortionSummary;
   std::map<CellType, TypeQuality> byType;
 };
@@ -94,8 +95,9 @@ JacobianBounds elementJacobianBounds(const Mesh& mesh, const ElementBlock& block
 
 // Quality measured before on another mesh, for evaluateQuality to take instead of measuring
 // again: an element whose nodes have the (finite) coordinates of its source element's nodes
-// (same type and order) has that element's values, since every measure here is a function of
-// those coordinates alone. A repair round changes a few hundred of a model's
+// (same type and order, the meshes of one dimension and plane normal) has that element's
+// values, since every measure here is a function of those alone. (Boundary cells' stretch is
+// measured again on all of them: it is cheap.) A repair round changes a few hundred of a model's
 // 200,000 elements; measuring only those saves the whole-mesh check (5 s at order 4).
 struct KnownQuality {
   const Mesh* mesh = nullptr;  // the mesh `quality` was measured on (its cells) ...

@@ -175,13 +175,13 @@ REFRIGERATOR = Path("/usr/share/opencascade/data/occ/MODERN_Refrigerator_1_opene
 
 
 def test_slivers_the_splits_leave_are_flipped_away(homesh_bin, tmp_path):
-    """OpenCASCADE's opened refrigerator at order 4 with the optimiser: the split rounds leave
-    flat tetrahedra with a vertex on a CAD face and three inside, which no split can mend (their
-    halves are as flat). A flip round takes them away, reusing the curved nodes of all but the
-    few cells it changed, and the mesh is certified valid; Gmsh's verdict agrees. (With repair
-    regions four layers deep, the splits left one such element invalid and a "flip" round made
-    the mesh valid; with one layer the splits make it valid, worst 0.036, and a "flip poor"
-    round flips 34 slivers away: 0.104.)"""
+    """OpenCASCADE's opened refrigerator at order 4 with the optimiser: after the split rounds,
+    flat tetrahedra with a vertex on a CAD face and three inside are left, which a split does
+    not mend (their halves are as flat). A flip round takes them away, reusing the curved nodes
+    of all but the few cells it changed, and the mesh is certified valid; Gmsh's verdict agrees.
+    With repair regions four layers deep, the splits left one such element invalid and a "flip"
+    round made the mesh valid; with one layer the splits make it valid (worst 0.036) and a
+    "flip poor" round flips 34 slivers away (0.104), which this test now covers."""
     assert REFRIGERATOR.is_file(), "occt-misc is not installed (scripts/install-deps.sh)"
     msh, report = tmp_path / "fridge.msh", tmp_path / "fridge.json"
     result = run([homesh_bin, "mesh", REFRIGERATOR, "--order", "4", "--optimise", "-j", "2",

@@ -285,6 +285,13 @@ TEST(Quality, KnownValuesAreTakenOnlyForElementsWhoseNodesAreUnchanged) {
   EXPECT_EQ(q.validity[1], Validity::Invalid);
   EXPECT_EQ(q.invalid, 1u);
   EXPECT_EQ(q.scaled.min, measured.scaled.min);
+  EXPECT_EQ(q.known, 1u);
+
+  // A mesh with another plane normal (what a 2D cell's Jacobian is measured along): nothing is
+  // taken.
+  Mesh tilted = after;
+  tilted.planeNormal = {0.0, 1.0, 0.0};
+  EXPECT_EQ(evaluateQuality(tilted, 1, &same).known, 0u);
 
   // A source map: the elements of `after` listed the other way round in `before`'s order, so
   // the unchanged first element of `after` is element 1 there; -1 measures.
@@ -296,6 +303,29 @@ TEST(Quality, KnownValuesAreTakenOnlyForElementsWhoseNodesAreUnchanged) {
   const QualitySummary partly = evaluateQuality(copy, 1, &none);
   EXPECT_NE(partly.scaledJacobian[0], 0.25);
   EXPECT_EQ(partly.scaledJacobian[1], 0.5);
+
+  // Blocks: a boundary triangle first, then each tetrahedron in a block of its own. The
+  // elements' global indices skip the triangle, and the second block's first element is the
+  // second element: folding it leaves the first's known values.
+  Mesh blocks = after;
+  blocks.blocks.clear();
+  ElementBlock triangle;
+  triangle.type = CellType::Triangle;
+  triangle.order = 1;
+  triangle.nodes = {0, 1, 2};
+  triangle.entity = {1};
+  blocks.blocks.push_back(triangle);
+  for (int k = 0; k < 2; ++k) {
+    ElementBlock tet = after.blocks[0];
+    tet.nodes.assign(after.blocks[0].element(k), after.blocks[0].element(k) + 10);
+    tet.entity = {1};
+    blocks.blocks.push_back(tet);
+  }
+  const QualitySummary b = evaluateQuality(blocks, 1, &same);
+  ASSERT_EQ(b.scaledJacobian.size(), 2u);
+  EXPECT_EQ(b.scaledJacobian[0], 0.25);
+  EXPECT_EQ(b.scaledJacobian[1], measured.scaledJacobian[1]);
+  EXPECT_EQ(b.known, 1u);
 
   // Coordinates given apart (the mesh's own have moved since): compared with those.
   Mesh moved = before;
