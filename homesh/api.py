@@ -327,7 +327,7 @@ def _cad_source(shape, name):
 
 
 def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_octree=None,
-            name=None, threads=1, heal=True, solids_only=False, surface=False):
+            name=None, threads=1, heal=True, solids_only=False, surface=False, auto=False):
     """The element count the linear mesh of a CAD shape will have, without making it.
 
     Builds the sizing octree (curvature sizes between min_delta and max_delta with sagitta
@@ -338,8 +338,8 @@ def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_o
     "curve", "edge": 3, "radius": ..., "delta": ...}``. write_octree: a .vtu path for the
     octree's leaves and sizes. shape may be a NekMesh .mcf path: its CAD (in metres) and,
     unless given here, its sizes are used (likewise in :func:`mesh`). heal, solids_only,
-    surface: the CAD check and healing, as for :func:`mesh` (the prediction is of the model
-    meshed; for a surface mesh, of its triangles).
+    surface, auto: the CAD check and healing, as for :func:`mesh` (the prediction is of the
+    model meshed; for a surface mesh, of its triangles).
 
     Returns the report as a dict: "predicted_elements", "dimension" and "sizing" (parameters,
     integrals and octree statistics).
@@ -350,15 +350,15 @@ def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_o
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
         text = _core.predict_brep(value, label, sizing, octree, threads, bool(heal),
-                                  bool(solids_only), bool(surface))
+                                  _cad_modes(solids_only, surface, auto))
     else:
-        text = _core.predict_file(value, sizing, octree, threads, bool(heal), bool(solids_only),
-                                  bool(surface))
+        text = _core.predict_file(value, sizing, octree, threads, bool(heal),
+                                  _cad_modes(solids_only, surface, auto))
     return json.loads(text)
 
 
 def size_field(shape, min_delta=None, max_delta=None, eps=None, sources=(), name=None,
-               threads=1, heal=True, solids_only=False, surface=False):
+               threads=1, heal=True, solids_only=False, surface=False, auto=False):
     """The sizing octree's leaves inside the model or on its boundary, for drawing the size
     field: a dict of numpy arrays ``centre`` (L, 3), ``half_width`` (L,), ``delta`` (L,), the
     size there, and ``boundary`` (L,) 1 where the model's boundary passes through the leaf,
@@ -368,14 +368,14 @@ def size_field(shape, min_delta=None, max_delta=None, eps=None, sources=(), name
     kind, value, label = _cad_source(shape, name)
     if kind != "brep":
         raise ParameterError("size_field takes a shape or BRep text, not a file path")
-    return dict(_core.size_field(value, label, sizing, threads, bool(heal), bool(solids_only),
-                                 bool(surface)))
+    return dict(_core.size_field(value, label, sizing, threads, bool(heal),
+                                 _cad_modes(solids_only, surface, auto)))
 
 
 def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
          optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=8,
          boundary_layer=None, cancel=None, optimise_seconds=0.0, linear_seconds=600.0,
-         heal=True, job_seconds=0.0, solids_only=False, surface=False):
+         heal=True, job_seconds=0.0, solids_only=False, surface=False, auto=False):
     """Meshes a CAD shape with curved elements of the given order.
 
     shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
@@ -430,6 +430,10 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
               where faces meet; ``report()["healing"]["surface"]`` says so. No volume, no
               optimiser (a note says so when optimise > 0), no boundary layer. False: such a
               model is refused (:class:`CadError` naming a free edge).
+    auto      for batch runs over files nobody looked at: a model with solids is meshed as
+              with solids_only, one without a solid as with surface (planar faces in one
+              plane stay 2D), and ``report()["healing"]["automatic"]`` and a note say which.
+              Not with solids_only or surface. False: such models are refused.
     repair_rounds
               at most this many repair rounds (0..20) while elements are not proven valid:
               each splits the offending linear elements' edges on curved CAD faces (or refines
@@ -467,12 +471,18 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     if kind == "brep":
         core = _core.mesh_brep(value, label, order, size, threads, verbosity, progress, optimise,
                                sizing, repair_rounds, layer, cancel, limits, bool(heal),
-                               bool(solids_only), bool(surface))
+                               _cad_modes(solids_only, surface, auto))
     else:
         core = _core.mesh_file(value, order, size, threads, verbosity, progress, optimise,
                                sizing, repair_rounds, layer, cancel, limits, bool(heal),
-                               bool(solids_only), bool(surface))
+                               _cad_modes(solids_only, surface, auto))
     return HighOrderMesh(core)
+
+
+def _cad_modes(solids_only, surface, auto):
+    """The core's one string for the CAD modes asked for (conflicts are the core's to name)."""
+    return ",".join(name for name, on in (("solids_only", solids_only), ("surface", surface),
+                                          ("auto", auto)) if on)
 
 
 def _job_arguments(order, threads, verbosity, optimise, progress, cancel, optimise_seconds):

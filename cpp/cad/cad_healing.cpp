@@ -547,9 +547,66 @@ TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal, bo
   return shape;
 }
 
+// The refusal of a model that has no solid once healed (and is not planar): under
+// HealingOptions::automatic, the cue to keep its faces as a surface instead.
+class NoSolidError : public CadError {
+ public:
+  NoSolidError(std::string reason, const std::string& message)
+      : CadError(message), why(std::move(reason)) {}
+  std::string why;  // why there is none, in words ("its 5 faces do not close (...)")
+};
+
+CadModel healAs(CadModel cad, const HealingOptions& options, HealingRecord& record);
+
 }  // namespace
 
+void HealingOptions::validate() const {
+  if (automatic && (surface || solidsOnly))
+    throw ParameterError(
+        "automatic mode (--auto) chooses between --solids-only and --surface itself: give none "
+        "of them with it");
+  if (surface && solidsOnly)
+    throw ParameterError(
+        "--surface meshes a model without solids and --solids-only its solids "
+        "alone: give one of them");
+}
+
 CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& record) {
+  options.validate();
+  if (!options.automatic) return healAs(std::move(cad), options, record);
+  // Solids in the file: the faces beside them are left out. None: the faces are all kept,
+  // made solids where every shell closes, else a surface (not a solid of the shells that
+  // close with the rest left out: surface_filling.step's one closed shell is no solid Gmsh
+  // can mesh, and a model of faces alone loses none of them this way).
+  bool solidInFile = false;
+  for (int s = 1; s <= cad.numSolids() && !solidInFile; ++s)
+    solidInFile = count(occtSolid(cad, s), TopAbs_FACE) > 0;
+  HealingOptions solids = options;
+  solids.automatic = false;
+  solids.solidsOnly = solidInFile;
+  const std::string name = cad.sourceName();
+  try {
+    // (A model of the same shape: `cad` stays for the surface attempt.)
+    CadModel healed = healAs(cadModelFromShape(occtShape(cad), name), solids, record);
+    if (!record.leftOut.empty() && !record.leftOutCopies)
+      record.automatic = "automatic mode: " + name +
+                         " is meshed as its solids, the faces in no solid left out (as "
+                         "--solids-only does)";
+    return healed;
+  } catch (const NoSolidError& e) {
+    HealingOptions faces = options;
+    faces.automatic = false;
+    faces.surface = true;
+    CadModel healed = healAs(std::move(cad), faces, record);
+    record.automatic = "automatic mode: " + name + " has no solid (" + e.why +
+                       "), so its faces get a surface mesh, as --surface does";
+    return healed;
+  }
+}
+
+namespace {
+
+CadModel healAs(CadModel cad, const HealingOptions& options, HealingRecord& record) {
   const auto start = std::chrono::steady_clock::now();
   const bool enabled = options.enabled;
   const TopoDS_Shape original = occtShape(cad);
@@ -652,16 +709,17 @@ CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& r
   if (solids.Extent() == 0 && !planar) {
     const int edge = firstFreeEdge(shape, edges);
     // Some shells closed: the option that meshes them and leaves the others out is worth naming.
-    throw CadError(
-        cad.sourceName() + " is not a closed solid: it has no solid, and " +
+    const std::string why =
         (cad.numFaces() == 1 ? std::string("its one face does not close")
                              : "its " + std::to_string(cad.numFaces()) + " faces do not close") +
-        (edge != 0 ? " (" + cadEntityName(1, edge) + " bounds only one face)" : "") + healed +
-        "; HOMesh meshes solids, planar faces in one plane (2D), or the faces alone "
-        "as a surface mesh: --surface (Python surface=True, FreeCAD Surface)" +
-        (record.sewnSolids > 0 && !options.solidsOnly
-             ? "; " + solidsOnlyOption + " meshes the closed shells alone"
-             : std::string()));
+        (edge != 0 ? " (" + cadEntityName(1, edge) + " bounds only one face)" : "") + healed;
+    throw NoSolidError(
+        why, cad.sourceName() + " is not a closed solid: it has no solid, and " + why +
+                 "; HOMesh meshes solids, planar faces in one plane (2D), or the faces alone "
+                 "as a surface mesh: --surface (Python surface=True, FreeCAD Surface)" +
+                 (record.sewnSolids > 0 && !options.solidsOnly
+                      ? "; " + solidsOnlyOption + " meshes the closed shells alone"
+                      : std::string()));
   }
   // Faces beside the solids would not be meshed: refused, or left out and recorded.
   const LooseFaces loose = solids.Extent() > 0 ? facesInNoSolid(shape) : LooseFaces{};
@@ -734,5 +792,7 @@ CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& r
   }
   return cad;
 }
+
+}  // namespace
 
 }  // namespace homesh

@@ -32,6 +32,16 @@ struct HealingOptions {
   // A model without solids whose faces do not close is kept as faces (a surface mesh), sewn
   // into shells where that joins them, instead of refused.
   bool surface = false;
+  // For batch runs over files nobody looked at: each model gets the one of the modes above
+  // that fits it. With solids: solidsOnly, so faces in no solid are left out and recorded.
+  // With no solid: its faces are sewn into solids if every shell closes (as without this
+  // option), else they get a surface mesh, none left out. Planar faces in one plane stay a 2D
+  // model. Without it an open shell is refused: a user who meant a solid hears so instead of
+  // getting triangles.
+  bool automatic = false;
+
+  // Throws ParameterError for modes that exclude each other.
+  void validate() const;
 };
 
 struct HealingRecord {
@@ -55,6 +65,8 @@ struct HealingRecord {
   // The model is kept as faces for a surface mesh (HealingOptions::surface): in words, how
   // many faces and shells, and whether sewing joined them.
   std::string surface;
+  // HealingOptions::automatic's choice, in words (empty without it).
+  std::string automatic;
   // What the mesh user must know that healing does not change: solids that lie against each
   // other on faces of their own (coincident, not shared), whose meshes do not conform there.
   std::vector<std::string> warnings;
@@ -69,6 +81,7 @@ struct HealingRecord {
   // only, or copies) and the warnings. The pipeline's notes and `homesh predict` print these.
   std::vector<std::string> notes() const {
     std::vector<std::string> lines;
+    if (!automatic.empty()) lines.push_back(automatic);
     if (!surface.empty()) lines.push_back(surface);
     if (!leftOut.empty())
       lines.push_back(std::string(leftOutCopies ? "" : "solids only: ") + "left out " + leftOut);
@@ -83,7 +96,9 @@ struct HealingRecord {
 // shells where sewing joins them without losing a face). Fills `record`. Throws CadError when
 // the model (healed or not) has a solid whose boundary is open, naming the solid and a free
 // edge, when faces are in no solid (without solidsOnly), naming them, when it has no solid and
-// no face, and when `options.surface` is asked of a model with solids.
+// no face, and when `options.surface` is asked of a model with solids. `options.automatic`
+// chooses solidsOnly or surface for the model (see HealingOptions) and says which in
+// `record.automatic`.
 CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& record);
 
 }  // namespace homesh

@@ -211,6 +211,7 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   table.flag({"--no-heal"}, [&cmd] { cmd.heal = false; });
   table.flag({"--solids-only"}, [&cmd] { cmd.solidsOnly = true; });
   table.flag({"--surface"}, [&cmd] { cmd.surface = true; });
+  table.flag({"--auto"}, [&cmd] { cmd.automatic = true; });
   table.value({"--maxiter", "-n"}, [&maxiter](const std::string& o, const std::string& v) {
     maxiter = parseInteger(o, v);
     if (*maxiter < 1) throw UsageError{"--maxiter must be >= 1, got " + v};
@@ -259,6 +260,7 @@ PredictCommand parsePredict(const std::vector<std::string>& args) {
   table.flag({"--no-heal"}, [&cmd] { cmd.heal = false; });
   table.flag({"--solids-only"}, [&cmd] { cmd.solidsOnly = true; });
   table.flag({"--surface"}, [&cmd] { cmd.surface = true; });
+  table.flag({"--auto"}, [&cmd] { cmd.automatic = true; });
   cmd.input = onlyInput(table.parse(args, 1, "predict"), "predict", "an INPUT CAD or .mcf file");
   return cmd;
 }
@@ -412,6 +414,10 @@ options:
       --surface       for a model without solids (a shell, faces that do not close): a
                       surface mesh of its faces, triangles curved on the CAD, sewn where
                       faces meet; no volume, no optimiser, no boundary layer
+      --auto          for batch runs over files nobody looked at: a model with solids is
+                      meshed as with --solids-only, one without a solid as with --surface
+                      (planar faces stay 2D); a note says which. Without it such models
+                      are refused, naming what is not a closed solid
       --linear-time-limit S  Gmsh's linear meshing (in a process of its own) is stopped after
                       S seconds and the run fails (default 600; 0: no limit)
       --job-time-limit S  the whole job's wall time: Gmsh and the optimiser get at most what
@@ -448,7 +454,7 @@ options:
       --max-delta D, --min-delta D, --eps E, --refine-line ..., --refine-sphere ...,
       --refine-box ..., --refine-curve ...   as for 'homesh mesh'
       --write-octree FILE.vtu   the octree's leaves with their sizes (ParaView)
-      --no-heal, --solids-only, --surface   as for 'homesh mesh'
+      --no-heal, --solids-only, --surface, --auto   as for 'homesh mesh'
       --report FILE   write the JSON report ("-" for standard output)
   -j, --threads N     threads (default 1)
   -q, --quiet         print nothing but errors

@@ -46,6 +46,7 @@ struct MeshCommand {
   bool heal = true;                // --no-heal: the CAD is only checked
   bool solidsOnly = false;         // --solids-only: faces in no solid are left out
   bool surface = false;            // --surface: a model without solids gets a surface mesh
+  bool automatic = false;          // --auto: --solids-only or --surface, whichever fits
   double linearTimeLimit = 600.0;  // --linear-time-limit S: seconds per Gmsh run (0: none)
   double jobTimeLimit = 0.0;       // --job-time-limit S: seconds for the whole job (0: none)
   // --bl-faces, --bl-thickness, --bl-layers, --bl-progression: a boundary layer (each
@@ -68,6 +69,7 @@ struct PredictCommand {
   bool heal = true;         // --no-heal, as for mesh
   bool solidsOnly = false;  // --solids-only, as for mesh
   bool surface = false;     // --surface, as for mesh
+  bool automatic = false;   // --auto, as for mesh
   CommonOptions common;
 };
 

@@ -153,6 +153,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
   options.heal = cmd.heal;
   options.solidsOnly = cmd.solidsOnly;
   options.surface = cmd.surface;
+  options.automatic = cmd.automatic;
   if (cmd.blFaces || cmd.blThickness || cmd.blLayers || cmd.blProgression) {
     homesh::BoundaryLayerParameters bl =
         options.boundaryLayer.value_or(homesh::BoundaryLayerParameters{});
@@ -253,6 +254,7 @@ int runPredict(const homesh::PredictCommand& cmd) {
   setup.options.heal = cmd.heal;
   setup.options.solidsOnly = cmd.solidsOnly;
   setup.options.surface = cmd.surface;
+  setup.options.automatic = cmd.automatic;
   const homesh::SizingResult s = homesh::runSizingStage(setup.source, setup.options);
   const bool toStdout = c.report && *c.report == "-";
   if (!c.quiet) {

@@ -42,10 +42,7 @@ void MeshingOptions::validate() const {
     throw ParameterError(
         "a boundary layer needs a volume or planar mesh, not a surface mesh "
         "(--surface)");
-  if (surface && solidsOnly)
-    throw ParameterError(
-        "--surface meshes a model without solids and --solids-only its solids "
-        "alone: give one of them");
+  healing().validate();
   if (size && !octreeOutput.empty())
     throw ParameterError("writing the sizing octree needs octree sizing, not a uniform size");
   if (size && sizing)
@@ -725,6 +722,10 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
       std::make_shared<const CadModel>(healModel(source.load(), options.healing(), result.healing));
   cad.done();
   for (const std::string& note : result.healing.notes()) result.notes.push_back(note);
+  if (options.boundaryLayer && isSurfaceModel(*result.cad))  // (automatic mode's choice)
+    throw ParameterError("a boundary layer needs a volume or planar mesh, and " +
+                         result.cad->sourceName() +
+                         " has no solid: automatic mode (--auto) gives it a surface mesh");
   checkRenumbering(result.healing, options);
   checkMeshDimension(*result.cad, options.expectedDimension);
   if (!options.size) options.sizing = resolveSizing(options.sizing, *result.cad);

@@ -72,7 +72,10 @@ struct MeshingOptions {
   // A model without solids gets a surface mesh of its faces (triangles on the CAD, no volume;
   // the optimiser and boundary layers do not apply) instead of being refused.
   bool surface = false;
-  HealingOptions healing() const { return {heal, solidsOnly, surface}; }
+  // Each model gets the mode that fits it (solidsOnly with solids, surface without), for batch
+  // runs: HealingOptions::automatic.
+  bool automatic = false;
+  HealingOptions healing() const { return {heal, solidsOnly, surface, automatic}; }
 
   // Throws ParameterError naming the offending parameter.
   void validate() const;

@@ -54,6 +54,8 @@ void appendHealing(JsonWriter& json, const HealingRecord& h) {
   json.value("left_out", h.leftOut);
   // The model was kept as faces for a surface mesh (--surface), in words; empty: it was not.
   json.value("surface", h.surface);
+  // Automatic mode's choice (--auto), in words; empty: not asked for, or nothing to choose.
+  json.value("automatic", h.automatic);
   // Face numbers (boundary layers, groups) are the healed model's when it was renumbered.
   json.value("renumbered", h.renumbered);
   json.value("faces_before", h.facesBefore);

@@ -399,14 +399,35 @@ void applyTimeLimits(MeshingOptions& options, const bp::object& limits) {
   read("job_seconds", options.jobSeconds);
 }
 
+// The CAD modes the Python functions pass as one string (Boost.Python's arity limit): a comma
+// list of "solids_only", "surface" and "auto" (HealingOptions), empty for none. Conflicts are
+// HealingOptions::validate's to name.
+void applyCadModes(MeshingOptions& options, const std::string& modes) {
+  std::size_t start = 0;
+  while (start < modes.size()) {
+    std::size_t end = modes.find(',', start);
+    if (end == std::string::npos) end = modes.size();
+    const std::string mode = modes.substr(start, end - start);
+    if (mode == "solids_only")
+      options.solidsOnly = true;
+    else if (mode == "surface")
+      options.surface = true;
+    else if (mode == "auto")
+      options.automatic = true;
+    else
+      throw ParameterError("unknown CAD mode '" + mode +
+                           "' (expected solids_only, surface or auto)");
+    start = end + 1;
+  }
+}
+
 MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity,
                            int optimise, const bp::object& sizing, int repairRounds,
                            const bp::object& boundaryLayer, const bp::object& limits,
-                           bool heal = true, bool solidsOnly = false, bool surface = false) {
+                           bool heal = true, const std::string& modes = "") {
   MeshingOptions options;
   options.heal = heal;
-  options.solidsOnly = solidsOnly;
-  options.surface = surface;
+  applyCadModes(options, modes);
   applyTimeLimits(options, limits);
   if (!boundaryLayer.is_none())
     options.boundaryLayer = boundaryLayerFrom(bp::extract<bp::dict>(boundaryLayer));
@@ -423,14 +444,12 @@ MeshingOptions makeOptions(int order, const bp::object& size, int threads, int v
 // The sizing octree and prediction of a CAD source: the JSON report of `homesh predict`,
 // and the octree's leaves written to `octreePath` when it is not empty.
 std::string predict(CaseSetup setup, const bp::object& sizing, const std::string& octreePath,
-                    const std::string& input, int threads, bool heal, bool solidsOnly,
-                    bool surface) {
+                    const std::string& input, int threads, bool heal, const std::string& modes) {
   if (!sizing.is_none()) setup.options.sizing = sizingFrom(bp::extract<bp::dict>(sizing));
   setup.options.octreeOutput = octreePath;
   setup.options.threads = threads;
   setup.options.heal = heal;
-  setup.options.solidsOnly = solidsOnly;
-  setup.options.surface = surface;
+  applyCadModes(setup.options, modes);
   const ReleaseGil nogil;
   return predictReportJson(runSizingStage(setup.source, setup.options), input);
 }
@@ -439,14 +458,13 @@ std::string predict(CaseSetup setup, const bp::object& sizing, const std::string
 // "half_width" (L,), "delta" (L,) and "boundary" (L,) uint8 (1: the boundary passes through the
 // leaf), with "predicted_elements". For drawing the size field.
 bp::dict sizeField(const std::string& text, const std::string& name, const bp::object& sizing,
-                   int threads, bool heal, bool solidsOnly, bool surface) {
+                   int threads, bool heal, const std::string& modes) {
   CaseSetup setup;
   setup.source = CadSource::brepText(text, name);
   if (!sizing.is_none()) setup.options.sizing = sizingFrom(bp::extract<bp::dict>(sizing));
   setup.options.threads = threads;
   setup.options.heal = heal;
-  setup.options.solidsOnly = solidsOnly;
-  setup.options.surface = surface;
+  applyCadModes(setup.options, modes);
   std::vector<double> centre, half, delta;
   std::vector<std::uint8_t> boundary;
   double predicted = 0.0;
@@ -475,17 +493,17 @@ bp::dict sizeField(const std::string& text, const std::string& name, const bp::o
 
 // A CAD file or a NekMesh .mcf case (pipeline/case_setup.hpp).
 std::string predictFile(const std::string& path, const bp::object& sizing,
-                        const std::string& octreePath, int threads, bool heal, bool solidsOnly,
-                        bool surface) {
-  return predict(setupCase(path), sizing, octreePath, path, threads, heal, solidsOnly, surface);
+                        const std::string& octreePath, int threads, bool heal,
+                        const std::string& modes) {
+  return predict(setupCase(path), sizing, octreePath, path, threads, heal, modes);
 }
 
 std::string predictBrep(const std::string& text, const std::string& name, const bp::object& sizing,
-                        const std::string& octreePath, int threads, bool heal, bool solidsOnly,
-                        bool surface) {
+                        const std::string& octreePath, int threads, bool heal,
+                        const std::string& modes) {
   CaseSetup setup;
   setup.source = CadSource::brepText(text, name);
-  return predict(setup, sizing, octreePath, name, threads, heal, solidsOnly, surface);
+  return predict(setup, sizing, octreePath, name, threads, heal, modes);
 }
 
 // The parameter table (core/parameters.hpp) as a list of dicts: key, property, option, label,
@@ -577,11 +595,10 @@ int defaultRepairRounds() {
 PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
                 int verbosity, bp::object progress, int optimise, const bp::object& sizing,
                 int repairRounds, const bp::object& boundaryLayer, const bp::object& cancel,
-                const bp::object& limits, bool heal, bool solidsOnly, bool surface) {
+                const bp::object& limits, bool heal, const std::string& modes) {
   const CaseSetup setup = setupCase(path);
-  MeshingOptions options =
-      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds, boundaryLayer,
-                  limits, heal, solidsOnly, surface);
+  MeshingOptions options = makeOptions(order, size, threads, verbosity, optimise, sizing,
+                                       repairRounds, boundaryLayer, limits, heal, modes);
   if (!options.size && !options.sizing) options.sizing = setup.options.sizing;
   if (!options.boundaryLayer) options.boundaryLayer = setup.options.boundaryLayer;
   options.expectedDimension = setup.options.expectedDimension;
@@ -591,11 +608,11 @@ PyMesh meshFile(const std::string& path, int order, const bp::object& size, int 
 PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
                 int threads, int verbosity, bp::object progress, int optimise,
                 const bp::object& sizing, int repairRounds, const bp::object& boundaryLayer,
-                const bp::object& cancel, const bp::object& limits, bool heal, bool solidsOnly,
-                bool surface) {
+                const bp::object& cancel, const bp::object& limits, bool heal,
+                const std::string& modes) {
   return runPipeline(CadSource::brepText(text, name),
                      makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds,
-                                 boundaryLayer, limits, heal, solidsOnly, surface),
+                                 boundaryLayer, limits, heal, modes),
                      std::move(progress), cancel);
 }
 
@@ -780,28 +797,25 @@ BOOST_PYTHON_MODULE(_core) {
       .def("report_json", &PyMesh::reportJson)
       .def("optimise", &PyMesh::optimise);
 
-  bp::def(
-      "mesh_file", &meshFile,
-      (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"), bp::arg("verbosity"),
-       bp::arg("progress"), bp::arg("optimise") = 0, bp::arg("sizing") = bp::object(),
-       bp::arg("repair_rounds") = defaultRepairRounds(), bp::arg("boundary_layer") = bp::object(),
-       bp::arg("cancel") = bp::object(), bp::arg("limits") = bp::object(), bp::arg("heal") = true,
-       bp::arg("solids_only") = false, bp::arg("surface") = false));
+  bp::def("mesh_file", &meshFile,
+          (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
+           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
+           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = defaultRepairRounds(),
+           bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object(),
+           bp::arg("limits") = bp::object(), bp::arg("heal") = true, bp::arg("cad_modes") = ""));
   bp::def("mesh_brep", &meshBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
            bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
            bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = defaultRepairRounds(),
            bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object(),
-           bp::arg("limits") = bp::object(), bp::arg("heal") = true, bp::arg("solids_only") = false,
-           bp::arg("surface") = false));
+           bp::arg("limits") = bp::object(), bp::arg("heal") = true, bp::arg("cad_modes") = ""));
   bp::def("predict_file", &predictFile,
           (bp::arg("path"), bp::arg("sizing") = bp::object(), bp::arg("octree_path") = "",
-           bp::arg("threads") = 1, bp::arg("heal") = true, bp::arg("solids_only") = false,
-           bp::arg("surface") = false));
+           bp::arg("threads") = 1, bp::arg("heal") = true, bp::arg("cad_modes") = ""));
   bp::def("predict_brep", &predictBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
            bp::arg("octree_path") = "", bp::arg("threads") = 1, bp::arg("heal") = true,
-           bp::arg("solids_only") = false, bp::arg("surface") = false));
+           bp::arg("cad_modes") = ""));
   bp::def("parameters", &parameters);
   bp::def("parameter_in_range", &parameterInRange, (bp::arg("key"), bp::arg("value")));
   bp::def(
@@ -813,10 +827,9 @@ BOOST_PYTHON_MODULE(_core) {
           (bp::arg("path"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("order"),
            bp::arg("threads"), bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise"),
            bp::arg("cancel") = bp::object(), bp::arg("limits") = bp::object()));
-  bp::def(
-      "size_field", &sizeField,
-      (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(), bp::arg("threads") = 1,
-       bp::arg("heal") = true, bp::arg("solids_only") = false, bp::arg("surface") = false));
+  bp::def("size_field", &sizeField,
+          (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
+           bp::arg("threads") = 1, bp::arg("heal") = true, bp::arg("cad_modes") = ""));
   bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("threads") = 1));
   bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
   bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));

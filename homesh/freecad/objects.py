@@ -145,6 +145,12 @@ class HighOrderMeshProxy(_Proxy, ParameterGuard):
                             "faces meet (no volume, no optimiser, no boundary layer); off: such "
                             "a shape is refused, naming a free edge")
             obj.Surface = False
+        if "AutoMode" not in have:
+            obj.addProperty("App::PropertyBool", "AutoMode", "Mesh",
+                            "Let HOMesh choose for the shape: with solids, as SolidsOnly (faces "
+                            "in no solid left out and named); without a solid, as Surface; the "
+                            "report view says which. Not with SolidsOnly or Surface")
+            obj.AutoMode = False
         add_parameter_property(obj, "repair_rounds", "Mesh")
         add_parameter_property(obj, "threads", "Mesh", " Default: all cores.",
                                default=os.cpu_count() or 1)
@@ -267,6 +273,7 @@ def mesh_arguments(obj, values=None):
                  "heal": bool(values.get("Heal", getattr(obj, "Heal", True))),
                  "solids_only": bool(values.get("SolidsOnly", getattr(obj, "SolidsOnly", False))),
                  "surface": bool(values.get("Surface", getattr(obj, "Surface", False))),
+                 "auto": bool(values.get("AutoMode", getattr(obj, "AutoMode", False))),
                  "repair_rounds": int(get("RepairRounds")), "threads": int(get("Threads"))}
     sizing = values.get("Sizing", getattr(obj, "Sizing", None))
     if arguments["size"] is None and sizing is not None:
@@ -345,7 +352,8 @@ def predicted_elements(obj, job):
     report = homesh.predict(job.brep_text, name=job.name, threads=arguments["threads"],
                             heal=arguments.get("heal", True),
                             solids_only=arguments.get("solids_only", False),
-                            surface=arguments.get("surface", False), **sizing)
+                            surface=arguments.get("surface", False),
+                            auto=arguments.get("auto", False), **sizing)
     return int(report["predicted_elements"])
 
 

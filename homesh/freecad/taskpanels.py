@@ -26,7 +26,7 @@ _MESH_PARAMETERS = ("Order", "Size", "OptimiserIterations", "OptimiserTimeLimit"
 _SIZING_PARAMETERS = ("MinDelta", "MaxDelta", "Eps")
 # The CAD check's switches (boolean properties): check boxes under the parameters.
 _MESH_FLAGS = (("Heal", "Heal the CAD"), ("SolidsOnly", "Solids only"),
-               ("Surface", "Surface mesh (no solid)"))
+               ("Surface", "Surface mesh (no solid)"), ("AutoMode", "Choose for the shape"))
 
 
 _LAST = []

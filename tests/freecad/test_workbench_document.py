@@ -183,6 +183,17 @@ class HighOrderMeshObject(unittest.TestCase):
         self.assertIn("a surface mesh of its 1 face", mesh.report()["healing"]["surface"])
         radial = (mesh.nodes[:, 0] ** 2 + mesh.nodes[:, 1] ** 2) ** 0.5
         self.assertLess(float(abs(radial - 1.0).max()), 1e-9)
+        # AutoMode chooses the surface mesh itself, and says so; with Surface too it is refused.
+        obj.AutoMode = True
+        self.doc.recompute()
+        self.assertFalse(obj.isValid())
+        self.assertIn("chooses between --solids-only and --surface", obj.Status)
+        obj.Surface = False
+        self.doc.recompute()
+        self.assertTrue(obj.isValid(), obj.Status)
+        mesh = homesh.freecad.get_mesh(obj)
+        self.assertEqual(mesh.dim, 2)
+        self.assertIn("as --surface does", mesh.report()["healing"]["automatic"])
         # A Sizing object sizes the shell as a surface mesh: its triangles, from the tube's area
         # 4 pi over triangles of side 0.5 (about 116), and leaves on the tube to draw.
         sizing = homesh.freecad.make_sizing(self.doc, part, max_delta=0.5)

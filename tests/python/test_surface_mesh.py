@@ -127,6 +127,52 @@ def test_what_a_surface_mesh_cannot_be_is_refused(shell, data):
         homesh.mesh(str(shell), order=2, size=0.5, surface=True, solids_only=True)
 
 
+def test_automatic_mode_meshes_what_fits_and_says_which(homesh_bin, shell, data, tmp_path):
+    """--auto (Python auto=True, FreeCAD AutoMode): the shell gets the surface mesh --surface
+    gives it, a solid beside loose faces the volume mesh --solids-only gives, a sound solid
+    what it gets without the option; each says which in a note and the report."""
+    hostile = data / "hostile"
+    out, report = tmp_path / "s.msh", tmp_path / "r.json"
+    r = run([homesh_bin, "mesh", shell, "--auto", "--order", "3", "--size", "0.5", "-o", out,
+             "--report", report], timeout=300)
+    assert r.returncode == 0, r.stderr
+    rep = json.loads(report.read_text())
+    auto = rep["healing"]["automatic"]
+    assert "has no solid (its 2 faces do not close" in auto and "as --surface does" in auto, auto
+    assert "homesh: note: automatic mode: " in r.stderr, r.stderr
+    assert rep["elements"]["tri"] > 0 and rep["elements"]["tet"] == 0, rep["elements"]
+    assert rep["quality"]["invalid_elements"] == 0
+    # Curved on the CAD: within the curving's interpolation error of an order-3 edge of length
+    # about 0.5 on radius 1 (h^4 / (384 R^3) x 4! ~ 4e-3; nodes themselves to OCCT's 1e-7).
+    assert on_shell(meshio.read(out).points).max() < 5e-3
+
+    r = run([homesh_bin, "mesh", hostile / "solid_and_open_shell.step", "--auto", "--order",
+             "2", "--size", "0.25", "-o", out, "--report", report], timeout=300)
+    assert r.returncode == 0, r.stderr
+    rep = json.loads(report.read_text())
+    assert "as --solids-only does" in rep["healing"]["automatic"], rep["healing"]
+    assert "Face7-Face11" in rep["healing"]["left_out"], rep["healing"]
+    assert rep["elements"]["tet"] > 0 and rep["elements"]["tri"] == 0, rep["elements"]
+    points = meshio.read(out).points  # the unit box alone, to the CAD's tolerance
+    assert points[:, 0].min() > -1e-6 and points[:, 0].max() < 1.0 + 1e-6
+
+    # The prediction is of the same choice: triangles of the shell.
+    r = run([homesh_bin, "predict", shell, "--auto", "--report", report], timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(report.read_text())["dimension"] == 2
+
+    # Python: a sound solid gets nothing to choose, and the modes exclude each other.
+    m = homesh.mesh(str(data / "box_hole.step"), order=2, size=1.0, auto=True)
+    assert m.dim == 3 and m.report()["healing"]["automatic"] == ""
+    with pytest.raises(homesh.ParameterError, match=r"automatic mode \(--auto\) chooses"):
+        homesh.mesh(str(shell), order=2, size=0.5, auto=True, surface=True)
+    with pytest.raises(homesh.ParameterError, match="has no solid: automatic mode"):
+        homesh.mesh(str(shell), order=2, size=0.5, auto=True,
+                    boundary_layer={"faces": [1], "thickness": 0.05})
+    r = run([homesh_bin, "mesh", shell, "--auto", "--solids-only", "-o", out], timeout=120)
+    assert r.returncode == 2 and "chooses between --solids-only and --surface" in r.stderr
+
+
 def test_predict_counts_the_surface_triangles(shell):
     p = homesh.predict(str(shell), min_delta=0.2, max_delta=0.2, eps=0.1, surface=True)
     # Tube 4 pi and cap 2 pi: 6 pi of area over triangles of side 0.2 (sqrt(3)/4 0.04 each).

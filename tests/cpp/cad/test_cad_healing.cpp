@@ -304,6 +304,69 @@ TEST(CadHealing, SolidsOnlySewsWhatClosesBesideSolidsAndLeavesOutTheRest) {
       << record.leftOut;
 }
 
+// Automatic mode picks, per model, what the refusals above name: a model with no solid (five
+// faces of a box, or loose faces of which only some close) becomes a surface of all its faces,
+// faces that all close become a solid as without it, a solid beside an open shell keeps the
+// solid (solids only), and a sound solid is left as it is with nothing said. With --surface or
+// --solids-only it is refused.
+TEST(CadHealing, AutomaticModeChoosesSurfaceOrSolidsOnlyAndSaysWhich) {
+  HealingOptions automatic;
+  automatic.automatic = true;
+
+  HealingRecord open;
+  const CadModel faces =
+      healModel(cadModelFromShape(looseFaces(false), "five faces"), automatic, open);
+  EXPECT_EQ(faces.numSolids(), 0);
+  EXPECT_EQ(faces.numFaces(), 5);
+  EXPECT_FALSE(open.surface.empty());
+  EXPECT_NE(open.automatic.find("five faces has no solid (its 5 faces do not close"),
+            std::string::npos)
+      << open.automatic;
+  EXPECT_NE(open.automatic.find("as --surface does"), std::string::npos) << open.automatic;
+  EXPECT_EQ(open.notes().front(), open.automatic);
+
+  TopoDS_Compound c;
+  BRep_Builder b;
+  b.MakeCompound(c);
+  addFaces(c, box(), 0.0, true);
+  addFaces(c, box(), 5.0, false);
+  HealingRecord some;
+  const CadModel kept = healModel(cadModelFromShape(c, "some close"), automatic, some);
+  EXPECT_EQ(kept.numSolids(), 0);
+  EXPECT_EQ(kept.numFaces(), 11);
+  EXPECT_TRUE(some.leftOut.empty()) << some.leftOut;
+  EXPECT_NE(some.automatic.find("sewing closed 1 of 2 shells"), std::string::npos)
+      << some.automatic;
+  EXPECT_NE(some.automatic.find("as --surface does"), std::string::npos) << some.automatic;
+
+  HealingRecord all;
+  const CadModel sewn = healModel(cadModelFromShape(looseFaces(true), "six"), automatic, all);
+  EXPECT_EQ(sewn.numSolids(), 1);
+  EXPECT_TRUE(all.surface.empty()) << all.surface;
+  EXPECT_TRUE(all.automatic.empty()) << all.automatic;
+
+  HealingRecord beside;
+  const CadModel solid =
+      healModel(cadModelFromShape(solidAndFaces(false), "open"), automatic, beside);
+  EXPECT_EQ(solid.numSolids(), 1);
+  EXPECT_NE(beside.leftOut.find("5 faces (Face7-Face11)"), std::string::npos) << beside.leftOut;
+  EXPECT_NE(beside.automatic.find("as --solids-only does"), std::string::npos) << beside.automatic;
+
+  HealingRecord sound;
+  const TopoDS_Shape shape = box();
+  const CadModel same = healModel(cadModelFromShape(shape, "box"), automatic, sound);
+  EXPECT_TRUE(occtShape(same).IsSame(shape));
+  EXPECT_TRUE(sound.automatic.empty()) << sound.automatic;
+  EXPECT_TRUE(sound.notes().empty());
+
+  for (const bool surface : {true, false}) {
+    HealingOptions both = automatic;
+    (surface ? both.surface : both.solidsOnly) = true;
+    HealingRecord record;
+    EXPECT_THROW(healModel(cadModelFromShape(box(), "box"), both, record), ParameterError);
+  }
+}
+
 // A loose shell that closes inside a solid (a void exported on its own) is no second solid:
 // the model is refused, not meshed as two solids; solids only meshes the solid and leaves the
 // shell out, saying why. (A shell on it, a surface copy of the body: the test below.)
