@@ -431,9 +431,11 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
               optimiser (a note says so when optimise > 0), no boundary layer. False: such a
               model is refused (:class:`CadError` naming a free edge).
     auto      for batch runs over files nobody looked at: a model with solids is meshed as
-              with solids_only, one without a solid as with surface (planar faces in one
-              plane stay 2D), and ``report()["healing"]["automatic"]`` and a note say which.
-              Not with solids_only or surface. False: such models are refused.
+              with solids_only; one without a solid is sewn into solids where every shell
+              closes (as without auto), else meshed as with surface (planar faces in one
+              plane stay 2D); ``report()["healing"]["automatic"]`` and a note say which.
+              Not with solids_only or surface. False: faces in no solid and open shells are
+              refused by name.
     repair_rounds
               at most this many repair rounds (0..20) while elements are not proven valid:
               each splits the offending linear elements' edges on curved CAD faces (or refines

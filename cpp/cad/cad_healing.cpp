@@ -2,6 +2,7 @@
 
 #include <BRepAdaptor_Curve.hxx>
 #include <BRepBndLib.hxx>
+#include <BRepBuilderAPI_Copy.hxx>
 #include <BRepBuilderAPI_Sewing.hxx>
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepClass3d_SolidClassifier.hxx>
@@ -581,23 +582,30 @@ CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& r
   bool solidInFile = false;
   for (int s = 1; s <= cad.numSolids() && !solidInFile; ++s)
     solidInFile = count(occtSolid(cad, s), TopAbs_FACE) > 0;
-  HealingOptions solids = options;
-  solids.automatic = false;
-  solids.solidsOnly = solidInFile;
   const std::string name = cad.sourceName();
-  try {
-    // (A model of the same shape: `cad` stays for the surface attempt.)
-    CadModel healed = healAs(cadModelFromShape(occtShape(cad), name), solids, record);
+  HealingOptions first = options;
+  first.automatic = false;
+  if (solidInFile) {
+    first.solidsOnly = true;
+    CadModel healed = healAs(std::move(cad), first, record);
     if (!record.leftOut.empty() && !record.leftOutCopies)
       record.automatic = "automatic mode: " + name +
                          " is meshed as its solids, the faces in no solid left out (as "
                          "--solids-only does)";
     return healed;
+  }
+  try {
+    // On a copy: the fixes of a failed attempt (tolerances widened in place) stay out of the
+    // surface attempt, which starts from the file's own shape.
+    return healAs(cadModelFromShape(BRepBuilderAPI_Copy(occtShape(cad)).Shape(), name), first,
+                  record);
   } catch (const NoSolidError& e) {
+    const double firstSeconds = record.seconds;
     HealingOptions faces = options;
     faces.automatic = false;
     faces.surface = true;
     CadModel healed = healAs(std::move(cad), faces, record);
+    record.seconds += firstSeconds;
     record.automatic = "automatic mode: " + name + " has no solid (" + e.why +
                        "), so its faces get a surface mesh, as --surface does";
     return healed;
@@ -709,17 +717,19 @@ CadModel healAs(CadModel cad, const HealingOptions& options, HealingRecord& reco
   if (solids.Extent() == 0 && !planar) {
     const int edge = firstFreeEdge(shape, edges);
     // Some shells closed: the option that meshes them and leaves the others out is worth naming.
-    const std::string why =
-        (cad.numFaces() == 1 ? std::string("its one face does not close")
-                             : "its " + std::to_string(cad.numFaces()) + " faces do not close") +
-        (edge != 0 ? " (" + cadEntityName(1, edge) + " bounds only one face)" : "") + healed;
+    const std::string notClosed =
+        cad.numFaces() == 1 ? std::string("its one face does not close")
+                            : "its " + std::to_string(cad.numFaces()) + " faces do not close";
+    // (Automatic mode's note leaves the edge out: it is numbered in this attempt's model.)
     throw NoSolidError(
-        why, cad.sourceName() + " is not a closed solid: it has no solid, and " + why +
-                 "; HOMesh meshes solids, planar faces in one plane (2D), or the faces alone "
-                 "as a surface mesh: --surface (Python surface=True, FreeCAD Surface)" +
-                 (record.sewnSolids > 0 && !options.solidsOnly
-                      ? "; " + solidsOnlyOption + " meshes the closed shells alone"
-                      : std::string()));
+        notClosed + healed,
+        cad.sourceName() + " is not a closed solid: it has no solid, and " + notClosed +
+            (edge != 0 ? " (" + cadEntityName(1, edge) + " bounds only one face)" : "") + healed +
+            "; HOMesh meshes solids, planar faces in one plane (2D), or the faces alone "
+            "as a surface mesh: --surface (Python surface=True, FreeCAD Surface)" +
+            (record.sewnSolids > 0 && !options.solidsOnly
+                 ? "; " + solidsOnlyOption + " meshes the closed shells alone"
+                 : std::string()));
   }
   // Faces beside the solids would not be meshed: refused, or left out and recorded.
   const LooseFaces loose = solids.Extent() > 0 ? facesInNoSolid(shape) : LooseFaces{};

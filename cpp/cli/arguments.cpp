@@ -415,9 +415,10 @@ options:
                       surface mesh of its faces, triangles curved on the CAD, sewn where
                       faces meet; no volume, no optimiser, no boundary layer
       --auto          for batch runs over files nobody looked at: a model with solids is
-                      meshed as with --solids-only, one without a solid as with --surface
-                      (planar faces stay 2D); a note says which. Without it such models
-                      are refused, naming what is not a closed solid
+                      meshed as with --solids-only; one without a solid is sewn into solids
+                      where every shell closes (as without --auto), else meshed as with
+                      --surface (planar faces stay 2D); a note says which. Without it, faces
+                      in no solid and open shells are refused by name
       --linear-time-limit S  Gmsh's linear meshing (in a process of its own) is stopped after
                       S seconds and the run fails (default 600; 0: no limit)
       --job-time-limit S  the whole job's wall time: Gmsh and the optimiser get at most what

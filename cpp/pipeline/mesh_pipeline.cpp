@@ -108,7 +108,8 @@ void checkRenumbering(const HealingRecord& healing, const MeshingOptions& option
   if (what.empty()) return;
   if (healing.actions.empty())  // renumbered by leaving faces out alone
     throw ParameterError(
-        "leaving out the faces in no solid (--solids-only) numbered the CAD's "
+        "leaving out the faces in no solid (--solids-only, or --auto's choice of it) numbered "
+        "the CAD's "
         "faces and edges afresh, and " +
         what +
         " is given in the original numbering: make a solid of those faces, or "
@@ -122,6 +123,7 @@ void checkRenumbering(const HealingRecord& healing, const MeshingOptions& option
 }  // namespace
 
 SizingResult runSizingStage(const CadSource& source, const MeshingOptions& options) {
+  options.healing().validate();  // before the (possibly slow) CAD import
   HealingRecord healing;
   const CadModel cad = healModel(source.load(), options.healing(), healing);
   checkRenumbering(healing, options);

@@ -148,8 +148,9 @@ class HighOrderMeshProxy(_Proxy, ParameterGuard):
         if "AutoMode" not in have:
             obj.addProperty("App::PropertyBool", "AutoMode", "Mesh",
                             "Let HOMesh choose for the shape: with solids, as SolidsOnly (faces "
-                            "in no solid left out and named); without a solid, as Surface; the "
-                            "report view says which. Not with SolidsOnly or Surface")
+                            "in no solid left out and named); without a solid, sewn into solids "
+                            "where every shell closes, else as Surface; the report view says "
+                            "which. Not with SolidsOnly or Surface")
             obj.AutoMode = False
         add_parameter_property(obj, "repair_rounds", "Mesh")
         add_parameter_property(obj, "threads", "Mesh", " Default: all cores.",

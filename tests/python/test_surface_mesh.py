@@ -169,8 +169,9 @@ def test_automatic_mode_meshes_what_fits_and_says_which(homesh_bin, shell, data,
     with pytest.raises(homesh.ParameterError, match="has no solid: automatic mode"):
         homesh.mesh(str(shell), order=2, size=0.5, auto=True,
                     boundary_layer={"faces": [1], "thickness": 0.05})
-    r = run([homesh_bin, "mesh", shell, "--auto", "--solids-only", "-o", out], timeout=120)
-    assert r.returncode == 2 and "chooses between --solids-only and --surface" in r.stderr
+    for command in ("mesh", "predict"):
+        r = run([homesh_bin, command, shell, "--auto", "--solids-only"], timeout=120)
+        assert r.returncode == 2 and "chooses between --solids-only and --surface" in r.stderr
 
 
 def test_predict_counts_the_surface_triangles(shell):
