@@ -559,6 +559,14 @@ class NoSolidError : public CadError {
 
 CadModel healAs(CadModel cad, const HealingOptions& options, HealingRecord& record);
 
+// The solids of `cad` that have a face (empty ones, which healing removes, do not count).
+int solidsWithFaces(const CadModel& cad) {
+  int n = 0;
+  for (int s = 1; s <= cad.numSolids(); ++s)
+    if (count(occtSolid(cad, s), TopAbs_FACE) > 0) ++n;
+  return n;
+}
+
 }  // namespace
 
 void HealingOptions::validate() const {
@@ -579,9 +587,7 @@ CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& r
   // made solids where every shell closes, else a surface (not a solid of the shells that
   // close with the rest left out: surface_filling.step's one closed shell is no solid Gmsh
   // can mesh, and a model of faces alone loses none of them this way).
-  bool solidInFile = false;
-  for (int s = 1; s <= cad.numSolids() && !solidInFile; ++s)
-    solidInFile = count(occtSolid(cad, s), TopAbs_FACE) > 0;
+  const bool solidInFile = solidsWithFaces(cad) > 0;
   const std::string name = cad.sourceName();
   HealingOptions first = options;
   first.automatic = false;
@@ -625,25 +631,23 @@ CadModel healAs(CadModel cad, const HealingOptions& options, HealingRecord& reco
   record.facesBefore = record.facesAfter = cad.numFaces();
   record.solidsBefore = record.solidsAfter = cad.numSolids();
   // (Solids without a face are removed below: they do not count.)
-  int solidsWithFaces = 0;
-  for (int s = 1; s <= cad.numSolids(); ++s)
-    if (count(occtSolid(cad, s), TopAbs_FACE) > 0) ++solidsWithFaces;
-  if (options.surface && solidsWithFaces > 0)
-    throw CadError(cad.sourceName() + " has " + std::to_string(solidsWithFaces) +
-                   (solidsWithFaces == 1 ? " solid" : " solids") +
+  const int withFaces = solidsWithFaces(cad);
+  if (options.surface && withFaces > 0)
+    throw CadError(cad.sourceName() + " has " + std::to_string(withFaces) +
+                   (withFaces == 1 ? " solid" : " solids") +
                    ": a surface mesh (--surface, Python surface=True, FreeCAD Surface) is for a "
                    "model of faces alone; without it the solids get a volume mesh");
   // Faces not meant to be sewn into a solid: planar ones in one plane (a 2D case), or any when
   // a surface mesh is asked for.
   bool planar = false;
-  if (solidsWithFaces == 0 && cad.numFaces() > 0) {
+  if (withFaces == 0 && cad.numFaces() > 0) {
     try {
       Eigen::Vector3d normal = Eigen::Vector3d::Zero();
       planar = modelMeshDimension(cad, normal) == 2 && !normal.isZero();
     } catch (const CadError&) {  // (OCCT could not give a face's plane: reported below)
     }
   }
-  const bool faces = planar || (options.surface && solidsWithFaces == 0);
+  const bool faces = planar || (options.surface && withFaces == 0);
   // A check that fails (OCCT cannot measure an edge, say) is recorded, not fatal: the model is
   // then meshed as it is, and a stage that cannot handle it says so.
   Findings found;

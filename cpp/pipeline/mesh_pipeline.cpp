@@ -109,8 +109,7 @@ void checkRenumbering(const HealingRecord& healing, const MeshingOptions& option
   if (healing.actions.empty())  // renumbered by leaving faces out alone
     throw ParameterError(
         "leaving out the faces in no solid (--solids-only, or --auto's choice of it) numbered "
-        "the CAD's "
-        "faces and edges afresh, and " +
+        "the CAD's faces and edges afresh, and " +
         what +
         " is given in the original numbering: make a solid of those faces, or "
         "remove them, in the CAD file");

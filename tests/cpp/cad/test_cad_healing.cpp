@@ -249,6 +249,17 @@ void addFaces(TopoDS_Compound& c, const TopoDS_Shape& shape, double dx, bool all
     if (all || ++k < total) b.Add(c, f.Current().Moved(TopLoc_Location(shift)));
 }
 
+// The faces of a box, loose, and beside them at x 5..6 those of another but its last: one
+// shell that sewing closes and one that it cannot.
+TopoDS_Shape closedAndOpenFaces() {
+  TopoDS_Compound c;
+  BRep_Builder b;
+  b.MakeCompound(c);
+  addFaces(c, box(), 0.0, true);
+  addFaces(c, box(), 5.0, false);
+  return c;
+}
+
 // healModel with healing on and without solids only refuses `shape`, saying `why`.
 void expectRefused(const TopoDS_Shape& shape, const std::string& name, const std::string& why) {
   HealingRecord record;
@@ -263,11 +274,7 @@ void expectRefused(const TopoDS_Shape& shape, const std::string& name, const std
 // Loose faces of which only some close: refused with the option named; solids only meshes the
 // closed shell and records the rest.
 TEST(CadHealing, SolidsOnlyKeepsTheShellsThatCloseAndRecordsTheRest) {
-  TopoDS_Compound c;
-  BRep_Builder b;
-  b.MakeCompound(c);
-  addFaces(c, box(), 0.0, true);
-  addFaces(c, box(), 5.0, false);
+  const TopoDS_Shape c = closedAndOpenFaces();
   HealingRecord refused;
   try {
     healModel(cadModelFromShape(c, "some close"), {}, refused);
@@ -325,13 +332,9 @@ TEST(CadHealing, AutomaticModeChoosesSurfaceOrSolidsOnlyAndSaysWhich) {
   EXPECT_NE(open.automatic.find("as --surface does"), std::string::npos) << open.automatic;
   EXPECT_EQ(open.notes().front(), open.automatic);
 
-  TopoDS_Compound c;
-  BRep_Builder b;
-  b.MakeCompound(c);
-  addFaces(c, box(), 0.0, true);
-  addFaces(c, box(), 5.0, false);
   HealingRecord some;
-  const CadModel kept = healModel(cadModelFromShape(c, "some close"), automatic, some);
+  const CadModel kept =
+      healModel(cadModelFromShape(closedAndOpenFaces(), "some close"), automatic, some);
   EXPECT_EQ(kept.numSolids(), 0);
   EXPECT_EQ(kept.numFaces(), 11);
   EXPECT_TRUE(some.leftOut.empty()) << some.leftOut;
