@@ -142,9 +142,10 @@ def test_automatic_mode_meshes_what_fits_and_says_which(homesh_bin, shell, data,
     assert "homesh: note: automatic mode: " in r.stderr, r.stderr
     assert rep["elements"]["tri"] > 0 and rep["elements"]["tet"] == 0, rep["elements"]
     assert rep["quality"]["invalid_elements"] == 0
-    # Curved on the CAD: within the curving's interpolation error of an order-3 edge of length
-    # about 0.5 on radius 1 (h^4 / (384 R^3) x 4! ~ 4e-3; nodes themselves to OCCT's 1e-7).
-    assert on_shell(meshio.read(out).points).max() < 5e-3
+    # Every node on the CAD: evaluated there, written with 17 digits (as the --surface test).
+    m = meshio.read(out)
+    used = np.unique(np.concatenate([c.data.ravel() for c in m.cells]))
+    assert on_shell(m.points[used]).max() < 1e-9
 
     r = run([homesh_bin, "mesh", hostile / "solid_and_open_shell.step", "--auto", "--order",
              "2", "--size", "0.25", "-o", out, "--report", report], timeout=300)
