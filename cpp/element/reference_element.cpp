@@ -2,24 +2,20 @@
 
 #include <Eigen/LU>
 #include <cmath>
-#include <map>
 #include <memory>
-#include <mutex>
 #include <string>
-#include <tuple>
 
 #include "core/error.hpp"
+#include "element/cell_table_cache.hpp"
 #include "element/orthogonal_basis.hpp"
 
 namespace homesh {
 
 const ReferenceElement& ReferenceElement::get(CellType type, int order, NodeSet set) {
-  static std::mutex mutex;
-  static std::map<std::tuple<CellType, int, NodeSet>, std::unique_ptr<ReferenceElement>> cache;
-  const std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[{type, order, set}];
-  if (!slot) slot = std::make_unique<ReferenceElement>(type, order, set);
-  return *slot;
+  static CellTableCache<ReferenceElement, 2> cache;  // variants: the node sets
+  return cache.get(
+      type, order, [&] { return std::make_unique<ReferenceElement>(type, order, set); },
+      static_cast<int>(set));
 }
 
 ReferenceElement::ReferenceElement(CellType type, int order, NodeSet set)

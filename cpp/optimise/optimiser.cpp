@@ -10,12 +10,14 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <string>
 #include <utility>
 
 #include "cad/cad_model.hpp"
 #include "core/error.hpp"
 #include "core/first_failure.hpp"
+#include "core/spatial_order.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 #include "optimise/cad_local_model.hpp"
@@ -158,14 +160,19 @@ class Optimiser {
   using Mat = Eigen::Matrix<double, D, D>;
   using Vec = Eigen::Matrix<double, D, 1>;
 
+  // `order`: the renumbering `mesh` has been given (applied), whose original numbers the
+  // sequential choices follow (see nodeRank_); null: the mesh's own numbers.
   Optimiser(Mesh& mesh, const OptimiserOptions& options, OptimiserObserver* observer,
-            const CadModel* cad, const QualitySummary* startQuality = nullptr)
+            const CadModel* cad, const QualitySummary* startQuality = nullptr,
+            const SpatialOrder* order = nullptr)
       : mesh_(mesh),
         options_(options),
         observer_(observer),
         cad_(cad),
         startQuality_(startQuality),
-        converting_(cad == nullptr && !options.regionThreshold && options.regionSeed.empty()) {}
+        converting_(cad == nullptr && !options.regionThreshold && options.regionSeed.empty()),
+        nodeRank_(order != nullptr ? &order->originalNodes() : nullptr),
+        elementRank_(order != nullptr ? &order->originalElements() : nullptr) {}
 
   OptimiserResult run() {
     const auto t0 = Clock::now();
@@ -293,6 +300,7 @@ class Optimiser {
     partition();
     changed_.resize(totalElements_);
     for (std::size_t i = 0; i < totalElements_; ++i) changed_[i] = i;
+    setEnergyOrder();
     computeGradients();
   }
 
@@ -358,6 +366,14 @@ class Optimiser {
   // with a region, where a fixed node of an element at the region's edge would otherwise change
   // its equispaced position with its free neighbours' working nodes.
   const bool converting_;
+  // The caller's number of each node and element (global index) where the mesh was renumbered
+  // for locality (optimiseMesh); null: the mesh's own. The choices made in sequence follow
+  // them: the greedy colouring visits the nodes in the caller's order, a node's elements are
+  // listed (and its patch summed) in it, a node shared by elements takes its working position
+  // from the caller's last one, and the total energy is summed in it. So the renumbering
+  // changes where data lies, never a result, to the last bit.
+  const std::vector<std::int64_t>* nodeRank_;
+  const std::vector<std::size_t>* elementRank_;
   std::vector<CadModel> cadPerThread_;  // evaluation caches are per thread
   std::vector<std::uint8_t> slide_;     // per node: 1 on a CAD curve, 2 on a CAD face, else 0
   std::vector<std::int32_t> cadSlot_;   // per node: its index in cadModel_, -1 if it stays
@@ -383,7 +399,8 @@ class Optimiser {
   std::vector<double> estimate_;  // and an upper bound (from values of J found)
   std::vector<char> tight_;       // scaled_ refined to kJacobianBoundTolerance (see evaluate)
   std::vector<Validity> validity_;
-  std::vector<std::size_t> changed_;  // elements with a free node
+  std::vector<std::size_t> changed_;      // elements with a free node
+  std::vector<std::size_t> energyOrder_;  // see setEnergyOrder()
   // Per element: kStale = a node moved since its quality was last computed, kDrifted = since
   // its F was last computed from the nodes. Set by relax() (atomics: threads mark shared
   // elements), cleared by the sweep.
@@ -487,18 +504,30 @@ class Optimiser {
 
   // The same polynomial maps through the working node set's nodes (shared nodes get the same
   // value from every element: the trace on a shared face depends on the face's nodes only).
+  // `elements` (global indices) in the caller's order (see nodeRank_).
+  std::vector<std::size_t> inCallersOrder(std::vector<std::size_t> elements) const {
+    if (elementRank_ != nullptr)
+      std::sort(elements.begin(), elements.end(), [&](std::size_t a, std::size_t b) {
+        return (*elementRank_)[a] < (*elementRank_)[b];
+      });
+    return elements;
+  }
+
   void convertToWorkingSet() {
     if (!converting_) return;
     std::vector<Vec> working = position_;
-    for (const Block<D>& b : blocks_)
-      for (std::size_t e = 0; e < b.cells->count(); ++e) {
-        const std::int64_t* v = b.cells->element(e);
-        for (int i = 0; i < b.nodes; ++i) {
-          Vec x = Vec::Zero();
-          for (int j = 0; j < b.nodes; ++j) x += b.toWorking(i, j) * position_[v[j]];
-          working[v[i]] = x;
-        }
+    std::vector<std::size_t> all(totalElements_);
+    std::iota(all.begin(), all.end(), std::size_t{0});
+    for (const std::size_t g : inCallersOrder(std::move(all))) {
+      const auto [bi, e] = locate(g);
+      const Block<D>& b = blocks_[bi];
+      const std::int64_t* v = b.cells->element(e);
+      for (int i = 0; i < b.nodes; ++i) {
+        Vec x = Vec::Zero();
+        for (int j = 0; j < b.nodes; ++j) x += b.toWorking(i, j) * position_[v[j]];
+        working[v[i]] = x;
       }
+    }
     position_.swap(working);
   }
 
@@ -517,6 +546,13 @@ class Optimiser {
         for (int k = 0; k < b.nodes; ++k) incidence_[fill[v[k]]++] = {static_cast<int>(bi), k, e};
       }
     }
+    if (elementRank_ != nullptr)
+      for (std::size_t n = 0; n < nn; ++n)
+        std::sort(incidence_.begin() + static_cast<std::ptrdiff_t>(incidenceStart_[n]),
+                  incidence_.begin() + static_cast<std::ptrdiff_t>(incidenceStart_[n + 1]),
+                  [&](const Incidence& a, const Incidence& b) {
+                    return (*elementRank_)[globalIndex(a)] < (*elementRank_)[globalIndex(b)];
+                  });
     nodeSize_.assign(nn, std::numeric_limits<double>::infinity());
     for (const Block<D>& b : blocks_)
       for (std::size_t e = 0; e < b.cells->count(); ++e) {
@@ -618,6 +654,7 @@ class Optimiser {
     result_.freeNodes = free_.size();
     for (std::size_t i = 0; i < totalElements_; ++i)
       if (touched[i] != 0) changed_.push_back(i);
+    setEnergyOrder();
   }
 
   // With CAD: nodes on a CAD curve (face, in 3D) move along it in t ((u, v)), nodes inside the
@@ -659,7 +696,13 @@ class Optimiser {
     colourOf_.assign(mesh_.numNodes(), -1);
     std::vector<std::size_t> stamp;  // stamp[c] == node + 1: colour c is taken by a neighbour
     int colours = 0;
-    for (const std::int64_t node : free_) {
+    std::vector<std::int64_t> visit = free_;
+    if (nodeRank_ != nullptr)
+      std::sort(visit.begin(), visit.end(), [&](std::int64_t a, std::int64_t b) {
+        return (*nodeRank_)[static_cast<std::size_t>(a)] <
+               (*nodeRank_)[static_cast<std::size_t>(b)];
+      });
+    for (const std::int64_t node : visit) {
       for (std::size_t k = incidenceStart_[node]; k < incidenceStart_[node + 1]; ++k) {
         const Incidence& inc = incidence_[k];
         const std::int64_t* v = blocks_[inc.block].cells->element(inc.element);
@@ -697,6 +740,16 @@ class Optimiser {
       for (std::size_t p = 1; p < begin.size(); ++p) starts.push_back(base + begin[p]);
     }
     return nodes;
+  }
+
+  // The positions in changed_ in the caller's order of their elements, for totalEnergy().
+  void setEnergyOrder() {
+    energyOrder_.resize(changed_.size());
+    std::iota(energyOrder_.begin(), energyOrder_.end(), std::size_t{0});
+    if (elementRank_ != nullptr)
+      std::sort(energyOrder_.begin(), energyOrder_.end(), [&](std::size_t a, std::size_t b) {
+        return (*elementRank_)[changed_[a]] < (*elementRank_)[changed_[b]];
+      });
   }
 
   // One part per thread, by recursive coordinate bisection of the elements' centroids weighted
@@ -767,11 +820,15 @@ class Optimiser {
     computeGradients(changed_);
   }
   void computeGradients(const std::vector<std::size_t>& elements) {
-    std::vector<Eigen::Matrix<double, D, Eigen::Dynamic>> scratchX(options_.threads),
-        scratchDx(options_.threads);
+    // One cache line or more per thread: resizing writes a matrix's header, and headers of two
+    // threads in one line would move it between the CPUs at every element.
+    struct alignas(64) Scratch {
+      Eigen::Matrix<double, D, Eigen::Dynamic> x, dx;
+    };
+    std::vector<Scratch> scratch(static_cast<std::size_t>(options_.threads));
     forEachOwned(elements, 16, [&](std::size_t i, int thread) {
-      auto& x = scratchX[static_cast<std::size_t>(thread)];
-      auto& dx = scratchDx[static_cast<std::size_t>(thread)];
+      auto& x = scratch[static_cast<std::size_t>(thread)].x;
+      auto& dx = scratch[static_cast<std::size_t>(thread)].dx;
       const auto [bi, e] = locate(elements[i]);
       Block<D>& b = blocks_[bi];
       const std::int64_t* v = b.cells->element(e);
@@ -1347,7 +1404,7 @@ class Optimiser {
       });
     });
     double total = 0.0;
-    for (const double x : energy) total += x;
+    for (const std::size_t i : energyOrder_) total += energy[i];
     return total;
   }
 
@@ -1373,10 +1430,38 @@ OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
     throw ParameterError(
         "the optimiser handles volume meshes and planar 2D meshes, not a surface mesh "
         "(triangles on curved faces in 3D)");
-  if (mesh.dim == 3) return Optimiser<3>(mesh, options, observer, cad, startQuality).run();
-  if (mesh.dim == 2) return Optimiser<2>(mesh, options, observer, cad, startQuality).run();
-  throw ParameterError("the optimiser needs a 2D or 3D mesh, got dimension " +
-                       std::to_string(mesh.dim));
+  if (mesh.dim != 2 && mesh.dim != 3)
+    throw ParameterError("the optimiser needs a 2D or 3D mesh, got dimension " +
+                         std::to_string(mesh.dim));
+  if (!options.spatialOrder)
+    return mesh.dim == 3 ? Optimiser<3>(mesh, options, observer, cad, startQuality).run()
+                         : Optimiser<2>(mesh, options, observer, cad, startQuality).run();
+  // The sweeps run on the mesh renumbered along a space-filling curve (OptimiserOptions::
+  // spatialOrder), with the per-node and per-element options and the caller's quality
+  // renumbered alongside; the caller's numbering is restored whatever happens.
+  const SpatialOrder order(mesh);
+  OptimiserOptions local = options;
+  local.fixedNodes = order.nodeValues(options.fixedNodes, 1);
+  local.normalLocked = order.nodeValues(options.normalLocked, 3);
+  local.regionSeed = order.elementValues(options.regionSeed);
+  QualitySummary known;  // the arrays takeStartQuality() reads
+  if (startQuality != nullptr) {
+    known.scaledJacobian = order.elementValues(startQuality->scaledJacobian);
+    known.scaledJacobianUpper = order.elementValues(startQuality->scaledJacobianUpper);
+    known.validity = order.elementValues(startQuality->validity);
+  }
+  const QualitySummary* start = startQuality != nullptr ? &known : nullptr;
+  order.apply(mesh);
+  try {
+    OptimiserResult result = mesh.dim == 3
+                                 ? Optimiser<3>(mesh, local, observer, cad, start, &order).run()
+                                 : Optimiser<2>(mesh, local, observer, cad, start, &order).run();
+    order.restore(mesh);
+    return result;
+  } catch (...) {
+    order.restore(mesh);
+    throw;
+  }
 }
 
 class NodeEnergyProbe::Impl {

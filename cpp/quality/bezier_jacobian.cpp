@@ -5,13 +5,12 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <memory>
-#include <mutex>
 #include <utility>
 #include <vector>
 
 #include "core/error.hpp"
+#include "element/cell_table_cache.hpp"
 #include "quality/bernstein.hpp"
 
 namespace homesh {
@@ -128,12 +127,7 @@ Eigen::MatrixXd lagrangeToBezier(const ReferenceElement& ref, const BernsteinSpa
   return out;
 }
 
-const BezierTables& tables(CellType type, int order) {
-  static std::mutex mutex;
-  static std::map<std::pair<CellType, int>, std::unique_ptr<BezierTables>> cache;
-  const std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[{type, order}];
-  if (slot) return *slot;
+std::unique_ptr<BezierTables> buildTables(CellType type, int order) {
   auto t = std::make_unique<BezierTables>();
   const ReferenceElement& ref = ReferenceElement::get(type, order);
   const int n = ref.numNodes(), dim = ref.dim();
@@ -177,8 +171,12 @@ const BezierTables& tables(CellType type, int order) {
   t->cornerOffsets = cornerOffsets(jacobian->factors());
   for (int j = 0; j < jacobian->size(); ++j)
     if (jacobian->isCorner(j)) t->corners.push_back(j);
-  slot = std::move(t);
-  return *slot;
+  return t;
+}
+
+const BezierTables& tables(CellType type, int order) {
+  static CellTableCache<BezierTables> cache;
+  return cache.get(type, order, [&] { return buildTables(type, order); });
 }
 
 // Bezier coefficients of J on the whole element for nodal coordinates x.

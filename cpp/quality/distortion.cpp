@@ -5,10 +5,9 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <memory>
-#include <mutex>
 
+#include "element/cell_table_cache.hpp"
 #include "element/quadrature.hpp"
 
 namespace homesh {
@@ -71,11 +70,8 @@ Eigen::MatrixXd stackedDerivatives(const ReferenceElement& ref, const Eigen::Mat
 }
 
 const DistortionSamplers& samplers(CellType type, int order) {
-  static std::mutex mutex;
-  static std::map<std::pair<CellType, int>, std::unique_ptr<DistortionSamplers>> cache;
-  const std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[{type, order}];
-  if (!slot) {
+  static CellTableCache<DistortionSamplers> cache;
+  return cache.get(type, order, [&] {
     const ReferenceElement& ref = ReferenceElement::get(type, order);
     const QuadratureRule rule = quadratureRule(type, order);
     const int dim = ref.dim();
@@ -84,11 +80,10 @@ const DistortionSamplers& samplers(CellType type, int order) {
       for (int k = 0; k < dim; ++k)
         points(q, k) = rule.points[static_cast<std::size_t>(q) * dim + k];
     points.bottomRows(ref.numNodes()) = ref.nodes();
-    slot = std::make_unique<DistortionSamplers>(
+    return std::make_unique<DistortionSamplers>(
         DistortionSamplers{dim, static_cast<int>(points.rows()), stackedDerivatives(ref, points),
                            stackedDerivatives(ReferenceElement::get(type, 1), points)});
-  }
-  return *slot;
+  });
 }
 
 }  // namespace

@@ -1,9 +1,8 @@
 #include "quality/element_measure.hpp"
 
-#include <map>
 #include <memory>
-#include <mutex>
 
+#include "element/cell_table_cache.hpp"
 #include "element/quadrature.hpp"
 #include "quality/mesh_quality.hpp"
 
@@ -32,12 +31,9 @@ int jacobianDegree(CellType type, int p) {
 }
 
 const MeasureRule& rule(CellType type, int order) {
-  static std::mutex mutex;
-  static std::map<std::pair<CellType, int>, std::unique_ptr<MeasureRule>> cache;
-  const std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[{type, order}];
-  if (!slot) {
-    slot = std::make_unique<MeasureRule>();
+  static CellTableCache<MeasureRule> cache;
+  return cache.get(type, order, [&] {
+    auto slot = std::make_unique<MeasureRule>();
     slot->rule = quadratureRule(type, jacobianDegree(type, order));
     const int dim = cellDimension(type);
     Eigen::MatrixXd points(slot->rule.size(), dim);
@@ -45,8 +41,8 @@ const MeasureRule& rule(CellType type, int order) {
       for (int k = 0; k < dim; ++k)
         points(q, k) = slot->rule.points[static_cast<std::size_t>(q) * dim + k];
     slot->sampler = std::make_unique<JacobianSampler>(ReferenceElement::get(type, order), points);
-  }
-  return *slot;
+    return slot;
+  });
 }
 
 }  // namespace
