@@ -1274,28 +1274,38 @@ class Optimiser {
     for (std::size_t i = 0; i < mesh_.numNodes(); ++i) active_[i].store(1);
   }
 
-  // The free nodes' equispaced positions into mesh_.xyz (in 2D only their in-plane part moves).
+  // The free nodes' equispaced positions into mesh_.xyz (in 2D only their in-plane part moves),
+  // each node by its part's thread (free_ is grouped by colour, then part), which reads and
+  // writes its data in the sweeps.
   void writeBack() {
-    const std::int64_t* freeNodes = free_.data();
-#pragma omp parallel for num_threads(options_.threads) schedule(static)
-    for (std::int64_t i = 0; i < static_cast<std::int64_t>(free_.size()); ++i) {
-      const std::int64_t node = freeNodes[i];
-      Vec x = position_[node];
-      if (converting_) {
-        const Incidence& inc = incidence_[incidenceStart_[node]];
-        const Block<D>& b = blocks_[inc.block];
-        const std::int64_t* v = b.cells->element(inc.element);
-        x.setZero();
-        for (int j = 0; j < b.nodes; ++j) x += b.toEquispaced(inc.local, j) * position_[v[j]];
-      } else if constexpr (D == 3) {
-        for (int c = 0; c < 3; ++c) mesh_.xyz[3 * node + c] = x[c];  // exactly the CAD point
-        start_[node] = x;
-        continue;
+    const auto colours = (colourStart_.size() - 1) / static_cast<std::size_t>(parts_);
+#pragma omp parallel num_threads(options_.threads)
+    {
+      const auto me = static_cast<std::size_t>(omp_get_thread_num());
+      for (std::size_t c = 0; c < colours && me < static_cast<std::size_t>(parts_); ++c) {
+        const std::size_t range = c * static_cast<std::size_t>(parts_) + me;
+        for (std::size_t i = colourStart_[range]; i < colourStart_[range + 1]; ++i)
+          writeBack(free_[i]);
       }
-      const Eigen::Vector3d d = frame_.transpose() * (x - start_[node]);
-      for (int c = 0; c < 3; ++c) mesh_.xyz[3 * node + c] += d[c];
-      start_[node] = x;
     }
+  }
+
+  void writeBack(std::int64_t node) {
+    Vec x = position_[node];
+    if (converting_) {
+      const Incidence& inc = incidence_[incidenceStart_[node]];
+      const Block<D>& b = blocks_[inc.block];
+      const std::int64_t* v = b.cells->element(inc.element);
+      x.setZero();
+      for (int j = 0; j < b.nodes; ++j) x += b.toEquispaced(inc.local, j) * position_[v[j]];
+    } else if constexpr (D == 3) {
+      for (int c = 0; c < 3; ++c) mesh_.xyz[3 * node + c] = x[c];  // exactly the CAD point
+      start_[node] = x;
+      return;
+    }
+    const Eigen::Vector3d d = frame_.transpose() * (x - start_[node]);
+    for (int c = 0; c < 3; ++c) mesh_.xyz[3 * node + c] += d[c];
+    start_[node] = x;
   }
 
   // The caller's quality of the input (evaluateQuality's, bounded to kJacobianBoundTolerance:
