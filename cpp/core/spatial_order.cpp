@@ -115,21 +115,21 @@ SpatialOrder::SpatialOrder(const Mesh& mesh) {
 }
 
 void SpatialOrder::apply(Mesh& mesh) const {
-  mesh.xyz = gather(mesh.xyz, oldNode_, 3);
-  mesh.nodeCadDim = gather(mesh.nodeCadDim, oldNode_, 1);
-  mesh.nodeCadIndex = gather(mesh.nodeCadIndex, oldNode_, 1);
-  mesh.nodeCadParam = gather(mesh.nodeCadParam, oldNode_, 2);
-  for (std::size_t bi = 0; bi < mesh.blocks.size(); ++bi)
-    reorderBlock(mesh.blocks[bi], blockOrder_[bi], newNode_, false);
+  renumber(mesh, oldNode_, newNode_, false);
 }
 
 void SpatialOrder::restore(Mesh& mesh) const {
-  mesh.xyz = gather(mesh.xyz, newNode_, 3);
-  mesh.nodeCadDim = gather(mesh.nodeCadDim, newNode_, 1);
-  mesh.nodeCadIndex = gather(mesh.nodeCadIndex, newNode_, 1);
-  mesh.nodeCadParam = gather(mesh.nodeCadParam, newNode_, 2);
+  renumber(mesh, newNode_, oldNode_, true);
+}
+
+void SpatialOrder::renumber(Mesh& mesh, const std::vector<std::int64_t>& from,
+                            const std::vector<std::int64_t>& id, bool inverse) const {
+  mesh.xyz = gather(mesh.xyz, from, 3);
+  mesh.nodeCadDim = gather(mesh.nodeCadDim, from, 1);
+  mesh.nodeCadIndex = gather(mesh.nodeCadIndex, from, 1);
+  mesh.nodeCadParam = gather(mesh.nodeCadParam, from, 2);
   for (std::size_t bi = 0; bi < mesh.blocks.size(); ++bi)
-    reorderBlock(mesh.blocks[bi], blockOrder_[bi], oldNode_, true);
+    reorderBlock(mesh.blocks[bi], blockOrder_[bi], id, inverse);
 }
 
 }  // namespace homesh

@@ -68,6 +68,12 @@ class SpatialOrder {
   }
 
  private:
+  // The node arrays gathered from `from` (new position -> source position), the blocks' node
+  // ids mapped through `id` and their elements moved by blockOrder_, forwards or (`inverse`)
+  // back.
+  void renumber(Mesh& mesh, const std::vector<std::int64_t>& from,
+                const std::vector<std::int64_t>& id, bool inverse) const;
+
   std::vector<std::int64_t> oldNode_;  // new node id -> original id
   std::vector<std::int64_t> newNode_;  // original node id -> new id
   // Per block: new position -> original position (empty for a block kept in its order).

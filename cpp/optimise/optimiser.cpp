@@ -352,7 +352,6 @@ class Optimiser {
   const OptimiserOptions& options_;
   OptimiserObserver* observer_;
   Clock::time_point runStart_;
-  bool budgetSpent_ = false;  // set by overBudget(), read after the threads joined
 
   // Whether the run has taken options_.timeLimit seconds (never, without a limit).
   bool overBudget() {
@@ -366,6 +365,10 @@ class Optimiser {
   // with a region, where a fixed node of an element at the region's edge would otherwise change
   // its equispaced position with its free neighbours' working nodes.
   const bool converting_;
+  bool budgetSpent_ = false;  // set by overBudget(), read after the threads joined
+  // Owner-computes split (work_partition.hpp): one part per thread; every phase of a sweep hands
+  // an element (a node) to its part's thread first (elementPart_, nodePart_ below).
+  int parts_ = 1;
   // The caller's number of each node and element (global index) where the mesh was renumbered
   // for locality (optimiseMesh); null: the mesh's own. The choices made in sequence follow
   // them: the greedy colouring visits the nodes in the caller's order, a node's elements are
@@ -409,9 +412,6 @@ class Optimiser {
   // Per node: visit it in the next sweep (it or a neighbour moved by more than
   // options_.activeTolerance of its element size since its last visit).
   std::unique_ptr<std::atomic<std::uint8_t>[]> active_;
-  // Owner-computes split (work_partition.hpp): one part per thread; every phase of a sweep hands
-  // an element (a node) to its part's thread first.
-  int parts_ = 1;
   std::vector<int> elementPart_;          // per global element
   std::vector<int> nodePart_;             // per node
   std::vector<std::int64_t> free_;        // free nodes, grouped by colour, then by part

@@ -27,7 +27,7 @@ Mesh shuffledGrid(int n, unsigned seed) {
   mesh.nodeCadIndex.resize(id.size());
   mesh.nodeCadParam.assign(2 * id.size(), std::nan(""));
   const auto grid = [&](int i, int j, int k) {
-    return id[static_cast<std::size_t>((k * m + j) * m + i)];
+    return id[(static_cast<std::size_t>(k) * m + j) * m + i];
   };
   for (int k = 0; k < m; ++k)
     for (int j = 0; j < m; ++j)

@@ -29,13 +29,14 @@ TEST(CellTableCache, BuildsEachTableOnceForAllThreads) {
         variant);
   };
   // Eight threads ask for the same four tables many times at once.
-  std::vector<std::thread> threads;
   std::vector<std::vector<const Table*>> seen(8);
-  for (std::size_t t = 0; t < seen.size(); ++t)
-    threads.emplace_back([&, t] {
+  std::vector<std::thread> threads;
+  threads.reserve(seen.size());
+  for (std::vector<const Table*>& mine : seen)
+    threads.emplace_back([&get, target = &mine] {
       for (int i = 0; i < 2000; ++i)
         for (const int order : {1, kMaxOrder})
-          for (const int variant : {0, 1}) seen[t].push_back(&get(CellType::Prism, order, variant));
+          for (const int variant : {0, 1}) target->push_back(&get(CellType::Prism, order, variant));
     });
   for (std::thread& t : threads) t.join();
   EXPECT_EQ(builds.load(), 4);

@@ -238,7 +238,8 @@ TEST(Optimiser, TheSpatialOrderChangesNoResult) {
   region.normalLocked.assign(3 * cube.numNodes(), std::nan(""));
   for (std::size_t i = 0; i < cube.numNodes(); i += 50) region.fixedNodes[i] = 1;
   for (std::size_t i = 1; i < cube.numNodes(); i += 7)
-    for (int d = 0; d < 3; ++d) region.normalLocked[3 * i + static_cast<std::size_t>(d)] = d == 2;
+    for (int d = 0; d < 3; ++d)
+      region.normalLocked[3 * i + static_cast<std::size_t>(d)] = d == 2 ? 1.0 : 0.0;
   cases.push_back({"cube-sphere, region", cube, region, nullptr, true});
   OptimiserOptions naca = plain;
   naca.functional = Functional::LinearElastic;
