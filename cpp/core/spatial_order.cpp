@@ -29,13 +29,18 @@ std::vector<T> gather(const std::vector<T>& values, const std::vector<std::int64
   return out;
 }
 
-// Block `b` with its elements in the order `order` (new position -> source position) and its
-// node ids mapped through `id`.
-void reorderBlock(ElementBlock& b, const std::vector<std::size_t>& order,
-                  const std::vector<std::int64_t>& id, bool inverse) {
+// Block `b` with its elements moved by `order` (new position -> original position; `inverse`:
+// back) and its node ids mapped through `id`.
+ElementBlock reorderedBlock(const ElementBlock& b, const std::vector<std::size_t>& order,
+                            const std::vector<std::int64_t>& id, bool inverse) {
   const auto per = static_cast<std::size_t>(b.nodesPerElement());
-  std::vector<std::int64_t> nodes(b.nodes.size());
-  std::vector<std::int32_t> entity(b.entity.size());
+  ElementBlock out;
+  out.type = b.type;
+  out.order = b.order;
+  std::vector<std::int64_t>& nodes = out.nodes;
+  std::vector<std::int32_t>& entity = out.entity;
+  nodes.resize(b.nodes.size());
+  entity.resize(b.entity.size());
   for (std::size_t k = 0; k < b.count(); ++k) {
     const std::size_t target = order.empty() ? k : (inverse ? order[k] : k);
     const std::size_t source = order.empty() ? k : (inverse ? k : order[k]);
@@ -43,8 +48,7 @@ void reorderBlock(ElementBlock& b, const std::vector<std::size_t>& order,
     for (std::size_t j = 0; j < per; ++j)
       nodes[target * per + j] = id[static_cast<std::size_t>(b.nodes[source * per + j])];
   }
-  b.nodes = std::move(nodes);
-  b.entity = std::move(entity);
+  return out;
 }
 
 }  // namespace
@@ -124,12 +128,20 @@ void SpatialOrder::restore(Mesh& mesh) const {
 
 void SpatialOrder::renumber(Mesh& mesh, const std::vector<std::int64_t>& from,
                             const std::vector<std::int64_t>& id, bool inverse) const {
-  mesh.xyz = gather(mesh.xyz, from, 3);
-  mesh.nodeCadDim = gather(mesh.nodeCadDim, from, 1);
-  mesh.nodeCadIndex = gather(mesh.nodeCadIndex, from, 1);
-  mesh.nodeCadParam = gather(mesh.nodeCadParam, from, 2);
-  for (std::size_t bi = 0; bi < mesh.blocks.size(); ++bi)
-    reorderBlock(mesh.blocks[bi], blockOrder_[bi], id, inverse);
+  // Every new array first, then the moves (which cannot throw): an allocation failure leaves
+  // the mesh as it was.
+  std::vector<double> xyz = gather(mesh.xyz, from, 3);
+  std::vector<std::uint8_t> cadDim = gather(mesh.nodeCadDim, from, 1);
+  std::vector<std::int32_t> cadIndex = gather(mesh.nodeCadIndex, from, 1);
+  std::vector<double> cadParam = gather(mesh.nodeCadParam, from, 2);
+  std::vector<ElementBlock> blocks(mesh.blocks.size());
+  for (std::size_t bi = 0; bi < blocks.size(); ++bi)
+    blocks[bi] = reorderedBlock(mesh.blocks[bi], blockOrder_[bi], id, inverse);
+  mesh.xyz = std::move(xyz);
+  mesh.nodeCadDim = std::move(cadDim);
+  mesh.nodeCadIndex = std::move(cadIndex);
+  mesh.nodeCadParam = std::move(cadParam);
+  mesh.blocks = std::move(blocks);
 }
 
 }  // namespace homesh

@@ -27,7 +27,8 @@ std::uint64_t mortonKey(const double point[3], const double low[3], const double
 //  - the nodes numbered by first use along those elements (block by block), so that an
 //    element's nodes and its neighbours' have nearby numbers; nodes no element uses follow in
 //    their original order.
-// apply() renumbers a mesh in place; restore() brings it (with whatever coordinates and CAD
+// apply() renumbers a mesh in place, all or nothing (on an allocation failure the mesh is left as
+// it was; meanwhile its arrays exist twice); restore() brings it (with whatever coordinates and CAD
 // parameters it has been given meanwhile) back to the original numbering, so that callers
 // never see the renumbering. The mesh must be consistent (Mesh::checkConsistency). Per-node and
 // per-element arrays given alongside the mesh (options, known quality) are carried over with

@@ -23,8 +23,9 @@ class CellTableCache {
   // The table of (type, order, variant): build() (returning std::unique_ptr<T>) makes it on the
   // first call, under a lock, and the table lives as long as the cache. Safe to call from any
   // thread; an exception from build() propagates and nothing is kept, so a later call tries
-  // again. Orders outside 0..kMaxOrder (which the builders refuse), variants outside
-  // 0..kVariants - 1 and types after Hexahedron are looked up under the lock.
+  // again. build() runs under the cache's lock: it must not ask the same cache for a table
+  // (other caches are fine). Orders outside 0..kMaxOrder (which the builders refuse), variants
+  // outside 0..kVariants - 1 and types after Hexahedron are looked up under the lock.
   template <class Build>
   const T& get(CellType type, int order, Build build, int variant = 0) {
     const bool direct = static_cast<std::size_t>(type) <= kLastType && order >= 0 &&

@@ -484,7 +484,7 @@ class Optimiser {
           const double det = functional_detail::determinant<D>(ideal);
           if (q < idealPoints) {
             if (!(std::abs(det) > 0.0))
-              throw ParameterError("element " + std::to_string(totalElements_ + e) +
+              throw ParameterError("element " + std::to_string(callersElement(totalElements_ + e)) +
                                    " (0-based, in block order)"
                                    " has a degenerate straight-sided shape (zero volume): "
                                    "the optimiser cannot measure its distortion");
@@ -504,6 +504,11 @@ class Optimiser {
 
   // The same polynomial maps through the working node set's nodes (shared nodes get the same
   // value from every element: the trace on a shared face depends on the face's nodes only).
+  // The caller's number of element `g` (global index), for messages.
+  std::size_t callersElement(std::size_t g) const {
+    return elementRank_ != nullptr ? (*elementRank_)[g] : g;
+  }
+
   // `elements` (global indices) in the caller's order (see nodeRank_).
   std::vector<std::size_t> inCallersOrder(std::vector<std::size_t> elements) const {
     if (elementRank_ != nullptr)
@@ -1276,17 +1281,20 @@ class Optimiser {
 
   // The free nodes' equispaced positions into mesh_.xyz (in 2D only their in-plane part moves),
   // each node by its part's thread (free_ is grouped by colour, then part), which reads and
-  // writes its data in the sweeps.
+  // writes its data in the sweeps. Every part is written whatever team OpenMP starts (fewer
+  // threads than asked, with OMP_THREAD_LIMIT or OMP_DYNAMIC): thread t takes parts t,
+  // t + team, ...
   void writeBack() {
-    const auto colours = (colourStart_.size() - 1) / static_cast<std::size_t>(parts_);
+    const auto parts = static_cast<std::size_t>(parts_);
+    const std::size_t colours = (colourStart_.size() - 1) / parts;
 #pragma omp parallel num_threads(options_.threads)
     {
-      const auto me = static_cast<std::size_t>(omp_get_thread_num());
-      for (std::size_t c = 0; c < colours && me < static_cast<std::size_t>(parts_); ++c) {
-        const std::size_t range = c * static_cast<std::size_t>(parts_) + me;
-        for (std::size_t i = colourStart_[range]; i < colourStart_[range + 1]; ++i)
-          writeBack(free_[i]);
-      }
+      const auto team = static_cast<std::size_t>(omp_get_num_threads());
+      for (auto p = static_cast<std::size_t>(omp_get_thread_num()); p < parts; p += team)
+        for (std::size_t c = 0; c < colours; ++c)
+          for (std::size_t i = colourStart_[c * parts + p]; i < colourStart_[c * parts + p + 1];
+               ++i)
+            writeBack(free_[i]);
     }
   }
 
@@ -1461,17 +1469,17 @@ OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
     known.validity = order.elementValues(startQuality->validity);
   }
   const QualitySummary* start = startQuality != nullptr ? &known : nullptr;
-  order.apply(mesh);
+  order.apply(mesh);  // all or nothing (spatial_order.hpp)
+  OptimiserResult result;
   try {
-    OptimiserResult result = mesh.dim == 3
-                                 ? Optimiser<3>(mesh, local, observer, cad, start, &order).run()
-                                 : Optimiser<2>(mesh, local, observer, cad, start, &order).run();
-    order.restore(mesh);
-    return result;
+    result = mesh.dim == 3 ? Optimiser<3>(mesh, local, observer, cad, start, &order).run()
+                           : Optimiser<2>(mesh, local, observer, cad, start, &order).run();
   } catch (...) {
-    order.restore(mesh);
+    order.restore(mesh);  // the run left the input's coordinates: the caller's mesh as given
     throw;
   }
+  order.restore(mesh);
+  return result;
 }
 
 class NodeEnergyProbe::Impl {

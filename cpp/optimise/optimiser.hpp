@@ -175,6 +175,8 @@ class OptimiserObserver {
 // `startQuality`, when the caller has it: evaluateQuality of `mesh` as given (a repair round
 // has it for all but its new elements); the set-up then takes the elements' certified quality
 // from it instead of measuring the whole mesh. Ignored where its size does not match.
+// While it runs, `mesh` is renumbered (OptimiserOptions::spatialOrder): an observer reading it
+// sees the internal numbering; the caller's is restored before it returns or throws.
 // Throws ParameterError for bad options or unsupported cells.
 OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
                              OptimiserObserver* observer = nullptr, const CadModel* cad = nullptr,

@@ -1,6 +1,7 @@
 // The optimiser: boundary detection, order change, options, and NekMesh's own regression cases
 // (the derivative checks are in test_derivatives.cpp).
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <Eigen/Dense>
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/spatial_order.hpp"
 #include "curving/order_elevation.hpp"
 #include "element/reference_element.hpp"
 #include "io/mesh_readers.hpp"
@@ -184,6 +186,35 @@ TEST(Optimiser, ResultDoesNotDependOnTheNumberOfThreads) {
   EXPECT_EQ(a.xyz, c.xyz);
 }
 
+// OpenMP may start fewer threads than asked (OMP_THREAD_LIMIT, OMP_DYNAMIC, or, as here, a call
+// from inside another parallel region, where nested regions get one thread): every phase still
+// covers every part, so the result is that of one thread.
+TEST(Optimiser, ATeamSmallerThanAskedGivesTheSameResult) {
+  const Mesh input = readMesh(peer("varopti_cube_sphere.msh"));
+  Mesh one = input, nested = input;
+  OptimiserOptions options;
+  options.maxIterations = 2;
+  options.threads = 1;
+  optimiseMesh(one, options);
+  options.threads = 3;  // three parts, one thread to write them
+  int team = 0;
+#pragma omp parallel num_threads(2)
+  {
+#pragma omp single
+    {
+#pragma omp parallel num_threads(3)
+      {
+#pragma omp single
+        team = omp_get_num_threads();
+      }
+      optimiseMesh(nested, options);
+    }
+  }
+  ASSERT_EQ(team, 1) << "nested regions run in parallel here: the test shows nothing";
+  EXPECT_EQ(one.xyz, nested.xyz);
+  EXPECT_NE(one.xyz, input.xyz);
+}
+
 // The same in 2D and in region mode, where only some elements carry weight in the threads'
 // partition (work_partition.hpp), so the parts' node counts differ most.
 TEST(Optimiser, ResultDoesNotDependOnTheNumberOfThreadsIn2DAndInARegion) {
@@ -251,7 +282,38 @@ TEST(Optimiser, TheSpatialOrderChangesNoResult) {
   const MeshResult hole =
       runMeshPipeline(CadSource::brepText(test::brepText(test::boxWithHole())), meshing);
   cases.push_back({"box with a hole, sliding on the CAD", hole.mesh, plain, hole.cad.get()});
+  // The cube-sphere's tetrahedra in two blocks with an empty one between (global element indices
+  // across blocks), in a region seeded by element.
+  Mesh split = cube;
+  for (std::size_t bi = 0; bi < split.blocks.size(); ++bi) {
+    ElementBlock& b = split.blocks[bi];
+    if (cellDimension(b.type) != 3) continue;
+    const std::size_t half = b.count() / 2;
+    const auto cut =
+        static_cast<std::ptrdiff_t>(half * static_cast<std::size_t>(b.nodesPerElement()));
+    ElementBlock empty, second;
+    empty.type = second.type = b.type;
+    empty.order = second.order = b.order;
+    second.nodes.assign(b.nodes.begin() + cut, b.nodes.end());
+    second.entity.assign(b.entity.begin() + static_cast<std::ptrdiff_t>(half), b.entity.end());
+    b.nodes.resize(static_cast<std::size_t>(cut));
+    b.entity.resize(half);
+    const auto at = split.blocks.begin() + static_cast<std::ptrdiff_t>(bi) + 1;
+    split.blocks.insert(split.blocks.insert(at, second), empty);
+    break;
+  }
+  ASSERT_EQ(split.numElements(), cube.numElements());
+  OptimiserOptions seeded = plain;
+  seeded.regionSeed.assign(cube.numElements(), 0);
+  for (std::size_t i = 3; i < seeded.regionSeed.size(); i += 30) seeded.regionSeed[i] = 1;
+  seeded.regionLayers = 1;
+  cases.push_back({"cube-sphere in three blocks, seeded region", split, seeded, nullptr, true});
   for (Case& c : cases) {
+    // The renumbering is not the identity: the test compares two different storage orders.
+    const SpatialOrder order(c.mesh);
+    std::vector<std::int64_t> identity(c.mesh.numNodes());
+    std::iota(identity.begin(), identity.end(), 0);
+    EXPECT_NE(order.originalNodes(), identity) << c.name;
     const QualitySummary quality = evaluateQuality(c.mesh);
     const QualitySummary* start = c.quality ? &quality : nullptr;
     Mesh spatial = c.mesh, own = c.mesh;
@@ -279,6 +341,35 @@ TEST(Optimiser, TheSpatialOrderChangesNoResult) {
     }
     EXPECT_EQ(spatial.nodeCadIndex, c.mesh.nodeCadIndex) << c.name;
   }
+}
+
+// A run that throws leaves the caller's mesh as given, in the caller's numbering, and its
+// messages name elements by the caller's numbers.
+TEST(Optimiser, AFailedRunLeavesTheCallersMeshAndNumbers) {
+  const Mesh cube = readMesh(peer("varopti_cube_sphere.msh"));
+  Mesh mesh = cube;
+  OptimiserOptions options;
+  options.fixedNodes.assign(5, 1);  // wrong size: refused inside the run
+  EXPECT_THROW(optimiseMesh(mesh, options), ParameterError);
+  EXPECT_EQ(mesh.xyz, cube.xyz);
+  for (std::size_t bi = 0; bi < cube.blocks.size(); ++bi)
+    EXPECT_EQ(mesh.blocks[bi].nodes, cube.blocks[bi].nodes);
+  // A flat tetrahedron (its four corners in z = 0) as element 2 of three, after two sound ones.
+  Mesh flat = twoTetrahedra(1);
+  const double corner[3] = {1.0, 1.0, 0.0};
+  flat.addNode(corner, 3, 1, NAN, NAN);
+  flat.blocks[0].nodes.insert(flat.blocks[0].nodes.end(), {0, 1, 2, 5});
+  flat.blocks[0].entity.push_back(1);
+  const Mesh given = flat;
+  ASSERT_NE(SpatialOrder(flat).originalElements(), (std::vector<std::size_t>{0, 1, 2}));
+  try {
+    optimiseMesh(flat, OptimiserOptions());
+    ADD_FAILURE() << "a flat element was accepted";
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("element 2 (0-based"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(flat.xyz, given.xyz);
+  EXPECT_EQ(flat.blocks[0].nodes, given.blocks[0].nodes);
 }
 
 TEST(Optimiser, RestingNodesAreVisitedOnlyWhenTheirNeighboursMove) {
