@@ -19,16 +19,6 @@ std::uint64_t spread(std::uint64_t v) {
   return v;
 }
 
-template <class T>
-std::vector<T> gather(const std::vector<T>& values, const std::vector<std::int64_t>& from,
-                      std::size_t stride) {
-  std::vector<T> out(values.size());
-  for (std::size_t n = 0; n < from.size(); ++n)
-    for (std::size_t k = 0; k < stride; ++k)
-      out[stride * n + k] = values[stride * static_cast<std::size_t>(from[n]) + k];
-  return out;
-}
-
 // Block `b` with its elements moved by `order` (new position -> original position; `inverse`:
 // back) and its node ids mapped through `id`.
 ElementBlock reorderedBlock(const ElementBlock& b, const std::vector<std::size_t>& order,

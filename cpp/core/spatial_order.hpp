@@ -50,12 +50,7 @@ class SpatialOrder {
   // size is left to the consumer's own check, which names the option).
   template <class T>
   std::vector<T> nodeValues(const std::vector<T>& values, std::size_t stride) const {
-    if (values.size() != stride * oldNode_.size()) return values;
-    std::vector<T> out(values.size());
-    for (std::size_t n = 0; n < oldNode_.size(); ++n)
-      for (std::size_t k = 0; k < stride; ++k)
-        out[stride * n + k] = values[stride * static_cast<std::size_t>(oldNode_[n]) + k];
-    return out;
+    return values.size() == stride * oldNode_.size() ? gather(values, oldNode_, stride) : values;
   }
 
   // One value per element (the cells of dimension mesh.dim, in block order, as elementsOf()
@@ -69,6 +64,17 @@ class SpatialOrder {
   }
 
  private:
+  // Entry n of the result (`stride` values each) is entry from[n] of `values`.
+  template <class T>
+  static std::vector<T> gather(const std::vector<T>& values, const std::vector<std::int64_t>& from,
+                               std::size_t stride) {
+    std::vector<T> out(values.size());
+    for (std::size_t n = 0; n < from.size(); ++n)
+      for (std::size_t k = 0; k < stride; ++k)
+        out[stride * n + k] = values[stride * static_cast<std::size_t>(from[n]) + k];
+    return out;
+  }
+
   // The node arrays gathered from `from` (new position -> source position), the blocks' node
   // ids mapped through `id` and their elements moved by blockOrder_, forwards or (`inverse`)
   // back.

@@ -502,8 +502,6 @@ class Optimiser {
                            " to optimise");
   }
 
-  // The same polynomial maps through the working node set's nodes (shared nodes get the same
-  // value from every element: the trace on a shared face depends on the face's nodes only).
   // The caller's number of element `g` (global index), for messages.
   std::size_t callersElement(std::size_t g) const {
     return elementRank_ != nullptr ? (*elementRank_)[g] : g;
@@ -518,6 +516,8 @@ class Optimiser {
     return elements;
   }
 
+  // The same polynomial maps through the working node set's nodes (shared nodes get the same
+  // value from every element: the trace on a shared face depends on the face's nodes only).
   void convertToWorkingSet() {
     if (!converting_) return;
     std::vector<Vec> working = position_;
