@@ -106,6 +106,8 @@ SpatialOrder::SpatialOrder(const Mesh& mesh) {
       newNode_[n] = static_cast<std::int64_t>(oldNode_.size());
       oldNode_.push_back(static_cast<std::int64_t>(n));
     }
+  newElement_.resize(oldElement_.size());
+  for (std::size_t i = 0; i < oldElement_.size(); ++i) newElement_[oldElement_[i]] = i;
 }
 
 void SpatialOrder::apply(Mesh& mesh) const {

@@ -44,6 +44,10 @@ class SpatialOrder {
   // order), in the new numbering.
   const std::vector<std::int64_t>& originalNodes() const { return oldNode_; }
   const std::vector<std::size_t>& originalElements() const { return oldElement_; }
+  // The inverses: the new number of each original node, and of each original element. Walking
+  // them visits the renumbered mesh in the original order, without a sort.
+  const std::vector<std::int64_t>& newNodes() const { return newNode_; }
+  const std::vector<std::size_t>& newElements() const { return newElement_; }
 
   // `values` with `stride` entries per node, in the original numbering, renumbered; returned
   // unchanged when its size is not stride x the number of nodes (empty: none given; another
@@ -87,6 +91,7 @@ class SpatialOrder {
   std::vector<std::vector<std::size_t>> blockOrder_;
   // The elements of dimension mesh.dim in block order: new index -> original index.
   std::vector<std::size_t> oldElement_;
+  std::vector<std::size_t> newElement_;  // its inverse
 };
 
 }  // namespace homesh

@@ -161,7 +161,7 @@ class Optimiser {
   using Vec = Eigen::Matrix<double, D, 1>;
 
   // `order`: the renumbering `mesh` has been given (applied), whose original numbers the
-  // sequential choices follow (see nodeRank_); null: the mesh's own numbers.
+  // sequential choices follow (see elementRank_); null: the mesh's own numbers.
   Optimiser(Mesh& mesh, const OptimiserOptions& options, OptimiserObserver* observer,
             const CadModel* cad, const QualitySummary* startQuality = nullptr,
             const SpatialOrder* order = nullptr)
@@ -171,8 +171,9 @@ class Optimiser {
         cad_(cad),
         startQuality_(startQuality),
         converting_(cad == nullptr && !options.regionThreshold && options.regionSeed.empty()),
-        nodeRank_(order != nullptr ? &order->originalNodes() : nullptr),
-        elementRank_(order != nullptr ? &order->originalElements() : nullptr) {}
+        elementRank_(order != nullptr ? &order->originalElements() : nullptr),
+        callersNodes_(order != nullptr ? &order->newNodes() : nullptr),
+        callersElements_(order != nullptr ? &order->newElements() : nullptr) {}
 
   OptimiserResult run() {
     const auto t0 = Clock::now();
@@ -369,14 +370,18 @@ class Optimiser {
   // Owner-computes split (work_partition.hpp): one part per thread; every phase of a sweep hands
   // an element (a node) to its part's thread first (elementPart_, nodePart_ below).
   int parts_ = 1;
-  // The caller's number of each node and element (global index) where the mesh was renumbered
-  // for locality (optimiseMesh); null: the mesh's own. The choices made in sequence follow
-  // them: the greedy colouring visits the nodes in the caller's order, a node's elements are
-  // listed (and its patch summed) in it, a node shared by elements takes its working position
-  // from the caller's last one, and the total energy is summed in it. So the renumbering
-  // changes where data lies, never a result, to the last bit.
-  const std::vector<std::int64_t>* nodeRank_;
+  // Where the mesh was renumbered for locality (optimiseMesh), the caller's numbering; null:
+  // the mesh's own. The choices made in sequence follow the caller's numbers: the greedy
+  // colouring visits the nodes in the caller's order, a node's elements are listed (and its
+  // patch summed) in it, a node shared by elements takes its working position from the caller's
+  // last one, and the total energy is summed in it. So the renumbering changes where data lies,
+  // never a result, to the last bit.
+  // elementRank_: the caller's number of each element (global index). callersNodes_,
+  // callersElements_: the node (element) with the caller's number i, walked in order for the
+  // caller's order without a sort.
   const std::vector<std::size_t>* elementRank_;
+  const std::vector<std::int64_t>* callersNodes_;
+  const std::vector<std::size_t>* callersElements_;
   std::vector<CadModel> cadPerThread_;  // evaluation caches are per thread
   std::vector<std::uint8_t> slide_;     // per node: 1 on a CAD curve, 2 on a CAD face, else 0
   std::vector<std::int32_t> cadSlot_;   // per node: its index in cadModel_, -1 if it stays
@@ -507,13 +512,12 @@ class Optimiser {
     return elementRank_ != nullptr ? (*elementRank_)[g] : g;
   }
 
-  // `elements` (global indices) in the caller's order (see nodeRank_).
-  std::vector<std::size_t> inCallersOrder(std::vector<std::size_t> elements) const {
-    if (elementRank_ != nullptr)
-      std::sort(elements.begin(), elements.end(), [&](std::size_t a, std::size_t b) {
-        return (*elementRank_)[a] < (*elementRank_)[b];
-      });
-    return elements;
+  // Every element (global index) in the caller's order (see elementRank_).
+  std::vector<std::size_t> elementsInCallersOrder() const {
+    if (callersElements_ != nullptr) return *callersElements_;
+    std::vector<std::size_t> all(totalElements_);
+    std::iota(all.begin(), all.end(), std::size_t{0});
+    return all;
   }
 
   // The same polynomial maps through the working node set's nodes (shared nodes get the same
@@ -521,9 +525,7 @@ class Optimiser {
   void convertToWorkingSet() {
     if (!converting_) return;
     std::vector<Vec> working = position_;
-    std::vector<std::size_t> all(totalElements_);
-    std::iota(all.begin(), all.end(), std::size_t{0});
-    for (const std::size_t g : inCallersOrder(std::move(all))) {
+    for (const std::size_t g : elementsInCallersOrder()) {
       const auto [bi, e] = locate(g);
       const Block<D>& b = blocks_[bi];
       const std::int64_t* v = b.cells->element(e);
@@ -701,12 +703,14 @@ class Optimiser {
     colourOf_.assign(mesh_.numNodes(), -1);
     std::vector<std::size_t> stamp;  // stamp[c] == node + 1: colour c is taken by a neighbour
     int colours = 0;
-    std::vector<std::int64_t> visit = free_;
-    if (nodeRank_ != nullptr)
-      std::sort(visit.begin(), visit.end(), [&](std::int64_t a, std::int64_t b) {
-        return (*nodeRank_)[static_cast<std::size_t>(a)] <
-               (*nodeRank_)[static_cast<std::size_t>(b)];
-      });
+    std::vector<std::int64_t> visit = free_;  // free_ is sorted (chooseFreeNodes)
+    if (callersNodes_ != nullptr) {
+      std::vector<char> isFree(mesh_.numNodes(), 0);
+      for (const std::int64_t node : free_) isFree[static_cast<std::size_t>(node)] = 1;
+      visit.clear();
+      for (const std::int64_t node : *callersNodes_)
+        if (isFree[static_cast<std::size_t>(node)] != 0) visit.push_back(node);
+    }
     for (const std::int64_t node : visit) {
       for (std::size_t k = incidenceStart_[node]; k < incidenceStart_[node + 1]; ++k) {
         const Incidence& inc = incidence_[k];
@@ -751,10 +755,13 @@ class Optimiser {
   void setEnergyOrder() {
     energyOrder_.resize(changed_.size());
     std::iota(energyOrder_.begin(), energyOrder_.end(), std::size_t{0});
-    if (elementRank_ != nullptr)
-      std::sort(energyOrder_.begin(), energyOrder_.end(), [&](std::size_t a, std::size_t b) {
-        return (*elementRank_)[changed_[a]] < (*elementRank_)[changed_[b]];
-      });
+    if (callersElements_ == nullptr) return;
+    constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+    std::vector<std::size_t> position(totalElements_, kNone);  // in changed_
+    for (std::size_t i = 0; i < changed_.size(); ++i) position[changed_[i]] = i;
+    energyOrder_.clear();
+    for (const std::size_t g : *callersElements_)
+      if (position[g] != kNone) energyOrder_.push_back(position[g]);
   }
 
   // One part per thread, by recursive coordinate bisection of the elements' centroids weighted

@@ -168,6 +168,14 @@ TEST(SpatialOrder, RenumbersAlongTheCurveAndRestoresExactly) {
   EXPECT_EQ(order.elementValues(input.blocks[0].entity), mesh.blocks[0].entity);
   const std::vector<double> wrongSize(5, 1.0);
   EXPECT_EQ(order.nodeValues(wrongSize, 3), wrongSize);  // left to the consumer's own check
+  // The inverses map each original number to the new one.
+  ASSERT_EQ(order.newNodes().size(), order.originalNodes().size());
+  for (std::size_t n = 0; n < order.originalNodes().size(); ++n)
+    EXPECT_EQ(order.newNodes()[static_cast<std::size_t>(order.originalNodes()[n])],
+              static_cast<std::int64_t>(n));
+  ASSERT_EQ(order.newElements().size(), order.originalElements().size());
+  for (std::size_t e = 0; e < order.originalElements().size(); ++e)
+    EXPECT_EQ(order.newElements()[order.originalElements()[e]], e);
   EXPECT_EQ(order.elementValues(wrongSize), wrongSize);
 
   // Coordinates and parameters changed meanwhile come back in the caller's numbering; the
