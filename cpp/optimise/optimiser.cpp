@@ -417,11 +417,13 @@ class Optimiser {
   // Per node: visit it in the next sweep (it or a neighbour moved by more than
   // options_.activeTolerance of its element size since its last visit).
   std::unique_ptr<std::atomic<std::uint8_t>[]> active_;
-  std::vector<int> elementPart_;          // per global element
-  std::vector<int> nodePart_;             // per node
-  std::vector<std::int64_t> free_;        // free nodes, grouped by colour, then by part
-  std::vector<std::size_t> colourStart_;  // colour c, part p: [cs[c * parts_ + p], cs[.. + 1])
-  std::vector<int> colourOf_;             // colour of each free node, -1 for fixed nodes
+  std::vector<int> elementPart_;  // per global element
+  std::vector<int> nodePart_;     // per node
+  static constexpr std::uint8_t kFarFromCut = 3;
+  std::vector<std::uint8_t> cutDistance_;  // per node, with more than one part (partition())
+  std::vector<std::int64_t> free_;         // free nodes, grouped by colour, then by part
+  std::vector<std::size_t> colourStart_;   // colour c, part p: [cs[c * parts_ + p], cs[.. + 1])
+  std::vector<int> colourOf_;              // colour of each free node, -1 for fixed nodes
 
   void setFrame() {
     if constexpr (D == 3) {
@@ -742,8 +744,20 @@ class Optimiser {
     starts.assign(1, 0);
     std::vector<std::size_t> begin;
     for (const auto& g : groups) {
-      const std::vector<std::int64_t> byPart = groupByPart(
+      std::vector<std::int64_t> byPart = groupByPart(
           g, parts_, [&](std::int64_t n) { return nodePart_[static_cast<std::size_t>(n)]; }, begin);
+      // Each part's nodes from its interior to the cut: its thread takes them from the front,
+      // a thread helping it from the back (OwnerFirstQueue), where the nodes' elements are the
+      // ones the two threads share already. A colour's nodes share no element: their order
+      // changes no result.
+      if (parts_ > 1)
+        for (std::size_t p = 0; p + 1 < begin.size(); ++p)
+          std::stable_sort(byPart.begin() + static_cast<std::ptrdiff_t>(begin[p]),
+                           byPart.begin() + static_cast<std::ptrdiff_t>(begin[p + 1]),
+                           [&](std::int64_t a, std::int64_t b) {
+                             return cutDistance_[static_cast<std::size_t>(a)] >
+                                    cutDistance_[static_cast<std::size_t>(b)];
+                           });
       const std::size_t base = nodes.size();
       nodes.insert(nodes.end(), byPart.begin(), byPart.end());
       for (std::size_t p = 1; p < begin.size(); ++p) starts.push_back(base + begin[p]);
@@ -793,6 +807,41 @@ class Optimiser {
       for (std::size_t k = incidenceStart_[n]; k < incidenceStart_[n + 1]; ++k)
         add(elementPart_[globalIndex(incidence_[k])]);
     });
+    measureCutDistance();
+  }
+
+  // Each node's distance from the cut between the parts, in element layers: 0 for a node of an
+  // element whose nodes belong to more than one part, kFarFromCut beyond kFarFromCut - 1 (the
+  // search stops there: its cost stays with the cut's neighbourhood).
+  void measureCutDistance() {
+    cutDistance_.assign(mesh_.numNodes(), kFarFromCut);
+    std::vector<std::int64_t> frontier, next;
+    for (const Block<D>& b : blocks_)
+      for (std::size_t e = 0; e < b.cells->count(); ++e) {
+        const std::int64_t* v = b.cells->element(e);
+        bool mixed = false;
+        for (int k = 1; k < b.nodes && !mixed; ++k) mixed = nodePart_[v[k]] != nodePart_[v[0]];
+        if (!mixed) continue;
+        for (int k = 0; k < b.nodes; ++k)
+          if (cutDistance_[v[k]] != 0) {
+            cutDistance_[v[k]] = 0;
+            frontier.push_back(v[k]);
+          }
+      }
+    for (std::uint8_t layer = 1; layer < kFarFromCut && !frontier.empty(); ++layer) {
+      next.clear();
+      for (const std::int64_t n : frontier)
+        for (std::size_t k = incidenceStart_[n]; k < incidenceStart_[n + 1]; ++k) {
+          const Block<D>& b = blocks_[incidence_[k].block];
+          const std::int64_t* v = b.cells->element(incidence_[k].element);
+          for (int j = 0; j < b.nodes; ++j)
+            if (cutDistance_[v[j]] == kFarFromCut) {
+              cutDistance_[v[j]] = layer;
+              next.push_back(v[j]);
+            }
+        }
+      frontier.swap(next);
+    }
   }
 
   // body(i, thread) for every i < elements.size(), on the threads: element elements[i] goes to

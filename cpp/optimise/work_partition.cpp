@@ -72,25 +72,36 @@ OwnerFirstQueue::OwnerFirstQueue(std::vector<std::size_t> begin, std::size_t chu
       chunk_(std::max<std::size_t>(chunk, 1)),
       cursors_(std::make_unique<Cursor[]>(begin_.size() < 2 ? 0 : begin_.size() - 1)) {
   if (begin_.size() < 2) throw std::invalid_argument("OwnerFirstQueue needs at least one part");
-  for (std::size_t p = 0; p + 1 < begin_.size(); ++p)
-    cursors_[p].next.store(begin_[p], std::memory_order_relaxed);
+  for (std::size_t p = 0; p + 1 < begin_.size(); ++p) {
+    const std::size_t size = begin_[p + 1] - begin_[p];
+    if (size > std::numeric_limits<std::uint32_t>::max())
+      throw std::invalid_argument("OwnerFirstQueue: part " + std::to_string(p) + " holds " +
+                                  std::to_string(size) + " items, more than 2^32 - 1");
+    cursors_[p].range.store(size, std::memory_order_relaxed);  // front 0, back size
+  }
 }
 
-bool OwnerFirstQueue::take(std::size_t part, std::size_t& lo, std::size_t& hi) {
-  std::atomic<std::size_t>& cursor = cursors_[part].next;
-  const std::size_t end = begin_[part + 1];
-  if (cursor.load(std::memory_order_relaxed) >= end) return false;  // no write on a done part
-  lo = cursor.fetch_add(chunk_, std::memory_order_relaxed);
-  if (lo >= end) return false;
-  hi = std::min(lo + chunk_, end);
-  return true;
+bool OwnerFirstQueue::take(std::size_t part, bool front, std::size_t& lo, std::size_t& hi) {
+  std::atomic<std::uint64_t>& range = cursors_[part].range;
+  std::uint64_t current = range.load(std::memory_order_relaxed);
+  for (;;) {
+    const std::uint64_t a = current >> 32, b = current & 0xffffffffU;
+    if (a >= b) return false;  // a done part is only read
+    const std::uint64_t n = std::min<std::uint64_t>(chunk_, b - a);
+    const std::uint64_t next = front ? ((a + n) << 32 | b) : (a << 32 | (b - n));
+    if (range.compare_exchange_weak(current, next, std::memory_order_relaxed)) {
+      lo = begin_[part] + static_cast<std::size_t>(front ? a : b - n);
+      hi = lo + static_cast<std::size_t>(n);
+      return true;
+    }
+  }
 }
 
 bool OwnerFirstQueue::next(int part, std::size_t& lo, std::size_t& hi) {
   const std::size_t parts = begin_.size() - 1;
   const auto own = static_cast<std::size_t>(part) % parts;
   for (std::size_t k = 0; k < parts; ++k)
-    if (take((own + k) % parts, lo, hi)) return true;
+    if (take((own + k) % parts, k == 0, lo, hi)) return true;
   return false;
 }
 

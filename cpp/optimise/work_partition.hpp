@@ -10,6 +10,7 @@
 #include <array>
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -44,9 +45,12 @@ std::vector<int> nodeOwners(std::size_t numNodes, int parts, PartsOfNode partsOf
 }
 
 // Items grouped by part (part t's are [begin[t], begin[t + 1])), handed out in chunks: a
-// thread takes its own part's chunks first and then helps the other parts with theirs, so the
-// work stays with its owner where the parts are balanced and no thread idles where they are
-// not. Safe to call next() from every thread at once; each item is handed out exactly once.
+// thread takes its own part's chunks first, from the front, and then helps the other parts with
+// theirs, from the back, so the work stays with its owner where the parts are balanced and no
+// thread idles where they are not. A part whose items are ordered from its interior to the cut
+// (the optimiser's node groups) so hands its helpers the items whose data they share already.
+// Safe to call next() from every thread at once; each item is handed out exactly once. A part
+// holds fewer than 2^32 items.
 class OwnerFirstQueue {
  public:
   OwnerFirstQueue(std::vector<std::size_t> begin, std::size_t chunk);
@@ -55,10 +59,12 @@ class OwnerFirstQueue {
   bool next(int part, std::size_t& lo, std::size_t& hi);
 
  private:
+  // The part's items not handed out yet, [begin + front, begin + back), as front << 32 | back:
+  // one word, so that the owner's and a helper's takes exclude each other.
   struct alignas(64) Cursor {  // one cache line each: parts take their own chunks unshared
-    std::atomic<std::size_t> next{0};
+    std::atomic<std::uint64_t> range{0};
   };
-  bool take(std::size_t part, std::size_t& lo, std::size_t& hi);
+  bool take(std::size_t part, bool front, std::size_t& lo, std::size_t& hi);
 
   std::vector<std::size_t> begin_;
   std::size_t chunk_;

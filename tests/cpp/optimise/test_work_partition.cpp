@@ -99,13 +99,15 @@ TEST(WorkPartition, GroupingByPartIsStable) {
   EXPECT_EQ(begin, (std::vector<std::size_t>{0, 0, 3, 6}));
 }
 
-TEST(WorkPartition, AThreadTakesItsOwnChunksFirstThenHelps) {
+TEST(WorkPartition, AThreadTakesItsOwnChunksFirstThenHelpsFromTheBack) {
   OwnerFirstQueue queue({0, 10, 13}, 4);
   std::size_t lo = 0, hi = 0;
   std::vector<std::pair<std::size_t, std::size_t>> taken;
-  while (queue.next(1, lo, hi)) taken.emplace_back(lo, hi);
+  ASSERT_TRUE(queue.next(0, lo, hi));  // part 0's thread starts its own, from the front
+  taken.emplace_back(lo, hi);
+  while (queue.next(1, lo, hi)) taken.emplace_back(lo, hi);  // part 1's, then helps part 0
   const std::vector<std::pair<std::size_t, std::size_t>> expected = {
-      {10, 13}, {0, 4}, {4, 8}, {8, 10}};
+      {0, 4}, {10, 13}, {6, 10}, {4, 6}};
   EXPECT_EQ(taken, expected);
   EXPECT_FALSE(queue.next(0, lo, hi));
 }
