@@ -87,7 +87,9 @@ bool OwnerFirstQueue::take(std::size_t part, bool front, std::size_t& lo, std::s
   for (;;) {
     const std::uint64_t a = current >> 32, b = current & 0xffffffffU;
     if (a >= b) return false;  // a done part is only read
-    const std::uint64_t n = std::min<std::uint64_t>(chunk_, b - a);
+    // An eighth of what is left, at most a chunk: small chunks at the end, so that the threads
+    // reach the barrier after a part's items within about one item of each other.
+    const std::uint64_t n = std::clamp<std::uint64_t>((b - a) / 8, 1, chunk_);
     const std::uint64_t next = front ? ((a + n) << 32 | b) : (a << 32 | (b - n));
     if (range.compare_exchange_weak(current, next, std::memory_order_relaxed)) {
       lo = begin_[part] + static_cast<std::size_t>(front ? a : b - n);

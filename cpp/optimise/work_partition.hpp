@@ -44,7 +44,8 @@ std::vector<int> nodeOwners(std::size_t numNodes, int parts, PartsOfNode partsOf
   return owner;
 }
 
-// Items grouped by part (part t's are [begin[t], begin[t + 1])), handed out in chunks: a
+// Items grouped by part (part t's are [begin[t], begin[t + 1])), handed out in chunks (of at
+// most `chunk` items, an eighth of what is left in the part near its end): a
 // thread takes its own part's chunks first, from the front, and then helps the other parts with
 // theirs, from the back, so the work stays with its owner where the parts are balanced and no
 // thread idles where they are not. A part whose items are ordered from its interior to the cut

@@ -100,15 +100,31 @@ TEST(WorkPartition, GroupingByPartIsStable) {
 }
 
 TEST(WorkPartition, AThreadTakesItsOwnChunksFirstThenHelpsFromTheBack) {
-  OwnerFirstQueue queue({0, 10, 13}, 4);
+  OwnerFirstQueue queue({0, 100, 130}, 4);
   std::size_t lo = 0, hi = 0;
-  std::vector<std::pair<std::size_t, std::size_t>> taken;
   ASSERT_TRUE(queue.next(0, lo, hi));  // part 0's thread starts its own, from the front
-  taken.emplace_back(lo, hi);
+  EXPECT_EQ(lo, 0U);
+  EXPECT_EQ(hi, 4U);  // a full chunk while more than 8 chunks are left
+  std::vector<std::pair<std::size_t, std::size_t>> taken;
   while (queue.next(1, lo, hi)) taken.emplace_back(lo, hi);  // part 1's, then helps part 0
-  const std::vector<std::pair<std::size_t, std::size_t>> expected = {
-      {0, 4}, {10, 13}, {6, 10}, {4, 6}};
-  EXPECT_EQ(taken, expected);
+  // Part 1's items from the front, then part 0's from the back, every chunk of 1 to 4 items,
+  // an eighth of what is left near the end: the last ones single items.
+  std::size_t expectOwn = 100, expectHelp = 100, k = 0;
+  for (; k < taken.size() && taken[k].first >= 100; ++k) {
+    EXPECT_EQ(taken[k].first, expectOwn) << k;
+    expectOwn = taken[k].second;
+  }
+  EXPECT_EQ(expectOwn, 130U);
+  for (; k < taken.size(); ++k) {
+    EXPECT_EQ(taken[k].second, expectHelp) << k;
+    expectHelp = taken[k].first;
+  }
+  EXPECT_EQ(expectHelp, 4U);
+  for (const auto& [a, b] : taken) {
+    EXPECT_GE(b - a, 1U);
+    EXPECT_LE(b - a, 4U);
+  }
+  EXPECT_EQ(taken.back().second - taken.back().first, 1U);
   EXPECT_FALSE(queue.next(0, lo, hi));
 }
 
