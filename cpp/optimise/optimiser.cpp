@@ -811,15 +811,17 @@ class Optimiser {
   }
 
   // Each node's distance from the cut between the parts, in element layers: 0 for a node of an
-  // element whose nodes belong to more than one part, kFarFromCut beyond kFarFromCut - 1 (the
-  // search stops there: its cost stays with the cut's neighbourhood).
+  // element whose nodes (or the element itself) belong to more than one part, kFarFromCut
+  // beyond kFarFromCut - 1 (the search stops there: its cost stays with the cut's
+  // neighbourhood).
   void measureCutDistance() {
     cutDistance_.assign(mesh_.numNodes(), kFarFromCut);
     std::vector<std::int64_t> frontier, next;
-    for (const Block<D>& b : blocks_)
+    for (std::size_t bi = 0; bi < blocks_.size(); ++bi) {
+      const Block<D>& b = blocks_[bi];
       for (std::size_t e = 0; e < b.cells->count(); ++e) {
         const std::int64_t* v = b.cells->element(e);
-        bool mixed = false;
+        bool mixed = elementPart_[blockOffset_[bi] + e] != nodePart_[v[0]];
         for (int k = 1; k < b.nodes && !mixed; ++k) mixed = nodePart_[v[k]] != nodePart_[v[0]];
         if (!mixed) continue;
         for (int k = 0; k < b.nodes; ++k)
@@ -828,6 +830,7 @@ class Optimiser {
             frontier.push_back(v[k]);
           }
       }
+    }
     for (std::uint8_t layer = 1; layer < kFarFromCut && !frontier.empty(); ++layer) {
       next.clear();
       for (const std::int64_t n : frontier)
