@@ -514,12 +514,19 @@ class Optimiser {
     return elementRank_ != nullptr ? (*elementRank_)[g] : g;
   }
 
-  // Every element (global index) in the caller's order (see elementRank_).
-  std::vector<std::size_t> elementsInCallersOrder() const {
-    if (callersElements_ != nullptr) return *callersElements_;
-    std::vector<std::size_t> all(totalElements_);
-    std::iota(all.begin(), all.end(), std::size_t{0});
-    return all;
+  // f(block index, element in the block) for every element, in the caller's order (see
+  // elementRank_).
+  template <class F>
+  void forEachElementInCallersOrder(F f) const {
+    if (callersElements_ != nullptr) {
+      for (const std::size_t g : *callersElements_) {
+        const auto [bi, e] = locate(g);
+        f(bi, e);
+      }
+      return;
+    }
+    for (std::size_t bi = 0; bi < blocks_.size(); ++bi)
+      for (std::size_t e = 0; e < blocks_[bi].cells->count(); ++e) f(bi, e);
   }
 
   // The same polynomial maps through the working node set's nodes (shared nodes get the same
@@ -527,8 +534,7 @@ class Optimiser {
   void convertToWorkingSet() {
     if (!converting_) return;
     std::vector<Vec> working = position_;
-    for (const std::size_t g : elementsInCallersOrder()) {
-      const auto [bi, e] = locate(g);
+    forEachElementInCallersOrder([&](std::size_t bi, std::size_t e) {
       const Block<D>& b = blocks_[bi];
       const std::int64_t* v = b.cells->element(e);
       for (int i = 0; i < b.nodes; ++i) {
@@ -536,7 +542,7 @@ class Optimiser {
         for (int j = 0; j < b.nodes; ++j) x += b.toWorking(i, j) * position_[v[j]];
         working[v[i]] = x;
       }
-    }
+    });
     position_.swap(working);
   }
 
@@ -547,21 +553,13 @@ class Optimiser {
       for (const std::int64_t id : b.cells->nodes) ++incidenceStart_[id + 1];
     for (std::size_t i = 0; i < nn; ++i) incidenceStart_[i + 1] += incidenceStart_[i];
     incidence_.resize(incidenceStart_[nn]);
+    // Filled in the caller's element order: each node's elements (and so its patch sums) in it.
     std::vector<std::size_t> fill(incidenceStart_.begin(), incidenceStart_.end() - 1);
-    for (std::size_t bi = 0; bi < blocks_.size(); ++bi) {
-      const Block<D>& b = blocks_[bi];
-      for (std::size_t e = 0; e < b.cells->count(); ++e) {
-        const std::int64_t* v = b.cells->element(e);
-        for (int k = 0; k < b.nodes; ++k) incidence_[fill[v[k]]++] = {static_cast<int>(bi), k, e};
-      }
-    }
-    if (elementRank_ != nullptr)
-      for (std::size_t n = 0; n < nn; ++n)
-        std::sort(incidence_.begin() + static_cast<std::ptrdiff_t>(incidenceStart_[n]),
-                  incidence_.begin() + static_cast<std::ptrdiff_t>(incidenceStart_[n + 1]),
-                  [&](const Incidence& a, const Incidence& b) {
-                    return (*elementRank_)[globalIndex(a)] < (*elementRank_)[globalIndex(b)];
-                  });
+    forEachElementInCallersOrder([&](std::size_t bi, std::size_t e) {
+      const std::int64_t* v = blocks_[bi].cells->element(e);
+      for (int k = 0; k < blocks_[bi].nodes; ++k)
+        incidence_[fill[v[k]]++] = {static_cast<int>(bi), k, e};
+    });
     nodeSize_.assign(nn, std::numeric_limits<double>::infinity());
     for (const Block<D>& b : blocks_)
       for (std::size_t e = 0; e < b.cells->count(); ++e) {
