@@ -829,10 +829,14 @@ class Optimiser {
           }
       }
     }
+    // An element scanned once has every node at most at that layer: never scanned again (a
+    // frontier node's elements are mostly another frontier node's too).
+    std::vector<char> scanned(totalElements_, 0);
     for (std::uint8_t layer = 1; layer < kFarFromCut && !frontier.empty(); ++layer) {
       next.clear();
       for (const std::int64_t n : frontier)
         for (std::size_t k = incidenceStart_[n]; k < incidenceStart_[n + 1]; ++k) {
+          if (std::exchange(scanned[globalIndex(incidence_[k])], 1) != 0) continue;
           const Block<D>& b = blocks_[incidence_[k].block];
           const std::int64_t* v = b.cells->element(incidence_[k].element);
           for (int j = 0; j < b.nodes; ++j)
