@@ -375,7 +375,8 @@ def size_field(shape, min_delta=None, max_delta=None, eps=None, sources=(), name
 def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
          optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=8,
          boundary_layer=None, cancel=None, optimise_seconds=0.0, linear_seconds=600.0,
-         heal=True, job_seconds=0.0, solids_only=False, surface=False, auto=False):
+         heal=True, job_seconds=0.0, solids_only=False, surface=False, auto=False,
+         facet_weight=0.0):
     """Meshes a CAD shape with curved elements of the given order.
 
     shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
@@ -403,6 +404,11 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     optimise_seconds
               > 0: each optimiser run stops after this many seconds with its best state so
               far (``report()["optimiser"]["stopped"] == "time budget"``); 0: no limit.
+    facet_weight
+              > 0 (0..100; 1 is a good start): once every element is proven valid, the
+              optimiser also keeps the boundary facets' nodes evenly spread as they slide on
+              the CAD, so the curved boundary stays on it between them
+              (``report()["geometry"]``); 0: off.
     linear_seconds
               Gmsh's linear meshing runs in a child process (a crash inside Gmsh becomes a
               :class:`MeshingError`); it is stopped after this many seconds and the job fails
@@ -456,7 +462,8 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
     repair_rounds = _check_int("repair_rounds", repair_rounds)
     limits = {"optimise_seconds": optimise_seconds,
               "linear_seconds": _check_seconds(linear_seconds, "linear_seconds"),
-              "job_seconds": _check_seconds(job_seconds, "job_seconds")}
+              "job_seconds": _check_seconds(job_seconds, "job_seconds"),
+              "facet_weight": _check_number(facet_weight, "facet_weight")}
     if size is not None:
         if isinstance(size, bool) or not isinstance(size, numbers.Real):
             raise ParameterError("size must be a positive number, got %r" % (size,))
@@ -523,7 +530,7 @@ def _four_argument_progress(progress):
 
 
 def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=None, name=None,
-          optimise=0, cancel=None, optimise_seconds=0.0, job_seconds=0.0):
+          optimise=0, cancel=None, optimise_seconds=0.0, job_seconds=0.0, facet_weight=0.0):
     """Curves a linear tetrahedral mesh made by another tool (FreeCAD FEM's Gmsh or Netgen
     mesher) on the CAD it was made from.
 
@@ -535,7 +542,7 @@ def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=No
     Each boundary node is put on the CAD vertex, edge or face it lies on, the mesh is raised to
     ``order`` with its boundary nodes on the CAD and, with ``optimise`` > 0, optimised with them
     sliding on it (stages "classify", "high_order", "optimise", ...). progress, cancel,
-    optimise_seconds, job_seconds, threads and name as for :func:`mesh`. Raises ParameterError, CadError or MeshingError (naming the
+    optimise_seconds, job_seconds, facet_weight, threads and name as for :func:`mesh`. Raises ParameterError, CadError or MeshingError (naming the
     boundary node that lies on no CAD face).
     """
     order, threads, verbosity, optimise, progress, optimise_seconds = _job_arguments(
@@ -548,7 +555,8 @@ def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=No
         raise ParameterError("tetrahedra must be an (E, 4) array of corner nodes, got shape %s"
                              % (tetrahedra.shape,))
     limits = {"optimise_seconds": optimise_seconds,
-              "job_seconds": _check_seconds(job_seconds, "job_seconds")}
+              "job_seconds": _check_seconds(job_seconds, "job_seconds"),
+              "facet_weight": _check_number(facet_weight, "facet_weight")}
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
         core = _core.curve_brep(value, label, nodes, tetrahedra, order, threads, verbosity,
@@ -594,6 +602,13 @@ def _boundary_layer(spec):
             raise ParameterError("boundary_layer progression must be a number, got %r" % (r,))
         out["progression"] = float(r)
     return out
+
+
+def _check_number(value, name):
+    """A real number (the core checks its range)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ParameterError("%s must be a number, got %r" % (name, value))
+    return float(value)
 
 
 def _check_seconds(value, name="optimise_seconds"):

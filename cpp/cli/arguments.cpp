@@ -222,6 +222,9 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   table.value({"--time-limit"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.timeLimit = parseParameter("optimise_seconds", o, v);
   });
+  table.value({"--facet-weight"}, [&cmd](const std::string& o, const std::string& v) {
+    cmd.facetWeight = parseParameter("facet_weight", o, v);
+  });
   table.value({"--linear-time-limit"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.linearTimeLimit = parseParameter("linear_seconds", o, v);
   });
@@ -405,6 +408,10 @@ options:
                       check again); default 8, 0 for none
       --time-limit S  each optimiser run stops after S seconds with its best state
                       (report: "stopped": "time budget"); default 0, no limit
+      --facet-weight W  once every element is proven valid, the optimiser also keeps the
+                      boundary facets' nodes evenly spread as they slide, so the curved
+                      boundary stays on the CAD between them (default 0: off; 1 is a good
+                      start; 0..100)
       --no-heal       check the CAD only; do not sew, fix or merge small edges and faces
                       (healing runs only when the check finds a problem, and the report's
                       "healing" says what it found and did)

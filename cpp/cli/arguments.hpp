@@ -43,6 +43,7 @@ struct MeshCommand {
   int optimiseIterations = 0;      // --optimise: 100, --maxiter N
   int repairRounds = 8;            // --repair-rounds N, range and default in core/parameters.hpp
   double timeLimit = 0.0;          // --time-limit S: seconds per optimiser run (0: none)
+  double facetWeight = 0.0;        // --facet-weight W: the optimiser's boundary-facet term
   bool heal = true;                // --no-heal: the CAD is only checked
   bool solidsOnly = false;         // --solids-only: faces in no solid are left out
   bool surface = false;            // --surface: a model without solids gets a surface mesh

@@ -148,6 +148,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
   options.optimiseIterations = cmd.optimiseIterations;
   options.repairRounds = cmd.repairRounds;
   options.optimiseSeconds = cmd.timeLimit;
+  options.facetWeight = cmd.facetWeight;
   options.linearSeconds = cmd.linearTimeLimit;
   options.jobSeconds = cmd.jobTimeLimit;
   options.heal = cmd.heal;

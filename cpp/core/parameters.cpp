@@ -27,6 +27,12 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        ParameterKind::Real, 0, kNoLimit, false, 0, false, "mesh",
        "Seconds one optimiser run may take (each of a job's runs); it then stops with the best "
        "state so far and the report says \"stopped\": \"time budget\"; 0: no limit"},
+      {"facet_weight", "FacetWeight", "--facet-weight", "facet weight", ParameterKind::Real, 0, 100,
+       false, 0, false, "mesh",
+       "Weight of the boundary facets' distortion within the CAD surface in the optimiser's "
+       "energy, added once every element is proven valid: it keeps a facet's nodes evenly spread "
+       "as they slide, so the curved boundary stays on the CAD between them (0: off; 1 is a "
+       "good start)"},
       {"linear_seconds", "LinearTimeLimit", "--linear-time-limit", "linear meshing time limit",
        ParameterKind::Real, 0, kNoLimit, false, 600, false, "mesh",
        "Seconds Gmsh's linear meshing may take (each run, in its own process); it is then "

@@ -17,10 +17,12 @@
 #include "cad/cad_model.hpp"
 #include "core/error.hpp"
 #include "core/first_failure.hpp"
+#include "core/parameters.hpp"
 #include "core/spatial_order.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 #include "optimise/cad_local_model.hpp"
+#include "optimise/facet_energy.hpp"
 #include "optimise/mesh_topology.hpp"
 #include "optimise/node_patch.hpp"
 #include "optimise/work_partition.hpp"
@@ -58,6 +60,7 @@ void OptimiserOptions::validate() const {
     throw ParameterError("focus passes must be >= 0, got " + std::to_string(focusPasses));
   if (!(focusMargin >= 0.0) || !std::isfinite(focusMargin))
     throw ParameterError("focus margin must be a finite number >= 0");
+  checkParameter("facet_weight", facetWeight);
 }
 
 namespace {
@@ -205,6 +208,7 @@ class Optimiser {
     if (overBudget()) return stoppedInSetup(before, t0);
 
     chooseFreeNodes();
+    buildFacets();
     partition();
     colour();
     computeGradients();
@@ -213,6 +217,7 @@ class Optimiser {
 
     IterationRecord best = before;
     best.energy = result_.energyBefore = totalEnergy();
+    facetsOn_ = before.invalid + before.undecided == 0;
     std::vector<double> bestXyz, bestParam;  // empty: the input
     const std::vector<double> input = mesh_.xyz, inputParam = mesh_.nodeCadParam;
     result_.stopReason = free_.empty() ? "no free nodes" : "iterations";
@@ -245,6 +250,7 @@ class Optimiser {
         result_.slides += moved.slides;
         result_.cadEvaluations += moved.cadEvaluations;
         record.energy = totalEnergy();
+        if (record.invalid + record.undecided == 0) facetsOn_ = true;
         result_.history.push_back(record);
         result_.iterations = it;
         if (observer_ != nullptr) observer_->iterationFinished(record);
@@ -298,6 +304,7 @@ class Optimiser {
     convertToWorkingSet();
     buildIncidence();
     chooseFreeNodes();
+    buildFacets();
     partition();
     changed_.resize(totalElements_);
     for (std::size_t i = 0; i < totalElements_; ++i) changed_[i] = i;
@@ -337,6 +344,14 @@ class Optimiser {
       patch.points.shift(shift);
       out.value =
           assemblePatch<D, decltype(fn)::value>(patch.points, eps, grad, hess, &out.magnitude);
+      if (slide_[node] != 0 && hasFacets()) {  // as a sweep on a valid mesh has it
+        const Vec kept = position_[node];
+        position_[node] += shift;
+        const double ef = facetAssemble(node, grad, hess, patch);
+        position_[node] = kept;
+        out.value += ef;
+        out.magnitude += std::abs(ef);
+      }
       if (slide_[node] == 0) {
         out.gradient = grad;
         out.hessian = hess;
@@ -387,6 +402,10 @@ class Optimiser {
   std::vector<std::int32_t> cadSlot_;   // per node: its index in cadModel_, -1 if it stays
   // per sliding node: its curve's (face's) model at the parameters it was built at
   std::vector<LocalCadModel<D>> cadModel_;
+  // The boundary facets' term (OptimiserOptions::facetWeight); null without it. facetsOn_: the
+  // sweeps add it, once the mesh is proven valid.
+  std::unique_ptr<FacetEnergy> facetEnergy_;
+  bool facetsOn_ = false;
   std::map<int, ParameterRange> curveRange_;
   std::map<int, SurfaceBounds> faceRange_;
   OptimiserResult result_;
@@ -664,6 +683,24 @@ class Optimiser {
     setEnergyOrder();
   }
 
+  // The boundary facets of the free sliding nodes (facet_energy.hpp), in 3D with a facet weight.
+  void buildFacets() {
+    facetEnergy_.reset();
+    if constexpr (D == 3) {
+      if (!(options_.facetWeight > 0.0) || cad_ == nullptr) return;
+      std::vector<std::uint8_t> movable(mesh_.numNodes(), 0);
+      bool any = false;
+      for (const std::int64_t node : free_)
+        if (slide_[static_cast<std::size_t>(node)] != 0) {
+          movable[static_cast<std::size_t>(node)] = 1;
+          any = true;
+        }
+      if (!any) return;
+      facetEnergy_ = std::make_unique<FacetEnergy>(mesh_, position_, movable, options_.facetWeight);
+      if (facetEnergy_->empty()) facetEnergy_.reset();
+    }
+  }
+
   // With CAD: nodes on a CAD curve (face, in 3D) move along it in t ((u, v)), nodes inside the
   // domain move freely, CAD vertices stay; nodes without a CAD record keep the topological rule.
   void chooseSlidingNodes(std::vector<char>& boundary) {
@@ -920,6 +957,7 @@ class Optimiser {
     };
     NodePatch<D> points;
     std::vector<Run> runs;
+    FacetEnergy::Patch facets;  // the node's boundary facets, when it slides (facetEnergy_)
     std::size_t slides = 0, cadEvaluations = 0;  // sliding visits, CAD evaluations
   };
 
@@ -1126,13 +1164,48 @@ class Optimiser {
     }
   }
 
+  bool hasFacets() const {
+    return facetEnergy_ != nullptr;
+  }
+  // The facet term of `node` added to grad and hess (facet_energy.hpp); fills patch.facets.
+  double facetAssemble(std::int64_t node, Vec& grad, Mat& hess, Patch& patch) const {
+    if constexpr (D == 3) {
+      return facetEnergy_->assemble(node, position_, grad, hess, patch.facets);
+    } else {
+      return 0.0;
+    }
+  }
+  static double facetAfter(const Patch& patch, const Vec& d) {
+    if constexpr (D == 3) {
+      return FacetEnergy::energyAfter(patch.facets, d);
+    } else {
+      return 0.0;
+    }
+  }
+
   template <Functional Fn>
-  double slideOn(const CadModel& cad, std::int64_t node, Patch& patch, double eps, double e0,
-                 double magnitude, const Vec& grad, const Mat& hess) {
+  double slideOn(const CadModel& cad, std::int64_t node, Patch& patch, double eps,
+                 double volumeEnergy, double magnitude, const Vec& volumeGrad,
+                 const Mat& volumeHess) {
     double* param = &mesh_.nodeCadParam[2 * node];
     const int entity = mesh_.nodeCadIndex[node];
     ++patch.slides;
     const LocalCadModel<D>& model = currentModel(cad, node, patch);
+    // The boundary facets' term joins the volume patch's once the mesh is valid (facetsOn_).
+    double e0 = volumeEnergy;
+    Vec grad = volumeGrad;
+    Mat hess = volumeHess;
+    const bool facets = facetsOn_ && hasFacets();
+    if (facets) {
+      const double ef = facetAssemble(node, grad, hess, patch);
+      if (!std::isfinite(ef)) return 0.0;
+      e0 += ef;
+      magnitude += std::abs(ef);
+    }
+    const auto energyAfter = [&](const Vec& d) {
+      const double e = patchEnergyAfter<D, Fn>(patch.points, d, eps);
+      return facets ? e + facetAfter(patch, d) : e;
+    };
     Eigen::VectorXd g;
     Eigen::MatrixXd h;
     model.chainRule(grad, hess, g, h);
@@ -1165,12 +1238,12 @@ class Optimiser {
         const Vec d = model.at(dp) - position_[node];
         const double r = std::min(1.0, std::hypot(dp[0], dp[1]) / fullStep);
         const double slack = (grad.norm() + hess.norm() * d.norm()) * 2.0 * fullError * r * r * r;
-        if (!(patchEnergyAfter<D, Fn>(patch.points, d, eps) <= bound + slack)) continue;
+        if (!(energyAfter(d) <= bound + slack)) continue;
       }
       ++patch.cadEvaluations;
       LocalCadModel<D> next = localModel(cad, node, trial);
       const Vec d = next.point - position_[node];
-      if (patchEnergyAfter<D, Fn>(patch.points, d, eps) <= bound) {
+      if (energyAfter(d) <= bound) {
         position_[node] = next.point;
         param[0] = trial[0];
         param[1] = trial[1];
@@ -1484,6 +1557,9 @@ class Optimiser {
     });
     double total = 0.0;
     for (const std::size_t i : energyOrder_) total += energy[i];
+    if constexpr (D == 3) {
+      if (hasFacets()) total += facetEnergy_->total(position_);
+    }
     return total;
   }
 

@@ -113,6 +113,13 @@ struct OptimiserOptions {
   // the last bit; the optimiser's tests compare). On Gmsh's numbering, an order-2 sweep of the
   // order-sweep benchmark got 1.25x from two threads where the machine allowed 1.9x.
   bool spatialOrder = true;
+  // Weight of the boundary facets' distortion inside their own surface (optimise/
+  // facet_energy.hpp) in the energy of the nodes sliding on the CAD (3D, with CAD; 0: none).
+  // Sliding keeps the nodes on the CAD but lets a facet's nodes bunch up, and its polynomial
+  // surface then leaves the CAD between them; this term keeps their spacing. It joins once the
+  // mesh is proven valid (the input, or after a sweep): untangling comes first. core/
+  // parameters.hpp's "facet_weight" gives its range and the pipeline's default.
+  double facetWeight = 0.0;
 
   // Throws ParameterError naming the offending option.
   void validate() const;

@@ -34,6 +34,7 @@ void MeshingOptions::validate() const {
   checkParameter("threads", threads);
   checkParameter("optimise", optimiseIterations);
   checkParameter("optimise_seconds", optimiseSeconds);
+  checkParameter("facet_weight", facetWeight);
   checkParameter("linear_seconds", linearSeconds);
   checkParameter("job_seconds", jobSeconds);
   checkParameter("repair_rounds", repairRounds);
@@ -423,6 +424,7 @@ OptimiserOptions pipelineOptimiserOptions(const MeshingOptions& options) {
   o.stuckWindow = kPipelineStuckWindow;  // not valid and not improving: repair rounds take over
   o.threads = options.threads;
   o.timeLimit = options.optimiseSeconds;
+  o.facetWeight = options.facetWeight;
   return o;
 }
 

@@ -52,6 +52,9 @@ struct MeshingOptions {
   // stall 0.001).
   int optimiseIterations = 0;
   double optimiseSeconds = 0.0;  // time limit of each optimiser run (0: none)
+  // The optimiser's boundary-facet term (OptimiserOptions::facetWeight), default and range in
+  // core/parameters.hpp ("facet_weight").
+  double facetWeight = 0.0;
   // Time limit of each Gmsh run of the linear mesher (0: none), default from the parameter table.
   double linearSeconds = 600.0;
   // Wall-time budget of the whole job (0: none), from the start of runMeshPipeline

@@ -385,9 +385,9 @@ BoundaryLayerParameters boundaryLayerFrom(const bp::dict& d) {
   return p;
 }
 
-// A job's time limits from a dict keyed as the parameter table ("optimise_seconds",
-// "linear_seconds", "job_seconds"; homesh/api.py checked the types); a key left out keeps its
-// default. Ranges are checked by MeshingOptions::validate.
+// A job's time limits and the optimiser's facet weight from a dict keyed as the parameter table
+// ("optimise_seconds", "linear_seconds", "job_seconds", "facet_weight"; homesh/api.py checked
+// the types); a key left out keeps its default. Ranges are checked by MeshingOptions::validate.
 void applyTimeLimits(MeshingOptions& options, const bp::object& limits) {
   if (limits.is_none()) return;
   const bp::dict d = bp::extract<bp::dict>(limits);
@@ -397,6 +397,7 @@ void applyTimeLimits(MeshingOptions& options, const bp::object& limits) {
   read("optimise_seconds", options.optimiseSeconds);
   read("linear_seconds", options.linearSeconds);
   read("job_seconds", options.jobSeconds);
+  read("facet_weight", options.facetWeight);
 }
 
 // The CAD modes the Python functions pass as one string (Boost.Python's arity limit): a comma

@@ -123,6 +123,7 @@ class HighOrderMeshProxy(_Proxy, ParameterGuard):
                             "Eps, refinement spheres) sizes the elements when Size is 0")
         add_parameter_property(obj, "optimise", "Mesh", " Boundary nodes slide on the CAD.")
         add_parameter_property(obj, "optimise_seconds", "Mesh")
+        add_parameter_property(obj, "facet_weight", "Mesh")
         add_parameter_property(obj, "linear_seconds", "Mesh")
         add_parameter_property(obj, "job_seconds", "Mesh")
         if "Heal" not in have:
@@ -269,6 +270,7 @@ def mesh_arguments(obj, values=None):
     arguments = {"order": int(get("Order")), "size": size if size > 0 else None,
                  "optimise": int(get("OptimiserIterations")),
                  "optimise_seconds": get("OptimiserTimeLimit"),
+                 "facet_weight": get("FacetWeight"),
                  "linear_seconds": get("LinearTimeLimit"),
                  "job_seconds": get("JobTimeLimit"),
                  "heal": bool(values.get("Heal", getattr(obj, "Heal", True))),
@@ -330,7 +332,8 @@ def job_for(obj, values=None):
                       nodes=nodes, tetrahedra=tets, order=arguments["order"],
                       optimise=arguments["optimise"], threads=arguments["threads"],
                       optimise_seconds=arguments["optimise_seconds"],
-                      job_seconds=arguments["job_seconds"])
+                      job_seconds=arguments["job_seconds"],
+                      facet_weight=arguments["facet_weight"])
         job.fem_elements = len(tets)
     job.values = values or {}
     return job

@@ -21,7 +21,7 @@ from . import objects
 from .job import confirm_large_mesh
 from .properties import definition, value_of
 
-_MESH_PARAMETERS = ("Order", "Size", "OptimiserIterations", "OptimiserTimeLimit",
+_MESH_PARAMETERS = ("Order", "Size", "OptimiserIterations", "OptimiserTimeLimit", "FacetWeight",
                     "LinearTimeLimit", "JobTimeLimit", "RepairRounds", "Threads")
 _SIZING_PARAMETERS = ("MinDelta", "MaxDelta", "Eps")
 # The CAD check's switches (boolean properties): check boxes under the parameters.
@@ -342,7 +342,7 @@ class TaskPanelHighOrderMesh:
 
 _LABELS = {"OptimiserIterations": "Optimiser sweeps", "OptimiserTimeLimit": "Time limit (s)",
            "LinearTimeLimit": "Gmsh time limit (s)", "JobTimeLimit": "Job time limit (s)",
-           "RepairRounds": "Repair rounds"}
+           "RepairRounds": "Repair rounds", "FacetWeight": "Facet weight"}
 
 
 def _row_label(prop):

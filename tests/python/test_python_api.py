@@ -305,6 +305,21 @@ def test_an_optimiser_time_limit_stops_it_with_the_best_state(data):
         homesh.mesh(text, order=2, size=0.5, optimise=5, optimise_seconds=-1.0)
 
 
+def test_the_facet_weight_reaches_the_core_and_is_checked(data):
+    # The sphere at size 0.5, order 4: the optimiser slides its nodes with and without the
+    # facet term; both valid, and the term changes the result (it is applied, not dropped).
+    text = (data / "sphere.brep").read_text()
+    plain = homesh.mesh(text, order=4, size=0.5, optimise=20)
+    facets = homesh.mesh(text, order=4, size=0.5, optimise=20, facet_weight=1.0)
+    for m in (plain, facets):
+        assert m.report()["optimiser"]["invalid_after"] == 0
+    assert not np.array_equal(plain.nodes, facets.nodes)
+    with pytest.raises(homesh.ParameterError, match="facet weight must be a number from 0 to 100"):
+        homesh.mesh(text, order=2, size=0.5, optimise=5, facet_weight=-1.0)
+    with pytest.raises(homesh.ParameterError, match="facet_weight must be a number"):
+        homesh.mesh(text, order=2, size=0.5, optimise=5, facet_weight="1")
+
+
 def test_the_command_line_takes_a_time_limit(homesh_bin, data, tmp_path):
     from conftest import run
     report = tmp_path / "r.json"
@@ -326,5 +341,5 @@ def test_keyword_defaults_are_the_parameter_tables():
     signature = inspect.signature(homesh.mesh).parameters
     table = {p["key"]: p["default"] for p in homesh.parameters()}
     for key in ("order", "threads", "repair_rounds", "optimise_seconds", "linear_seconds",
-                "job_seconds"):
+                "job_seconds", "facet_weight"):
         assert signature[key].default == table[key], key

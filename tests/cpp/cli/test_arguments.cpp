@@ -57,6 +57,20 @@ TEST(Arguments, RepairRounds) {
         << bad;
 }
 
+TEST(Arguments, FacetWeight) {
+  // The CLI's, the pipeline's, the optimiser's and the parameter table's defaults agree: off.
+  const double table = parameterDefinition("facet_weight").defaultValue;
+  EXPECT_EQ(table, 0.0);
+  EXPECT_EQ(parse({"mesh", "part.brep"}).mesh.facetWeight, table);
+  EXPECT_EQ(MeshingOptions{}.facetWeight, table);
+  EXPECT_EQ(OptimiserOptions{}.facetWeight, table);
+  EXPECT_EQ(parse({"mesh", "part.brep", "--facet-weight", "1.5"}).mesh.facetWeight, 1.5);
+  for (const char* bad : {"-0.5", "101", "x"})
+    EXPECT_NE(usageError({"mesh", "part.brep", "--facet-weight", bad}).find("--facet-weight"),
+              std::string::npos)
+        << bad;
+}
+
 TEST(Arguments, SizingAndPredict) {
   const ParsedCommand p =
       parse({"predict", "case.mcf", "--max-delta", "0.5", "--eps", "0.1", "--refine-sphere",

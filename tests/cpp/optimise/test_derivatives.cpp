@@ -25,6 +25,7 @@
 
 #include "core/error.hpp"
 #include "element/reference_element.hpp"
+#include "optimise/facet_energy.hpp"
 #include "optimise/functional.hpp"
 #include "optimise/optimiser.hpp"
 #include "pipeline/mesh_pipeline.hpp"
@@ -166,6 +167,71 @@ TEST(Functional, ValueMatchesTheDensityAlone) {
     Eigen::Matrix3d h;
     EXPECT_EQ(energyDensityDerivatives<3>(f, F, a, 1e-10, g, h), energyDensity<3>(f, F, 1e-10));
   }
+}
+
+// The boundary facets' density (optimise/facet_energy.hpp): its analytic gradient and Hessian in
+// the displacement d of a node, M(d) = [m1 + a1 d, m2 + a2 d], against AD as above.
+template <class T>
+struct FacetResult {
+  Eigen::Matrix<T, 3, 1> gradient, adGradient;
+  Eigen::Matrix<T, 3, 3> hessian, adHessian;
+};
+
+template <class T>
+FacetResult<T> facetKernel(const Eigen::Vector3d& m1d, const Eigen::Vector3d& m2d, double a1d,
+                           double a2d) {
+  using AD = Eigen::AutoDiffScalar<Eigen::Matrix<T, 3, 1>>;
+  using V = Eigen::Matrix<T, 3, 1>;
+  using VA = Eigen::Matrix<AD, 3, 1>;
+  V m1 = m1d.cast<T>(), m2 = m2d.cast<T>();  // (a copy for T = double as well)
+  const T a1 = a1d, a2 = a2d;
+  FacetResult<T> r;
+  T value = 0;
+  EXPECT_TRUE(facet_detail::derivatives<T>(m1, m2, a1, a2, value, r.gradient, r.hessian));
+  VA n1, n2;  // M(d) with d the AD variables
+  for (int i = 0; i < 3; ++i) {
+    n1[i] = AD(m1[i], V::Zero());
+    n1[i].derivatives()[i] = a1;
+    n2[i] = AD(m2[i], V::Zero());
+    n2[i].derivatives()[i] = a2;
+  }
+  r.adGradient = facet_detail::density<AD>(n1, n2).derivatives();
+  AD v;
+  VA g;
+  Eigen::Matrix<AD, 3, 3> h;
+  EXPECT_TRUE(facet_detail::derivatives<AD>(n1, n2, AD(a1, V::Zero()), AD(a2, V::Zero()), v, g, h));
+  for (int l = 0; l < 3; ++l) r.adHessian.row(l) = g[l].derivatives().transpose();
+  return r;
+}
+
+Mismatch checkFacetKernel(std::mt19937& rng, double plant = 0.0) {
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  // Columns near an orthonormal pair (a facet near its ideal), stretched and sheared.
+  Eigen::Vector3d m1(1.0 + u(rng), u(rng), u(rng)), m2(u(rng), 1.0 + u(rng), u(rng));
+  const double a1 = 1.0 + u(rng), a2 = -0.5 + u(rng);
+  FacetResult<double> r = facetKernel<double>(m1, m2, a1, a2);
+  FacetResult<long double> l = facetKernel<long double>(m1, m2, a1, a2);
+  r.gradient *= 1.0 + plant;
+  l.gradient *= 1.0L + plant;
+  r.hessian *= 1.0 + plant;
+  l.hessian *= 1.0L + plant;
+  Mismatch m;
+  compare(r.gradient, r.adGradient, l.gradient, l.adGradient, r.gradient.cwiseAbs().maxCoeff(), m);
+  compare(r.hessian, r.adHessian, l.hessian, l.adHessian, r.hessian.cwiseAbs().maxCoeff(), m);
+  return m;
+}
+
+TEST(FacetEnergy, DensityDerivativesMatchAutomaticDifferentiation) {
+  std::mt19937 rng(17);
+  double resolution = 0.0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const Mismatch m = checkFacetKernel(rng);
+    EXPECT_LE(m.worstRatio, 1.0) << "trial " << trial;
+    resolution = std::max(resolution, m.worstBound);
+  }
+  EXPECT_LT(resolution, 1e-8);
+  // And the check sees a relative error of 1e-4.
+  EXPECT_GT(checkFacetKernel(rng, 1e-4).worstRatio, 1.0);
 }
 
 // ---- 2. The optimiser's assembly against finite differences -----------------------------------
@@ -365,6 +431,36 @@ TEST(Optimiser, SlidingNodeDerivativesMatchFiniteDifferencesThroughTheCad) {
                 functionalName(f).c_str(), curve.sensitive, curve.checks, face.sensitive,
                 face.checks, inside.sensitive, inside.checks);
   }
+}
+
+// The same with the boundary facets' term (OptimiserOptions::facetWeight): the probe adds it to
+// every sliding node's patch, before the chain rule through the CAD.
+TEST(Optimiser, SlidingNodeDerivativesWithTheFacetTermMatchFiniteDifferences) {
+  const MeshResult r = holeMesh();
+  OptimiserOptions options;
+  options.facetWeight = 1.0;
+  const NodeEnergyProbe probe(r.mesh, options, r.cad.get());
+  OptimiserOptions plainOptions;
+  const NodeEnergyProbe plain(r.mesh, plainOptions, r.cad.get());
+  ProbeStats stats;
+  int checked = 0, differ = 0;
+  for (std::int64_t node = 0; node < static_cast<std::int64_t>(r.mesh.numNodes()) && checked < 12;
+       ++node) {
+    if (!probe.isFree(node) || r.mesh.nodeCadDim[node] == 3) continue;
+    const Eigen::VectorXd x = probe.coordinates(node);
+    // Off the input's position, where the term's gradient is not zero.
+    Eigen::VectorXd moved = x;
+    moved[0] += 0.02;
+    const double eps = probe.regularisation(node);
+    if (probe.evaluate(node, moved, eps).value != plain.evaluate(node, moved, eps).value) ++differ;
+    checkNode(probe, node, 1.0 / 3.0, stats,
+              "facet term " + cadEntityName(r.mesh.nodeCadDim[node], r.mesh.nodeCadIndex[node]));
+    ++checked;
+  }
+  EXPECT_EQ(checked, 12);
+  EXPECT_EQ(differ, checked) << "the facet term is missing from some sliding nodes' energy";
+  EXPECT_LE(stats.worstRatio, 1.0);
+  EXPECT_GT(stats.sensitive, 0);
 }
 
 TEST(Optimiser, NodeCheckCatchesAPlantedRelativeErrorOf1e4) {

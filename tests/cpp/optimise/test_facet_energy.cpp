@@ -1,0 +1,117 @@
+// The boundary facets' in-surface energy (optimise/facet_energy.hpp) on single facets: zero and
+// stationary for a rigid motion of the straight facet, positive for nodes bunched along it, the
+// trial energy equal to the energy recomputed at the moved node, and a clear error for a
+// degenerate facet. Its derivatives are checked against AD and finite differences in
+// test_derivatives.cpp.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "element/reference_element.hpp"
+#include "optimise/facet_energy.hpp"
+
+namespace homesh {
+namespace {
+
+constexpr double kU = std::numeric_limits<double>::epsilon() / 2;
+
+// One order-P triangle on CAD face 7 of a 3D mesh: the reference triangle's equispaced nodes
+// scaled by `side`, rotated and translated (a rigid motion of a straight facet).
+struct OneFacet {
+  Mesh mesh;
+  std::vector<Eigen::Vector3d> positions;
+};
+
+OneFacet straightFacet(int order, double side) {
+  const ReferenceElement& ref = ReferenceElement::get(CellType::Triangle, order);
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, 2.0, -0.5).normalized()).toRotationMatrix();
+  const Eigen::Vector3d shift(0.3, -1.2, 2.0);
+  OneFacet f;
+  f.mesh.dim = 3;
+  f.mesh.order = order;
+  for (int i = 0; i < ref.numNodes(); ++i) {
+    const Eigen::Vector3d x =
+        rotation * Eigen::Vector3d(side * ref.nodes()(i, 0), side * ref.nodes()(i, 1), 0.0) + shift;
+    const double p[3] = {x[0], x[1], x[2]};
+    f.mesh.addNode(p, 2, 7, 0.0, 0.0);
+    f.positions.push_back(x);
+  }
+  ElementBlock b;
+  b.type = CellType::Triangle;
+  b.order = order;
+  for (int i = 0; i < ref.numNodes(); ++i) b.nodes.push_back(i);
+  b.entity = {7};
+  f.mesh.blocks.push_back(b);
+  return f;
+}
+
+TEST(FacetEnergy, ARigidMotionOfTheStraightFacetCostsNothing) {
+  const double side = 2.5, weight = 1.0;
+  OneFacet f = straightFacet(3, side);
+  const std::vector<std::uint8_t> movable(f.positions.size(), 1);
+  const FacetEnergy energy(f.mesh, f.positions, movable, weight);
+  ASSERT_EQ(energy.size(), 1u);
+  // Every point has C = I to a few ulps, so each density (|C| - 2 and ln det C) is a few u; the
+  // weights add up to weight x area x sqrt(area).
+  const double area = 0.5 * side * side;
+  const double scale = weight * area * std::sqrt(area);
+  EXPECT_LE(std::abs(energy.total(f.positions)), 64 * kU * scale);
+  // Stationary too: the gradient of every node is a few u times scale / side.
+  for (std::int64_t node = 0; node < static_cast<std::int64_t>(f.positions.size()); ++node) {
+    Eigen::Vector3d g = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+    FacetEnergy::Patch patch;
+    energy.assemble(node, f.positions, g, h, patch);
+    EXPECT_LE(g.norm(), 256 * kU * scale / side) << "node " << node;
+    EXPECT_GT(h.trace(), 0.0) << "node " << node;
+  }
+}
+
+TEST(FacetEnergy, BunchedNodesCostAndTrialsMatchTheMovedFacet) {
+  OneFacet f = straightFacet(4, 1.0);
+  const std::vector<std::uint8_t> movable(f.positions.size(), 1);
+  const FacetEnergy energy(f.mesh, f.positions, movable, 1.0);
+  // Node 3 (the first on edge 0-1, at a quarter of it) slid towards vertex 0, along the edge.
+  const std::int64_t node = 3;
+  const Eigen::Vector3d along = (f.positions[1] - f.positions[0]).normalized();
+  Eigen::Vector3d g = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  FacetEnergy::Patch patch;
+  const double e0 = energy.assemble(node, f.positions, g, h, patch);
+  for (const double s : {0.02, 0.1}) {
+    const Eigen::Vector3d d = -s * along;
+    std::vector<Eigen::Vector3d> moved = f.positions;
+    moved[node] += d;
+    const double direct = energy.total(moved);
+    EXPECT_GT(direct, e0 + 1e-6) << "bunching by " << s << " costs nothing";
+    // The trial formula (M + d a^T) and the recomputed facet differ by rounding only: a few
+    // hundred u of the energy's terms, which are of the size of the energy itself here.
+    EXPECT_NEAR(FacetEnergy::energyAfter(patch, d), direct, 1e3 * kU * (direct + 1.0))
+        << "bunching by " << s;
+  }
+}
+
+TEST(FacetEnergy, OnlyFacetsOfMovableNodesAndADegenerateFacetIsNamed) {
+  OneFacet f = straightFacet(2, 1.0);
+  std::vector<std::uint8_t> movable(f.positions.size(), 0);
+  EXPECT_TRUE(FacetEnergy(f.mesh, f.positions, movable, 1.0).empty());
+  movable[4] = 1;
+  EXPECT_EQ(FacetEnergy(f.mesh, f.positions, movable, 1.0).size(), 1u);
+  // All three vertices on one line.
+  f.positions[2] = 0.5 * (f.positions[0] + f.positions[1]);
+  try {
+    const FacetEnergy degenerate(f.mesh, f.positions, movable, 1.0);
+    FAIL() << "a facet of zero area was accepted";
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("CAD face 7"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace homesh
