@@ -30,7 +30,8 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
       {"facet_weight", "FacetWeight", "--facet-weight", "facet weight", ParameterKind::Real, 0, 100,
        false, 0, false, "mesh",
        "Weight of the boundary facets' distortion within the CAD surface in the optimiser's "
-       "energy, added once every element is proven valid: it keeps a facet's nodes evenly spread "
+       "energy (3D meshes), added once every element is proven valid: it keeps a facet's nodes "
+       "evenly spread "
        "as they slide, so the curved boundary stays on the CAD between them (0: off; 1 is a "
        "good start)"},
       {"linear_seconds", "LinearTimeLimit", "--linear-time-limit", "linear meshing time limit",

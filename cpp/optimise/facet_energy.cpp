@@ -98,7 +98,7 @@ FacetEnergy::FacetEnergy(const Mesh& mesh, const std::vector<Vec>& positions,
 }
 
 double FacetEnergy::facetEnergy(const Facet& f, const std::vector<Vec>& positions, int local,
-                                Vec* g, Mat* h, Patch* patch) const {
+                                Vec* g, Mat* h, Patch* patch, double* size) const {
   const Shape& s = shapes_[static_cast<std::size_t>(f.shape)];
   const std::int64_t* v = s.cells->element(f.cell);
   double energy = 0.0;
@@ -124,6 +124,7 @@ double FacetEnergy::facetEnergy(const Facet& f, const std::vector<Vec>& position
     if (!facet_detail::derivatives<double>(m.col(0), m.col(1), a[0], a[1], value, gq, hq))
       return std::numeric_limits<double>::infinity();
     energy += w * value;
+    if (size != nullptr) *size += w * (std::abs(value) + m.squaredNorm());
     *g += w * gq;
     *h += w * hq;
     patch->m1.emplace_back(m.col(0));
@@ -136,7 +137,7 @@ double FacetEnergy::facetEnergy(const Facet& f, const std::vector<Vec>& position
 }
 
 double FacetEnergy::assemble(std::int64_t node, const std::vector<Vec>& positions, Vec& g, Mat& h,
-                             Patch& patch) const {
+                             Patch& patch, double* size) const {
   patch.m1.clear();
   patch.m2.clear();
   patch.a1.clear();
@@ -148,8 +149,8 @@ double FacetEnergy::assemble(std::int64_t node, const std::vector<Vec>& position
   Mat hs = Mat::Zero();
   double energy = 0.0;
   for (std::size_t k = start_[n]; k < start_[n + 1]; ++k) {
-    energy +=
-        facetEnergy(facets_[incidence_[k].facet], positions, incidence_[k].local, &gs, &hs, &patch);
+    energy += facetEnergy(facets_[incidence_[k].facet], positions, incidence_[k].local, &gs, &hs,
+                          &patch, size);
     if (!std::isfinite(energy)) return energy;
   }
   g += gs;

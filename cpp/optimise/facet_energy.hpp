@@ -102,9 +102,16 @@ class FacetEnergy {
 
   // The energy of `node`'s facets at `positions`, with its gradient and Hessian in the node's
   // displacement (added to g and h); fills `patch`. Infinite (g, h untouched) where a facet is
-  // degenerate. 0 for a node on no facet.
+  // degenerate. 0 for a node on no facet. `size`, if given, receives the size of the terms the
+  // energy sums, sum w (|W_s| + tr C), for rounding estimates (the energy itself is near 0 close
+  // to the ideal while its terms are not).
   double assemble(std::int64_t node, const std::vector<Vec>& positions, Vec& g, Mat& h,
-                  Patch& patch) const;
+                  Patch& patch, double* size = nullptr) const;
+  // Whether `node` is on a facet (a movable node of one).
+  bool touches(std::int64_t node) const {
+    const auto n = static_cast<std::size_t>(node);
+    return n + 1 < start_.size() && start_[n + 1] > start_[n];
+  }
   // The same energy with the node moved by d from where assemble() had it.
   static double energyAfter(const Patch& patch, const Vec& d);
   // The energy of every facet at `positions`, summed in facet order.
@@ -131,7 +138,7 @@ class FacetEnergy {
   // The energy of one facet (node `local` moved by nothing), and with derivatives in that
   // node's displacement when `patch` is given.
   double facetEnergy(const Facet& f, const std::vector<Vec>& positions, int local, Vec* g, Mat* h,
-                     Patch* patch) const;
+                     Patch* patch, double* size = nullptr) const;
 
   std::vector<Shape> shapes_;
   std::vector<Facet> facets_;

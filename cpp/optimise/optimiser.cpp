@@ -249,8 +249,12 @@ class Optimiser {
         result_.visits += moved.visits;
         result_.slides += moved.slides;
         result_.cadEvaluations += moved.cadEvaluations;
+        // The facet term joins once the mesh is proven valid: every node of a facet is visited
+        // again (resting nodes too), and the sweep is not judged by the stop rules, whose energy
+        // would compare totals with and without the term.
+        const bool switching = !facetsOn_ && hasFacets() && record.invalid + record.undecided == 0;
+        if (switching) switchFacetsOn();
         record.energy = totalEnergy();
-        if (record.invalid + record.undecided == 0) facetsOn_ = true;
         result_.history.push_back(record);
         result_.iterations = it;
         if (observer_ != nullptr) observer_->iterationFinished(record);
@@ -259,7 +263,7 @@ class Optimiser {
           bestXyz = mesh_.xyz;
           bestParam = mesh_.nodeCadParam;
         }
-        const std::string reason = stopRule(record, previous, before);
+        const std::string reason = switching ? "" : stopRule(record, previous, before);
         previous = record;
         if (!reason.empty()) {
           result_.converged = reason != "stuck";
@@ -347,10 +351,11 @@ class Optimiser {
       if (slide_[node] != 0 && hasFacets()) {  // as a sweep on a valid mesh has it
         const Vec kept = position_[node];
         position_[node] += shift;
-        const double ef = facetAssemble(node, grad, hess, patch);
+        double size = 0.0;
+        const double ef = facetAssemble(node, grad, hess, patch, size);
         position_[node] = kept;
         out.value += ef;
-        out.magnitude += std::abs(ef);
+        out.magnitude += size;
       }
       if (slide_[node] == 0) {
         out.gradient = grad;
@@ -1167,10 +1172,16 @@ class Optimiser {
   bool hasFacets() const {
     return facetEnergy_ != nullptr;
   }
+  void switchFacetsOn() {
+    facetsOn_ = true;
+    if constexpr (D == 3)
+      for (const std::int64_t node : free_)
+        if (facetEnergy_->touches(node)) active_[node].store(1, std::memory_order_relaxed);
+  }
   // The facet term of `node` added to grad and hess (facet_energy.hpp); fills patch.facets.
-  double facetAssemble(std::int64_t node, Vec& grad, Mat& hess, Patch& patch) const {
+  double facetAssemble(std::int64_t node, Vec& grad, Mat& hess, Patch& patch, double& size) const {
     if constexpr (D == 3) {
-      return facetEnergy_->assemble(node, position_, grad, hess, patch.facets);
+      return facetEnergy_->assemble(node, position_, grad, hess, patch.facets, &size);
     } else {
       return 0.0;
     }
@@ -1197,10 +1208,11 @@ class Optimiser {
     Mat hess = volumeHess;
     const bool facets = facetsOn_ && hasFacets();
     if (facets) {
-      const double ef = facetAssemble(node, grad, hess, patch);
+      double size = 0.0;
+      const double ef = facetAssemble(node, grad, hess, patch, size);
       if (!std::isfinite(ef)) return 0.0;
       e0 += ef;
-      magnitude += std::abs(ef);
+      magnitude += size;
     }
     const auto energyAfter = [&](const Vec& d) {
       const double e = patchEnergyAfter<D, Fn>(patch.points, d, eps);
@@ -1558,7 +1570,7 @@ class Optimiser {
     double total = 0.0;
     for (const std::size_t i : energyOrder_) total += energy[i];
     if constexpr (D == 3) {
-      if (hasFacets()) total += facetEnergy_->total(position_);
+      if (facetsOn_ && hasFacets()) total += facetEnergy_->total(position_);
     }
     return total;
   }

@@ -117,8 +117,10 @@ struct OptimiserOptions {
   // facet_energy.hpp) in the energy of the nodes sliding on the CAD (3D, with CAD; 0: none).
   // Sliding keeps the nodes on the CAD but lets a facet's nodes bunch up, and its polynomial
   // surface then leaves the CAD between them; this term keeps their spacing. It joins once the
-  // mesh is proven valid (the input, or after a sweep): untangling comes first. core/
-  // parameters.hpp's "facet_weight" gives its range and the pipeline's default.
+  // mesh is proven valid (the input, or after a sweep; its nodes are then all visited again, the
+  // stop rules skip that sweep, and the reported energy includes the term from then on):
+  // untangling comes first. core/parameters.hpp's "facet_weight" gives its range and the
+  // pipeline's default.
   double facetWeight = 0.0;
 
   // Throws ParameterError naming the offending option.

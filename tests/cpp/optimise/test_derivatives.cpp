@@ -440,27 +440,35 @@ TEST(Optimiser, SlidingNodeDerivativesWithTheFacetTermMatchFiniteDifferences) {
   OptimiserOptions options;
   options.facetWeight = 1.0;
   const NodeEnergyProbe probe(r.mesh, options, r.cad.get());
-  OptimiserOptions plainOptions;
+  const OptimiserOptions plainOptions;
   const NodeEnergyProbe plain(r.mesh, plainOptions, r.cad.get());
-  ProbeStats stats;
-  int checked = 0, differ = 0;
-  for (std::int64_t node = 0; node < static_cast<std::int64_t>(r.mesh.numNodes()) && checked < 12;
-       ++node) {
+  ProbeStats curve, face;
+  int curves = 0, faces = 0;
+  for (std::int64_t node = 0; node < static_cast<std::int64_t>(r.mesh.numNodes()); ++node) {
     if (!probe.isFree(node) || r.mesh.nodeCadDim[node] == 3) continue;
     const Eigen::VectorXd x = probe.coordinates(node);
-    // Off the input's position, where the term's gradient is not zero.
-    Eigen::VectorXd moved = x;
-    moved[0] += 0.02;
     const double eps = probe.regularisation(node);
-    if (probe.evaluate(node, moved, eps).value != plain.evaluate(node, moved, eps).value) ++differ;
-    checkNode(probe, node, 1.0 / 3.0, stats,
-              "facet term " + cadEntityName(r.mesh.nodeCadDim[node], r.mesh.nodeCadIndex[node]));
-    ++checked;
+    // Nodes whose facets are off their ideal (on the cylinder and its circles): there the term
+    // has a gradient of its own (on a plane a facet can be at its ideal, where it has none).
+    const double with = probe.evaluate(node, x, eps).value;
+    const double without = plain.evaluate(node, x, eps).value;
+    if (!(with - without > 1e-6 * std::abs(with))) continue;
+    const std::string what =
+        "facet term " + cadEntityName(r.mesh.nodeCadDim[node], r.mesh.nodeCadIndex[node]);
+    if (x.size() == 1 && curves < 6) {
+      checkNode(probe, node, 1.0 / 3.0, curve, what);
+      ++curves;
+    } else if (x.size() == 2 && faces < 6) {
+      checkNode(probe, node, 1.0 / 3.0, face, what);
+      ++faces;
+    }
   }
-  EXPECT_EQ(checked, 12);
-  EXPECT_EQ(differ, checked) << "the facet term is missing from some sliding nodes' energy";
-  EXPECT_LE(stats.worstRatio, 1.0);
-  EXPECT_GT(stats.sensitive, 0);
+  EXPECT_EQ(curves, 6);
+  EXPECT_EQ(faces, 6);
+  for (const ProbeStats* s : {&curve, &face}) {
+    EXPECT_LE(s->worstRatio, 1.0);
+    EXPECT_GT(s->sensitive, 0);
+  }
 }
 
 TEST(Optimiser, NodeCheckCatchesAPlantedRelativeErrorOf1e4) {
