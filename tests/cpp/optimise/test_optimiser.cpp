@@ -239,6 +239,31 @@ TEST(Optimiser, ResultDoesNotDependOnTheNumberOfThreadsIn2DAndInARegion) {
   }
 }
 
+// With the boundary facets' term (OptimiserOptions::facetWeight) too: a sliding node's term reads
+// the other nodes of its facets, which share a volume element with it and so have other colours.
+TEST(Optimiser, ResultDoesNotDependOnTheNumberOfThreadsWithTheFacetTerm) {
+  MeshingOptions meshing;
+  meshing.order = 3;
+  meshing.size = 1.0;
+  const MeshResult hole =
+      runMeshPipeline(CadSource::brepText(test::brepText(test::boxWithHole())), meshing);
+  Mesh one = hole.mesh, three = hole.mesh, off = hole.mesh;
+  OptimiserOptions options;
+  options.maxIterations = 3;
+  options.facetWeight = 1.0;
+  options.threads = 1;
+  optimiseMesh(one, options, nullptr, hole.cad.get());
+  options.threads = 3;
+  optimiseMesh(three, options, nullptr, hole.cad.get());
+  EXPECT_EQ(one.xyz, three.xyz);
+  EXPECT_EQ(std::memcmp(one.nodeCadParam.data(), three.nodeCadParam.data(),
+                        one.nodeCadParam.size() * sizeof(double)),
+            0);
+  options.facetWeight = 0.0;
+  optimiseMesh(off, options, nullptr, hole.cad.get());
+  EXPECT_NE(one.xyz, off.xyz) << "the facet term changed nothing";
+}
+
 // The sweeps run on the mesh renumbered along a space-filling curve (OptimiserOptions::
 // spatialOrder), for locality only: every choice made in sequence follows the caller's numbers,
 // so the result is the one without the renumbering, bit for bit: in 3D and 2D, with the mesh's
@@ -282,6 +307,9 @@ TEST(Optimiser, TheSpatialOrderChangesNoResult) {
   const MeshResult hole =
       runMeshPipeline(CadSource::brepText(test::brepText(test::boxWithHole())), meshing);
   cases.push_back({"box with a hole, sliding on the CAD", hole.mesh, plain, hole.cad.get()});
+  OptimiserOptions facets = plain;
+  facets.facetWeight = 1.0;
+  cases.push_back({"box with a hole, sliding, facet term", hole.mesh, facets, hole.cad.get()});
   // The cube-sphere's tetrahedra in two blocks with an empty one between (global element indices
   // across blocks), in a region seeded by element.
   Mesh split = cube;
