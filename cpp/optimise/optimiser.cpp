@@ -216,8 +216,8 @@ class Optimiser {
     result_.setupSeconds = since(t0);
 
     IterationRecord best = before;
+    facetsOn_ = before.invalid + before.undecided == 0;  // before the energy: it counts the term
     best.energy = result_.energyBefore = totalEnergy();
-    facetsOn_ = before.invalid + before.undecided == 0;
     std::vector<double> bestXyz, bestParam;  // empty: the input
     const std::vector<double> input = mesh_.xyz, inputParam = mesh_.nodeCadParam;
     result_.stopReason = free_.empty() ? "no free nodes" : "iterations";
