@@ -124,4 +124,13 @@ QuadratureRule quadratureRule(CellType type, int degree) {
   }
 }
 
+Eigen::MatrixXd pointRows(const QuadratureRule& rule, const Eigen::MatrixXd& after) {
+  Eigen::MatrixXd rows(rule.size() + after.rows(), rule.dim);
+  for (int q = 0; q < rule.size(); ++q)
+    for (int k = 0; k < rule.dim; ++k)
+      rows(q, k) = rule.points[static_cast<std::size_t>(q) * rule.dim + k];
+  if (after.rows() > 0) rows.bottomRows(after.rows()) = after;
+  return rows;
+}
+
 }  // namespace homesh

@@ -6,6 +6,7 @@
 // strictly inside the element.
 #pragma once
 
+#include <Eigen/Core>
 #include <vector>
 
 #include "core/cell_type.hpp"
@@ -27,5 +28,9 @@ void gaussJacobi(int n, double alpha, double beta, std::vector<double>& x, std::
 // A rule exact to `degree` on the reference shape. Throws ParameterError for unsupported shapes
 // or degree < 0.
 QuadratureRule quadratureRule(CellType type, int degree);
+
+// The rule's points as the rows of a matrix (size() x dim), followed by the rows of `after`
+// (an element's nodes, where samplers take both; dim columns, or none).
+Eigen::MatrixXd pointRows(const QuadratureRule& rule, const Eigen::MatrixXd& after = {});
 
 }  // namespace homesh

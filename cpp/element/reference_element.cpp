@@ -67,6 +67,20 @@ Eigen::MatrixXd ReferenceElement::valuesAt(const Eigen::MatrixXd& points) const 
   return out;
 }
 
+std::vector<Eigen::MatrixXd> ReferenceElement::derivativesAt(const Eigen::MatrixXd& points) const {
+  std::vector<Eigen::MatrixXd> out(static_cast<std::size_t>(dim_),
+                                   Eigen::MatrixXd(points.rows(), numNodes()));
+  Eigen::VectorXd values;
+  Eigen::MatrixXd gradients;
+  for (Eigen::Index r = 0; r < points.rows(); ++r) {
+    const Eigen::VectorXd xi = points.row(r).transpose();
+    evaluate(xi.data(), values, gradients);
+    for (int k = 0; k < dim_; ++k)
+      out[static_cast<std::size_t>(k)].row(r) = gradients.col(k).transpose();
+  }
+  return out;
+}
+
 double ReferenceElement::lebesgueConstant(int samples) const {
   const std::vector<LatticePoint> lattice = samplingLattice(type_, samples);
   Eigen::MatrixXd points = nodeCoordinates(type_, samples, NodeSet::Equispaced, lattice);

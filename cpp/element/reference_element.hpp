@@ -42,6 +42,10 @@ class ReferenceElement {
 
   // Values of the basis at many points (rows of `points`): (points x numNodes()).
   Eigen::MatrixXd valuesAt(const Eigen::MatrixXd& points) const;
+  // Derivatives of the basis at many points (rows of `points`): one (points x numNodes())
+  // matrix per reference direction, d/dxi_k in entry k (dim() entries). The tables the
+  // optimiser, its facet term and the quality samplers lay out in their own orders.
+  std::vector<Eigen::MatrixXd> derivativesAt(const Eigen::MatrixXd& points) const;
 
   // Lebesgue constant max_xi sum_n |l_n(xi)|, estimated on a lattice of `samples` points per
   // edge (a measure of how well the node set interpolates; 1 is ideal).

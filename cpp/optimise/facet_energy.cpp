@@ -23,21 +23,17 @@ FacetEnergy::FacetEnergy(const Mesh& mesh, const std::vector<Vec>& positions,
     const QuadratureRule rule = quadratureRule(cells.type, 2 * cells.order);
     s.points = rule.size();
     s.weights = rule.weights;
-    s.gradients.resize(static_cast<std::size_t>(s.nodes) * s.points * 2);
-    s.linear.resize(static_cast<std::size_t>(s.vertices) * s.points * 2);
-    Eigen::VectorXd values;
-    Eigen::MatrixXd grad;
-    for (int q = 0; q < s.points; ++q) {
-      const double* xi = &rule.points[static_cast<std::size_t>(q) * 2];
-      ref.evaluate(xi, values, grad);
-      for (int n = 0; n < s.nodes; ++n)
-        for (int k = 0; k < 2; ++k)
-          s.gradients[(static_cast<std::size_t>(n) * s.points + q) * 2 + k] = grad(n, k);
-      lin.evaluate(xi, values, grad);
-      for (int n = 0; n < s.vertices; ++n)
-        for (int k = 0; k < 2; ++k)
-          s.linear[(static_cast<std::size_t>(n) * s.points + q) * 2 + k] = grad(n, k);
-    }
+    const Eigen::MatrixXd points = pointRows(rule);
+    const auto tabulate = [&](const ReferenceElement& element, std::vector<double>& out) {
+      const std::vector<Eigen::MatrixXd> grad = element.derivativesAt(points);
+      out.resize(static_cast<std::size_t>(element.numNodes()) * s.points * 2);
+      for (int n = 0; n < element.numNodes(); ++n)
+        for (int q = 0; q < s.points; ++q)
+          for (int k = 0; k < 2; ++k)
+            out[(static_cast<std::size_t>(n) * s.points + q) * 2 + k] = grad[k](q, n);
+    };
+    tabulate(ref, s.gradients);
+    tabulate(lin, s.linear);
     const int shape = static_cast<int>(shapes_.size());
     for (std::size_t c = 0; c < cells.count(); ++c) {
       const std::int64_t* v = cells.element(c);

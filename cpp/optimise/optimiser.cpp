@@ -486,20 +486,18 @@ class Optimiser {
       const ReferenceElement& lin = ReferenceElement::get(cells.type, 1);
       const QuadratureRule rule = energySamples(cells.type, cells.order, equi);
       b.points = rule.size();
-      Eigen::VectorXd values;
-      Eigen::MatrixXd grad;
-      std::vector<Eigen::MatrixXd> linGrad(b.points);
+      const Eigen::MatrixXd points = pointRows(rule);
+      const std::vector<Eigen::MatrixXd> grad = ref.derivativesAt(points);
+      const std::vector<Eigen::MatrixXd> linGrad = lin.derivativesAt(points);
       b.gradients.resize(static_cast<std::size_t>(b.points) * b.nodes * D);
       b.gradientTable.resize(b.nodes, static_cast<Eigen::Index>(b.points) * D);
-      for (int q = 0; q < b.points; ++q) {
-        const double* xi = &rule.points[static_cast<std::size_t>(q) * D];
-        ref.evaluate(xi, values, grad);
+      for (int q = 0; q < b.points; ++q)
         for (int n = 0; n < b.nodes; ++n)
-          for (int k = 0; k < D; ++k)
-            b.gradients[(static_cast<std::size_t>(n) * D + k) * b.points + q] = grad(n, k);
-        b.gradientTable.middleCols(static_cast<Eigen::Index>(q) * D, D) = grad;
-        lin.evaluate(xi, values, linGrad[q]);
-      }
+          for (int k = 0; k < D; ++k) {
+            const double g = grad[k](q, n);
+            b.gradients[(static_cast<std::size_t>(n) * D + k) * b.points + q] = g;
+            b.gradientTable(n, static_cast<Eigen::Index>(q) * D + k) = g;
+          }
       const int nv = lin.numNodes();
       const std::size_t count = cells.count();
       const int idealPoints = b.affine ? 1 : b.points;
@@ -511,7 +509,8 @@ class Optimiser {
         const std::int64_t* v = cells.element(e);
         for (int q = 0; q < b.points; ++q) {
           Mat ideal = Mat::Zero();
-          for (int k = 0; k < nv; ++k) ideal += position_[v[k]] * linGrad[q].row(k);
+          for (int n = 0; n < nv; ++n)
+            for (int k = 0; k < D; ++k) ideal.col(k) += position_[v[n]] * linGrad[k](q, n);
           const double det = functional_detail::determinant<D>(ideal);
           if (q < idealPoints) {
             if (!(std::abs(det) > 0.0))

@@ -294,7 +294,7 @@ class PyMesh {
   // A copy of this mesh optimised (optimise/optimiser.hpp), and the optimiser's JSON record.
   bp::tuple optimise(const std::string& functional, int maxIterations, double tolerance,
                      int threads, const bp::object& region, int layers, int focus,
-                     bool freeInterfaces) const {
+                     bool freeInterfaces, double facetWeight) const {
     OptimiserOptions options;
     options.functional = parseFunctional(functional);
     options.maxIterations = maxIterations;
@@ -304,6 +304,7 @@ class PyMesh {
     options.regionLayers = layers;
     options.focusPasses = focus;
     options.freeInterfaces = freeInterfaces;
+    options.facetWeight = facetWeight;
     options.validate();
     MeshResult copy = *result_;
     OptimiserResult record;

@@ -57,15 +57,10 @@ struct DistortionSamplers {
 };
 
 Eigen::MatrixXd stackedDerivatives(const ReferenceElement& ref, const Eigen::MatrixXd& points) {
-  const int dim = ref.dim();
-  Eigen::MatrixXd out(dim * points.rows(), ref.numNodes());
-  Eigen::VectorXd values;
-  Eigen::MatrixXd gradients;
-  for (Eigen::Index p = 0; p < points.rows(); ++p) {
-    const Eigen::VectorXd xi = points.row(p).transpose();
-    ref.evaluate(xi.data(), values, gradients);
-    for (int k = 0; k < dim; ++k) out.row(k * points.rows() + p) = gradients.col(k).transpose();
-  }
+  const std::vector<Eigen::MatrixXd> d = ref.derivativesAt(points);
+  Eigen::MatrixXd out(ref.dim() * points.rows(), ref.numNodes());
+  for (int k = 0; k < ref.dim(); ++k)
+    out.middleRows(k * points.rows(), points.rows()) = d[static_cast<std::size_t>(k)];
   return out;
 }
 
@@ -75,11 +70,7 @@ const DistortionSamplers& samplers(CellType type, int order) {
     const ReferenceElement& ref = ReferenceElement::get(type, order);
     const QuadratureRule rule = quadratureRule(type, order);
     const int dim = ref.dim();
-    Eigen::MatrixXd points(rule.size() + ref.numNodes(), dim);
-    for (int q = 0; q < rule.size(); ++q)
-      for (int k = 0; k < dim; ++k)
-        points(q, k) = rule.points[static_cast<std::size_t>(q) * dim + k];
-    points.bottomRows(ref.numNodes()) = ref.nodes();
+    const Eigen::MatrixXd points = pointRows(rule, ref.nodes());
     return std::make_unique<DistortionSamplers>(
         DistortionSamplers{dim, static_cast<int>(points.rows()), stackedDerivatives(ref, points),
                            stackedDerivatives(ReferenceElement::get(type, 1), points)});

@@ -35,12 +35,8 @@ const MeasureRule& rule(CellType type, int order) {
   return cache.get(type, order, [&] {
     auto slot = std::make_unique<MeasureRule>();
     slot->rule = quadratureRule(type, jacobianDegree(type, order));
-    const int dim = cellDimension(type);
-    Eigen::MatrixXd points(slot->rule.size(), dim);
-    for (int q = 0; q < slot->rule.size(); ++q)
-      for (int k = 0; k < dim; ++k)
-        points(q, k) = slot->rule.points[static_cast<std::size_t>(q) * dim + k];
-    slot->sampler = std::make_unique<JacobianSampler>(ReferenceElement::get(type, order), points);
+    slot->sampler = std::make_unique<JacobianSampler>(ReferenceElement::get(type, order),
+                                                      pointRows(slot->rule));
     return slot;
   });
 }

@@ -32,10 +32,7 @@ Sampling makeSampling(CellType type, int order) {
   const ReferenceElement& ref = ReferenceElement::get(type, order);
   const QuadratureRule rule = quadratureRule(type, 2 * order + 2);
   const int dim = ref.dim(), nodes = ref.numNodes(), count = rule.size() + nodes;
-  Eigen::MatrixXd points(count, dim);
-  for (int q = 0; q < rule.size(); ++q)
-    for (int k = 0; k < dim; ++k) points(q, k) = rule.points[static_cast<std::size_t>(q) * dim + k];
-  points.bottomRows(nodes) = ref.nodes();
+  const Eigen::MatrixXd points = pointRows(rule, ref.nodes());
 
   Sampling s;
   s.dim = dim;

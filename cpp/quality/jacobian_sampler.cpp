@@ -4,17 +4,8 @@
 
 namespace homesh {
 
-JacobianSampler::JacobianSampler(const ReferenceElement& ref, const Eigen::MatrixXd& points) {
-  const int dim = ref.dim();
-  dxi_.assign(dim, Eigen::MatrixXd(points.rows(), ref.numNodes()));
-  Eigen::VectorXd values;
-  Eigen::MatrixXd gradients;
-  for (Eigen::Index s = 0; s < points.rows(); ++s) {
-    const Eigen::VectorXd xi = points.row(s).transpose();
-    ref.evaluate(xi.data(), values, gradients);
-    for (int k = 0; k < dim; ++k) dxi_[k].row(s) = gradients.col(k).transpose();
-  }
-}
+JacobianSampler::JacobianSampler(const ReferenceElement& ref, const Eigen::MatrixXd& points)
+    : dxi_(ref.derivativesAt(points)) {}
 
 void JacobianSampler::jacobians(const NodeCoordinates& x, const Eigen::Vector3d* normal,
                                 Eigen::VectorXd& out) const {

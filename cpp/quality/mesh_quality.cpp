@@ -56,12 +56,7 @@ double boundaryStretch(const JacobianSampler& sampler, const NodeCoordinates& x)
 JacobianSampler boundarySampler(CellType type, int order) {
   const ReferenceElement& ref = ReferenceElement::get(type, order);
   const QuadratureRule rule = quadratureRule(type, 2 * order + 2);
-  Eigen::MatrixXd points(rule.size() + ref.numNodes(), ref.dim());
-  for (int q = 0; q < rule.size(); ++q)
-    for (int k = 0; k < ref.dim(); ++k)
-      points(q, k) = rule.points[static_cast<std::size_t>(q) * ref.dim() + k];
-  points.bottomRows(ref.numNodes()) = ref.nodes();
-  return {ref, points};
+  return {ref, pointRows(rule, ref.nodes())};
 }
 
 // Where evaluateQuality may take an element's values from `known`: the source element of each

@@ -170,6 +170,27 @@ def test_python_optimise_slides_on_the_cad(data):
                                                          size=0.5).nodes[on_cad])
 
 
+def test_python_optimise_takes_the_facet_weight(data):
+    # The same curved sphere optimised in place with and without the boundary facets' term: the
+    # term is applied (the sliding nodes end elsewhere), they stay on the sphere, and a bad
+    # weight is named.
+    from homesh import mesh as make_mesh
+    plain = make_mesh(str(data / "sphere.brep"), order=4, size=0.5)
+    facets = make_mesh(str(data / "sphere.brep"), order=4, size=0.5)
+    assert np.array_equal(plain.nodes, facets.nodes)
+    plain.optimise(maxiter=10, threads=2)
+    record = facets.optimise(maxiter=10, threads=2, facet_weight=1.0)
+    assert record["invalid_after"] == 0
+    on_cad = facets.node_cad_dim < 3
+    assert not np.array_equal(plain.nodes[on_cad], facets.nodes[on_cad])
+    radii = np.linalg.norm(facets.nodes[on_cad], axis=1)
+    assert np.abs(radii - 1.0).max() < 1e-7  # points of OCCT's sphere: 1 to rounding
+    with pytest.raises(ParameterError, match="facet weight must be a number from 0 to 100"):
+        facets.optimise(maxiter=1, facet_weight=101.0)
+    with pytest.raises(ParameterError, match="facet_weight must be a number"):
+        facets.optimise(maxiter=1, facet_weight="1")
+
+
 def test_mesh_command_with_optimise(homesh_bin, data, tmp_path):
     report = tmp_path / "r.json"
     r = run([homesh_bin, "mesh", str(data / "sphere.brep"), "--order", "4", "--size", "0.5",

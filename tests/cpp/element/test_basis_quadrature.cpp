@@ -162,6 +162,37 @@ TEST_P(Shapes, BasisReproducesItsPolynomialsAndTheirDerivatives) {
     }
 }
 
+// The tables of many points (pointRows, derivativesAt) hold what one evaluation at each point
+// gives, in their stated layouts: the same arithmetic, so the same bits.
+TEST_P(Shapes, TablesAtManyPointsHoldEachPointsEvaluation) {
+  const CellType type = GetParam();
+  const int dim = cellDimension(type);
+  const ReferenceElement& ref = ReferenceElement::get(type, 3);
+  const QuadratureRule rule = quadratureRule(type, 4);
+  const Eigen::MatrixXd points = pointRows(rule, ref.nodes());
+  ASSERT_EQ(points.rows(), rule.size() + ref.numNodes());
+  ASSERT_EQ(points.cols(), dim);
+  for (int q = 0; q < rule.size(); ++q)
+    for (int k = 0; k < dim; ++k)
+      ASSERT_EQ(points(q, k), rule.points[static_cast<std::size_t>(q) * dim + k]);
+  ASSERT_EQ(points.bottomRows(ref.numNodes()), ref.nodes());
+  ASSERT_EQ(pointRows(rule).rows(), rule.size());
+
+  const std::vector<Eigen::MatrixXd> tables = ref.derivativesAt(points);
+  ASSERT_EQ(tables.size(), static_cast<std::size_t>(dim));
+  Eigen::VectorXd values;
+  Eigen::MatrixXd gradients;
+  for (Eigen::Index r = 0; r < points.rows(); ++r) {
+    const Eigen::VectorXd xi = points.row(r).transpose();
+    ref.evaluate(xi.data(), values, gradients);
+    for (int k = 0; k < dim; ++k) {
+      ASSERT_EQ(tables[static_cast<std::size_t>(k)].rows(), points.rows());
+      ASSERT_EQ(tables[static_cast<std::size_t>(k)].row(r), gradients.col(k).transpose())
+          << "direction " << k << ", point " << r;
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(All, Shapes, ::testing::ValuesIn(kShapes), shapeName);
 
 TEST(NodeSets, OptimalSetsPutGllPointsOnEdgesAndTriangleNodesOnTetrahedronFaces) {

@@ -1,8 +1,8 @@
-// The boundary facets' in-surface energy (optimise/facet_energy.hpp) on single facets: zero and
-// stationary for a rigid motion of the straight facet, positive for nodes bunched along it, the
-// trial energy equal to the energy recomputed at the moved node, and a clear error for a
-// degenerate facet. Its derivatives are checked against AD and finite differences in
-// test_derivatives.cpp.
+// The boundary facets' in-surface energy (optimise/facet_energy.hpp) on single triangles and
+// quadrilaterals: zero and stationary for a rigid motion of the straight facet, positive for
+// nodes bunched along it, the trial energy equal to the energy recomputed at the moved node, and
+// a clear error for a degenerate facet. Its derivatives are checked against AD and finite
+// differences in test_derivatives.cpp.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -21,18 +21,19 @@ namespace {
 
 constexpr double kU = std::numeric_limits<double>::epsilon() / 2;
 
-// One order-P triangle on CAD face 7 of a 3D mesh: the reference triangle's equispaced nodes
-// mapped by a shear with unequal sides (so that W is neither a multiple of the identity nor
-// symmetric: a W^-1 / W^-T mix-up shows), scaled by `side`, rotated and translated. A straight
-// facet, so its own ideal up to a rigid motion.
+// One order-P triangle (or quadrilateral) on CAD face 7 of a 3D mesh: the reference cell's
+// equispaced nodes mapped by a shear with unequal sides (so that W is neither a multiple of the
+// identity nor symmetric: a W^-1 / W^-T mix-up shows), scaled by `side`, rotated and
+// translated. A straight facet (the quadrilateral a parallelogram), so its own ideal up to a
+// rigid motion.
 struct OneFacet {
   Mesh mesh;
   std::vector<Eigen::Vector3d> positions;
   double area = 0.0;
 };
 
-OneFacet straightFacet(int order, double side) {
-  const ReferenceElement& ref = ReferenceElement::get(CellType::Triangle, order);
+OneFacet straightFacet(int order, double side, CellType type = CellType::Triangle) {
+  const ReferenceElement& ref = ReferenceElement::get(type, order);
   Eigen::Matrix2d shear;
   shear << 1.0, 0.45, 0.0, 0.8;
   shear *= side;
@@ -42,7 +43,7 @@ OneFacet straightFacet(int order, double side) {
   OneFacet f;
   f.mesh.dim = 3;
   f.mesh.order = order;
-  f.area = 0.5 * shear.determinant();
+  f.area = (type == CellType::Triangle ? 0.5 : 1.0) * shear.determinant();
   for (int i = 0; i < ref.numNodes(); ++i) {
     const Eigen::Vector2d xi = shear * Eigen::Vector2d(ref.nodes()(i, 0), ref.nodes()(i, 1));
     const Eigen::Vector3d x = rotation * Eigen::Vector3d(xi[0], xi[1], 0.0) + shift;
@@ -51,7 +52,7 @@ OneFacet straightFacet(int order, double side) {
     f.positions.push_back(x);
   }
   ElementBlock b;
-  b.type = CellType::Triangle;
+  b.type = type;
   b.order = order;
   for (int i = 0; i < ref.numNodes(); ++i) b.nodes.push_back(i);
   b.entity = {7};
@@ -59,14 +60,14 @@ OneFacet straightFacet(int order, double side) {
   return f;
 }
 
-// The largest |grad_xi l_n| of the order-P triangle's basis over a grid of the triangle.
-double largestBasisGradient(int order) {
-  const ReferenceElement& ref = ReferenceElement::get(CellType::Triangle, order);
+// The largest |grad_xi l_n| of the order-P cell's basis over a grid of the cell.
+double largestBasisGradient(int order, CellType type) {
+  const ReferenceElement& ref = ReferenceElement::get(type, order);
   Eigen::VectorXd values;
   Eigen::MatrixXd grad;
   double largest = 0.0;
   for (int i = 0; i <= 20; ++i)
-    for (int j = 0; i + j <= 20; ++j) {
+    for (int j = 0; j <= 20 && (type != CellType::Triangle || i + j <= 20); ++j) {
       const double xi[2] = {i / 20.0, j / 20.0};
       ref.evaluate(xi, values, grad);
       largest = std::max(largest, grad.rowwise().norm().maxCoeff());
@@ -74,10 +75,18 @@ double largestBasisGradient(int order) {
   return largest;
 }
 
-TEST(FacetEnergy, ARigidMotionOfTheStraightFacetCostsNothing) {
+// The first node on the edge from vertex 0 to vertex 1, in Gmsh's order (after the vertices).
+std::int64_t firstEdgeNode(CellType type) {
+  return type == CellType::Triangle ? 3 : 4;
+}
+
+class FacetShapes : public ::testing::TestWithParam<CellType> {};
+
+TEST_P(FacetShapes, ARigidMotionOfTheStraightFacetCostsNothing) {
+  const CellType type = GetParam();
   const double side = 2.5, weight = 1.0;
   const int order = 3;
-  OneFacet f = straightFacet(order, side);
+  OneFacet f = straightFacet(order, side, type);
   const std::vector<std::uint8_t> movable(f.positions.size(), 1);
   const FacetEnergy energy(f.mesh, f.positions, movable, weight);
   ASSERT_EQ(energy.size(), 1U);
@@ -89,7 +98,7 @@ TEST(FacetEnergy, ARigidMotionOfTheStraightFacetCostsNothing) {
   // Stationary too: a point's gradient is mu (a1 m1 + a2 m2) - mu dl, and at C = I the two cancel
   // to the rounding of M times |a| <= |W^-1| |grad l| (W^-1 of norm at most about 2 / side
   // for this shear).
-  const double a = 2.0 / side * largestBasisGradient(order);
+  const double a = 2.0 / side * largestBasisGradient(order, type);
   for (std::int64_t node = 0; node < static_cast<std::int64_t>(f.positions.size()); ++node) {
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
     Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
@@ -100,12 +109,13 @@ TEST(FacetEnergy, ARigidMotionOfTheStraightFacetCostsNothing) {
   }
 }
 
-TEST(FacetEnergy, BunchedNodesCostAndTrialsMatchTheMovedFacet) {
-  OneFacet f = straightFacet(4, 1.0);
+TEST_P(FacetShapes, BunchedNodesCostAndTrialsMatchTheMovedFacet) {
+  const CellType type = GetParam();
+  OneFacet f = straightFacet(4, 1.0, type);
   const std::vector<std::uint8_t> movable(f.positions.size(), 1);
   const FacetEnergy energy(f.mesh, f.positions, movable, 1.0);
-  // Node 3 (the first on edge 0-1, at a quarter of it) slid towards vertex 0, along the edge.
-  const std::int64_t node = 3;
+  // The first node on edge 0-1 (at a quarter of it) slid towards vertex 0, along the edge.
+  const std::int64_t node = firstEdgeNode(type);
   const Eigen::Vector3d along = (f.positions[1] - f.positions[0]).normalized();
   Eigen::Vector3d g = Eigen::Vector3d::Zero();
   Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
@@ -141,6 +151,12 @@ TEST(FacetEnergy, OnlyFacetsOfMovableNodesAndADegenerateFacetIsNamed) {
     EXPECT_NE(std::string(e.what()).find("CAD face 7"), std::string::npos) << e.what();
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(FacetEnergy, FacetShapes,
+                         ::testing::Values(CellType::Triangle, CellType::Quadrilateral),
+                         [](const ::testing::TestParamInfo<CellType>& param) {
+                           return cellShortName(param.param);
+                         });
 
 }  // namespace
 }  // namespace homesh
