@@ -242,7 +242,12 @@ RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
     std::vector<CurvedFaceEdge> edges;
     if (finder) {
       edges = finder->interior(c);
-      if (edges.empty() && optimised)
+      // Not in 2D: there a triangle with every vertex on the boundary sits where CAD curves
+      // meet, at a cusp or across a narrow gap, and its invalid Jacobian is set by its curved
+      // edges at the shared vertex; a chord from that vertex changes nothing there, halving
+      // the curved edge halves its sag (gmsh-doc's fragment_numbering.step: valid after 2
+      // rounds so, 2 triangles invalid after 8 with the chord).
+      if (edges.empty() && optimised && linear.dim == 3)
         if (const auto chord = finder->longestBoundaryChord(c)) edges.push_back(*chord);
       if (edges.empty())
         if (const auto onFace = finder->longestOnFace(c)) edges.push_back(*onFace);

@@ -113,13 +113,13 @@ struct RepairPlan {
 // Locates the elements whose verdict is not Valid (`validity` per element of the curved mesh,
 // in element order) in `linear`. A flagged cell with interior edges on one curved face gets
 // those split; else, when `optimised` (the optimiser runs on the new mesh: the new node at the
-// edge's midpoint helps only once something moves it), one whose vertices all lie on the
-// boundary gets its longest interior edge split (longestBoundaryChord); else one with an edge on a
-// curved face gets its longest such edge split (the face's triangles there are halved, which halves
-// the sagitta curving has to follow); else it gets a sphere of radius its longest edge, centred at
-// its centroid, of size half its mean edge length. A mesh with other cells than simplices (a
-// boundary layer's prisms) gets spheres only. Throws ParameterError when `validity` does not match
-// the linear mesh's cell count.
+// edge's midpoint helps only once something moves it) and in 3D, a tetrahedron whose vertices
+// all lie on the boundary gets its longest interior edge split (longestBoundaryChord); else one
+// with an edge on a curved face gets its longest such edge split (the face's triangles there
+// are halved, which halves the sagitta curving has to follow); else it gets a sphere of radius
+// its longest edge, centred at its centroid, of size half its mean edge length. A mesh with
+// other cells than simplices (a boundary layer's prisms) gets spheres only. Throws
+// ParameterError when `validity` does not match the linear mesh's cell count.
 RepairPlan planRepair(const Mesh& linear, const std::vector<Validity>& validity,
                       const CadModel& cad, bool optimised);
 

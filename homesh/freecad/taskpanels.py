@@ -60,9 +60,11 @@ def parameter_widget(obj, prop):
         widget.setValue(int(value))
     else:
         widget = QtWidgets.QDoubleSpinBox()
-        # Seconds need no more than a tenth (600.0000 did not fit the panel's field).
+        # Seconds need no more than a tenth (600.0000 did not fit the panel's field), weights
+        # and ratios up to 100 a hundredth ("0.0000" did not fit either); fractions (EPS) 4.
         seconds = p["key"].endswith("_seconds")
-        widget.setDecimals(6 if p["kind"] == "length" else 1 if seconds else 4)
+        widget.setDecimals(6 if p["kind"] == "length" else 1 if seconds else
+                           2 if p["max"] >= 10 else 4)
         low = 0.0 if p["zero_is_automatic"] or p["min_exclusive"] else p["min"]
         high = p["max"] if p["max"] != float("inf") else 1e9
         widget.setRange(low, high)

@@ -4,6 +4,7 @@
 
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
 #include <gp_Circ.hxx>
 
@@ -316,6 +317,42 @@ TEST(RepairPlan, ACellWithEveryVertexOnTheBoundaryGetsItsLongestInteriorEdgeSpli
 // A repair round's split changes the cells around one edge; every other element must come back
 // with its old curved nodes (here marked by a shift the new elevation cannot reproduce), and
 // only the split cells are fresh.
+// In 2D a triangle whose vertices all lie on the boundary, on two CAD curves meeting at its
+// corner, gets its longest edge on a curve split, not the chord between the curves: its
+// Jacobian at the corner is set by the curved edges there (gmsh-doc's fragment_numbering.step
+// stayed invalid at two cusps with the chord, and was valid in two rounds with the curve
+// split). The unit square cut along its diagonal; the triangle at corner 0 is flagged.
+TEST(RepairPlan, In2DACornerTriangleGetsAnEdgeOnACurveSplitNotTheChord) {
+  BRepBuilderAPI_MakePolygon square(gp_Pnt(0, 0, 0), gp_Pnt(1, 0, 0), gp_Pnt(1, 1, 0),
+                                    gp_Pnt(0, 1, 0), Standard_True);
+  const CadModel cad = test::toModel(BRepBuilderAPI_MakeFace(square.Wire()).Face());
+  ASSERT_EQ(cad.numEdges(), 4);
+  Mesh mesh;
+  mesh.dim = 2;
+  mesh.planeNormal = {0.0, 0.0, 1.0};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double corners[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  for (int k = 0; k < 4; ++k) mesh.addNode(corners[k], 0, k + 1, nan, nan);
+  ElementBlock tris, lines;
+  tris.type = CellType::Triangle;
+  lines.type = CellType::Line;
+  tris.nodes = {3, 0, 1, 1, 2, 3};
+  tris.entity = {1, 1};
+  for (std::int64_t k = 0; k < 4; ++k) {
+    lines.nodes.insert(lines.nodes.end(), {k, (k + 1) % 4});
+    lines.entity.push_back(static_cast<int>(k) + 1);
+  }
+  mesh.blocks = {tris, lines};
+  mesh.checkConsistency();
+  const RepairPlan plan = planRepair(mesh, {Validity::Invalid, Validity::Valid}, cad, true);
+  ASSERT_EQ(plan.splits.size(), 1u);
+  // Edges 3-0 (curve 4) and 0-1 (curve 1) are equally long; the first of the cell's is taken.
+  EXPECT_EQ(plan.splits[0].edge, meshEdge(0, 3));
+  EXPECT_EQ(plan.splits[0].entity, 4);
+  EXPECT_TRUE(plan.splits[0].boundary);
+  EXPECT_EQ(plan.splitCells, 1u);
+}
+
 TEST(CurvedReuse, UnchangedCellsKeepTheirCurvedNodesAndOnlySplitCellsAreFresh) {
   const CadModel cad = test::toModel(test::box(1, 1, 1));
   const Mesh oldLinear = generateLinearMesh(cad, LinearMeshOptions::uniform(0.4));
