@@ -219,11 +219,16 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   table.value({"--repair-rounds"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.repairRounds = static_cast<int>(parseParameter("repair_rounds", o, v));
   });
-  table.value({"--time-limit"}, [&cmd](const std::string& o, const std::string& v) {
+  // Options of the optimiser, which runs only with --optimise: given without it they would do
+  // nothing, so they are refused by name (the first one given).
+  std::string optimiserOption;
+  table.value({"--time-limit"}, [&](const std::string& o, const std::string& v) {
     cmd.timeLimit = parseParameter("optimise_seconds", o, v);
+    if (optimiserOption.empty()) optimiserOption = "--time-limit";
   });
-  table.value({"--facet-weight"}, [&cmd](const std::string& o, const std::string& v) {
+  table.value({"--facet-weight"}, [&](const std::string& o, const std::string& v) {
     cmd.facetWeight = parseParameter("facet_weight", o, v);
+    if (optimiserOption.empty()) optimiserOption = "--facet-weight";
   });
   table.value({"--linear-time-limit"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.linearTimeLimit = parseParameter("linear_seconds", o, v);
@@ -245,6 +250,8 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   table.flag({"-vv"}, [&cmd] { cmd.verbosity += 2; });
   cmd.input = onlyInput(table.parse(args, 1, "mesh"), "mesh", "an INPUT CAD or .mcf file");
   if (maxiter && !optimise) throw UsageError{"--maxiter needs --optimise"};
+  if (!optimiserOption.empty() && !optimise)
+    throw UsageError{optimiserOption + " needs --optimise"};
   if (cmd.size && (cmd.sizing.anyDelta() || !cmd.sizing.sources.empty()))
     throw UsageError{
         "--size (uniform) cannot be combined with the octree's --min-delta, "

@@ -64,7 +64,14 @@ TEST(Arguments, FacetWeight) {
   EXPECT_EQ(parse({"mesh", "part.brep"}).mesh.facetWeight, table);
   EXPECT_EQ(MeshingOptions{}.facetWeight, table);
   EXPECT_EQ(OptimiserOptions{}.facetWeight, table);
-  EXPECT_EQ(parse({"mesh", "part.brep", "--facet-weight", "1.5"}).mesh.facetWeight, 1.5);
+  EXPECT_EQ(parse({"mesh", "part.brep", "--optimise", "--facet-weight", "1.5"}).mesh.facetWeight,
+            1.5);
+  // The optimiser's options do nothing without it: refused by name.
+  EXPECT_EQ(usageError({"mesh", "part.brep", "--facet-weight", "1.5"}),
+            "--facet-weight needs --optimise");
+  EXPECT_EQ(usageError({"mesh", "part.brep", "--time-limit", "40"}),
+            "--time-limit needs --optimise");
+  EXPECT_EQ(parse({"mesh", "part.brep", "--time-limit", "40", "--optimise"}).mesh.timeLimit, 40.0);
   for (const char* bad : {"-0.5", "101", "x"})
     EXPECT_NE(usageError({"mesh", "part.brep", "--facet-weight", bad}).find("--facet-weight"),
               std::string::npos)
