@@ -240,6 +240,7 @@ class Optimiser {
         } catch (const CancelledError&) {  // asked between colour groups: the best is kept
           result_.cancelled = !budgetSpent_;
           result_.stopReason = budgetSpent_ ? "time budget" : "cancelled";
+          if (budgetSpent_) keepPartialSweep(it, before, best, bestXyz, bestParam, s0, t0);
           break;
         }
         result_.sweepSeconds += since(s0);
@@ -286,6 +287,34 @@ class Optimiser {
     result_.nodalWorstAfter = nodalScaledJacobian(mesh_, options_.threads);
     result_.seconds = since(t0);
     return result_;
+  }
+
+  // A sweep the time limit stopped between colour groups, finished as far as it got: the
+  // nodes it moved are written back and the elements they changed certified, and the state is
+  // recorded as sweep `it` (partial) and kept if acceptable and better than `best`.
+  void keepPartialSweep(int it, const IterationRecord& before, IterationRecord& best,
+                        std::vector<double>& bestXyz, std::vector<double>& bestParam,
+                        Clock::time_point s0, Clock::time_point t0) {
+    writeBack();
+    evaluate(take(kStale));
+    result_.sweepSeconds += since(s0);
+    const Moves& moved = interrupted_;
+    IterationRecord record = summarise(it, moved.absolute, t0);
+    record.maxRelativeMove = moved.relative;
+    record.visits = moved.visits;
+    record.partial = true;
+    result_.visits += moved.visits;
+    result_.slides += moved.slides;
+    result_.cadEvaluations += moved.cadEvaluations;
+    record.energy = totalEnergy();
+    result_.history.push_back(record);
+    result_.iterations = it;
+    if (observer_ != nullptr) observer_->iterationFinished(record);
+    if (acceptable(record, before) && better(record, best)) {
+      best = record;
+      bestXyz = mesh_.xyz;
+      bestParam = mesh_.nodeCadParam;
+    }
   }
 
   // The result of a run stopped by its time limit during the set-up: the input, as evaluated
@@ -1278,6 +1307,9 @@ class Optimiser {
     std::size_t visits = 0;
     std::size_t slides = 0, cadEvaluations = 0;  // see Patch
   };
+  // What the current sweep's passes moved before the time limit stopped one (relax(), read by
+  // keepPartialSweep()).
+  Moves interrupted_;
 
   // After a node's visit: mark the elements it moved, and decide which nodes the next sweep
   // visits. A node that did not move by more than activeTolerance of its element size rests
@@ -1357,10 +1389,17 @@ class Optimiser {
       cadEvaluations += patch.cadEvaluations;
     }
     failure.rethrow();
-    // run() keeps its best state: a half-done sweep is never kept.
-    if (cancel)
+    // A cancelled sweep is dropped; one the time limit stopped is finished as far as it got
+    // (run(), keepPartialSweep), from what its passes moved so far.
+    if (cancel) {
+      interrupted_.absolute = std::max(interrupted_.absolute, moved);
+      interrupted_.relative = std::max(interrupted_.relative, relative);
+      interrupted_.visits += visits;
+      interrupted_.slides += slides;
+      interrupted_.cadEvaluations += cadEvaluations;
       throw CancelledError(budgetSpent_ ? "time budget spent during an optimiser sweep"
                                         : "cancelled during an optimiser sweep");
+    }
     return {moved, relative, visits, slides, cadEvaluations};
   }
 
@@ -1371,7 +1410,9 @@ class Optimiser {
   // take the worst value after five iterations from 0.714 to 0.757 for 25 % more time).
   // Leaves mesh_.xyz and the certified quality up to date.
   Moves sweep() {
+    interrupted_ = Moves{};
     Moves moved = relax(free_, colourStart_, true);
+    interrupted_ = moved;  // a focused pass the limit stops adds its own
     writeBack();
     evaluate(take(kStale));
     if (options_.focusPasses > 0) {
@@ -1397,6 +1438,7 @@ class Optimiser {
         moved.visits += m.visits;
         moved.slides += m.slides;
         moved.cadEvaluations += m.cadEvaluations;
+        interrupted_ = moved;
       }
       writeBack();
       evaluate(take(kStale));  // the elements the focused passes changed

@@ -66,8 +66,11 @@ struct OptimiserOptions {
   //  "time budget" (only with `timeLimit` > 0): the run has taken `timeLimit` seconds, set-up
   //    included; checked once in the set-up (after the input's certified quality: the input is
   //    then kept and its energy not computed, NaN), after every sweep and between a sweep's
-  //    colour groups (a half-done sweep is dropped); the best state so far is kept, as for
-  //    every rule.
+  //    colour groups; the best state so far is kept, as for every rule. A sweep the limit
+  //    stops between its colour groups is finished as far as it got: the elements its nodes
+  //    changed are certified (past the limit, one evaluation of them) and it counts as a sweep,
+  //    marked `partial`, kept where it is acceptable and better, so that a run whose first
+  //    sweep outlasts the limit is not lost (a cancel request drops the half-done sweep).
   double tolerance = 1e-6;
   double timeLimit = 0.0;  // seconds, 0: none
   double energyTolerance = 1e-5;
@@ -138,6 +141,7 @@ struct IterationRecord {
   std::size_t visits = 0;        // Newton steps tried (active nodes, then focused passes)
   double energy = 0.0;           // total energy of the elements with a free node, after
   double seconds = 0.0;          // since the optimiser started
+  bool partial = false;          // stopped by the time limit part-way (OptimiserOptions)
 };
 
 struct OptimiserResult {

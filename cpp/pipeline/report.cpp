@@ -432,6 +432,7 @@ void appendOptimiser(JsonWriter& json, const OptimiserResult& r, const std::stri
     json.value("visits", h.visits);
     json.value("energy", h.energy);
     json.value("seconds", h.seconds);
+    if (h.partial) json.value("partial", true);
     json.endObject();
   }
   json.endArray();

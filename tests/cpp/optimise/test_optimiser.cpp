@@ -4,11 +4,14 @@
 #include <omp.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <numeric>
 #include <random>
 #include <string>
+#include <thread>
 
 #include "core/error.hpp"
 #include "core/spatial_order.hpp"
@@ -465,11 +468,70 @@ TEST(Optimiser, ATimeLimitStopsWithTheBestStateSoFar) {
   EXPECT_LT(some.iterations, 1000);
   EXPECT_GE(some.worstAfter, some.worstBefore);
   EXPECT_LE(some.invalidAfter, some.invalidBefore);
-  // It stops at the first check past the limit: the sweep then running is dropped, so the run
-  // ends within one colour group's time of the limit (a generous 0.5 s on a loaded machine).
+  // It stops at the first check past the limit: the sweep then running is finished as far as
+  // it got (its changed elements certified), so the run ends within one colour group's and one
+  // evaluation's time of the limit (a generous 0.5 s on a loaded machine).
   EXPECT_LT(some.seconds, 0.5 + 0.5);
   options.timeLimit = -1.0;
   EXPECT_THROW(optimiseMesh(mesh, options), ParameterError);
+}
+
+// The time limit stopping the first sweep part-way keeps what that sweep moved, once certified:
+// an observer holds the run at the colour group nine tenths of the way through the sweep until
+// the limit has passed (cancelRequested is asked before each sweep and at each colour group).
+// One thread, so the same nodes move every time.
+TEST(Optimiser, ATimeLimitPartWayThroughASweepKeepsWhatItMoved) {
+  const Mesh input = readMesh(peer("varopti_cube_sphere.msh"));
+  OptimiserOptions options;
+  options.maxIterations = 1;
+  options.threads = 1;
+  options.focusPasses = 0;
+  Mesh whole = input;
+  const OptimiserResult full = optimiseMesh(whole, options);
+  ASSERT_EQ(full.iterations, 1);
+  ASSERT_GT(full.colours, 10u);
+
+  struct HoldAt : OptimiserObserver {
+    int call = 0, holdAt = 0;
+    bool cancelRequested() override {
+      if (++call == holdAt) std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+      return false;
+    }
+  } hold;
+  hold.holdAt = 1 + static_cast<int>(full.colours * 9 / 10);
+  options.maxIterations = 5;
+  options.timeLimit = 1.0;
+  Mesh mesh = input;
+  const OptimiserResult part = optimiseMesh(mesh, options, &hold);
+  EXPECT_EQ(part.stopReason, "time budget");
+  EXPECT_FALSE(part.cancelled);
+  ASSERT_EQ(part.iterations, 1);
+  ASSERT_EQ(part.history.size(), 1u);
+  const IterationRecord& r = part.history.front();
+  EXPECT_TRUE(r.partial);
+  EXPECT_GT(r.visits, 0u);
+  EXPECT_LT(r.visits, full.visits);  // the last tenth of the colour groups was not visited
+  // Certified like a whole sweep, and kept, as it beats the input; the returned mesh is
+  // proven valid by the quality check too.
+  EXPECT_GT(r.worst, part.worstBefore);
+  EXPECT_EQ(part.keptIteration, 1);
+  EXPECT_EQ(part.worstAfter, r.worst);
+  EXPECT_EQ(part.invalidAfter, 0u);
+  EXPECT_NE(mesh.xyz, input.xyz);
+  const QualitySummary after = evaluateQuality(mesh);
+  EXPECT_GT(*std::min_element(after.scaledJacobian.begin(), after.scaledJacobian.end()), 0.0);
+  // A cancel request instead drops the half-done sweep.
+  struct CancelAt : OptimiserObserver {
+    int call = 0, at = 0;
+    bool cancelRequested() override { return ++call == at; }
+  } cancel;
+  cancel.at = hold.holdAt;
+  options.timeLimit = 0.0;
+  mesh = input;
+  const OptimiserResult cancelled = optimiseMesh(mesh, options, &cancel);
+  EXPECT_TRUE(cancelled.cancelled);
+  EXPECT_TRUE(cancelled.history.empty());
+  EXPECT_EQ(mesh.xyz, input.xyz);
 }
 
 TEST(Optimiser, NeverReturnsAWorseMesh) {
