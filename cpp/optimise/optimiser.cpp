@@ -244,26 +244,14 @@ class Optimiser {
           break;
         }
         result_.sweepSeconds += since(s0);
-        IterationRecord record = summarise(it, moved.absolute, t0);
-        record.maxRelativeMove = moved.relative;
-        record.visits = moved.visits;
-        result_.visits += moved.visits;
-        result_.slides += moved.slides;
-        result_.cadEvaluations += moved.cadEvaluations;
+        IterationRecord record = sweepRecord(it, moved, t0);
         // The facet term joins once the mesh is proven valid: every node of a facet is visited
         // again (resting nodes too), and the sweep is not judged by the stop rules, whose energy
         // would compare totals with and without the term.
         const bool switching = !facetsOn_ && hasFacets() && record.invalid + record.undecided == 0;
         if (switching) switchFacetsOn();
         record.energy = totalEnergy();
-        result_.history.push_back(record);
-        result_.iterations = it;
-        if (observer_ != nullptr) observer_->iterationFinished(record);
-        if (acceptable(record, before) && better(record, best)) {
-          best = record;
-          bestXyz = mesh_.xyz;
-          bestParam = mesh_.nodeCadParam;
-        }
+        finishSweep(record, before, best, bestXyz, bestParam);
         const std::string reason = switching ? "" : stopRule(record, previous, before);
         previous = record;
         if (!reason.empty()) {
@@ -298,17 +286,19 @@ class Optimiser {
     writeBack();
     evaluate(take(kStale));
     result_.sweepSeconds += since(s0);
-    const Moves& moved = interrupted_;
-    IterationRecord record = summarise(it, moved.absolute, t0);
-    record.maxRelativeMove = moved.relative;
-    record.visits = moved.visits;
+    IterationRecord record = sweepRecord(it, interrupted_, t0);
     record.partial = true;
-    result_.visits += moved.visits;
-    result_.slides += moved.slides;
-    result_.cadEvaluations += moved.cadEvaluations;
     record.energy = totalEnergy();
+    finishSweep(record, before, best, bestXyz, bestParam);
+  }
+
+  // Sweep `record` into the history and to the observer; its state (mesh_) becomes `best`
+  // where it is acceptable against the input and better than `best`.
+  void finishSweep(const IterationRecord& record, const IterationRecord& before,
+                   IterationRecord& best, std::vector<double>& bestXyz,
+                   std::vector<double>& bestParam) {
     result_.history.push_back(record);
-    result_.iterations = it;
+    result_.iterations = record.iteration;
     if (observer_ != nullptr) observer_->iterationFinished(record);
     if (acceptable(record, before) && better(record, best)) {
       best = record;
@@ -1310,6 +1300,18 @@ class Optimiser {
   // What the current sweep's passes moved before the time limit stopped one (relax(), read by
   // keepPartialSweep()).
   Moves interrupted_;
+
+  // The record of sweep `it` from what it moved (added to the run's totals), its energy left to
+  // the caller.
+  IterationRecord sweepRecord(int it, const Moves& moved, Clock::time_point t0) {
+    IterationRecord record = summarise(it, moved.absolute, t0);
+    record.maxRelativeMove = moved.relative;
+    record.visits = moved.visits;
+    result_.visits += moved.visits;
+    result_.slides += moved.slides;
+    result_.cadEvaluations += moved.cadEvaluations;
+    return record;
+  }
 
   // After a node's visit: mark the elements it moved, and decide which nodes the next sweep
   // visits. A node that did not move by more than activeTolerance of its element size rests
