@@ -607,18 +607,16 @@ def _boundary_layer(spec):
     return out
 
 
-def _check_number(value, name):
-    """A real number (the core checks its range)."""
+def _check_number(value, name, what="a number"):
+    """A real number (the core checks its range); ``what`` names it in the message."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ParameterError("%s must be a number, got %r" % (name, value))
+        raise ParameterError("%s must be %s, got %r" % (name, what, value))
     return float(value)
 
 
 def _check_seconds(value, name="optimise_seconds"):
     """A time limit in seconds: a number (the core checks its range)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ParameterError("%s must be a number of seconds, got %r" % (name, value))
-    return float(value)
+    return _check_number(value, name, "a number of seconds")
 
 
 _INT32_MAX = 2**31 - 1
