@@ -1622,10 +1622,16 @@ class Optimiser {
   static bool acceptable(const IterationRecord& r, const IterationRecord& input) {
     return r.invalid <= input.invalid && r.worst >= input.worst;
   }
-  // Fewer elements not proven valid first, then the better worst value.
+  // Fewer elements not proven valid first, then the better worst value, then, with the worst
+  // value unchanged to the last bit (the worst element's nodes did not move: fixed, or not
+  // reached before the time limit), the lower energy: the rest of the mesh improved. Two such
+  // records have the facet term alike: it joins at the first proven-valid record, and every
+  // record before it has elements not proven valid.
   static bool better(const IterationRecord& r, const IterationRecord& than) {
     const std::size_t a = r.invalid + r.undecided, b = than.invalid + than.undecided;
-    return a != b ? a < b : r.worst > than.worst;
+    if (a != b) return a < b;
+    if (r.worst != than.worst) return r.worst > than.worst;
+    return r.energy < than.energy;
   }
 };
 

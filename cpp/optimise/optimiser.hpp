@@ -23,7 +23,9 @@
 // Never worse: after every sweep the certified scaled Jacobian (quality/bezier_jacobian.hpp)
 // of every element that can have changed is recomputed; the state kept at the end is the best
 // one seen among those whose worst value and invalid count are no worse than the input's (the
-// input itself if no sweep qualifies), and the result says which sweep it was.
+// input itself if no sweep qualifies), and the result says which sweep it was. Best: fewer
+// elements not proven valid, then a higher worst value, then, the worst value the same to the
+// last bit (its element's nodes did not move), a lower energy.
 #pragma once
 
 #include <cstddef>

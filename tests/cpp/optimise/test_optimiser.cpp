@@ -476,6 +476,40 @@ TEST(Optimiser, ATimeLimitStopsWithTheBestStateSoFar) {
   EXPECT_THROW(optimiseMesh(mesh, options), ParameterError);
 }
 
+// With the worst element's nodes all fixed its value cannot change, so every sweep ties with the
+// input on the worst value: the state kept is then the one of lowest energy, not the input.
+TEST(Optimiser, ATieOnTheWorstValueKeepsTheLowerEnergy) {
+  const Mesh input = readMesh(peer("varopti_cube_sphere.msh"));
+  const QualitySummary quality = evaluateQuality(input);
+  const ElementBlock& tets = input.blocks[0];
+  ASSERT_EQ(tets.count(), input.numElements());
+  const auto worst = static_cast<std::size_t>(
+      std::min_element(quality.scaledJacobian.begin(), quality.scaledJacobian.end()) -
+      quality.scaledJacobian.begin());
+  OptimiserOptions options;
+  options.maxIterations = 3;
+  options.fixedNodes.assign(input.numNodes(), 0);
+  for (int k = 0; k < tets.nodesPerElement(); ++k) options.fixedNodes[tets.element(worst)[k]] = 1;
+  Mesh mesh = input;
+  const OptimiserResult r = optimiseMesh(mesh, options);
+  EXPECT_EQ(r.worstAfter, r.worstBefore);
+  EXPECT_EQ(r.worstAfter, quality.scaled.min);
+  EXPECT_EQ(r.invalidAfter, 0U);
+  EXPECT_GE(r.keptIteration, 1);
+  EXPECT_LT(r.energyAfter, r.energyBefore);
+  EXPECT_NE(mesh.xyz, input.xyz);
+  // The kept state is the lowest-energy record among those that tie.
+  for (const IterationRecord& h : r.history) {
+    if (h.worst == r.worstAfter && h.invalid + h.undecided == 0) {
+      EXPECT_GE(h.energy, r.energyAfter);
+    }
+  }
+  for (int k = 0; k < tets.nodesPerElement(); ++k) {
+    const auto n = static_cast<std::size_t>(tets.element(worst)[k]);
+    for (std::size_t d = 0; d < 3; ++d) EXPECT_EQ(mesh.xyz[3 * n + d], input.xyz[3 * n + d]);
+  }
+}
+
 // The time limit stopping the first sweep part-way keeps what that sweep moved, once certified:
 // an observer holds the run at the colour group nine tenths of the way through the sweep until
 // the limit has passed (cancelRequested is asked before each sweep and at each colour group).
