@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -19,6 +20,7 @@
 #include "core/first_failure.hpp"
 #include "core/parameters.hpp"
 #include "core/spatial_order.hpp"
+#include "core/team_barrier.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 #include "optimise/cad_local_model.hpp"
@@ -1356,21 +1358,32 @@ class Optimiser {
       const auto first = starts.begin() + c * parts_;
       queues.emplace_back(std::vector<std::size_t>(first, first + parts_ + 1), 8);
     }
+    // A sweep of a large high-order mesh takes seconds: a cancel request (or the time limit) is
+    // honoured between colour groups, asked once for the team by the thread that completes a
+    // group's barrier, so that every thread leaves the loop together.
     const bool observed = observer_ != nullptr || options_.timeLimit > 0.0;
-    bool cancel = false;  // shared: one thread asks, the barrier after `single` publishes it
+    bool cancel = false;  // shared: written before a barrier releases, read after it
+    const auto askToStop = [&] {
+      if (!observed) return;
+      try {
+        cancel = (observer_ != nullptr && observer_->cancelRequested()) || overBudget();
+      } catch (...) {  // an observer's own failure ends the sweep and is rethrown below
+        failure.capture();
+        cancel = true;
+      }
+    };
+    std::optional<TeamBarrier> barrier;  // for the team OpenMP starts (it may be smaller)
 #pragma omp parallel num_threads(options_.threads) reduction(max : moved, relative) \
     reduction(+ : visits, slides, cadEvaluations)
     {
       Patch patch;
       const int me = omp_get_thread_num();
-      for (std::int64_t c = 0; c < colours; ++c) {
-        if (observed) {
-          // A sweep of a large high-order mesh takes seconds: a cancel request is honoured
-          // between colour groups, every thread leaving the loop together.
 #pragma omp single
-          cancel = (observer_ != nullptr && observer_->cancelRequested()) || overBudget();
-          if (cancel) break;
-        }
+      {
+        barrier.emplace(omp_get_num_threads());
+        askToStop();
+      }
+      for (std::int64_t c = 0; c < colours && !cancel; ++c) {
         std::size_t lo = 0, hi = 0;
         while (queues[static_cast<std::size_t>(c)].next(me, lo, hi))
           for (std::size_t i = lo; i < hi; ++i) {
@@ -1385,7 +1398,12 @@ class Optimiser {
               failure.capture();
             }
           }
-#pragma omp barrier
+        // The colour's moves reach every thread before the next colour starts; a colour
+        // group is short (about a millisecond at order 2), so a thread that waits longer than
+        // the barrier's brief spin sleeps instead of holding a core another thread needs.
+        barrier->arriveAndWait([&] {
+          if (c + 1 < colours) askToStop();
+        });
       }
       slides += patch.slides;
       cadEvaluations += patch.cadEvaluations;
