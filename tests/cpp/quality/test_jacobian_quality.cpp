@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "core/error.hpp"
 #include "element/quadrature.hpp"
@@ -362,8 +364,14 @@ TEST(Quality, HighOrderBoundsStayExact) {
   // Order 10: J has degree 27 on a tetrahedron (4060 Bezier coefficients); the exact Bezier
   // arithmetic keeps a constant J constant to round-off, and the proven rounding margin stays
   // small (at most 1e-4 of J: 4.5e-5 for hexahedra of order 6).
-  for (const CellType type : kVolumeShapes) {
-    const int p = type == CellType::Tetrahedron ? 10 : 6;
+  // Prisms at order 8 too, the top of the orders the boundary layers are split at: Gmsh 4.8's
+  // own Bezier check drifts there (a straight prism of Gmsh's own making: 0.998 at order 7,
+  // 0.704 at order 8), so its verdict cannot stand in for this test. (A hexahedron of order 8
+  // keeps its bounds within 1.6 % of J only, still certified valid.)
+  for (const auto& [type, p] : std::vector<std::pair<CellType, int>>{{CellType::Tetrahedron, 10},
+                                                                     {CellType::Prism, 6},
+                                                                     {CellType::Prism, 8},
+                                                                     {CellType::Hexahedron, 6}}) {
     const NodeCoordinates x = affineElement(type, p);
     const JacobianBounds b = boundJacobian(type, p, x, nullptr);
     EXPECT_TRUE(b.certified);
@@ -372,8 +380,8 @@ TEST(Quality, HighOrderBoundsStayExact) {
     // Within the proven rounding margins (measured: 2e-11 relative, margins up to 2.2e-5).
     EXPECT_NEAR(computedMin(b), j, 0.5 * (b.minUpper - b.minLower)) << cellShortName(type);
     EXPECT_NEAR(computedMax(b), j, 0.5 * (b.maxUpper - b.maxLower)) << cellShortName(type);
-    EXPECT_GT(b.minLower, (1.0 - 1e-4) * j) << cellShortName(type);
-    EXPECT_LT(b.maxUpper, (1.0 + 1e-4) * j) << cellShortName(type);
+    EXPECT_GT(b.minLower, (1.0 - 1e-4) * j) << cellShortName(type) << " order " << p;
+    EXPECT_LT(b.maxUpper, (1.0 + 1e-4) * j) << cellShortName(type) << " order " << p;
   }
 }
 
