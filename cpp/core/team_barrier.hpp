@@ -1,13 +1,13 @@
 // A barrier for a fixed team of threads that spins only briefly and then sleeps.
 //
-// Why not OpenMP's own: libgomp's barrier waits by spinning (300,000 pause instructions, about
-// 10 ms on recent x86, before it sleeps). On a machine whose cores are also busy with other work
-// (a second job, FreeCAD's own threads), a thread spinning at a barrier holds a core that the
-// thread it waits for needs: the optimiser's colour groups, a barrier each, then ran 3 to 4 times
+// Why not OpenMP's own: libgomp's barrier waits by spinning (300,000 pause instructions, 6 ms on
+// the development machine's EPYC, before it sleeps). On a machine whose cores are also busy with
+// other work (a second job, FreeCAD's own threads), a thread spinning at a barrier holds a core
+// that the thread it waits for needs: the optimiser's colour groups, a barrier each, then ran
 // slower on two threads than on one (3d_bl_cyl at order 4 beside two other processes on the
-// 2-core machine: 18.6 s against 5.7 s). The spin here is bounded in time, long enough to cover
-// the usual gap between threads finishing a balanced step, and then the thread sleeps on a
-// condition variable until the last one arrives.
+// 2-core machine: 18.6 s against 5.7 s; bench/README.md, "A busy machine"). The spin here is
+// bounded in time, long enough to cover the usual gap between threads finishing a balanced step,
+// and then the thread sleeps on a condition variable until the last one arrives.
 //
 // Memory: everything a thread wrote before arriveAndWait() is visible to every thread after it
 // returns (the counter and the phase are acquire/release), as with an OpenMP barrier.
