@@ -528,8 +528,8 @@ TEST(BoundaryLayer2D, AerofoilIsValidWithSixQuadrilateralsOnEveryWallLineAndItsF
 // Above order 4 the pipeline optimises at order 4 and raises the order after; the layer's inner
 // nodes are then placed straight between the raised wall and the top again, which the split's
 // levels assume. Without that the cylinder's first layer at order 6 was 47 % off its height
-// (63 % at order 8); with it 16 % (the final order's optimiser moves the inner nodes again, the
-// top keeps the low order's shape), so 0.25 separates the two.
+// (63 % at order 8); with it 16 % (probably what the final order's optimiser moves again, and
+// the top keeping the low order's shape), so 0.25 separates the two.
 TEST(BoundaryLayer, AtOrderSixTheFirstLayerFollowsTheRaisedWall) {
   CaseSetup setup = setupCase(kCylinderCase);
   setup.options.order = 6;
