@@ -27,6 +27,17 @@ namespace {
 const std::string kCylinderCase =
     std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/meshgen/3d_bl_cyl.mcf";
 
+// NekMesh's meshgen case `name`.mcf (boundary layer included) at `order` with the optimiser (100
+// sweeps, 2 threads): the acceptance's path.
+MeshResult meshPeerCase(const std::string& name, int order) {
+  CaseSetup setup =
+      setupCase(std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/meshgen/" + name + ".mcf");
+  setup.options.order = order;
+  setup.options.optimiseIterations = 100;
+  setup.options.threads = 2;
+  return runMeshPipeline(setup.source, setup.options);
+}
+
 TEST(Expression, EvaluatesNekMeshThicknessesAndNamesWhatIsWrong) {
   const Expression t = Expression::parse("0.01+0.05*x", "BndLayerThickness");
   EXPECT_EQ(t(2.0, 7.0, 9.0), 0.01 + 0.05 * 2.0);  // the same operations: exact
@@ -178,13 +189,7 @@ TEST(BoundaryLayer, ATangentNeighbourWithoutALayerIsNamed) {
 // progression 1.5, at order 2 with the optimiser (as README's example runs it).
 class CylinderCase : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    CaseSetup setup = setupCase(kCylinderCase);
-    setup.options.order = 2;
-    setup.options.optimiseIterations = 100;
-    setup.options.threads = 2;
-    result_ = new MeshResult(runMeshPipeline(setup.source, setup.options));
-  }
+  static void SetUpTestSuite() { result_ = new MeshResult(meshPeerCase("3d_bl_cyl", 2)); }
   static void TearDownTestSuite() { delete result_; }
   static MeshResult* result_;
 };
@@ -306,11 +311,7 @@ TEST(BoundaryLayer, NektarXmlOfTheSplitLayerReadsBackEveryStoredNodeExactly) {
 
 TEST(BoundaryLayer, FirstLayerHeightAlongTheWallNormalIsWithinFivePercent) {
   double worstNearEnds = 0.0;
-  CaseSetup setup = setupCase(kCylinderCase);
-  setup.options.order = 4;
-  setup.options.optimiseIterations = 100;
-  setup.options.threads = 2;
-  const MeshResult r = runMeshPipeline(setup.source, setup.options);
+  const MeshResult r = meshPeerCase("3d_bl_cyl", 4);
   ASSERT_TRUE(r.boundaryLayer.has_value());
   ASSERT_TRUE(r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
@@ -429,27 +430,10 @@ TEST_F(CylinderCase, NektarAndGmshFilesCarryThePrismsAndReadBack) {
   }
 }
 
-}  // namespace
-}  // namespace homesh
-
-namespace homesh {
-namespace {
-
-// NekMesh's meshgen case NAME.mcf at order 4 with the optimiser (100 sweeps, 2 threads): the
-// acceptance's path.
-MeshResult meshPeerCaseAtOrder4(const std::string& name) {
-  CaseSetup setup =
-      setupCase(std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/meshgen/" + name + ".mcf");
-  setup.options.order = 4;
-  setup.options.optimiseIterations = 100;
-  setup.options.threads = 2;
-  return runMeshPipeline(setup.source, setup.options);
-}
-
 // NekMesh's 2d_bl_aerofoil case: a layer of thickness 0.1 on the aerofoil's two curves (Edge2,
 // Edge4), 6 layers, progression 1.5, at order 4 with the optimiser.
 TEST(BoundaryLayer2D, AerofoilIsValidWithSixQuadrilateralsOnEveryWallLineAndItsFirstHeight) {
-  const MeshResult r = meshPeerCaseAtOrder4("2d_bl_aerofoil");
+  const MeshResult r = meshPeerCase("2d_bl_aerofoil", 4);
   ASSERT_TRUE(r.boundaryLayer.has_value());
   EXPECT_EQ(r.mesh.dim, 2);
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
@@ -531,11 +515,7 @@ TEST(BoundaryLayer2D, AerofoilIsValidWithSixQuadrilateralsOnEveryWallLineAndItsF
 // (63 % at order 8); with it 16 % (probably what the final order's optimiser moves again, and
 // the top keeping the low order's shape), so 0.25 separates the two.
 TEST(BoundaryLayer, AtOrderSixTheFirstLayerFollowsTheRaisedWall) {
-  CaseSetup setup = setupCase(kCylinderCase);
-  setup.options.order = 6;
-  setup.options.optimiseIterations = 100;
-  setup.options.threads = 2;
-  const MeshResult r = runMeshPipeline(setup.source, setup.options);
+  const MeshResult r = meshPeerCase("3d_bl_cyl", 6);
   ASSERT_TRUE(r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
   EXPECT_GT(r.layerSplit->firstHeightMeasured, 0U);
@@ -545,7 +525,7 @@ TEST(BoundaryLayer, AtOrderSixTheFirstLayerFollowsTheRaisedWall) {
 }
 
 TEST(BoundaryLayer2D, T106KeepsItsFirstLayerHeightAroundItsRoundedEdges) {
-  const MeshResult r = meshPeerCaseAtOrder4("2d_bl_t106");
+  const MeshResult r = meshPeerCase("2d_bl_t106", 4);
   ASSERT_TRUE(r.boundaryLayer.has_value());
   ASSERT_TRUE(r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
@@ -581,7 +561,7 @@ TEST(BoundaryLayer2D, T106KeepsItsFirstLayerHeightAroundItsRoundedEdges) {
 // differs from the height along the normal line by the first layer's lean against a wall whose
 // curvature is small there, well under 1 %; 5 % is the bound.
 TEST(BoundaryLayer2D, NacaSharpTrailingEdgeGrowsAFanAndItsCellsKeepTheFirstHeight) {
-  const MeshResult r = meshPeerCaseAtOrder4("2d_bl_naca0012");
+  const MeshResult r = meshPeerCase("2d_bl_naca0012", 4);
   ASSERT_TRUE(r.boundaryLayer.has_value());
   ASSERT_TRUE(r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
