@@ -1298,6 +1298,12 @@ class Optimiser {
     double absolute = 0.0, relative = 0.0;
     std::size_t visits = 0;
     std::size_t slides = 0, cadEvaluations = 0;  // see Patch
+    // Adds another pass's counts (not its moves: a sweep's displacement is its first pass's).
+    void addCounts(const Moves& m) {
+      visits += m.visits;
+      slides += m.slides;
+      cadEvaluations += m.cadEvaluations;
+    }
   };
   // What the current sweep's passes moved before the time limit stopped one (relax(), read by
   // keepPartialSweep()).
@@ -1414,9 +1420,7 @@ class Optimiser {
     if (cancel) {
       interrupted_.absolute = std::max(interrupted_.absolute, moved);
       interrupted_.relative = std::max(interrupted_.relative, relative);
-      interrupted_.visits += visits;
-      interrupted_.slides += slides;
-      interrupted_.cadEvaluations += cadEvaluations;
+      interrupted_.addCounts({moved, relative, visits, slides, cadEvaluations});
       throw CancelledError(budgetSpent_ ? "time budget spent during an optimiser sweep"
                                         : "cancelled during an optimiser sweep");
     }
@@ -1454,10 +1458,7 @@ class Optimiser {
       std::vector<std::size_t> starts;
       const std::vector<std::int64_t> focus = groupByColourAndPart(groups, starts);
       for (int p = 0; p < options_.focusPasses; ++p) {
-        const Moves m = relax(focus, starts, false);
-        moved.visits += m.visits;
-        moved.slides += m.slides;
-        moved.cadEvaluations += m.cadEvaluations;
+        moved.addCounts(relax(focus, starts, false));
         interrupted_ = moved;
       }
       writeBack();

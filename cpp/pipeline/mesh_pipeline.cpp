@@ -581,9 +581,8 @@ CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& ca
     // free at three times the time, so 3D keeps the raised top but places the nodes between
     // wall and top again, straight between the raised wall and the top (raised, the low
     // order's optimised positions bend the columns, and the split's levels assume straight
-    // ones): the
-    // cylinder's first layer 47 % -> 16 % off at order 6, 63 % -> 16 % at order 8, and its
-    // worst element 0.23 -> 0.35 and 0.09 -> 0.33, for the same time.
+    // ones): the cylinder's first layer 47 % -> 16 % off at order 6, 63 % -> 16 % at order 8,
+    // and its worst element 0.23 -> 0.35 and 0.09 -> 0.33, for the same time.
     if (layered && state.layerRelease != LayerRelease::Free)
       blendLayerInteriors(state.mesh, &cad, /*tops=*/state.mesh.dim == 2);
     reserveAfterElevation(1.0);
