@@ -45,7 +45,11 @@ Mesh elevateOrder(const Mesh& linear, int order, const CadModel* cad, CurvingSta
 // evaluated at the node's reference position, so raising the order keeps the geometry exactly
 // and lowering it interpolates it (what NekMesh does before optimising at a lower order). Nodes
 // the new mesh no longer uses are dropped and the rest renumbered in order. With `cad`, new
-// nodes on CAD curves and faces are placed on them as above.
+// nodes on CAD curves and faces are placed on them as above, but with `layer` in 3D (a mesh
+// whose prisms are a macro boundary layer, wall 0-1-2 and tops 3-4-5) the edges of the layer's
+// top that lie on a CAD face (the layer's sides) keep the source's shape, projected onto the
+// face: placed afresh between their ends they would run straight where the source had them
+// parallel to the wall.
 Mesh changeOrder(const Mesh& mesh, int order, const CadModel* cad, CurvingStats* stats = nullptr,
                  bool layer = false);
 
