@@ -6,6 +6,7 @@
 #include <set>
 
 #include "core/error.hpp"
+#include "curving/layer_split.hpp"
 #include "curving/order_elevation.hpp"
 #include "element/reference_element.hpp"
 #include "linear/linear_mesher.hpp"
@@ -203,12 +204,20 @@ TEST(OrderElevation, HexahedraPrismsAndQuadrilateralsShareTheirNodes) {
   EXPECT_NEAR(q.scaled.min, 1.0, 1e-7);
 }
 
-// Eight prisms around the axis of a cylinder (radius 1, height 1), their outer quadrilaterals on
-// its lateral face, their end triangles on its end faces, the arcs on its two circles: elevation
-// must put every new node of the lateral face on the cylinder, evenly in its (angle, height)
-// parameters, and keep the prisms valid.
-TEST(OrderElevation, PrismsAroundACylinderAxisCurveOntoItsLateralFace) {
-  const CadModel cad = test::toModel(test::cylinder(1.0, 1.0));
+// The entities of test::cylinder(1, 1) (axis z, from z = 0 to 1), found by where they are.
+// OpenCASCADE's cylinder closes its circles and its lateral face at angle 0, where its two
+// vertices are: a mesh has nodes there, and the seam line between them is a mesh edge.
+struct CylinderEntities {
+  int lateral = 0, bottom = 0, top = 0;  // faces
+  int lower = 0, upper = 0, seam = 0;    // curves: the circles at z = 0 and 1, the seam
+  int seamVertex[2] = {0, 0};            // at (1, 0, 0) and (1, 0, 1)
+  bool found() const {
+    return lateral > 0 && bottom > 0 && top > 0 && lower > 0 && upper > 0 && seam > 0 &&
+           seamVertex[0] > 0 && seamVertex[1] > 0;
+  }
+};
+
+CylinderEntities cylinderEntities(const CadModel& cad) {
   const auto faceThrough = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
     for (int f = 1; f <= cad.numFaces(); ++f)
       if (cad.projectOnSurface(f, a).distance < 1e-9 && cad.projectOnSurface(f, b).distance < 1e-9)
@@ -221,22 +230,34 @@ TEST(OrderElevation, PrismsAroundACylinderAxisCurveOntoItsLateralFace) {
         return c;
     return 0;
   };
-  const int lateral = faceThrough({1, 0, 0.5}, {0, 1, 0.5});
-  const int bottom = faceThrough({0, 0, 0}, {0.5, 0, 0});
-  const int top = faceThrough({0, 0, 1}, {0.5, 0, 1});
-  const int lower = curveThrough({0, 1, 0}, {-1, 0, 0});
-  const int upper = curveThrough({0, 1, 1}, {-1, 0, 1});
-  const int seam = curveThrough({1, 0, 0.25}, {1, 0, 0.75});
   const auto vertexAt = [&](const Eigen::Vector3d& x) {
     for (int v = 1; v <= cad.numVertices(); ++v)
       if ((cad.vertexPoint(v) - x).norm() < 1e-9) return v;
     return 0;
   };
-  // OpenCASCADE's cylinder closes its circles and its lateral face at angle 0, where its two
-  // vertices are: a mesh has nodes there, and the seam line between them is a mesh edge.
-  const int seamVertex[2] = {vertexAt({1, 0, 0}), vertexAt({1, 0, 1})};
-  ASSERT_TRUE(lateral > 0 && bottom > 0 && top > 0 && lower > 0 && upper > 0 && seam > 0);
-  ASSERT_TRUE(seamVertex[0] > 0 && seamVertex[1] > 0);
+  CylinderEntities c;
+  c.lateral = faceThrough({1, 0, 0.5}, {0, 1, 0.5});
+  c.bottom = faceThrough({0, 0, 0}, {0.5, 0, 0});
+  c.top = faceThrough({0, 0, 1}, {0.5, 0, 1});
+  c.lower = curveThrough({0, 1, 0}, {-1, 0, 0});
+  c.upper = curveThrough({0, 1, 1}, {-1, 0, 1});
+  c.seam = curveThrough({1, 0, 0.25}, {1, 0, 0.75});
+  c.seamVertex[0] = vertexAt({1, 0, 0});
+  c.seamVertex[1] = vertexAt({1, 0, 1});
+  return c;
+}
+
+// Eight prisms around the axis of a cylinder (radius 1, height 1), their outer quadrilaterals on
+// its lateral face, their end triangles on its end faces, the arcs on its two circles: elevation
+// must put every new node of the lateral face on the cylinder, evenly in its (angle, height)
+// parameters, and keep the prisms valid.
+TEST(OrderElevation, PrismsAroundACylinderAxisCurveOntoItsLateralFace) {
+  const CadModel cad = test::toModel(test::cylinder(1.0, 1.0));
+  const CylinderEntities c = cylinderEntities(cad);
+  ASSERT_TRUE(c.found());
+  const int lateral = c.lateral, bottom = c.bottom, top = c.top;
+  const int lower = c.lower, upper = c.upper, seam = c.seam;
+  const int* seamVertex = c.seamVertex;
 
   const int n = 8;
   const double nan = std::nan("");
@@ -308,6 +329,95 @@ TEST(OrderElevation, PrismsAroundACylinderAxisCurveOntoItsLateralFace) {
   const QualitySummary q = evaluateQuality(mesh);
   EXPECT_EQ(q.invalid + q.undecided, 0u);
   EXPECT_GT(q.scaled.min, 0.0);
+}
+
+// A macro boundary layer inside the same cylinder: 16 prisms grown 0.2 inwards from its lateral
+// face (the wall), their sides on its end faces. At order 4 the layer's top is placed parallel to
+// the wall (blendLayerInteriors): the top's edges on the end faces are arcs of radius 0.8.
+// Raising the order to 6 must keep them so (the order-4 map at the new nodes, projected onto the
+// face), not place them afresh between their ends: a chord of that 45-degree arc comes to 0.739
+// at its middle, and the first layer split there would be thin by as much. The order-4
+// interpolant of the arc (its nodes equally spaced in angle, as the wall's) is within 1.9e-6 of
+// the radius (computed), so 1e-5.
+TEST(OrderElevation, RaisingALayerKeepsItsTopEdgesOnTheSideFacesParallelToTheWall) {
+  const CadModel cad = test::toModel(test::cylinder(1.0, 1.0));
+  const CylinderEntities c = cylinderEntities(cad);
+  ASSERT_TRUE(c.found());
+  const int n = 8;
+  const double height = 0.2, nan = std::nan("");
+  Mesh linear;
+  linear.dim = 3;
+  for (int level = 0; level < 2; ++level)  // wall nodes W(level, i), then tops T(level, i)
+    for (int i = 0; i < n; ++i) {
+      const double a = i * 2.0 * M_PI / n;
+      const double x[3] = {std::cos(a), std::sin(a), double(level)};
+      if (i == 0) {
+        linear.addNode(x, 0, c.seamVertex[level], nan, nan);
+      } else {
+        linear.addNode(x, 1, level == 0 ? c.lower : c.upper, nan, nan);
+      }
+    }
+  for (int level = 0; level < 2; ++level)
+    for (int i = 0; i < n; ++i) {
+      const double a = i * 2.0 * M_PI / n, r = 1.0 - height;
+      const double x[3] = {r * std::cos(a), r * std::sin(a), double(level)};
+      linear.addNode(x, 2, level == 0 ? c.bottom : c.top, nan, nan);
+    }
+  const auto wall = [&](int level, int i) -> std::int64_t { return level * n + i % n; };
+  const auto topOf = [&](std::int64_t w) { return w + std::int64_t{2} * n; };
+  ElementBlock prisms{CellType::Prism, 1, {}, {}}, tris{CellType::Triangle, 1, {}, {}};
+  ElementBlock quads{CellType::Quadrilateral, 1, {}, {}}, lines{CellType::Line, 1, {}, {}};
+  for (int i = 0; i < n; ++i) {
+    // Two wall triangles per panel, ordered so that the prism's map has a positive Jacobian
+    // (the wall's normal 0-1-2 points inwards, to the top).
+    for (const std::array<std::int64_t, 3>& w :
+         {std::array<std::int64_t, 3>{wall(0, i), wall(1, i + 1), wall(0, i + 1)},
+          std::array<std::int64_t, 3>{wall(0, i), wall(1, i), wall(1, i + 1)}}) {
+      prisms.nodes.insert(prisms.nodes.end(),
+                          {w[0], w[1], w[2], topOf(w[0]), topOf(w[1]), topOf(w[2])});
+      prisms.entity.push_back(1);
+      tris.nodes.insert(tris.nodes.end(), w.begin(), w.end());
+      tris.entity.push_back(c.lateral);
+    }
+    for (int level = 0; level < 2; ++level) {
+      const std::int64_t a = wall(level, i), b = wall(level, i + 1);
+      quads.nodes.insert(quads.nodes.end(), {a, b, topOf(b), topOf(a)});
+      quads.entity.push_back(level == 0 ? c.bottom : c.top);
+      lines.nodes.insert(lines.nodes.end(), {a, b});
+      lines.entity.push_back(level == 0 ? c.lower : c.upper);
+    }
+  }
+  lines.nodes.insert(lines.nodes.end(), {wall(0, 0), wall(1, 0)});
+  lines.entity.push_back(c.seam);
+  linear.blocks = {prisms, tris, quads, lines};
+  linear.checkConsistency();
+
+  Mesh low = elevateOrder(linear, 4, &cad, nullptr, /*layer=*/true);
+  blendLayerInteriors(low, &cad);
+  const int p = 6;
+  const Mesh raised = changeOrder(low, p, &cad, nullptr, /*layer=*/true);
+  const ReferenceElement& ref = ReferenceElement::get(CellType::Prism, p);
+  std::set<std::int64_t> onTopEdges;
+  for (const ElementBlock& b : raised.blocks) {
+    if (b.type != CellType::Prism) continue;
+    for (std::size_t e = 0; e < b.count(); ++e)
+      for (int r = 0; r < ref.numNodes(); ++r) {
+        const auto& l = ref.lattice()[static_cast<std::size_t>(r)];
+        const bool topEdge = l[2] == p && (l[0] == 0 || l[1] == 0 || l[0] + l[1] == p);
+        const std::int64_t id = b.element(e)[r];
+        if (topEdge && raised.nodeCadDim[id] == 2) onTopEdges.insert(id);
+      }
+  }
+  // The top's edges on the two end faces: n each, P - 1 new nodes and the two vertices (the
+  // tops, on the face) each, the vertices shared: 2 n P.
+  EXPECT_EQ(onTopEdges.size(), static_cast<std::size_t>(2 * n * p));
+  for (const std::int64_t id : onTopEdges) {
+    const Eigen::Vector3d x = nodePoint(raised, id);
+    EXPECT_NEAR(std::hypot(x.x(), x.y()), 1.0 - height, 1e-5) << "node " << id;
+    EXPECT_NEAR(x.z(), std::round(x.z()), 1e-12) << "node " << id;  // on its end face
+  }
+  const QualitySummary q = evaluateQuality(raised);
+  EXPECT_EQ(q.invalid + q.undecided, 0u);
 }
 
 TEST(OrderElevation, RejectsBadOrders) {
