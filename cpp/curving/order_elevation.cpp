@@ -344,6 +344,24 @@ struct Elevator {
   }
 };
 
+// Moves node `id`, which lies on a CAD curve or face, onto it by closest-point projection from
+// where it is, with its parameters there.
+void projectNode(Mesh& mesh, std::int64_t id, const CadModel& cad) {
+  const int entity = mesh.nodeCadIndex[id];
+  double* x = &mesh.xyz[3 * id];
+  const Eigen::Vector3d from(x[0], x[1], x[2]);
+  if (mesh.nodeCadDim[id] == 1) {
+    const CurveProjection proj = cad.projectOnCurve(entity, from);
+    mesh.nodeCadParam[2 * id] = proj.t;
+    for (int c = 0; c < 3; ++c) x[c] = proj.point[c];
+  } else {
+    const SurfaceProjection proj = cad.projectOnSurface(entity, from);
+    mesh.nodeCadParam[2 * id] = proj.u;
+    mesh.nodeCadParam[2 * id + 1] = proj.v;
+    for (int c = 0; c < 3; ++c) x[c] = proj.point[c];
+  }
+}
+
 // Moves the nodes created by elevation (ids >= firstNew) that lie on a CAD curve or face and
 // that `placed` does not mark onto it by closest-point projection (the last resort).
 void projectNewNodes(Mesh& mesh, std::size_t firstNew, const CadModel& cad,
@@ -351,20 +369,7 @@ void projectNewNodes(Mesh& mesh, std::size_t firstNew, const CadModel& cad,
   for (auto id = static_cast<std::int64_t>(firstNew);
        id < static_cast<std::int64_t>(mesh.numNodes()); ++id) {
     const int dim = static_cast<int>(mesh.nodeCadDim[id]);
-    const int entity = mesh.nodeCadIndex[id];
-    if ((dim != 1 && dim != 2) || placed[id] != 0) continue;
-    double* x = &mesh.xyz[3 * id];
-    const Eigen::Vector3d straight(x[0], x[1], x[2]);
-    if (dim == 1) {
-      const CurveProjection proj = cad.projectOnCurve(entity, straight);
-      mesh.nodeCadParam[2 * id] = proj.t;
-      for (int c = 0; c < 3; ++c) x[c] = proj.point[c];
-    } else {
-      const SurfaceProjection proj = cad.projectOnSurface(entity, straight);
-      mesh.nodeCadParam[2 * id] = proj.u;
-      mesh.nodeCadParam[2 * id + 1] = proj.v;
-      for (int c = 0; c < 3; ++c) x[c] = proj.point[c];
-    }
+    if ((dim == 1 || dim == 2) && placed[id] == 0) projectNode(mesh, id, cad);
   }
 }
 
@@ -525,14 +530,8 @@ class BoundaryPlacer {
   // from where it is: a raised edge is within the source's interpolation error of the face).
   void projectEdge(const std::vector<std::int64_t>& nodes) {
     for (std::size_t i = 1; i + 1 < nodes.size(); ++i) {
-      const auto id = static_cast<std::size_t>(nodes[i]);
-      const SurfaceProjection proj = cad_.projectOnSurface(
-          mesh_.nodeCadIndex[id], Eigen::Vector3d(&mesh_.xyz[3 * id]), std::nullopt);
-      for (std::size_t c = 0; c < 3; ++c)
-        mesh_.xyz[3 * id + c] = proj.point(static_cast<Eigen::Index>(c));
-      mesh_.nodeCadParam[2 * id] = proj.u;
-      mesh_.nodeCadParam[2 * id + 1] = proj.v;
-      placed_[id] = 1;
+      projectNode(mesh_, nodes[i], cad_);
+      placed_[static_cast<std::size_t>(nodes[i])] = 1;
     }
   }
 
