@@ -8,6 +8,7 @@ thickness, spheres of radius 1e-6 and 1e6)."""
 import json
 import os
 import signal
+import struct
 import zlib
 import base64
 
@@ -177,10 +178,17 @@ def test_a_mesh_predicted_not_to_fit_in_memory_is_refused_before_meshing(homesh_
 
 
 def test_compressed_nektar_xml_that_inflates_without_bound(homesh_bin, tmp_path):
-    # 3 GiB of zeros compress to about 3 MB: the reader stops at its 2 GiB limit.
+    # 3 GiB of zeros compress to about 3 MB: the reader stops at its 2 GiB limit. Compressing
+    # them took 16 s; after a full flush the compressor starts afresh, so one 16 MiB chunk's
+    # block repeats. The stream ends with an empty final block and the Adler-32 of n zeros
+    # (a = 1, b = n mod 65521); zlib inflates it to 3 GiB with a valid checksum.
     packer = zlib.compressobj(9)
     chunk = bytes(1 << 24)
-    packed = b"".join(packer.compress(chunk) for _ in range(192)) + packer.flush()
+    first = packer.compress(chunk) + packer.flush(zlib.Z_FULL_FLUSH)
+    block = packer.compress(chunk) + packer.flush(zlib.Z_FULL_FLUSH)
+    assert first[2:] == block  # the 2-byte zlib header, then the same block
+    size = 192 * len(chunk)
+    packed = first + block * 191 + b"\x03\x00" + struct.pack(">I", (size % 65521) << 16 | 1)
     text = base64.b64encode(packed).decode()
     xml = ('<?xml version="1.0" encoding="utf-8" ?>\n<NEKTAR>\n<GEOMETRY DIM="3" SPACE="3">\n'
            '<VERTEX COMPRESSED="B64Z-LittleEndian" BITSIZE="64">%s</VERTEX>\n'
