@@ -5,6 +5,7 @@ the `homesh` package with the compiled core.
 """
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -33,3 +34,9 @@ def run(args, **kwargs):
     """Runs a command, returning the CompletedProcess (text mode, never raises on failure)."""
     kwargs.setdefault("timeout", 600)
     return subprocess.run([str(a) for a in args], capture_output=True, text=True, **kwargs)
+
+
+def stages_run(stderr):
+    """The stages the CLI reported timings for ("homesh: linear        0.051 s" lines): a test
+    matching a stage's name anywhere in stderr would also match it in a temporary path."""
+    return re.findall(r"^homesh: (\w+(?: \d+)?) +[0-9.]+ s$", stderr, re.M)
