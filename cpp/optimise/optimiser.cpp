@@ -1597,7 +1597,14 @@ class Optimiser {
       const double then = n > options_.stallWindow
                               ? result_.history[n - 1 - options_.stallWindow].worst
                               : input.worst;
-      if (n >= options_.stallWindow && r.worst - then < options_.stall) return "stalled";
+      // Still climbing back from a dip inside the window (a sweep that lowers the worst while
+      // it lowers the energy elsewhere) is not a stall.
+      double low = r.worst;
+      for (int k = std::max(0, n - 1 - options_.stallWindow); k < n - 1; ++k)
+        low = std::min(low, result_.history[k].worst);
+      if (n >= options_.stallWindow && r.worst - then < options_.stall &&
+          r.worst - low < options_.stall)
+        return "stalled";
     }
     // Invalid and stuck: over the last stuckWindow sweeps no element became proven valid and the
     // worst value did not rise by `stall`; what is left is for a repair round, not more sweeps.

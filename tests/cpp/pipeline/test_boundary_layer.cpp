@@ -2,10 +2,12 @@
 // layers, and NekMesh's cylinder case end to end.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/expression.hpp"
@@ -15,6 +17,7 @@
 #include "io/mesh_readers.hpp"
 #include "io/mesh_writers.hpp"
 #include "linear/boundary_layer.hpp"
+#include "optimise/optimiser.hpp"
 #include "pipeline/case_setup.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
@@ -525,6 +528,22 @@ TEST(BoundaryLayer, AtOrderSixTheFirstLayerFollowsTheRaisedWall) {
   EXPECT_LE(r.layerSplit->firstHeightDeviation, 0.05);
   RecordProperty("first_layer_height_worst_deviation",
                  std::to_string(r.layerSplit->firstHeightDeviation));
+  // The order-6 optimiser's first sweep after the raise lifts the worst element from 0.24 to
+  // 0.29; the second lowers it to 0.27 while it lowers the energy elsewhere, and it climbs back
+  // from there (0.35 after 37 sweeps). The stall rule used to stop at the fourth sweep, the worst
+  // still rising, because three sweeps had not beaten the first's. "stalled" now also needs the
+  // worst to have stopped rising within the window: the pipeline's stall of 1e-3 over 3 sweeps
+  // (pipelineOptimiserOptions in mesh_pipeline.cpp).
+  ASSERT_TRUE(r.optimiser.has_value());
+  const std::vector<IterationRecord>& h = r.optimiser->history;
+  ASSERT_FALSE(h.empty());
+  if (r.optimiser->stopReason == "stalled") {
+    double low = h.back().worst;
+    for (std::size_t k = h.size() >= 4 ? h.size() - 4 : 0; k + 1 < h.size(); ++k)
+      low = std::min(low, h[k].worst);
+    EXPECT_LT(h.back().worst - low, 1e-3) << "stopped after sweep " << h.back().iteration;
+  }
+  EXPECT_GT(r.optimiser->worstAfter, r.optimiser->worstBefore);
 }
 
 TEST(BoundaryLayer2D, T106KeepsItsFirstLayerHeightAroundItsRoundedEdges) {
