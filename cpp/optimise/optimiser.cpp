@@ -1594,17 +1594,15 @@ class Optimiser {
     if (valid && fall < options_.energyTolerance) return "energy";
     if (options_.stall > 0.0 && valid && fall < options_.stallEnergy) {
       const auto n = static_cast<int>(result_.history.size());  // r is the last entry
-      const double then = n > options_.stallWindow
-                              ? result_.history[n - 1 - options_.stallWindow].worst
-                              : input.worst;
-      // Still climbing back from a dip inside the window (a sweep that lowers the worst while
-      // it lowers the energy elsewhere) is not a stall.
-      double low = r.worst;
-      for (int k = std::max(0, n - 1 - options_.stallWindow); k < n - 1; ++k)
+      // The lowest worst of the state before the window and the window's earlier sweeps: the
+      // last sweep measured against it, not only against the state before, so that climbing
+      // back from a dip inside the window (a sweep that lowers the worst while it lowers the
+      // energy elsewhere) is not a stall.
+      double low = n > options_.stallWindow ? result_.history[n - 1 - options_.stallWindow].worst
+                                            : input.worst;
+      for (int k = std::max(0, n - options_.stallWindow); k < n - 1; ++k)
         low = std::min(low, result_.history[k].worst);
-      if (n >= options_.stallWindow && r.worst - then < options_.stall &&
-          r.worst - low < options_.stall)
-        return "stalled";
+      if (n >= options_.stallWindow && r.worst - low < options_.stall) return "stalled";
     }
     // Invalid and stuck: over the last stuckWindow sweeps no element became proven valid and the
     // worst value did not rise by `stall`; what is left is for a repair round, not more sweeps.

@@ -55,13 +55,12 @@ struct OptimiserOptions {
   //  "energy": every element is proven valid and the sweep lowered the total energy by less
   //    than `energyTolerance` of it (an invalid mesh keeps going: untangling can follow a
   //    plateau of the energy);
-  //  "stalled" (only with `stall` > 0): every element is proven valid, the last `stallWindow`
-  //    sweeps together raised the worst scaled Jacobian by less than `stall`, the last sweep
-  //    raised it by less than `stall` over its lowest in those sweeps, and the last sweep
-  //    lowered the energy by less than `stallEnergy` of it: the worst element no longer
-  //    improves and the rest only slowly (a single sweep can lower the worst value while it
-  //    lowers the energy elsewhere, hence the window, and the worst climbing back from such a
-  //    dip is still improving);
+  //  "stalled" (only with `stall` > 0): every element is proven valid, the last sweep's worst
+  //    scaled Jacobian is less than `stall` above its lowest value in the state before the last
+  //    `stallWindow` sweeps and in those sweeps, and the last sweep lowered the energy by less
+  //    than `stallEnergy` of it: the worst element no longer improves and the rest only slowly
+  //    (a single sweep can lower the worst value while it lowers the energy elsewhere, hence
+  //    the window, and the worst climbing back from such a dip is still improving);
   //  "stuck" (only with `stall` > 0): elements are not proven valid, and over the last
   //    `stuckWindow` sweeps their count did not fall, the worst scaled Jacobian rose by less
   //    than `stall` and the last sweep lowered the energy by less than `stallEnergy`: more
