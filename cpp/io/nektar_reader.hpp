@@ -3,10 +3,11 @@
 //
 // Elements get their vertices the way Nektar++ derives them from the faces and edges, then
 // become Gmsh-ordered elements of the order the curves carry (order 1 without curves). Edge
-// and face nodes come from the curves (or lie straight); element-interior nodes of 3D elements,
-// which the format does not store, are filled by a discrete harmonic extension of the element's
-// boundary nodes on its node lattice. Composites named "SolidN", "FaceN" or "EdgeN" give the
-// elements' and boundary cells' entities; nodes take the entity of the cells they lie on.
+// and face nodes come from the curves (or lie straight); the nodes the format does not store
+// (element interiors) are rebuilt as Nektar++ builds them: for triangles, tetrahedra and prisms
+// its modified basis with the interior modes zero (nektar_expansion.hpp), for quadrilaterals and
+// hexahedra the transfinite blend of the boundary. Composites named "SolidN", "FaceN" or "EdgeN"
+// give the elements' and boundary cells' entities; nodes take the entity of the cells they lie on.
 #pragma once
 
 #include <string>

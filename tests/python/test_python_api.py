@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import homesh
-from conftest import ROOT
+from conftest import DATA, PEER_CASES, needs_peer_files
 from homesh import tessellation
 
 
@@ -220,30 +220,35 @@ def test_tessellation_follows_the_curved_surface(sphere):
     assert geometry["edge_polylines"].shape[1] == 7
 
 
-CYLINDER = ROOT.parent / "shared" / "peer-cases" / "nekmesh" / "meshgen"
+# NekMesh's cylinder case (peer files, skipped where absent): 3d_bl_cyl.stp (millimetres), the
+# cylinder's two faces 1 and 8 between the end planes z = 0 and 500.
+CYLINDER = PEER_CASES / "meshgen"
+# The repository's box with a hole (4 x 4 x 2 mm, the hole of radius 1 mm along z): Face7 the
+# hole's wall, between the planes z = 0 and 2.
+BOX_HOLE = DATA / "box_hole.step"
+HOLE_FACE = 7
 
 
-def test_boundary_layer_argument_and_mcf_keys():
-    # The cylinder STEP read as is (millimetres): a 40 mm layer on the cylinder's two faces,
-    # 3 layers growing by 1.2 from the wall.
-    m = homesh.mesh(str(CYLINDER / "3d_bl_cyl.stp"), order=2, optimise=50, threads=2,
-                    boundary_layer={"faces": [1, 8], "thickness": 40, "layers": 3,
+def _boundary_layer_argument(cad, faces, thickness, ends):
+    # A layer of the given thickness on the faces, 3 layers growing by 1.2 from the wall.
+    m = homesh.mesh(str(cad), order=2, optimise=50, threads=2,
+                    boundary_layer={"faces": faces, "thickness": thickness, "layers": 3,
                                     "progression": 1.2})
     report = m.report()
     layer = report["boundary_layer"]
-    assert layer["faces"] == [1, 8] and layer["layers"] == 3
+    assert layer["faces"] == faces and layer["layers"] == 3
     assert report["elements"]["prism"] == 3 * layer["macro_cells"] > 0
-    # First layer: 40 (1 - 1.2) / (1 - 1.2^3), measured at the wall's quadrature points within
-    # the worst deviation the report gives, itself within the 5 % asked for.
-    first, expected = layer["first_height"], 40 * 0.2 / (1.2 ** 3 - 1)
+    # First layer: thickness (1 - 1.2) / (1 - 1.2^3), measured at the wall's quadrature points
+    # within the worst deviation the report gives, itself within the 5 % asked for.
+    first, expected = layer["first_height"], thickness * 0.2 / (1.2 ** 3 - 1)
     assert first["worst_deviation"] <= 0.05 and first["corner_cells"] == 0
     for key in ("min", "max"):
         assert abs(first[key] / expected - 1) <= first["worst_deviation"] + 1e-12
     assert m.quality()["invalid_elements"] == 0
     blocks = {b.element_type for b in m.element_blocks}
     assert blocks == {"tet", "prism"}
-    # Drawn: the walls' triangles and the layer's side quadrilaterals (on the end planes z = 0
-    # and 500), each owned by a prism or tetrahedron; two sub-triangles per quad lattice cell.
+    # Drawn: the walls' triangles and the layer's side quadrilaterals (on the end planes), each
+    # owned by a prism or tetrahedron; two sub-triangles per quad lattice cell.
     level = 3
     geometry = tessellation.surface_and_edges(m, level=level)
     faces = {b.element_type: b.elements for b in m.boundary}
@@ -253,24 +258,70 @@ def test_boundary_layer_argument_and_mcf_keys():
         assert (tessellation.face_owners(m.element_blocks, faces[kind], corners) >= 0).all()
     quad_points = geometry["points"][-len(faces["quad"]) * (level + 1) ** 2:]
     # On the planes to the rounding of the Lagrange sums of coordinates up to ~1e3 (1e-9 mm).
-    assert np.all(np.minimum(abs(quad_points[:, 2]), abs(quad_points[:, 2] - 500)) < 1e-9)
+    z = quad_points[:, 2]
+    assert np.all(np.minimum(abs(z - ends[0]), abs(z - ends[1])) < 1e-9)
+
+
+def test_boundary_layer_argument_and_mcf_keys():
+    needs_peer_files()
+    # The cylinder STEP read as is (millimetres): a 40 mm layer on the cylinder's two faces.
+    _boundary_layer_argument(CYLINDER / "3d_bl_cyl.stp", [1, 8], 40, (0, 500))
     # A .mcf's BndLayer keys are used when no boundary_layer is given.
     c = homesh.mesh(str(CYLINDER / "3d_bl_cyl.mcf"), order=2, optimise=50, threads=2)
     assert c.report()["boundary_layer"]["layers"] == 6
 
 
+def test_boundary_layer_argument_and_mcf_keys_on_a_hole(tmp_path):
+    # The box with a hole read as is (millimetres): a 0.2 mm layer on the hole's wall.
+    _boundary_layer_argument(BOX_HOLE, [HOLE_FACE], 0.2, (0, 2))
+    # A .mcf written beside a copy of the STEP (read in metres): its BndLayer keys are used when
+    # no boundary_layer is given.
+    (tmp_path / BOX_HOLE.name).write_bytes(BOX_HOLE.read_bytes())
+    mcf = tmp_path / "hole.mcf"
+    mcf.write_text("""<NEKTAR><MESHING>
+  <INFORMATION>
+    <I PROPERTY="CADFile" VALUE="%s" />
+    <I PROPERTY="MeshType" VALUE="3DBndLayer" />
+  </INFORMATION>
+  <PARAMETERS>
+    <P PARAM="MinDelta" VALUE="0.0001" />
+    <P PARAM="MaxDelta" VALUE="0.0004" />
+    <P PARAM="EPS" VALUE="0.1" />
+    <P PARAM="Order" VALUE="2" />
+    <P PARAM="BndLayerSurfaces" VALUE="%d" />
+    <P PARAM="BndLayerThickness" VALUE="0.0001" />
+    <P PARAM="BndLayerLayers" VALUE="4" />
+  </PARAMETERS>
+</MESHING></NEKTAR>
+""" % (BOX_HOLE.name, HOLE_FACE))
+    c = homesh.mesh(str(mcf), order=2, optimise=50, threads=2)
+    layer = c.report()["boundary_layer"]
+    assert layer["faces"] == [HOLE_FACE] and layer["layers"] == 4
+    assert c.report()["elements"]["prism"] == 4 * layer["macro_cells"] > 0
+
+
+# Errors in the boundary_layer argument, named before any meshing: on the repository's box with a
+# hole (7 faces), and on NekMesh's cylinder (8 faces) where the peer files are here.
+@pytest.fixture(params=["box_hole", "peer_cylinder"])
+def layer_cad(request):
+    if request.param == "peer_cylinder":
+        needs_peer_files()
+        return CYLINDER / "3d_bl_cyl.stp"
+    return BOX_HOLE
+
+
 @pytest.mark.parametrize("spec, message", [
     ({"faces": [1]}, "needs 'thickness'"),
-    ({"faces": [1, 8], "thickness": 40, "layer": 3}, "unknown key 'layer'"),
+    ({"faces": [1], "thickness": 40, "layer": 3}, "unknown key 'layer'"),
     ({"faces": [9], "thickness": 1}, "face 9 does not exist"),
     ({"faces": [1], "thickness": "x*"}, "not an expression of x, y, z"),
     ({"faces": [1], "thickness": True}, "must be a number or an expression"),
     ({"faces": [1], "thickness": 1, "layers": 0}, "layers must be an integer from 1 to 100"),
     (5, "must be a dict"),
 ])
-def test_bad_boundary_layers_are_named(spec, message):
+def test_bad_boundary_layers_are_named(layer_cad, spec, message):
     with pytest.raises(homesh.ParameterError, match=message):
-        homesh.mesh(str(CYLINDER / "3d_bl_cyl.stp"), order=2, boundary_layer=spec)
+        homesh.mesh(str(layer_cad), order=2, boundary_layer=spec)
 
 
 def test_size_field_is_the_octree_that_predict_integrates(data):

@@ -1,20 +1,46 @@
 """`homesh quality` and `homesh convert`: the JSON quality report, --strict on a certified-invalid
 mesh, conversions between MSH, Nektar++ XML and VTU that keep every node, and third-party
-readers (Gmsh, meshio) on the binary and appended outputs."""
+readers (Gmsh, meshio) on the binary and appended outputs.
 
+NekMesh's meshes live in ../shared, beside the clone: the tests that read them skip where it is
+absent, and each has a sibling on a mesh made here (`homesh mesh` of tests/data/sphere.brep) or
+on tests/data/sphere_in_box_p4.msh.gz, Gmsh's tangled order-4 sphere in a box."""
+
+import gzip
 import json
-from pathlib import Path
+import re
 
 import meshio
 import numpy as np
 import pytest
 
-from conftest import run
+from conftest import PEER_CASES, needs_peer_files, run
 from homesh import HighOrderMesh, _core, read
 
-PEERS = Path(__file__).resolve().parents[3] / "shared" / "peer-cases" / "nekmesh" / "optimiser"
+PEERS = PEER_CASES / "optimiser"
 NACA = PEERS / "varopti_naca.msh"
 CUBE_SPHERE = PEERS / "varopti_cube_sphere.msh"
+NEKTAR_XML = PEER_CASES / "nektar-xml" / "sphere_box_o6_varopti.xml"
+
+
+@pytest.fixture(scope="module")
+def made(tmp_path_factory, homesh_bin, data):
+    """tests/data/sphere.brep meshed by `homesh mesh` at order 4 (tetrahedra, proven valid):
+    the MSH file and the mesh command's report."""
+    folder = tmp_path_factory.mktemp("made")
+    path, report = folder / "sphere.msh", folder / "mesh.json"
+    r = run([homesh_bin, "mesh", data / "sphere.brep", "--order", "4", "--size", "0.5", "-o", path,
+             "--report", report, "-q"])
+    assert r.returncode == 0, r.stderr
+    return path, json.loads(report.read_text())
+
+
+@pytest.fixture(scope="module")
+def tangled(tmp_path_factory, data):
+    """Gmsh's order-4 sphere in a box (MSH 4.1, tests/data), with negative Jacobians inside."""
+    path = tmp_path_factory.mktemp("tangled") / "t.msh"
+    path.write_bytes(gzip.decompress((data / "sphere_in_box_p4.msh.gz").read_bytes()))
+    return path
 
 
 def two_tetrahedra(order, fold=False):
@@ -37,6 +63,7 @@ def two_tetrahedra(order, fold=False):
 
 
 def test_quality_report_of_a_peer_mesh(homesh_bin, tmp_path):
+    needs_peer_files()
     report = tmp_path / "q.json"
     r = run([homesh_bin, "quality", NACA, "--report", report])
     assert r.returncode == 0, r.stderr
@@ -57,6 +84,32 @@ def test_quality_report_of_a_peer_mesh(homesh_bin, tmp_path):
     assert quality["flagged_elements"] == []
     # The report on standard output is the same document.
     r = run([homesh_bin, "quality", NACA, "--report", "-", "-q", "-j", "2"])
+    assert r.returncode == 0 and json.loads(r.stdout)["quality"] == quality
+
+
+def test_quality_report_of_a_made_mesh(homesh_bin, tmp_path, made):
+    """The sibling of the test above on a mesh made here: the same report, its counts those of
+    the file as meshio reads it, and its worst value the one `homesh mesh` reported of the mesh
+    it wrote (the file keeps every double)."""
+    path, mesh_report = made
+    report = tmp_path / "q.json"
+    r = run([homesh_bin, "quality", path, "--report", report])
+    assert r.returncode == 0, r.stderr
+    assert "certified valid" in r.stdout
+    q = json.loads(report.read_text())
+    tets = sum(len(c.data) for c in meshio.read(path).cells if c.type == "tetra35")
+    assert tets > 0 and q["elements"]["tet"] == tets and q["order"] == 4
+    quality = q["quality"]
+    for key in ("scaled_jacobian", "distortion"):
+        m = quality[key]
+        assert 0.0 < m["min"] <= m["mean"] <= 1.0
+        assert len(m["histogram"]["edges"]) == 21 and len(m["histogram"]["counts"]) == 20
+        assert sum(m["histogram"]["counts"]) + m["histogram"]["below_zero"] == tets
+    assert quality["scaled_jacobian"]["min"] == mesh_report["quality"]["scaled_jacobian"]["min"]
+    assert quality["invalid_elements"] == 0 and quality["certified"] is True
+    assert quality["by_type"]["tet"]["count"] == tets
+    assert quality["flagged_elements"] == []
+    r = run([homesh_bin, "quality", path, "--report", "-", "-q", "-j", "2"])
     assert r.returncode == 0 and json.loads(r.stdout)["quality"] == quality
 
 
@@ -99,13 +152,25 @@ def test_per_element_verdicts_and_intervals():
     assert list(q["validity"]) == [1, -1]
     # A straight element: 1 less the proven rounding margin (~1e-11 at order 2).
     assert q["scaled_jacobian"][0] == pytest.approx(1.0, abs=1e-9) and q["scaled_jacobian"][1] < 0
+
+
+def check_intervals(path):
+    q = read(path).quality()
+    assert (q["validity"] == 1).all()
+    # min J / max J lies in [lower, upper]; the bounds of min J and of max J are each refined to
+    # 1e-3 of max J, so the ratio's interval is at most about 2e-3 wide.
+    gap = q["scaled_jacobian_upper"] - q["scaled_jacobian"]
+    assert gap.min() >= 0.0 and gap.max() < 2e-3, path
+
+
+def test_per_element_intervals_of_peer_meshes():
+    needs_peer_files()
     for name in ("varopti_naca.msh", "varopti_cube_sphere.msh"):
-        q = read(PEERS / name).quality()
-        assert (q["validity"] == 1).all()
-        # min J / max J lies in [lower, upper]; the bounds of min J and of max J are each
-        # refined to 1e-3 of max J, so the ratio's interval is at most about 2e-3 wide.
-        gap = q["scaled_jacobian_upper"] - q["scaled_jacobian"]
-        assert gap.min() >= 0.0 and gap.max() < 2e-3, name
+        check_intervals(PEERS / name)
+
+
+def test_per_element_intervals_of_a_made_mesh(made):
+    check_intervals(made[0])
 
 
 def test_validity_field_in_files(tmp_path):
@@ -140,17 +205,17 @@ def same_mesh(a, b, tol, interior=0):
                 assert np.abs(a.nodes[ea[m]] - b.nodes[eb[n]]).max() <= tol, (n, m)
 
 
-@pytest.mark.parametrize("binary", [False, True])
-def test_convert_round_trips(homesh_bin, tmp_path, binary):
-    source = read(CUBE_SPHERE)
+def convert_round_trip(homesh_bin, tmp_path, binary, path):
+    """`path`: an order-4 tetrahedral mesh written by Gmsh."""
+    source = read(path)
     flag = ["--binary"] if binary else []
-    # MSH 2.2 in -> MSH 4.1 (ASCII or binary) and compressed Nektar++ XML in one run.
-    r = run([homesh_bin, "convert", CUBE_SPHERE, "-o", tmp_path / "a.msh", "-o",
+    # Gmsh's MSH in -> MSH 4.1 (ASCII or binary) and compressed Nektar++ XML in one run.
+    r = run([homesh_bin, "convert", path, "-o", tmp_path / "a.msh", "-o",
              tmp_path / "a.xml", "--compressed", "-q"] + flag)
     assert r.returncode == 0 and r.stdout == "", r.stderr
     assert "B64Z-LittleEndian" in (tmp_path / "a.xml").read_text()
     # Binary and ASCII with 17 significant digits both keep every double exactly; the source
-    # (MSH 2.2 from Gmsh) is read once and written by us.
+    # (from Gmsh) is read once and written by us.
     tol = 0.0
     same_mesh(source, read(tmp_path / "a.msh"), tol)
     # From XML back to MSH: the same mesh again. Nektar++ files store vertices, edges and faces
@@ -170,27 +235,52 @@ def test_convert_round_trips(homesh_bin, tmp_path, binary):
     assert min(vtu.cell_data["scaled_jacobian"][0]) == source.quality()["min"]
 
 
-def test_meshio_reads_binary_msh_and_appended_vtu(tmp_path):
-    mesh = read(NACA)
+@pytest.mark.parametrize("binary", [False, True])
+def test_convert_round_trips(homesh_bin, tmp_path, binary):
+    needs_peer_files()
+    convert_round_trip(homesh_bin, tmp_path, binary, CUBE_SPHERE)  # MSH 2.2
+
+
+@pytest.mark.parametrize("binary", [False, True])
+def test_convert_round_trips_gmsh_sphere_in_box(homesh_bin, tmp_path, binary, tangled):
+    convert_round_trip(homesh_bin, tmp_path, binary, tangled)  # MSH 4.1
+
+
+def meshio_reads_binary_msh_and_appended_vtu(tmp_path, path, cell_type, count):
+    """`cell_type`: meshio's name of the mesh's elements, `count` of them."""
+    mesh = read(path)
     mesh.write(tmp_path / "n.msh", binary=True)
     mesh.write(tmp_path / "n.vtu", binary=True)
     msh = meshio.read(tmp_path / "n.msh")
-    assert sum(len(c.data) for c in msh.cells if c.type == "triangle10") == 524
+    assert sum(len(c.data) for c in msh.cells if c.type == cell_type) == count
     # meshio keeps Gmsh's node order within cells (MSH 4.1 lists nodes by entity, so compare
     # through the connectivity).
-    triangles = np.vstack([c.data for c in msh.cells if c.type == "triangle10"])
-    assert np.array_equal(msh.points[triangles], mesh.nodes[mesh.elements])
+    cells = np.vstack([c.data for c in msh.cells if c.type == cell_type])
+    assert np.array_equal(msh.points[cells], mesh.nodes[mesh.elements])
     vtu = meshio.read(tmp_path / "n.vtu")
     assert np.array_equal(vtu.points, mesh.nodes)
-    assert sum(len(c.data) for c in vtu.cells) == 524
+    assert sum(len(c.data) for c in vtu.cells) == count
     assert np.array_equal(vtu.cell_data["scaled_jacobian"][0], mesh.quality()["scaled_jacobian"])
 
 
+def test_meshio_reads_binary_msh_and_appended_vtu(tmp_path):
+    needs_peer_files()
+    meshio_reads_binary_msh_and_appended_vtu(tmp_path, NACA, "triangle10", 524)
+
+
+def test_meshio_reads_binary_msh_and_appended_vtu_of_a_made_mesh(tmp_path, made):
+    # The count as the mesh command reported it.
+    meshio_reads_binary_msh_and_appended_vtu(tmp_path, made[0], "tetra35",
+                                             made[1]["elements"]["tet"])
+
+
 def test_convert_errors_name_the_problem(homesh_bin, tmp_path):
-    r = run([homesh_bin, "convert", NACA, "-o", tmp_path / "x.foo"])
+    mesh_file = tmp_path / "good.msh"  # any mesh file
+    two_tetrahedra(2).write(mesh_file)
+    r = run([homesh_bin, "convert", mesh_file, "-o", tmp_path / "x.foo"])
     assert r.returncode != 0 and "unknown mesh format '.foo'" in r.stderr
     assert not (tmp_path / "x.foo").exists()
-    r = run([homesh_bin, "convert", NACA])
+    r = run([homesh_bin, "convert", mesh_file])
     assert r.returncode != 0 and "-o" in r.stderr
     garbage = tmp_path / "garbage.msh"
     garbage.write_text("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2\n")
@@ -203,7 +293,8 @@ def test_nektar_output_is_checked_as_nektar_builds_it(homesh_bin, tmp_path):
     """Nektar++ rebuilds element interiors from the faces, so a written .xml is read back and
     checked as Nektar++ will build it: NekMesh's tangled sphere_box_o6 file, passed through, is
     reported with its invalid elements; a valid mesh is reported with none."""
-    nektar = PEERS.parent / "nektar-xml" / "sphere_box_o6_varopti.xml"
+    needs_peer_files()
+    nektar = NEKTAR_XML
     r = run([homesh_bin, "convert", nektar, "-o", tmp_path / "t.xml"])
     assert r.returncode == 0, r.stderr
     line = [s for s in r.stderr.splitlines() if "as Nektar++ builds it" in s]
@@ -221,13 +312,61 @@ def test_nektar_output_is_checked_as_nektar_builds_it(homesh_bin, tmp_path):
     assert r.returncode == 0 and r.stderr == "", r.stderr
 
 
+def nektar_line(stderr):
+    """(scaled Jacobian min, invalid) from convert's line on the written .xml."""
+    [line] = [s for s in stderr.splitlines() if "as Nektar++ builds it" in s]
+    found = re.search(r"scaled Jacobian min (\S+); (\d+) invalid, (\d+) undecided", line)
+    assert found, line
+    return float(found.group(1)), int(found.group(2))
+
+
+def test_nektar_output_of_repo_meshes_is_checked_as_nektar_builds_it(homesh_bin, tmp_path, made,
+                                                                      tangled):
+    """The sibling of the test above: Gmsh's tangled sphere in a box written as Nektar++ XML is
+    reported with its invalid elements, quiet or not; a valid mesh made here is reported with
+    none. Read back, each written file has the verdicts the line gave, and the valid mesh's
+    elements (interiors rebuilt from the faces) those of its MSH file."""
+    r = run([homesh_bin, "convert", tangled, "-o", tmp_path / "t.xml"])
+    assert r.returncode == 0, r.stderr
+    worst, invalid = nektar_line(r.stderr)
+    assert invalid > 0 and worst < 0
+    back = read(tmp_path / "t.xml").quality()
+    assert back["invalid_elements"] == invalid
+    assert back["min"] == pytest.approx(worst, abs=5e-5)  # printed with 4 decimals
+    r = run([homesh_bin, "convert", tangled, "-o", tmp_path / "t.xml", "-q"])
+    assert "as Nektar++ builds it" in r.stderr
+    path = made[0]
+    r = run([homesh_bin, "convert", path, "-o", tmp_path / "c.xml"])
+    assert r.returncode == 0, r.stderr
+    worst, invalid = nektar_line(r.stderr)
+    assert invalid == 0 and "; 0 invalid, 0 undecided" in r.stderr, r.stderr
+    back, msh = read(tmp_path / "c.xml").quality(), read(path).quality()
+    assert back["min"] == pytest.approx(worst, abs=5e-5)
+    assert np.array_equal(back["validity"], msh["validity"]) and (msh["validity"] == 1).all()
+    r = run([homesh_bin, "convert", path, "-o", tmp_path / "c.xml", "-q"])
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+
+
 def test_python_write_warns_when_nektar_geometry_is_not_valid(tmp_path):
     """HighOrderMesh.write to .xml says, as a warning, when the geometry Nektar++ builds from the
     file (element interiors from the faces) is not proven valid, and is silent when it is."""
     import warnings
-    nektar = read(PEERS.parent / "nektar-xml" / "sphere_box_o6_varopti.xml")
+    needs_peer_files()
+    nektar = read(NEKTAR_XML)
     with pytest.warns(UserWarning, match="as Nektar..? builds it.*[1-9][0-9]* invalid"):
         nektar.write(tmp_path / "t.xml")
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         read(CUBE_SPHERE).write(tmp_path / "c.xml")
+
+
+def test_python_write_warns_when_nektar_geometry_of_a_repo_mesh_is_not_valid(tmp_path, made,
+                                                                             tangled):
+    """The sibling of the test above: Gmsh's tangled sphere in a box warns, a valid mesh made
+    here does not."""
+    import warnings
+    with pytest.warns(UserWarning, match="as Nektar..? builds it.*[1-9][0-9]* invalid"):
+        read(tangled).write(tmp_path / "t.xml")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        read(made[0]).write(tmp_path / "c.xml")

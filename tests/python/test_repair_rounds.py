@@ -8,8 +8,7 @@ from pathlib import Path
 import pytest
 
 import homesh
-from conftest import run
-from test_optimise import gmsh_worst
+from conftest import gmsh_worst, run
 
 SPHERE_BOX = Path(__file__).resolve().parents[2] / "examples" / "sphere_box.step"
 # Order 4 at size 1.2: curving alone leaves tetrahedra outside the sphere invalid.

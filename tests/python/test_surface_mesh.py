@@ -13,8 +13,7 @@ import numpy as np
 import pytest
 
 import homesh
-from conftest import run
-from test_optimise import GMSH_VERDICT, gmsh_worst
+from conftest import gmsh_worst, run
 
 # A tube (the lateral face of a cylinder of radius 1, height 2) and a hemispherical cap on its
 # top circle, exported as two loose faces: nothing shared, no solid.
@@ -73,8 +72,7 @@ def test_a_shell_gets_a_certified_surface_mesh_that_gmsh_agrees_with(homesh_bin,
     assert 0.0 < worst <= 1.0
     # Gmsh measures a surface element's Jacobian along its straight triangle's normal too, and
     # refines its bounds to 1e-3 of the largest |J| (as ours): the two agree to that.
-    if GMSH_VERDICT.exists():
-        assert gmsh_worst(out, 2) == pytest.approx(worst, abs=2e-3)
+    assert gmsh_worst(out, 2) == pytest.approx(worst, abs=2e-3)
     m = meshio.read(out)
     types = {c.type for c in m.cells}
     assert "triangle15" in types and not any(t.startswith("tetra") for t in types), types
@@ -204,8 +202,7 @@ def test_a_shell_with_degenerated_edges_off_their_vertex(homesh_bin, tmp_path):
             timeout=300)
     assert r.returncode == 0, r.stderr
     assert re.search(r"; 0 invalid$", r.stderr, re.M), r.stderr
-    if GMSH_VERDICT.exists():
-        assert gmsh_worst(out, 2) > 0.0
+    assert gmsh_worst(out, 2) > 0.0
 
 
 @pytest.mark.parametrize("suffix", [".msh", ".vtu", ".xml"])

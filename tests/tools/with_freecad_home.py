@@ -5,7 +5,8 @@ usage: with_freecad_home.py BUILD_DIR COMMAND [ARGS...]
 
 HOME and FREECAD_USER_HOME point at a fresh temporary folder whose Mod/HOMesh is a symlink to
 the staged workbench (BUILD_DIR/Mod/HOMesh), so tests neither read nor write the user's FreeCAD
-configuration. The command's exit status is returned; the folder is removed afterwards unless
+configuration, and TMPDIR points at a folder inside it, so that what FreeCAD and HOMesh write
+there (and what a test finds there) is this run's alone, whatever runs beside it. The command's exit status is returned; the folder is removed afterwards unless
 HOMESH_KEEP_HOME is set.
 """
 
@@ -26,8 +27,10 @@ def main():
     home = tempfile.mkdtemp(prefix="homesh-freecad-home-")
     try:
         os.makedirs(os.path.join(home, "Mod"))
+        os.makedirs(os.path.join(home, "tmp"))
         os.symlink(workbench, os.path.join(home, "Mod", "HOMesh"))
         env = dict(os.environ, HOME=home, FREECAD_USER_HOME=home, HOMESH_BUILD_DIR=build,
+                   TMPDIR=os.path.join(home, "tmp"),
                    QTWEBENGINE_CHROMIUM_FLAGS="--no-sandbox")
         return subprocess.call(sys.argv[2:], env=env)
     finally:

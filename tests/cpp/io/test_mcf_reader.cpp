@@ -1,19 +1,21 @@
-// NekMesh mesh configuration files (.mcf): the five peer cases, notices for keys HOMesh does not
-// use, and malformed files.
+// NekMesh mesh configuration files (.mcf): the five peer cases (when NekMesh's files are here)
+// and cases of each kind written here, notices for keys HOMesh does not use, and malformed files.
 #include <gtest/gtest.h>
 
+#include <STEPControl_Writer.hxx>
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/error.hpp"
 #include "io/mcf_reader.hpp"
+#include "peer_data.hpp"
 #include "test_support.hpp"
-
-#ifndef HOMESH_SHARED_DIR
-#error "HOMESH_SHARED_DIR must name the shared data folder"
-#endif
 
 namespace homesh {
 namespace {
@@ -21,7 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string peer(const std::string& name) {
-  return std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/meshgen/" + name;
+  return test::peerFile("meshgen/" + name);
 }
 
 // Writes an .mcf whose MESHING holds `body` into a fresh folder and returns its path.
@@ -58,7 +60,36 @@ bool hasNotice(const McfCase& c, const std::string& text) {
   EXPECT_NE(parameterError(path).find(text), std::string::npos) \
       << "message: " << parameterError(path)
 
+// A case file laid out as NekMesh writes them (an XML declaration, a comment, indentation, tabs
+// and blank lines between the sections), holding `sections`, written as dir / name.
+std::string writeCase(const fs::path& dir, const std::string& name, const std::string& sections) {
+  const fs::path path = dir / name;
+  std::ofstream(path) << "<?xml version=\"1.0\" encoding=\"utf-8\" ?>\n"
+                      << "<!-- a case written by the test -->\n<NEKTAR>\n  <MESHING>\n\n"
+                      << sections << "\n  </MESHING>\n</NEKTAR>\n";
+  return path.string();
+}
+
+std::string information(const std::string& cad, const std::string& type) {
+  return "    <INFORMATION>\n      <I PROPERTY=\"CADFile\" VALUE=\"" + cad +
+         "\" />\n      <I PROPERTY=\"MeshType\" VALUE=\"" + type + "\"\t/>\n    </INFORMATION>\n\n";
+}
+
+std::string parameters(const std::vector<std::pair<std::string, std::string>>& values) {
+  std::string out = "    <PARAMETERS>\n";
+  for (const auto& [key, value] : values)
+    out += "      <P PARAM=\"" + key + "\"\tVALUE=\"" + value + "\"   />\n";
+  return out + "    </PARAMETERS>\n\n";
+}
+
+std::string boolParameters(const std::vector<std::string>& names) {
+  std::string out = "    <BOOLPARAMETERS>\n";
+  for (const auto& name : names) out += "      <P VALUE=\"" + name + "\" />\n";
+  return out + "    </BOOLPARAMETERS>\n";
+}
+
 TEST(McfReader, ReadsTheSphereCase) {
+  HOMESH_REQUIRE_PEER_FILES();
   const McfCase c = readMcfFile(peer("3d_sphere.mcf"));
   EXPECT_EQ(c.path, peer("3d_sphere.mcf"));
   EXPECT_EQ(c.cadFile, fs::path(peer("3d_sphere.stp")).lexically_normal().string());
@@ -80,6 +111,7 @@ TEST(McfReader, ReadsTheSphereCase) {
 }
 
 TEST(McfReader, ReadsTheBoundaryLayerCylinderWithoutBoolParameters) {
+  HOMESH_REQUIRE_PEER_FILES();
   const McfCase c = readMcfFile(peer("3d_bl_cyl.mcf"));
   EXPECT_EQ(c.meshType, "3DBndLayer");
   EXPECT_TRUE(c.hasBoundaryLayer());
@@ -99,6 +131,7 @@ TEST(McfReader, ReadsTheBoundaryLayerCylinderWithoutBoolParameters) {
 }
 
 TEST(McfReader, ReadsThe2DAerofoilAndT106Cases) {
+  HOMESH_REQUIRE_PEER_FILES();
   const McfCase a = readMcfFile(peer("2d_bl_aerofoil.mcf"));
   EXPECT_EQ(a.meshType, "2DBndLayer");
   EXPECT_TRUE(a.is2D());
@@ -127,6 +160,7 @@ TEST(McfReader, ReadsThe2DAerofoilAndT106Cases) {
 }
 
 TEST(McfReader, ReadsTheNacaCase) {
+  HOMESH_REQUIRE_PEER_FILES();
   const McfCase c = readMcfFile(peer("2d_bl_naca0012.mcf"));
   ASSERT_TRUE(c.isNaca());
   EXPECT_EQ(*c.nacaDigits, "0012");
@@ -149,6 +183,192 @@ TEST(McfReader, ReadsTheNacaCase) {
   EXPECT_EQ(c.notices[0],
             "2d_bl_naca0012.mcf: BOOLPARAMETERS BndLayerAdjustEverywhere is not "
             "supported yet and is ignored");
+}
+
+// The cases below are of the peer files' kinds, written here with values of their own, so that
+// the reader is covered without NekMesh's files: every field it gives is checked.
+
+// A 3D sphere case beside its CAD, a STEP file OCCT writes here: the CAD path resolves beside
+// the case, and the one notice is for the surface optimiser HOMesh does not have.
+TEST(McfReader, ReadsASphereCaseBesideItsStepFile) {
+  const fs::path dir = test::tempDir();
+  STEPControl_Writer step;
+  ASSERT_EQ(step.Transfer(test::sphere(0.8), STEPControl_AsIs), IFSelect_RetDone);
+  ASSERT_EQ(step.Write((dir / "ball.step").string().c_str()), IFSelect_RetDone);
+  const std::string path = writeCase(
+      dir, "ball.mcf",
+      information("ball.step", "3D") +
+          parameters({{"MinDelta", "0.05"}, {"MaxDelta", "0.3"}, {"EPS", "0.05"}, {"Order", "3"}}) +
+          boolParameters({"SurfaceOptimiser"}));
+  const McfCase c = readMcfFile(path);
+  EXPECT_EQ(c.path, path);
+  EXPECT_EQ(c.cadFile, (dir / "ball.step").lexically_normal().string());
+  EXPECT_TRUE(fs::exists(c.cadFile));
+  EXPECT_FALSE(c.isNaca());
+  EXPECT_EQ(c.meshType, "3D");
+  EXPECT_FALSE(c.is2D());
+  EXPECT_FALSE(c.hasBoundaryLayer());
+  EXPECT_DOUBLE_EQ(*c.minDelta, 0.05);
+  EXPECT_DOUBLE_EQ(*c.maxDelta, 0.3);
+  EXPECT_DOUBLE_EQ(*c.eps, 0.05);
+  EXPECT_EQ(*c.order, 3);
+  EXPECT_TRUE(c.boundaryLayer.empty());
+  EXPECT_FALSE(c.boundaryLayerLayers || c.boundaryLayerProgression);
+  EXPECT_FALSE(c.xmin || c.ymin || c.xmax || c.ymax || c.aoa);
+  EXPECT_EQ(c.boolParameters, std::set<std::string>{"SurfaceOptimiser"});
+  EXPECT_TRUE(c.refinementLines.empty());
+  ASSERT_EQ(c.notices.size(), 1u);
+  EXPECT_EQ(c.notices[0],
+            "ball.mcf: BOOLPARAMETERS SurfaceOptimiser is not supported yet and is ignored");
+}
+
+// A 3D boundary-layer case without BOOLPARAMETERS, beside a copy of the repository's box with a
+// hole: the layer's four parameters as text, the count and the progression parsed, no notice.
+TEST(McfReader, ReadsABoundaryLayerCaseWithoutBoolParameters) {
+  const fs::path dir = test::tempDir();
+  fs::copy_file(fs::path(HOMESH_SOURCE_DIR) / "tests" / "data" / "box_hole.step",
+                dir / "holed.step");
+  const McfCase c = readMcfFile(writeCase(
+      dir, "holed.mcf",
+      information("holed.step", "3DBndLayer") + parameters({{"MinDelta", "0.02"},
+                                                            {"MaxDelta", "0.5"},
+                                                            {"EPS", "0.25"},
+                                                            {"Order", "2"},
+                                                            {"BndLayerSurfaces", "3,7"},
+                                                            {"BndLayerThickness", "0.06"},
+                                                            {"BndLayerLayers", "5"},
+                                                            {"BndLayerProgression", "1.25"}})));
+  EXPECT_EQ(c.meshType, "3DBndLayer");
+  EXPECT_TRUE(c.hasBoundaryLayer());
+  EXPECT_FALSE(c.is2D());
+  EXPECT_FALSE(c.isNaca());
+  EXPECT_EQ(c.cadFile, (dir / "holed.step").string());
+  EXPECT_TRUE(fs::exists(c.cadFile));
+  EXPECT_DOUBLE_EQ(*c.minDelta, 0.02);
+  EXPECT_DOUBLE_EQ(*c.maxDelta, 0.5);
+  EXPECT_DOUBLE_EQ(*c.eps, 0.25);
+  EXPECT_EQ(*c.order, 2);
+  const std::map<std::string, std::string> bl = {{"BndLayerSurfaces", "3,7"},
+                                                 {"BndLayerThickness", "0.06"},
+                                                 {"BndLayerLayers", "5"},
+                                                 {"BndLayerProgression", "1.25"}};
+  EXPECT_EQ(c.boundaryLayer, bl);
+  EXPECT_EQ(c.boundaryLayerLayers, 5);
+  EXPECT_EQ(c.boundaryLayerProgression, 1.25);
+  EXPECT_FALSE(c.xmin || c.ymin || c.xmax || c.ymax || c.aoa);
+  EXPECT_TRUE(c.boolParameters.empty());
+  EXPECT_TRUE(c.refinementLines.empty());
+  EXPECT_TRUE(c.notices.empty());
+}
+
+// 2D cases: a boundary layer with an empty BOOLPARAMETERS, one whose thickness is an expression
+// (kept as text) with EPS at its upper limit, and a plain 2D case whose absent parameters stay
+// absent (the pipeline's defaults apply).
+TEST(McfReader, Reads2DCases) {
+  const fs::path dir = test::tempDir();
+  const McfCase a = readMcfFile(writeCase(dir, "fin.mcf",
+                                          information("fin.stp", "2DBndLayer") +
+                                              parameters({{"MinDelta", "0.002"},
+                                                          {"MaxDelta", "1.5"},
+                                                          {"EPS", "0.001"},
+                                                          {"Order", "5"},
+                                                          {"BndLayerSurfaces", "1,3"},
+                                                          {"BndLayerThickness", "0.2"},
+                                                          {"BndLayerLayers", "3"},
+                                                          {"BndLayerProgression", "2"}}) +
+                                              "    <BOOLPARAMETERS>\n    </BOOLPARAMETERS>\n"));
+  EXPECT_EQ(a.meshType, "2DBndLayer");
+  EXPECT_TRUE(a.is2D());
+  EXPECT_TRUE(a.hasBoundaryLayer());
+  EXPECT_EQ(a.cadFile, (dir / "fin.stp").string());
+  EXPECT_DOUBLE_EQ(*a.minDelta, 0.002);
+  EXPECT_DOUBLE_EQ(*a.maxDelta, 1.5);
+  EXPECT_DOUBLE_EQ(*a.eps, 0.001);
+  EXPECT_EQ(*a.order, 5);
+  EXPECT_EQ(a.boundaryLayer.at("BndLayerSurfaces"), "1,3");
+  EXPECT_EQ(a.boundaryLayer.at("BndLayerThickness"), "0.2");
+  EXPECT_EQ(a.boundaryLayer.at("BndLayerLayers"), "3");
+  EXPECT_EQ(a.boundaryLayer.at("BndLayerProgression"), "2");
+  EXPECT_EQ(a.boundaryLayer.size(), 4u);
+  EXPECT_EQ(a.boundaryLayerLayers, 3);
+  EXPECT_EQ(a.boundaryLayerProgression, 2.0);
+  EXPECT_TRUE(a.boolParameters.empty());  // an empty BOOLPARAMETERS
+  EXPECT_TRUE(a.notices.empty());
+
+  const McfCase b = readMcfFile(writeCase(
+      dir, "blade.mcf",
+      information("blade.stp", "2DBndLayer") + parameters({{"MinDelta", "0.02"},
+                                                           {"MaxDelta", "0.4"},
+                                                           {"EPS", "1"},
+                                                           {"BndLayerSurfaces", "7-9"},
+                                                           {"BndLayerThickness", "0.02+0.1*x"}})));
+  EXPECT_DOUBLE_EQ(*b.minDelta, 0.02);
+  EXPECT_DOUBLE_EQ(*b.maxDelta, 0.4);
+  EXPECT_DOUBLE_EQ(*b.eps, 1.0);  // the upper limit is valid
+  EXPECT_FALSE(b.order);
+  EXPECT_EQ(b.boundaryLayer.at("BndLayerSurfaces"), "7-9");
+  EXPECT_EQ(b.boundaryLayer.at("BndLayerThickness"), "0.02+0.1*x");  // an expression, as text
+  EXPECT_EQ(b.boundaryLayer.size(), 2u);
+  EXPECT_FALSE(b.boundaryLayerLayers || b.boundaryLayerProgression);
+  EXPECT_TRUE(b.notices.empty());
+
+  const McfCase c =
+      readMcfFile(writeCase(dir, "plate.mcf",
+                            information("shapes/plate.igs", "2D") +
+                                parameters({{"MinDelta", "0.1"}, {"MaxDelta", "0.1"}})));
+  EXPECT_EQ(c.meshType, "2D");
+  EXPECT_TRUE(c.is2D());
+  EXPECT_FALSE(c.hasBoundaryLayer());
+  EXPECT_EQ(c.cadFile, (dir / "shapes" / "plate.igs").string());
+  EXPECT_DOUBLE_EQ(*c.minDelta, 0.1);  // MinDelta equal to MaxDelta: a uniform size
+  EXPECT_DOUBLE_EQ(*c.maxDelta, 0.1);
+  EXPECT_FALSE(c.eps || c.order);
+  EXPECT_TRUE(c.boundaryLayer.empty());
+  EXPECT_TRUE(c.boolParameters.empty());
+  EXPECT_TRUE(c.notices.empty());
+}
+
+// A NACA case: CADFile "NNNN" is the aerofoil's digits, not a file; its box and angle of attack
+// are read, and the BOOLPARAMETERS HOMesh does not use yet gets its notice.
+TEST(McfReader, ReadsANacaCase) {
+  const McfCase c = readMcfFile(writeCase(test::tempDir(), "wing.mcf",
+                                          information("4415", "2DBndLayer") +
+                                              parameters({{"MinDelta", "0.05"},
+                                                          {"MaxDelta", "4"},
+                                                          {"EPS", "0.2"},
+                                                          {"Order", "3"},
+                                                          {"BndLayerSurfaces", "2-3"},
+                                                          {"BndLayerThickness", "0.08"},
+                                                          {"BndLayerAdjustment", "1.5"},
+                                                          {"Xmin", "-2.5"},
+                                                          {"Ymin", "-1.5"},
+                                                          {"Xmax", "4"},
+                                                          {"Ymax", "1.25"},
+                                                          {"AOA", "7.5"}}) +
+                                              boolParameters({"BndLayerAdjustEverywhere"})));
+  ASSERT_TRUE(c.isNaca());
+  EXPECT_EQ(*c.nacaDigits, "4415");
+  EXPECT_TRUE(c.cadFile.empty());
+  EXPECT_EQ(c.meshType, "2DBndLayer");
+  EXPECT_TRUE(c.is2D());
+  EXPECT_DOUBLE_EQ(*c.minDelta, 0.05);
+  EXPECT_DOUBLE_EQ(*c.maxDelta, 4.0);
+  EXPECT_DOUBLE_EQ(*c.eps, 0.2);
+  EXPECT_EQ(*c.order, 3);
+  EXPECT_DOUBLE_EQ(*c.xmin, -2.5);
+  EXPECT_DOUBLE_EQ(*c.ymin, -1.5);
+  EXPECT_DOUBLE_EQ(*c.xmax, 4.0);
+  EXPECT_DOUBLE_EQ(*c.ymax, 1.25);
+  EXPECT_DOUBLE_EQ(*c.aoa, 7.5);
+  const std::map<std::string, std::string> bl = {
+      {"BndLayerSurfaces", "2-3"}, {"BndLayerThickness", "0.08"}, {"BndLayerAdjustment", "1.5"}};
+  EXPECT_EQ(c.boundaryLayer, bl);
+  EXPECT_EQ(c.boolParameters, std::set<std::string>{"BndLayerAdjustEverywhere"});
+  EXPECT_TRUE(c.refinementLines.empty());
+  ASSERT_EQ(c.notices.size(), 1u);
+  EXPECT_EQ(c.notices[0],
+            "wing.mcf: BOOLPARAMETERS BndLayerAdjustEverywhere is not supported yet and is "
+            "ignored");
 }
 
 TEST(McfReader, NoticesUnknownAndUnsupportedKeys) {

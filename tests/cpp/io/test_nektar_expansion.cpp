@@ -1,9 +1,14 @@
 // The geometry Nektar++ builds from a file (io/nektar_expansion): the modified basis's element
-// interiors, NodalTriElec points, and the peer file written by NekMesh judged on that geometry.
+// interiors, NodalTriElec points, and files judged on that geometry: the peer file written by
+// NekMesh (when NekMesh's files are here) and curved meshes of ours written as Nektar++ XML.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -12,18 +17,19 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
+#include "curving/order_elevation.hpp"
 #include "element/node_sets.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 #include "io/mesh_readers.hpp"
+#include "io/mesh_writers.hpp"
 #include "io/nektar_expansion.hpp"
+#include "linear/linear_mesher.hpp"
+#include "peer_data.hpp"
 #include "quality/mesh_quality.hpp"
 #include "test_support.hpp"
-
-#ifndef HOMESH_SHARED_DIR
-#error "HOMESH_SHARED_DIR must name the shared data folder"
-#endif
 
 namespace homesh {
 namespace {
@@ -226,7 +232,8 @@ double jacobianAt(const ReferenceElement& ref, const Eigen::MatrixXd& x, const d
 // is invalid in our certified verdict; and each further element we call invalid has negative J
 // at some point of a dense lattice of that geometry (Nektar++'s sampling missed it).
 TEST(NektarXml, NekMeshFileIsJudgedOnTheGeometryNektarBuilds) {
-  const std::string dir = std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/nektar-xml/";
+  HOMESH_REQUIRE_PEER_FILES();
+  const std::string dir = test::peerFile("nektar-xml/");
   ASSERT_TRUE(std::filesystem::exists(dir + "sphere_box_o6_varopti.xml"));
   std::map<std::size_t, double> nektar;  // element id -> its min J / max J
   std::ifstream list(dir + "sphere_box_o6_varopti.jac.txt");
@@ -293,6 +300,277 @@ TEST(NektarXml, NekMeshFileIsJudgedOnTheGeometryNektarBuilds) {
   }
   std::printf("Nektar++ flags %zu elements, HOMesh %zu (all of Nektar++'s included)\n",
               nektar.size(), ours.size());
+}
+
+// A tetrahedron's interior as Nektar++ builds it, rebuilt here from the modes themselves
+// (nektar::modifiedTetMode) apart from the reader's interiorFromBoundary: at the points of the
+// lattice of order + 4 strictly inside the element (where the collapsed coordinates are regular;
+// as many as the modes (p, q, r), p + q + r <= order, and unisolvent for the polynomials of the
+// order) the modes' values A and the Lagrange basis's L give a map's modal coefficients
+// C = A^-1 L X from its node values X; C's interior rows set to zero fix the interior nodes
+// from the others.
+struct TetRebuild {
+  std::vector<int> boundary, interior;  // node indices (Gmsh order)
+  Eigen::MatrixXd weights;              // interior = weights * boundary
+  double condition = 0.0;               // the larger condition number of the two solves
+};
+
+double conditionNumber(const Eigen::MatrixXd& m) {
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(m);
+  return svd.singularValues()(0) / svd.singularValues()(svd.singularValues().size() - 1);
+}
+
+TetRebuild rebuildTetInterior(int order) {
+  const ReferenceElement& ref = ReferenceElement::get(CellType::Tetrahedron, order);
+  std::vector<std::array<int, 3>> modes;
+  for (int p = 0; p <= order; ++p)
+    for (int q = 0; p + q <= order; ++q)
+      for (int r = 0; p + q + r <= order; ++r) modes.push_back({p, q, r});
+  const auto n = static_cast<Eigen::Index>(modes.size());
+  Eigen::MatrixXd a(n, n), l(n, n);
+  const int m = order + 4;
+  Eigen::Index s = 0;
+  for (int k = 1; k < m; ++k)
+    for (int j = 1; j + k < m; ++j)
+      for (int i = 1; i + j + k < m; ++i, ++s) {
+        const double xi[3] = {double(i) / m, double(j) / m, double(k) / m};
+        const std::array<double, 4> lambda{1.0 - xi[0] - xi[1] - xi[2], xi[0], xi[1], xi[2]};
+        for (Eigen::Index c = 0; c < n; ++c) {
+          const auto& [p, q, r] = modes[static_cast<std::size_t>(c)];
+          a(s, c) = nektar::modifiedTetMode(p, q, r, lambda);
+        }
+        Eigen::VectorXd values;
+        Eigen::MatrixXd gradients;
+        ref.evaluate(xi, values, gradients);
+        l.row(s) = values.transpose();
+      }
+  EXPECT_EQ(s, n);
+  EXPECT_EQ(n, ref.numNodes());
+  const Eigen::MatrixXd coefficients = a.fullPivLu().solve(l);  // modes x nodes
+  TetRebuild out;
+  for (int k = 0; k < ref.numNodes(); ++k) {
+    const LatticePoint& p = ref.lattice()[static_cast<std::size_t>(k)];
+    const bool inside = p[0] > 0 && p[1] > 0 && p[2] > 0 && p[0] + p[1] + p[2] < order;
+    (inside ? out.interior : out.boundary).push_back(k);
+  }
+  std::vector<Eigen::Index> interiorModes;
+  for (Eigen::Index c = 0; c < n; ++c) {
+    const auto& [p, q, r] = modes[static_cast<std::size_t>(c)];
+    if (nektar::isInteriorTetMode(p, q, r)) interiorModes.push_back(c);
+  }
+  EXPECT_EQ(interiorModes.size(), out.interior.size());
+  const auto rows = static_cast<Eigen::Index>(interiorModes.size());
+  Eigen::MatrixXd onInterior(rows, static_cast<Eigen::Index>(out.interior.size()));
+  Eigen::MatrixXd onBoundary(rows, static_cast<Eigen::Index>(out.boundary.size()));
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    for (std::size_t k = 0; k < out.interior.size(); ++k)
+      onInterior(r, static_cast<Eigen::Index>(k)) =
+          coefficients(interiorModes[static_cast<std::size_t>(r)], out.interior[k]);
+    for (std::size_t k = 0; k < out.boundary.size(); ++k)
+      onBoundary(r, static_cast<Eigen::Index>(k)) =
+          coefficients(interiorModes[static_cast<std::size_t>(r)], out.boundary[k]);
+  }
+  out.weights = -onInterior.fullPivLu().solve(onBoundary);
+  out.condition = std::max(conditionNumber(a), conditionNumber(onInterior));
+  return out;
+}
+
+Eigen::MatrixXd tetNodes(const Mesh& mesh, std::size_t e) {
+  const ElementBlock& tets = mesh.blocks[0];
+  const int n = ReferenceElement::get(CellType::Tetrahedron, tets.order).numNodes();
+  Eigen::MatrixXd x(n, 3);
+  for (int k = 0; k < n; ++k)
+    for (int c = 0; c < 3; ++c)
+      x(k, c) = mesh.xyz[3 * static_cast<std::size_t>(tets.element(e)[k]) + c];
+  return x;
+}
+
+double maxAbsCoordinate(const Mesh& mesh) {
+  double m = 0.0;
+  for (const double v : mesh.xyz) m = std::max(m, std::abs(v));
+  return m;
+}
+
+// The same end to end as the NekMesh file above, on curved meshes of ours at order 5 (4 interior
+// nodes per tetrahedron, which the format does not store): written as Nektar++ XML, read back,
+// and judged on the geometry Nektar++ builds.
+//  1. A box's straight mesh moved by a cubic map: every element's map is cubic, so it has no
+//     interior modes (Nektar++'s modes are hierarchical, those of order 3 span the cubics, and
+//     interior modes have p >= 2, q >= 1, r >= 1, so p + q + r >= 4) and Nektar++ builds it
+//     exactly: every node read back, interior ones included, is the map's, and every element
+//     keeps its certified verdict.
+//  2. A sphere curved onto its CAD, whose boundary elements' interiors (placed by our curving)
+//     are not of that kind: the nodes the file stores come back bit for bit, the interior ones
+//     are the rebuild above of them, and each element's verdict is the certified verdict of
+//     that rebuilt geometry; straight elements keep theirs; wherever J < 0 at a sample point,
+//     the verdict is invalid (the certified lower bound is below every value of J).
+TEST(NektarXml, OurCurvedFilesAreJudgedOnTheGeometryNektarBuilds) {
+  constexpr int kOrder = 5;
+  const auto dir = test::tempDir();
+  const ReferenceElement& ref = ReferenceElement::get(CellType::Tetrahedron, kOrder);
+  const TetRebuild rebuild = rebuildTetInterior(kOrder);
+  ASSERT_EQ(rebuild.interior.size(), 4U);
+  // The reader's weights and ours come from solves whose condition numbers stay below 2e5
+  // (the reader's: TetrahedronInteriorKeepsTheBoundaryModes; ours checked here), so each carries
+  // relative errors below about 2.5e5 u; a sum of weighted values of size <= xmax errs by that
+  // times the weights' row sums, a factor 40 kept in hand (as there).
+  EXPECT_LT(rebuild.condition, 2e5);
+  const double rowSum = std::max(rebuild.weights.cwiseAbs().rowwise().sum().maxCoeff(),
+                                 nektar::interiorFromBoundary(CellType::Tetrahedron, kOrder)
+                                     .weights.cwiseAbs()
+                                     .rowwise()
+                                     .sum()
+                                     .maxCoeff());
+  const auto isInterior = [&](int node) {
+    return std::find(rebuild.interior.begin(), rebuild.interior.end(), node) !=
+           rebuild.interior.end();
+  };
+
+  {  // 1. A cubic map.
+    const CadModel cad = test::toModel(test::box(2.0, 1.0, 1.0));
+    Mesh mesh =
+        elevateOrder(generateLinearMesh(cad, LinearMeshOptions::uniform(0.5)), kOrder, nullptr);
+    const auto phi = [](const Eigen::Vector3d& x) {
+      return Eigen::Vector3d(x.x() + 0.08 * x.y() * x.y() * x.z(),
+                             x.y() + 0.03 * x.x() * x.x() * x.x() - 0.1 * x.z() * x.z(),
+                             x.z() + 0.1 * x.x() * x.y());
+    };
+    std::map<std::array<double, 3>, Eigen::Vector3d> straightOf;  // moved node -> straight
+    for (std::size_t i = 0; i < mesh.numNodes(); ++i) {
+      const Eigen::Vector3d x(&mesh.xyz[3 * i]), y = phi(x);
+      for (int c = 0; c < 3; ++c) mesh.xyz[3 * i + static_cast<std::size_t>(c)] = y[c];
+      straightOf[{y.x(), y.y(), y.z()}] = x;
+    }
+    const std::string path = (dir / "cubic.xml").string();
+    writeMesh(mesh, path, {}, {});
+    const Mesh back = readMesh(path);
+    ASSERT_EQ(back.order, kOrder);
+    ASSERT_EQ(back.blocks[0].type, CellType::Tetrahedron);
+    ASSERT_EQ(back.numElements(), mesh.numElements());
+    const double xmax = maxAbsCoordinate(mesh);
+    // Stored nodes: the same doubles, against the map at straight points interpolated another
+    // way (a few roundings of values of size xmax, through a map of Lipschitz constant < 2).
+    const double storedBound = 1e2 * kU * xmax;
+    const double interiorBound = 1e7 * kU * xmax * rowSum + storedBound * rowSum;
+    double stored = 0.0, interior = 0.0;
+    for (std::size_t e = 0; e < back.numElements(); ++e) {
+      const Eigen::MatrixXd y = tetNodes(back, e);
+      std::array<Eigen::Vector3d, 4> v;
+      for (int k = 0; k < 4; ++k) {
+        const auto found = straightOf.find({y(k, 0), y(k, 1), y(k, 2)});
+        ASSERT_NE(found, straightOf.end()) << "element " << e << " vertex " << k;
+        v[static_cast<std::size_t>(k)] = found->second;
+      }
+      for (int n = 0; n < ref.numNodes(); ++n) {
+        const LatticePoint& l = ref.lattice()[static_cast<std::size_t>(n)];
+        const double p = kOrder;
+        const Eigen::Vector3d straight = (p - l[0] - l[1] - l[2]) / p * v[0] + l[0] / p * v[1] +
+                                         l[1] / p * v[2] + l[2] / p * v[3];
+        const double error = (y.row(n).transpose() - phi(straight)).norm();
+        double& worst = isInterior(n) ? interior : stored;
+        worst = std::max(worst, error);
+      }
+    }
+    EXPECT_LE(stored, storedBound);
+    EXPECT_LE(interior, interiorBound);
+    const QualitySummary before = evaluateQuality(mesh), after = evaluateQuality(back);
+    EXPECT_TRUE(before.certified);
+    EXPECT_TRUE(after.certified);
+    for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+      EXPECT_EQ(after.validity[e], before.validity[e]) << "element " << e;
+      // The same J (to rounding), its minimum bounded to the tolerance along possibly different
+      // subdivisions (the vertices may be renumbered).
+      EXPECT_NEAR(after.scaledJacobian[e], before.scaledJacobian[e], kJacobianBoundTolerance)
+          << "element " << e;
+    }
+    std::printf("cubic map: %zu elements, worst node error %.2e (stored), %.2e (interior)\n",
+                mesh.numElements(), stored, interior);
+  }
+
+  {  // 2. A sphere curved onto its CAD.
+    const CadModel cad = test::toModel(test::sphere(1.0));
+    const Mesh mesh =
+        elevateOrder(generateLinearMesh(cad, LinearMeshOptions::uniform(0.4)), kOrder, &cad);
+    const std::string path = (dir / "sphere.xml").string();
+    writeMesh(mesh, path, {}, {});
+    const Mesh back = readMesh(path);
+    ASSERT_EQ(back.order, kOrder);
+    ASSERT_EQ(back.numElements(), mesh.numElements());
+    const double xmax = maxAbsCoordinate(mesh);
+    Mesh rebuilt = back;  // the interiors rebuilt here
+    double interior = 0.0;
+    for (std::size_t e = 0; e < back.numElements(); ++e) {
+      const Eigen::MatrixXd x = tetNodes(mesh, e), y = tetNodes(back, e);
+      // The stored nodes, as sets (the reader may renumber the vertices): bit for bit.
+      std::vector<std::array<double, 3>> written, stored;
+      for (const int n : rebuild.boundary) {
+        written.push_back({x(n, 0), x(n, 1), x(n, 2)});
+        stored.push_back({y(n, 0), y(n, 1), y(n, 2)});
+      }
+      std::sort(written.begin(), written.end());
+      std::sort(stored.begin(), stored.end());
+      EXPECT_EQ(stored, written) << "element " << e;
+      Eigen::MatrixXd boundary(static_cast<Eigen::Index>(rebuild.boundary.size()), 3);
+      for (std::size_t k = 0; k < rebuild.boundary.size(); ++k)
+        boundary.row(static_cast<Eigen::Index>(k)) = y.row(rebuild.boundary[k]);
+      const Eigen::MatrixXd inside = rebuild.weights * boundary;
+      for (std::size_t k = 0; k < rebuild.interior.size(); ++k) {
+        const auto row = static_cast<Eigen::Index>(k);
+        interior = std::max(interior, (y.row(rebuild.interior[k]) - inside.row(row)).norm());
+        const auto node = static_cast<std::size_t>(back.blocks[0].element(e)[rebuild.interior[k]]);
+        for (int c = 0; c < 3; ++c)
+          rebuilt.xyz[3 * node + static_cast<std::size_t>(c)] = inside(row, c);
+      }
+    }
+    EXPECT_LE(interior, 1e7 * kU * xmax * rowSum);
+    const QualitySummary ours = evaluateQuality(mesh), read = evaluateQuality(back),
+                         again = evaluateQuality(rebuilt);
+    EXPECT_TRUE(read.certified);
+    EXPECT_TRUE(again.certified);
+    std::size_t straight = 0, changed = 0;
+    const std::vector<LatticePoint> samples = samplingLattice(CellType::Tetrahedron, 10);
+    for (std::size_t e = 0; e < back.numElements(); ++e) {
+      // The geometry read is the rebuilt one to rounding: the same verdict, and scaled
+      // Jacobians both within the tolerance of its minimum.
+      EXPECT_EQ(read.validity[e], again.validity[e]) << "element " << e;
+      EXPECT_NEAR(read.scaledJacobian[e], again.scaledJacobian[e], kJacobianBoundTolerance)
+          << "element " << e;
+      // A straight element (every node at its place between the vertices, to rounding) is
+      // affine, so Nektar++ builds it exactly: it keeps its verdict.
+      const Eigen::MatrixXd x = tetNodes(mesh, e);
+      double bend = 0.0;
+      for (int n = 0; n < ref.numNodes(); ++n) {
+        const LatticePoint& l = ref.lattice()[static_cast<std::size_t>(n)];
+        const double p = kOrder;
+        const Eigen::RowVector3d affine = (p - l[0] - l[1] - l[2]) / p * x.row(0) +
+                                          l[0] / p * x.row(1) + l[1] / p * x.row(2) +
+                                          l[2] / p * x.row(3);
+        bend = std::max(bend, (x.row(n) - affine).norm());
+      }
+      if (bend <= 1e2 * kU * xmax) {
+        ++straight;
+        EXPECT_EQ(read.validity[e], ours.validity[e]) << "straight element " << e;
+        EXPECT_NEAR(read.scaledJacobian[e], ours.scaledJacobian[e], kJacobianBoundTolerance)
+            << "straight element " << e;
+      }
+      if (read.validity[e] != ours.validity[e]) ++changed;
+      // J < 0 at a sample point of the read geometry: proven invalid.
+      const Eigen::MatrixXd y = tetNodes(back, e);
+      double lo = std::numeric_limits<double>::infinity();
+      for (const LatticePoint& l : samples) {
+        const double xi[3] = {l[0] / 10.0, l[1] / 10.0, l[2] / 10.0};
+        lo = std::min(lo, jacobianAt(ref, y, xi));
+      }
+      if (lo < 0.0) {
+        EXPECT_EQ(read.validity[e], Validity::Invalid) << "element " << e;
+      }
+    }
+    EXPECT_GT(straight, 0U);
+    std::printf(
+        "sphere: %zu elements (%zu straight), worst interior node against the rebuild %.2e; "
+        "invalid %zu as written, %zu as Nektar++ builds it (%zu verdicts changed)\n",
+        mesh.numElements(), straight, interior, ours.invalid, read.invalid, changed);
+  }
 }
 
 }  // namespace

@@ -1,8 +1,9 @@
 // Readers: MSH 2.2 / 4.1 (ASCII and binary, ours and Gmsh's), Nektar++ XML (plain and
-// compressed) round trips, every element type, and the peer meshes' quality against Gmsh's own
-// AnalyseMeshQuality.
+// compressed) round trips, every element type, and meshes' quality against Gmsh's own
+// AnalyseMeshQuality (NekMesh's peer meshes when they are here, and Gmsh's own meshes).
 #include <gmsh.h>
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <algorithm>
@@ -22,14 +23,11 @@
 #include "io/msh_reader.hpp"
 #include "io/nektar_expansion.hpp"
 #include "linear/linear_mesher.hpp"
+#include "peer_data.hpp"
 #include "peers/gmsh_quality.hpp"
 #include "quality/bezier_jacobian.hpp"
 #include "quality/mesh_quality.hpp"
 #include "test_support.hpp"
-
-#ifndef HOMESH_SHARED_DIR
-#error "HOMESH_SHARED_DIR must name the shared data folder"
-#endif
 
 namespace homesh {
 namespace {
@@ -474,7 +472,8 @@ TEST(NektarXml, CurvesAtGaussLobattoPointsAreResampledExactly) {
 }
 
 TEST(PeerMeshes, WorstScaledJacobianAgreesWithGmsh) {
-  const std::string dir = std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/optimiser/";
+  HOMESH_REQUIRE_PEER_FILES();
+  const std::string dir = test::peerFile("optimiser/");
   for (const auto& [file, dim] : {std::pair<std::string, int>{"varopti_cube_sphere.msh", 3},
                                   std::pair<std::string, int>{"varopti_naca.msh", 2}}) {
     ASSERT_TRUE(std::filesystem::exists(dir + file)) << dir + file << " is missing";
@@ -489,6 +488,73 @@ TEST(PeerMeshes, WorstScaledJacobianAgreesWithGmsh) {
     EXPECT_NEAR(q.scaled.min, gmsh, 1e-3) << file;
     EXPECT_TRUE(q.certified);
     EXPECT_EQ(q.invalid, 0u);
+  }
+}
+
+// A gzip file's content, written to `path`.
+void gunzip(const std::string& from, const std::string& path) {
+  gzFile in = gzopen(from.c_str(), "rb");
+  ASSERT_NE(in, nullptr) << from;
+  std::ofstream out(path, std::ios::binary);
+  char buffer[1 << 16];
+  int n = 0;
+  while ((n = gzread(in, buffer, sizeof buffer)) > 0) out.write(buffer, n);
+  EXPECT_EQ(n, 0) << "reading " << from;
+  gzclose(in);
+}
+
+// Gmsh's order-3 triangles on a plate with a round hole (curved edges on the circle), written
+// by Gmsh as MSH 4.1.
+void gmshPlateWithHole(const std::string& path) {
+  gmsh::initialize(0, nullptr, false);
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::model::add("plate");
+  const int plate = gmsh::model::occ::addRectangle(0, 0, 0, 3, 2);
+  const int hole = gmsh::model::occ::addDisk(1.2, 1, 0, 0.5, 0.5);
+  gmsh::vectorpair out;
+  std::vector<gmsh::vectorpair> map;
+  gmsh::model::occ::cut({{2, plate}}, {{2, hole}}, out, map);
+  gmsh::model::occ::synchronize();
+  gmsh::option::setNumber("Mesh.MeshSizeMax", 0.4);
+  gmsh::option::setNumber("Mesh.ElementOrder", 3);
+  gmsh::option::setNumber("Mesh.HighOrderOptimize", 0);
+  gmsh::model::mesh::generate(2);
+  gmsh::write(path);
+  gmsh::finalize();
+}
+
+// The same comparison as PeerMeshes.WorstScaledJacobianAgreesWithGmsh on Gmsh's own meshes: the
+// repository's order-4 sphere in a box (tests/data/sphere_in_box_p4.msh.gz, tangled: negative
+// Jacobians inside) and a 2D plate with a hole that Gmsh meshes here.
+TEST(GmshMeshes, WorstScaledJacobianAgreesWithGmsh) {
+  const auto dir = test::tempDir();
+  const std::string sphereInBox = (dir / "sphere_in_box_p4.msh").string();
+  gunzip(std::string(HOMESH_SOURCE_DIR) + "/tests/data/sphere_in_box_p4.msh.gz", sphereInBox);
+  const std::string plate = (dir / "plate.msh").string();
+  gmshPlateWithHole(plate);
+  for (const auto& [path, dim] :
+       {std::pair<std::string, int>{sphereInBox, 3}, std::pair<std::string, int>{plate, 2}}) {
+    SCOPED_TRACE(path);
+    const Mesh mesh = readMsh(path);
+    EXPECT_EQ(mesh.dim, dim);
+    const QualitySummary q = evaluateQuality(mesh);
+    const double gmsh = peers::gmshWorstScaledJacobian(path, dim);
+    std::printf("%s: worst scaled Jacobian, HOMesh %.6f, Gmsh %.6f\n", path.c_str(), q.scaled.min,
+                gmsh);
+    // As for the peer meshes: both are certified lower bounds of the same worst min J / max J,
+    // r, from different subdivisions, each bounding min J and max J to 1e-3 of the largest |J|
+    // (kJacobianBoundTolerance). That puts r within 1e-3 max(1, |r|) (1 + |r|): about 1e-3 for
+    // a valid mesh (the peer test's tolerance), 1e-3 |r| (1 + |r|) where min J < -max J (the
+    // tangled sphere in a box, r near -3.8, whose largest |J| is |min J| = |r| max J).
+    const double r = std::abs(gmsh);
+    EXPECT_NEAR(q.scaled.min, gmsh, kJacobianBoundTolerance * std::max(1.0, r) * (1.0 + r)) << path;
+    EXPECT_TRUE(q.certified);
+    // Tangled or not, both say so; the sphere in a box is (negative J inside its elements,
+    // which Gmsh did not optimise).
+    EXPECT_EQ(q.invalid > 0, gmsh < 0) << path;
+    if (path == sphereInBox) {
+      EXPECT_GT(q.invalid, 0U);
+    }
   }
 }
 

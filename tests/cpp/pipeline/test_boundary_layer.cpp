@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <functional>
 #include <map>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -18,6 +21,7 @@
 #include "io/mesh_writers.hpp"
 #include "linear/boundary_layer.hpp"
 #include "optimise/optimiser.hpp"
+#include "peer_data.hpp"
 #include "pipeline/case_setup.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
@@ -27,18 +31,19 @@
 namespace homesh {
 namespace {
 
-const std::string kCylinderCase =
-    std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/meshgen/3d_bl_cyl.mcf";
-
-// NekMesh's meshgen case `name`.mcf (boundary layer included) at `order` with the optimiser (100
-// sweeps, 2 threads): the acceptance's path.
-MeshResult meshPeerCase(const std::string& name, int order) {
-  CaseSetup setup =
-      setupCase(std::string(HOMESH_SHARED_DIR) + "/peer-cases/nekmesh/meshgen/" + name + ".mcf");
+// The .mcf case at `path` (boundary layer included) at `order` with the optimiser (100 sweeps,
+// 2 threads): the acceptance's path.
+MeshResult meshCase(const std::string& path, int order) {
+  CaseSetup setup = setupCase(path);
   setup.options.order = order;
   setup.options.optimiseIterations = 100;
   setup.options.threads = 2;
   return runMeshPipeline(setup.source, setup.options);
+}
+
+// NekMesh's meshgen case `name`.mcf (peer files: call HOMESH_REQUIRE_PEER_FILES first).
+MeshResult meshPeerCase(const std::string& name, int order) {
+  return meshCase(test::peerFile("meshgen/" + name + ".mcf"), order);
 }
 
 TEST(Expression, EvaluatesNekMeshThicknessesAndNamesWhatIsWrong) {
@@ -94,6 +99,387 @@ TEST(BoundaryLayerParameters, FaceListsSplitCoordinatesAndRanges) {
 
 Eigen::Vector3d point(const Mesh& m, std::int64_t i) {
   return {m.xyz[3 * i], m.xyz[3 * i + 1], m.xyz[3 * i + 2]};
+}
+
+// Checks shared by the peer cases and their siblings on shapes the tests make, on a MeshResult.
+
+// The wall cells (3D: triangles, 2D: lines) on the CAD faces (curves) `walls`, by their sorted
+// vertices.
+template <std::size_t N>
+std::set<std::array<std::int64_t, N>> wallCells(const Mesh& m, const std::set<int>& walls) {
+  const CellType type = N == 3 ? CellType::Triangle : CellType::Line;
+  std::set<std::array<std::int64_t, N>> out;
+  for (const ElementBlock& b : m.blocks)
+    if (b.type == type)
+      for (std::size_t e = 0; e < b.count(); ++e)
+        if (walls.count(b.entity[e]) != 0) {
+          std::array<std::int64_t, N> key;
+          std::copy(b.element(e), b.element(e) + N, key.begin());
+          std::sort(key.begin(), key.end());
+          out.insert(key);
+        }
+  return out;
+}
+
+// 3D: certified valid, nothing shrunk, and `layers` prisms in the column on every wall triangle
+// of `walls` (prisms stacked bottom (0, 1, 2) to top (3, 4, 5)), every prism in one column.
+void expectValidWithLayersInEveryWallColumn(const MeshResult& r, const std::set<int>& walls,
+                                            int layers) {
+  ASSERT_TRUE(r.boundaryLayer.has_value());
+  EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
+  EXPECT_TRUE(r.boundaryLayer->shrunk.empty());
+  const Mesh& m = r.mesh;
+  std::map<std::array<std::int64_t, 3>, const std::int64_t*> byBottom;
+  std::size_t prisms = 0;
+  for (const ElementBlock& b : m.blocks)
+    if (b.type == CellType::Prism)
+      for (std::size_t e = 0; e < b.count(); ++e, ++prisms) {
+        std::array<std::int64_t, 3> key{b.element(e)[0], b.element(e)[1], b.element(e)[2]};
+        std::sort(key.begin(), key.end());
+        EXPECT_TRUE(byBottom.emplace(key, b.element(e)).second);
+      }
+  EXPECT_EQ(prisms, static_cast<std::size_t>(layers) * r.boundaryLayer->cells);
+  const auto bottoms = wallCells<3>(m, walls);
+  for (std::array<std::int64_t, 3> key : bottoms) {
+    int found = 0;
+    for (;;) {
+      std::sort(key.begin(), key.end());
+      const auto it = byBottom.find(key);
+      if (it == byBottom.end()) break;
+      ++found;
+      key = {it->second[3], it->second[4], it->second[5]};
+    }
+    EXPECT_EQ(found, layers);
+  }
+  EXPECT_EQ(bottoms.size(), r.boundaryLayer->cells);
+}
+
+// 3D: the first layer's height along the wall's normal at the quadrature points (degree 2P) of
+// the wall triangles on `walls`: the distance from the wall point to where its normal line meets
+// the first prism's top, found by Newton on (a, b, t) together (the report projects onto the
+// tangent plane instead). `visit(wall point, height)` for each point.
+void forEachFirstLayerHeight(const MeshResult& r, const std::set<int>& walls,
+                             const std::function<void(const Eigen::Vector3d&, double)>& visit) {
+  const Mesh& m = r.mesh;
+  const ReferenceElement& ref = ReferenceElement::get(CellType::Prism, m.order);
+  const QuadratureRule rule = quadratureRule(CellType::Triangle, 2 * m.order);
+  const auto bottoms = wallCells<3>(m, walls);
+  Eigen::VectorXd values;
+  Eigen::MatrixXd gradients;
+  for (const ElementBlock& b : m.blocks) {
+    if (b.type != CellType::Prism) continue;
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      const std::int64_t* v = b.element(e);
+      std::array<std::int64_t, 3> key{v[0], v[1], v[2]};
+      std::sort(key.begin(), key.end());
+      if (bottoms.count(key) == 0) continue;
+      for (std::size_t q = 0; q < rule.weights.size(); ++q) {
+        Eigen::Vector3d bottom = Eigen::Vector3d::Zero(), top = Eigen::Vector3d::Zero();
+        Eigen::Vector3d dxi = Eigen::Vector3d::Zero(), deta = Eigen::Vector3d::Zero();
+        for (const double zeta : {0.0, 1.0}) {
+          const double xi[3] = {rule.points[2 * q], rule.points[2 * q + 1], zeta};
+          ref.evaluate(xi, values, gradients);
+          for (int i = 0; i < ref.numNodes(); ++i) {
+            const Eigen::Vector3d x = point(m, v[i]);
+            (zeta == 0.0 ? bottom : top) += values(i) * x;
+            if (zeta == 0.0) {
+              dxi += gradients(i, 0) * x;
+              deta += gradients(i, 1) * x;
+            }
+          }
+        }
+        Eigen::Vector3d normal = dxi.cross(deta).normalized();
+        if ((top - bottom).dot(normal) < 0.0) normal = -normal;
+        // Where the normal line meets the top: top(a, b) = bottom + t normal.
+        Eigen::Vector3d abt(rule.points[2 * q], rule.points[2 * q + 1], 0.0);
+        for (int it = 0; it < 50; ++it) {
+          const double xi[3] = {abt[0], abt[1], 1.0};
+          ref.evaluate(xi, values, gradients);
+          Eigen::Matrix3d jac = Eigen::Matrix3d::Zero();
+          Eigen::Vector3d x = Eigen::Vector3d::Zero();
+          for (int i = 0; i < ref.numNodes(); ++i) {
+            x += values(i) * point(m, v[i]);
+            jac.col(0) += gradients(i, 0) * point(m, v[i]);
+            jac.col(1) += gradients(i, 1) * point(m, v[i]);
+          }
+          jac.col(2) = -normal;
+          abt -= jac.fullPivLu().solve(x - bottom - abt[2] * normal);
+        }
+        ASSERT_GE(abt[0], -1e-9);
+        ASSERT_GE(abt[1], -1e-9);
+        ASSERT_LE(abt[0] + abt[1], 1 + 1e-9);
+        visit(bottom, abt[2]);
+      }
+    }
+  }
+}
+
+// 3D: the split's new nodes were put on the CAD and the report says so (`input` names the case
+// in the JSON report, `layers` the layers asked for). The split's side nodes lie on the curved
+// macro quadrilaterals (on the planar side faces), but the first level's shift (onto the wall
+// normal, layer_split.hpp) follows the curved wall's interpolated normal, which leans off the
+// side plane by the wall's interpolation error; `maxProjection` bounds that move, relative to
+// the layer's height. Then every node on a CAD face lies on it: to the precision of the
+// projections that put it there (found to 1e-9 of the bounding diagonal, CadModel).
+void expectSplitNodesOnTheCad(const MeshResult& r, const std::string& input, int layers,
+                              double maxProjection) {
+  ASSERT_TRUE(r.layerSplit.has_value());
+  ASSERT_TRUE(r.cad);
+  EXPECT_GT(r.layerSplit->projected, 0U);
+  EXPECT_LT(r.layerSplit->maxProjection, maxProjection);
+  const Mesh& m = r.mesh;
+  double worst = 0.0;
+  for (std::size_t i = 0; i < m.numNodes(); ++i)
+    if (m.nodeCadDim[i] == 2) {
+      const Eigen::Vector3d x = point(m, static_cast<std::int64_t>(i));
+      const std::array<double, 2> uv{m.nodeCadParam[2 * i], m.nodeCadParam[2 * i + 1]};
+      worst = std::max(worst, r.cad->projectOnSurface(m.nodeCadIndex[i], x, uv).distance);
+    }
+  EXPECT_LE(worst, 1e-8 * r.cad->boundingDiagonal()) << "a node off its CAD face";
+  const std::string json = meshReportJson(r, input);
+  const std::string count = "\"layers\": " + std::to_string(layers);
+  for (const char* key :
+       {"\"boundary_layer\"", "\"first_height\"", "\"shrunk\": []", "\"prism\": "})
+    EXPECT_NE(json.find(key), std::string::npos) << key;
+  EXPECT_NE(json.find(count), std::string::npos) << count;
+}
+
+// The mesh written as Nektar++ XML and as Gmsh .msh, read back: the same 3D elements by type, the
+// same order, still certified valid.
+void expectNektarAndGmshFilesReadBack(const MeshResult& r, const std::string& stem) {
+  const auto dir = test::tempDir();
+  for (const std::string& name : {stem + ".xml", stem + ".msh"}) {
+    const std::string path = (dir / name).string();
+    writeMeshFiles(r, {path});
+    const Mesh back = readMesh(path);
+    std::map<CellType, std::size_t> a, b;
+    for (const ElementBlock& blk : r.mesh.blocks)
+      if (cellDimension(blk.type) == 3) a[blk.type] += blk.count();
+    for (const ElementBlock& blk : back.blocks)
+      if (cellDimension(blk.type) == 3) b[blk.type] += blk.count();
+    EXPECT_EQ(a, b) << name;
+    EXPECT_GT(b[CellType::Prism], 0U) << name;
+    EXPECT_EQ(back.order, r.mesh.order);
+    const QualitySummary q = evaluateQuality(back);
+    EXPECT_EQ(q.invalid + q.undecided, 0U) << name;
+  }
+}
+
+// The Nektar++ XML of a split 3D layer read back: the same elements, and every node the file
+// stores (vertices, edge and face points: all but the interior of each 3D element, which
+// Nektar++ rebuilds from the faces itself) bit for bit among the same element's nodes.
+// Nektar++'s own reader refused such files until the writer numbered the layer's columns as
+// runs (a prism's triangles need their apex vertices to carry their highest ids); NekMesh's
+// jac module now reads them and finds no negative Jacobian (bench/boundary_layer with NEKMESH).
+void expectNektarXmlStoresEveryNodeExactly(const MeshResult& r, const std::string& stem) {
+  const Mesh& a = r.mesh;
+  const int p = a.order;
+  const auto dir = test::tempDir();
+  const std::string path = (dir / (stem + ".xml")).string();
+  writeMeshFiles(r, {path});
+  const Mesh b = readMesh(path);
+  ASSERT_EQ(b.order, p);
+  // a's 3D elements by their sorted vertex coordinates.
+  using Key = std::vector<std::array<double, 3>>;
+  const auto key = [](const Mesh& m, const std::int64_t* v, int nv) {
+    Key k;
+    for (int i = 0; i < nv; ++i)
+      k.push_back({m.xyz[3 * v[i]], m.xyz[3 * v[i] + 1], m.xyz[3 * v[i] + 2]});
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  std::map<Key, const std::int64_t*> elements;
+  std::map<CellType, std::size_t> countA, countB;
+  for (const ElementBlock& blk : a.blocks)
+    if (cellDimension(blk.type) == 3)
+      for (std::size_t e = 0; e < blk.count(); ++e, ++countA[blk.type])
+        elements[key(a, blk.element(e), cellNumVertices(blk.type))] = blk.element(e);
+  std::size_t stored = 0, interior = 0;
+  for (const ElementBlock& blk : b.blocks) {
+    if (cellDimension(blk.type) != 3) continue;
+    const ReferenceElement& ref = ReferenceElement::get(blk.type, p);
+    for (std::size_t e = 0; e < blk.count(); ++e, ++countB[blk.type]) {
+      const std::int64_t* v = blk.element(e);
+      const auto it = elements.find(key(b, v, cellNumVertices(blk.type)));
+      ASSERT_NE(it, elements.end()) << "an element of the file is not in the mesh written";
+      std::set<std::array<double, 3>> nodesA;
+      for (int i = 0; i < ref.numNodes(); ++i) {
+        const std::int64_t n = it->second[i];
+        nodesA.insert({a.xyz[3 * n], a.xyz[3 * n + 1], a.xyz[3 * n + 2]});
+      }
+      for (int i = 0; i < ref.numNodes(); ++i) {
+        const LatticePoint& l = ref.lattice()[static_cast<std::size_t>(i)];
+        const bool inside = blk.type == CellType::Prism
+                                ? l[0] > 0 && l[1] > 0 && l[0] + l[1] < p && l[2] > 0 && l[2] < p
+                                : l[0] > 0 && l[1] > 0 && l[2] > 0 && l[0] + l[1] + l[2] < p;
+        if (inside) {
+          ++interior;
+          continue;
+        }
+        ++stored;
+        const std::int64_t n = v[i];
+        EXPECT_EQ(nodesA.count({b.xyz[3 * n], b.xyz[3 * n + 1], b.xyz[3 * n + 2]}), 1U)
+            << "node " << i << " of a " << cellShortName(blk.type);
+      }
+    }
+  }
+  EXPECT_EQ(countA, countB);
+  EXPECT_GT(countB[CellType::Prism], 0U);
+  EXPECT_GT(stored, 0U);
+  if (p >= 3) {
+    EXPECT_GT(interior, 0U);  // a prism has interior nodes from order 3 on
+  }
+}
+
+// The optimiser's stop rule: "stalled" also needs the worst element to have stopped rising
+// within the window, the pipeline's stall of 1e-3 over 3 sweeps (pipelineOptimiserOptions in
+// mesh_pipeline.cpp).
+void expectStalledOnlyOnceTheWorstStoppedRising(const OptimiserResult& o) {
+  const std::vector<IterationRecord>& h = o.history;
+  ASSERT_FALSE(h.empty());
+  if (o.stopReason != "stalled") return;
+  double low = h.back().worst;
+  for (std::size_t k = h.size() >= 4 ? h.size() - 4 : 0; k + 1 < h.size(); ++k)
+    low = std::min(low, h[k].worst);
+  EXPECT_LT(h.back().worst - low, 1e-3) << "stopped after sweep " << h.back().iteration;
+}
+
+// A case meshed at order 6 through the continuation (optimised at order 4, raised, optimised
+// again): certified valid, the first layer's height within 5 % after the raise, and the
+// optimiser's stop rule.
+void expectRaisedToOrderSixKeepingTheFirstHeight(const MeshResult& r) {
+  ASSERT_EQ(r.mesh.order, 6);
+  ASSERT_TRUE(r.layerSplit.has_value());
+  EXPECT_TRUE(r.lowOrderOptimiser.has_value());
+  EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
+  EXPECT_GT(r.layerSplit->firstHeightMeasured, 0U);
+  EXPECT_LE(r.layerSplit->firstHeightDeviation, 0.05);
+  ::testing::Test::RecordProperty("first_layer_height_worst_deviation",
+                                  std::to_string(r.layerSplit->firstHeightDeviation));
+  ASSERT_TRUE(r.optimiser.has_value());
+  expectStalledOnlyOnceTheWorstStoppedRising(*r.optimiser);
+}
+
+// 2D: `layers` quadrilaterals in the column on every wall line of `walls` (wall (0, 1), top
+// (3, 2)), every quadrilateral in one column, and in `worst` the largest relative deviation of
+// the first layer's height, the top's component along the wall's normal at the wall's quadrature
+// points (degree 2P), from `firstHeight`.
+void expectQuadrilateralColumnsOnEveryWallLine(const MeshResult& r, const std::set<int>& walls,
+                                               int layers, double firstHeight, double& worst) {
+  worst = 0.0;
+  ASSERT_TRUE(r.boundaryLayer.has_value());
+  const Mesh& m = r.mesh;
+  std::map<std::array<std::int64_t, 2>, const std::int64_t*> byWall;
+  std::size_t quads = 0;
+  for (const ElementBlock& b : m.blocks)
+    if (b.type == CellType::Quadrilateral)
+      for (std::size_t e = 0; e < b.count(); ++e, ++quads) {
+        std::array<std::int64_t, 2> key{b.element(e)[0], b.element(e)[1]};
+        std::sort(key.begin(), key.end());
+        EXPECT_TRUE(byWall.emplace(key, b.element(e)).second);
+      }
+  EXPECT_EQ(quads, static_cast<std::size_t>(layers) * r.boundaryLayer->cells);
+  const ReferenceElement& ref = ReferenceElement::get(CellType::Quadrilateral, m.order);
+  const QuadratureRule rule = quadratureRule(CellType::Line, 2 * m.order);
+  const Eigen::Vector3d plane(m.planeNormal[0], m.planeNormal[1], m.planeNormal[2]);
+  Eigen::VectorXd values;
+  Eigen::MatrixXd gradients;
+  const auto lines = wallCells<2>(m, walls);
+  for (std::array<std::int64_t, 2> key : lines) {
+    int found = 0;
+    const std::int64_t* first = nullptr;
+    for (;;) {
+      std::sort(key.begin(), key.end());
+      const auto it = byWall.find(key);
+      if (it == byWall.end()) break;
+      if (found++ == 0) first = it->second;
+      key = {it->second[3], it->second[2]};
+    }
+    EXPECT_EQ(found, layers);
+    ASSERT_NE(first, nullptr);
+    for (int q = 0; q < rule.size(); ++q) {
+      Eigen::Vector3d bottom = Eigen::Vector3d::Zero(), top = Eigen::Vector3d::Zero();
+      Eigen::Vector3d tangent = Eigen::Vector3d::Zero();
+      for (const double eta : {0.0, 1.0}) {
+        const double xi[2] = {rule.points[static_cast<std::size_t>(q)], eta};
+        ref.evaluate(xi, values, gradients);
+        for (int i = 0; i < ref.numNodes(); ++i) {
+          const Eigen::Vector3d x = point(m, first[i]);
+          (eta == 0.0 ? bottom : top) += values(i) * x;
+          if (eta == 0.0) tangent += gradients(i, 0) * x;
+        }
+      }
+      const Eigen::Vector3d normal = plane.cross(tangent).normalized();
+      worst = std::max(worst, std::fabs(std::fabs((top - bottom).dot(normal)) / firstHeight - 1));
+    }
+  }
+  EXPECT_EQ(lines.size(), r.boundaryLayer->cells);
+}
+
+// 2D: the fan at the sharp convex corner at CAD vertex `vertex`: its first layer's triangles
+// (a vertex at the corner), each at most 40 degrees wide (the fan's step, kFanStep in
+// boundary_layer.cpp), and the first layers on either side (quadrilaterals with a wall vertex at
+// the corner) with the largest relative deviation of their height along the wall normal (the
+// top's component) from `firstHeight`.
+struct CornerFan {
+  std::size_t pieces = 0, sides = 0;
+  double angle = 0.0;  // radians, summed over the pieces
+  double worstSideHeight = 0.0;
+};
+void measureCornerFan(const MeshResult& r, int vertex, double firstHeight, CornerFan& fan) {
+  fan = CornerFan();
+  ASSERT_TRUE(r.cad);
+  const Mesh& m = r.mesh;
+  const Eigen::Vector3d corner = r.cad->vertexPoint(vertex);
+  std::int64_t at = -1;
+  for (std::size_t i = 0; i < m.numNodes(); ++i)
+    if ((point(m, static_cast<std::int64_t>(i)) - corner).norm() < 1e-9)
+      at = static_cast<std::int64_t>(i);
+  ASSERT_GE(at, 0);
+  const Eigen::Vector3d plane(m.planeNormal[0], m.planeNormal[1], m.planeNormal[2]);
+  const auto angleAt = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::atan2(a.cross(b).dot(plane), a.dot(b));
+  };
+  for (const ElementBlock& b : m.blocks) {
+    if (b.type != CellType::Triangle) continue;
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      const std::int64_t* v = b.element(e);
+      for (int k = 0; k < 3; ++k)
+        if (v[k] == at) {
+          const double a =
+              angleAt(point(m, v[(k + 1) % 3]) - corner, point(m, v[(k + 2) % 3]) - corner);
+          EXPECT_GT(a, 0.0);
+          EXPECT_LE(a, 40.0 * M_PI / 180.0 + 1e-9);
+          fan.angle += a;
+          ++fan.pieces;
+        }
+    }
+  }
+  const ReferenceElement& ref = ReferenceElement::get(CellType::Quadrilateral, m.order);
+  const QuadratureRule rule = quadratureRule(CellType::Line, 2 * m.order);
+  Eigen::VectorXd values;
+  Eigen::MatrixXd gradients;
+  for (const ElementBlock& b : m.blocks) {
+    if (b.type != CellType::Quadrilateral) continue;
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      const std::int64_t* v = b.element(e);
+      if (v[0] != at && v[1] != at) continue;
+      ++fan.sides;
+      for (int q = 0; q < rule.size(); ++q) {
+        Eigen::Vector3d bottom = Eigen::Vector3d::Zero(), top = bottom, tangent = bottom;
+        for (const double eta : {0.0, 1.0}) {
+          const double xi[2] = {rule.points[static_cast<std::size_t>(q)], eta};
+          ref.evaluate(xi, values, gradients);
+          for (int i = 0; i < ref.numNodes(); ++i) {
+            (eta == 0.0 ? bottom : top) += values(i) * point(m, v[i]);
+            if (eta == 0.0) tangent += gradients(i, 0) * point(m, v[i]);
+          }
+        }
+        const double h = std::fabs((top - bottom).dot(plane.cross(tangent).normalized()));
+        fan.worstSideHeight = std::max(fan.worstSideHeight, std::fabs(h / firstHeight - 1.0));
+      }
+    }
+  }
 }
 
 // A plate 2 x 2 x 0.1 with a layer of 0.06 asked on both large faces (5: z = 0, 6: z = 0.1):
@@ -189,51 +575,50 @@ TEST(BoundaryLayer, ATangentNeighbourWithoutALayerIsNamed) {
 }
 
 // NekMesh's 3d_bl_cyl case: a cylinder (faces 1 and 8) in a box, thickness 0.04, 6 layers,
-// progression 1.5, at order 2 with the optimiser (as README's example runs it).
+// progression 1.5, at order 2 with the optimiser (as README's example runs it). The meshing runs
+// once for the suite, and only where the peer files are (SetUp skips each test otherwise).
 class CylinderCase : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { result_ = new MeshResult(meshPeerCase("3d_bl_cyl", 2)); }
-  static void TearDownTestSuite() { delete result_; }
+  static void SetUpTestSuite() {
+    if (test::havePeerFiles()) result_ = new MeshResult(meshPeerCase("3d_bl_cyl", 2));
+  }
+  static void TearDownTestSuite() {
+    delete result_;
+    result_ = nullptr;
+  }
+  void SetUp() override {
+    HOMESH_REQUIRE_PEER_FILES();
+    ASSERT_NE(result_, nullptr);
+  }
   static MeshResult* result_;
 };
 MeshResult* CylinderCase::result_ = nullptr;
 
 TEST_F(CylinderCase, IsCertifiedValidWithTheRequestedLayersInEveryWallColumn) {
-  const MeshResult& r = *result_;
-  ASSERT_TRUE(r.boundaryLayer.has_value());
-  EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
-  EXPECT_TRUE(r.boundaryLayer->shrunk.empty());
-  const Mesh& m = r.mesh;
-  // Columns: from each wall triangle, prisms stacked bottom (0, 1, 2) to top (3, 4, 5).
-  std::map<std::array<std::int64_t, 3>, const std::int64_t*> byBottom;
-  std::size_t prisms = 0;
-  for (const ElementBlock& b : m.blocks)
-    if (b.type == CellType::Prism)
-      for (std::size_t e = 0; e < b.count(); ++e, ++prisms) {
-        std::array<std::int64_t, 3> key{b.element(e)[0], b.element(e)[1], b.element(e)[2]};
-        std::sort(key.begin(), key.end());
-        EXPECT_TRUE(byBottom.emplace(key, b.element(e)).second);
-      }
-  EXPECT_EQ(prisms, 6 * r.boundaryLayer->cells);
-  std::size_t walls = 0;
-  for (const ElementBlock& b : m.blocks) {
-    if (b.type != CellType::Triangle) continue;
-    for (std::size_t e = 0; e < b.count(); ++e) {
-      if (b.entity[e] != 1 && b.entity[e] != 8) continue;
-      ++walls;
-      std::array<std::int64_t, 3> key{b.element(e)[0], b.element(e)[1], b.element(e)[2]};
-      int layers = 0;
-      for (;;) {
-        std::sort(key.begin(), key.end());
-        const auto it = byBottom.find(key);
-        if (it == byBottom.end()) break;
-        ++layers;
-        key = {it->second[3], it->second[4], it->second[5]};
-      }
-      EXPECT_EQ(layers, 6);
-    }
-  }
-  EXPECT_EQ(walls, r.boundaryLayer->cells);
+  expectValidWithLayersInEveryWallColumn(*result_, {1, 8}, 6);
+}
+
+TEST_F(CylinderCase, SplitNodesLieOnTheCadAndTheReportSaysSo) {
+  // The side nodes' move onto the end planes: measured 0.27 % of the layer's height at order 2
+  // (rounding alone before the first level's shift).
+  expectSplitNodesOnTheCad(*result_, "3d_bl_cyl.mcf", 6, 0.01);
+}
+
+TEST_F(CylinderCase, NektarAndGmshFilesCarryThePrismsAndReadBack) {
+  expectNektarAndGmshFilesReadBack(*result_, "cyl");
+}
+
+// The order-4 cylinder, without the optimiser (the geometry as split; the optimiser is not the
+// point), written as Nektar++ XML and read back.
+TEST(BoundaryLayer, NektarXmlOfTheSplitLayerReadsBackEveryStoredNodeExactly) {
+  HOMESH_REQUIRE_PEER_FILES();
+  CaseSetup setup = setupCase(test::peerFile("meshgen/3d_bl_cyl.mcf"));
+  setup.options.order = 4;
+  setup.options.optimiseIterations = 0;
+  setup.options.repairRounds = 0;
+  const MeshResult r = runMeshPipeline(setup.source, setup.options);
+  ASSERT_EQ(r.mesh.order, 4);
+  expectNektarXmlStoresEveryNodeExactly(r, "cyl4");
 }
 
 // The first layer's height, measured along the wall's normal at the wall triangles' quadrature
@@ -244,147 +629,21 @@ TEST_F(CylinderCase, IsCertifiedValidWithTheRequestedLayersInEveryWallColumn) {
 // 4.1 %, against 9.7 % with the levels alone and 13 % with the top moving freely). The
 // report's own figure (LayerSplitStats) is checked against this independent one.
 constexpr double kEndBand = 0.05;
-// The Nektar++ XML of the order-4 cylinder read back: the same elements, and every node the file
-// stores (vertices, edge and face points: all but the interior of each 3D element, which
-// Nektar++ rebuilds from the faces itself) bit for bit among the same element's nodes.
-// Nektar++'s own reader refused this file until the writer numbered the layer's columns as
-// runs (a prism's triangles need their apex vertices to carry their highest ids); NekMesh's
-// jac module now reads it and finds no negative Jacobian (bench/boundary_layer with NEKMESH).
-TEST(BoundaryLayer, NektarXmlOfTheSplitLayerReadsBackEveryStoredNodeExactly) {
-  CaseSetup setup = setupCase(kCylinderCase);
-  setup.options.order = 4;
-  setup.options.optimiseIterations = 0;  // the geometry as split; the optimiser is not the point
-  setup.options.repairRounds = 0;
-  const MeshResult r = runMeshPipeline(setup.source, setup.options);
-  const Mesh& a = r.mesh;
-  const auto dir = test::tempDir();
-  const std::string path = (dir / "cyl4.xml").string();
-  writeMeshFiles(r, {path});
-  const Mesh b = readMesh(path);
-  ASSERT_EQ(b.order, 4);
-  // a's 3D elements by their sorted vertex coordinates.
-  using Key = std::vector<std::array<double, 3>>;
-  const auto key = [](const Mesh& m, const std::int64_t* v, int nv) {
-    Key k;
-    for (int i = 0; i < nv; ++i)
-      k.push_back({m.xyz[3 * v[i]], m.xyz[3 * v[i] + 1], m.xyz[3 * v[i] + 2]});
-    std::sort(k.begin(), k.end());
-    return k;
-  };
-  std::map<Key, const std::int64_t*> elements;
-  std::map<CellType, std::size_t> countA, countB;
-  for (const ElementBlock& blk : a.blocks)
-    if (cellDimension(blk.type) == 3)
-      for (std::size_t e = 0; e < blk.count(); ++e, ++countA[blk.type])
-        elements[key(a, blk.element(e), cellNumVertices(blk.type))] = blk.element(e);
-  std::size_t stored = 0, interior = 0;
-  for (const ElementBlock& blk : b.blocks) {
-    if (cellDimension(blk.type) != 3) continue;
-    const ReferenceElement& ref = ReferenceElement::get(blk.type, 4);
-    for (std::size_t e = 0; e < blk.count(); ++e, ++countB[blk.type]) {
-      const std::int64_t* v = blk.element(e);
-      const auto it = elements.find(key(b, v, cellNumVertices(blk.type)));
-      ASSERT_NE(it, elements.end()) << "an element of the file is not in the mesh written";
-      std::set<std::array<double, 3>> nodesA;
-      for (int i = 0; i < ref.numNodes(); ++i) {
-        const std::int64_t n = it->second[i];
-        nodesA.insert({a.xyz[3 * n], a.xyz[3 * n + 1], a.xyz[3 * n + 2]});
-      }
-      for (int i = 0; i < ref.numNodes(); ++i) {
-        const LatticePoint& l = ref.lattice()[static_cast<std::size_t>(i)];
-        const bool inside = blk.type == CellType::Prism
-                                ? l[0] > 0 && l[1] > 0 && l[0] + l[1] < 4 && l[2] > 0 && l[2] < 4
-                                : l[0] > 0 && l[1] > 0 && l[2] > 0 && l[0] + l[1] + l[2] < 4;
-        if (inside) {
-          ++interior;
-          continue;
-        }
-        ++stored;
-        const std::int64_t n = v[i];
-        EXPECT_EQ(nodesA.count({b.xyz[3 * n], b.xyz[3 * n + 1], b.xyz[3 * n + 2]}), 1U)
-            << "node " << i << " of a " << cellShortName(blk.type);
-      }
-    }
-  }
-  EXPECT_EQ(countA, countB);
-  EXPECT_GT(countB[CellType::Prism], 0U);
-  EXPECT_GT(stored, 0U);
-  EXPECT_GT(interior, 0U);
-}
-
 TEST(BoundaryLayer, FirstLayerHeightAlongTheWallNormalIsWithinFivePercent) {
-  double worstNearEnds = 0.0;
+  HOMESH_REQUIRE_PEER_FILES();
   const MeshResult r = meshPeerCase("3d_bl_cyl", 4);
   ASSERT_TRUE(r.boundaryLayer.has_value());
   ASSERT_TRUE(r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
   const double expected = 0.04 * (1 - 1.5) / (1 - std::pow(1.5, 6));
-  const Mesh& m = r.mesh;
-  const ReferenceElement& ref = ReferenceElement::get(CellType::Prism, m.order);
-  const QuadratureRule rule = quadratureRule(CellType::Triangle, 2 * m.order);
-  std::set<std::array<std::int64_t, 3>> walls;
-  for (const ElementBlock& b : m.blocks)
-    if (b.type == CellType::Triangle)
-      for (std::size_t e = 0; e < b.count(); ++e)
-        if (b.entity[e] == 1 || b.entity[e] == 8) {
-          std::array<std::int64_t, 3> key{b.element(e)[0], b.element(e)[1], b.element(e)[2]};
-          std::sort(key.begin(), key.end());
-          walls.insert(key);
-        }
-  double worst = 0.0;
+  double worst = 0.0, worstNearEnds = 0.0;
   std::size_t measured = 0;
-  Eigen::VectorXd values;
-  Eigen::MatrixXd gradients;
-  for (const ElementBlock& b : m.blocks) {
-    if (b.type != CellType::Prism) continue;
-    for (std::size_t e = 0; e < b.count(); ++e) {
-      const std::int64_t* v = b.element(e);
-      std::array<std::int64_t, 3> key{v[0], v[1], v[2]};
-      std::sort(key.begin(), key.end());
-      if (walls.count(key) == 0) continue;
-      for (std::size_t q = 0; q < rule.weights.size(); ++q) {
-        Eigen::Vector3d bottom = Eigen::Vector3d::Zero(), top = Eigen::Vector3d::Zero();
-        Eigen::Vector3d dxi = Eigen::Vector3d::Zero(), deta = Eigen::Vector3d::Zero();
-        for (const double zeta : {0.0, 1.0}) {
-          const double xi[3] = {rule.points[2 * q], rule.points[2 * q + 1], zeta};
-          ref.evaluate(xi, values, gradients);
-          for (int i = 0; i < ref.numNodes(); ++i) {
-            const Eigen::Vector3d x = point(m, v[i]);
-            (zeta == 0.0 ? bottom : top) += values(i) * x;
-            if (zeta == 0.0) {
-              dxi += gradients(i, 0) * x;
-              deta += gradients(i, 1) * x;
-            }
-          }
-        }
-        Eigen::Vector3d normal = dxi.cross(deta).normalized();
-        if ((top - bottom).dot(normal) < 0.0) normal = -normal;
-        // Where the normal line meets the top: top(a, b) = bottom + t normal, by Newton on
-        // (a, b, t) together (the report projects onto the tangent plane instead).
-        Eigen::Vector3d abt(rule.points[2 * q], rule.points[2 * q + 1], 0.0);
-        for (int it = 0; it < 50; ++it) {
-          const double xi[3] = {abt[0], abt[1], 1.0};
-          ref.evaluate(xi, values, gradients);
-          Eigen::Matrix3d jac = Eigen::Matrix3d::Zero();
-          Eigen::Vector3d x = Eigen::Vector3d::Zero();
-          for (int i = 0; i < ref.numNodes(); ++i) {
-            x += values(i) * point(m, v[i]);
-            jac.col(0) += gradients(i, 0) * point(m, v[i]);
-            jac.col(1) += gradients(i, 1) * point(m, v[i]);
-          }
-          jac.col(2) = -normal;
-          abt -= jac.fullPivLu().solve(x - bottom - abt[2] * normal);
-        }
-        ASSERT_GE(abt[0], -1e-9);
-        ASSERT_GE(abt[1], -1e-9);
-        ASSERT_LE(abt[0] + abt[1], 1 + 1e-9);
-        const double dev = std::fabs(abt[2] / expected - 1);
-        const bool nearEnd = bottom.z() < kEndBand || bottom.z() > 0.5 - kEndBand;
-        (nearEnd ? worstNearEnds : worst) = std::max(nearEnd ? worstNearEnds : worst, dev);
-        ++measured;
-      }
-    }
-  }
+  forEachFirstLayerHeight(r, {1, 8}, [&](const Eigen::Vector3d& bottom, double height) {
+    const double dev = std::fabs(height / expected - 1);
+    const bool nearEnd = bottom.z() < kEndBand || bottom.z() > 0.5 - kEndBand;
+    (nearEnd ? worstNearEnds : worst) = std::max(nearEnd ? worstNearEnds : worst, dev);
+    ++measured;
+  });
   EXPECT_GT(measured, 0U);
   EXPECT_LE(worst, 0.05) << "worst relative deviation of the first-layer height";
   RecordProperty("first_layer_height_worst_relative_deviation", std::to_string(worst));
@@ -399,119 +658,25 @@ TEST(BoundaryLayer, FirstLayerHeightAlongTheWallNormalIsWithinFivePercent) {
   EXPECT_GE(r.layerSplit->firstHeightMin, expected * (1 - 0.05));
 }
 
-TEST_F(CylinderCase, SplitNodesLieOnTheCadAndTheReportSaysSo) {
-  const MeshResult& r = *result_;
-  ASSERT_TRUE(r.layerSplit.has_value());
-  EXPECT_GT(r.layerSplit->projected, 0U);
-  // The split's side nodes lie on the curved macro quadrilaterals (on the planar end faces),
-  // but the first level's shift (onto the wall normal, layer_split.hpp) follows the curved
-  // wall's interpolated normal, which leans off the end plane by the wall's interpolation
-  // error: measured 0.27 % of the layer's height at order 2 (rounding alone before the shift).
-  EXPECT_LT(r.layerSplit->maxProjection, 0.01);
-  const std::string json = meshReportJson(r, "3d_bl_cyl.mcf");
-  for (const char* key :
-       {"\"boundary_layer\"", "\"first_height\"", "\"shrunk\": []", "\"layers\": 6", "\"prism\": "})
-    EXPECT_NE(json.find(key), std::string::npos) << key;
-}
-
-TEST_F(CylinderCase, NektarAndGmshFilesCarryThePrismsAndReadBack) {
-  const MeshResult& r = *result_;
-  const auto dir = test::tempDir();
-  for (const char* name : {"cyl.xml", "cyl.msh"}) {
-    const std::string path = (dir / name).string();
-    writeMeshFiles(r, {path});
-    const Mesh back = readMesh(path);
-    std::map<CellType, std::size_t> a, b;
-    for (const ElementBlock& blk : r.mesh.blocks)
-      if (cellDimension(blk.type) == 3) a[blk.type] += blk.count();
-    for (const ElementBlock& blk : back.blocks)
-      if (cellDimension(blk.type) == 3) b[blk.type] += blk.count();
-    EXPECT_EQ(a, b) << name;
-    EXPECT_EQ(back.order, r.mesh.order);
-    const QualitySummary q = evaluateQuality(back);
-    EXPECT_EQ(q.invalid + q.undecided, 0U) << name;
-  }
-}
-
 // NekMesh's 2d_bl_aerofoil case: a layer of thickness 0.1 on the aerofoil's two curves (Edge2,
 // Edge4), 6 layers, progression 1.5, at order 4 with the optimiser.
 TEST(BoundaryLayer2D, AerofoilIsValidWithSixQuadrilateralsOnEveryWallLineAndItsFirstHeight) {
+  HOMESH_REQUIRE_PEER_FILES();
   const MeshResult r = meshPeerCase("2d_bl_aerofoil", 4);
   ASSERT_TRUE(r.boundaryLayer.has_value());
   EXPECT_EQ(r.mesh.dim, 2);
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
   EXPECT_TRUE(r.boundaryLayer->shrunk.empty());
   ASSERT_EQ(r.boundaryLayer->release, LayerRelease::None);  // the layer as grown: heights hold
-  const Mesh& m = r.mesh;
-  // Columns: quadrilaterals with wall (0, 1) and top (3, 2), stacked from each wall line.
-  std::map<std::array<std::int64_t, 2>, const std::int64_t*> byWall;
-  std::size_t quads = 0;
-  for (const ElementBlock& b : m.blocks)
-    if (b.type == CellType::Quadrilateral)
-      for (std::size_t e = 0; e < b.count(); ++e, ++quads) {
-        std::array<std::int64_t, 2> key{b.element(e)[0], b.element(e)[1]};
-        std::sort(key.begin(), key.end());
-        EXPECT_TRUE(byWall.emplace(key, b.element(e)).second);
-      }
-  EXPECT_EQ(quads, 6 * r.boundaryLayer->cells);
-  const double expected = 0.1 * (1 - 1.5) / (1 - std::pow(1.5, 6));
-  const ReferenceElement& ref = ReferenceElement::get(CellType::Quadrilateral, m.order);
-  const QuadratureRule rule = quadratureRule(CellType::Line, 2 * m.order);
-  const Eigen::Vector3d plane(m.planeNormal[0], m.planeNormal[1], m.planeNormal[2]);
-  Eigen::VectorXd values;
-  Eigen::MatrixXd gradients;
   double worst = 0.0;
-  std::size_t walls = 0;
-  for (const ElementBlock& b : m.blocks) {
-    if (b.type != CellType::Line) continue;
-    for (std::size_t e = 0; e < b.count(); ++e) {
-      if (b.entity[e] != 2 && b.entity[e] != 4) continue;
-      ++walls;
-      std::array<std::int64_t, 2> key{b.element(e)[0], b.element(e)[1]};
-      int layers = 0;
-      const std::int64_t* first = nullptr;
-      for (;;) {
-        std::sort(key.begin(), key.end());
-        const auto it = byWall.find(key);
-        if (it == byWall.end()) break;
-        if (layers++ == 0) first = it->second;
-        key = {it->second[3], it->second[2]};
-      }
-      EXPECT_EQ(layers, 6);
-      ASSERT_NE(first, nullptr);
-      // The first layer's height along the wall normal at the wall's quadrature points.
-      for (int q = 0; q < rule.size(); ++q) {
-        Eigen::Vector3d bottom = Eigen::Vector3d::Zero(), top = Eigen::Vector3d::Zero();
-        Eigen::Vector3d tangent = Eigen::Vector3d::Zero();
-        for (const double eta : {0.0, 1.0}) {
-          const double xi[2] = {rule.points[static_cast<std::size_t>(q)], eta};
-          ref.evaluate(xi, values, gradients);
-          for (int i = 0; i < ref.numNodes(); ++i) {
-            const Eigen::Vector3d x = point(m, first[i]);
-            (eta == 0.0 ? bottom : top) += values(i) * x;
-            if (eta == 0.0) tangent += gradients(i, 0) * x;
-          }
-        }
-        const Eigen::Vector3d normal = plane.cross(tangent).normalized();
-        worst = std::max(worst, std::fabs(std::fabs((top - bottom).dot(normal)) / expected - 1));
-      }
-    }
-  }
-  EXPECT_EQ(walls, r.boundaryLayer->cells);
+  expectQuadrilateralColumnsOnEveryWallLine(r, {2, 4}, 6, 0.1 * (1 - 1.5) / (1 - std::pow(1.5, 6)),
+                                            worst);
   EXPECT_LE(worst, 0.05) << "first-layer height, worst relative deviation";
   std::ostringstream figure;
   figure << worst;
   RecordProperty("first_layer_height_worst_relative_deviation", figure.str());
 }
 
-// NekMesh's 2d_bl_t106 case at order 4 with the optimiser: a layer of thickness 0.01 + 0.05 x
-// on the blade (Edge11, Edge12), whose rounded edges (radius about 0.005, with wiggles in the
-// splines' curvature) lie under a layer 1 to 11 times thicker. The wall segments there are
-// halved until each turns by at most 30 degrees, and the wall's high-order nodes are spaced on
-// the offset at a quarter of the height; the top then stays fixed or at most slides parallel to
-// the wall (heights kept), the split is certified valid, and the first layer keeps its height
-// within the issue's 5 % on the whole wall, tip cells included (10.5 % at the trailing edge's
-// tip before, with segments 0.04 long there turning up to 110 degrees).
 // Above order 4 the pipeline optimises at order 4 and raises the order after; the layer's inner
 // nodes are then placed straight between the raised wall and the top again, which the split's
 // levels assume, and the raise keeps the top's edges on the layer's sides (the cylinder's end
@@ -521,6 +686,7 @@ TEST(BoundaryLayer2D, AerofoilIsValidWithSixQuadrilateralsOnEveryWallLineAndItsF
 // wall where the layer is 0.04 thick. With both, 0.00 % (the levels are set per column, and the
 // columns now have the height grown); 0.05 is what the 2D cases hold.
 TEST(BoundaryLayer, AtOrderSixTheFirstLayerFollowsTheRaisedWall) {
+  HOMESH_REQUIRE_PEER_FILES();
   const MeshResult r = meshPeerCase("3d_bl_cyl", 6);
   ASSERT_TRUE(r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
@@ -535,18 +701,20 @@ TEST(BoundaryLayer, AtOrderSixTheFirstLayerFollowsTheRaisedWall) {
   // worst to have stopped rising within the window: the pipeline's stall of 1e-3 over 3 sweeps
   // (pipelineOptimiserOptions in mesh_pipeline.cpp).
   ASSERT_TRUE(r.optimiser.has_value());
-  const std::vector<IterationRecord>& h = r.optimiser->history;
-  ASSERT_FALSE(h.empty());
-  if (r.optimiser->stopReason == "stalled") {
-    double low = h.back().worst;
-    for (std::size_t k = h.size() >= 4 ? h.size() - 4 : 0; k + 1 < h.size(); ++k)
-      low = std::min(low, h[k].worst);
-    EXPECT_LT(h.back().worst - low, 1e-3) << "stopped after sweep " << h.back().iteration;
-  }
+  expectStalledOnlyOnceTheWorstStoppedRising(*r.optimiser);
   EXPECT_GT(r.optimiser->worstAfter, r.optimiser->worstBefore);
 }
 
+// NekMesh's 2d_bl_t106 case at order 4 with the optimiser: a layer of thickness 0.01 + 0.05 x
+// on the blade (Edge11, Edge12), whose rounded edges (radius about 0.005, with wiggles in the
+// splines' curvature) lie under a layer 1 to 11 times thicker. The wall segments there are
+// halved until each turns by at most 30 degrees, and the wall's high-order nodes are spaced on
+// the offset at a quarter of the height; the top then stays fixed or at most slides parallel to
+// the wall (heights kept), the split is certified valid, and the first layer keeps its height
+// within the issue's 5 % on the whole wall, tip cells included (10.5 % at the trailing edge's
+// tip before, with segments 0.04 long there turning up to 110 degrees).
 TEST(BoundaryLayer2D, T106KeepsItsFirstLayerHeightAroundItsRoundedEdges) {
+  HOMESH_REQUIRE_PEER_FILES();
   const MeshResult r = meshPeerCase("2d_bl_t106", 4);
   ASSERT_TRUE(r.boundaryLayer.has_value());
   ASSERT_TRUE(r.layerSplit.has_value());
@@ -583,70 +751,18 @@ TEST(BoundaryLayer2D, T106KeepsItsFirstLayerHeightAroundItsRoundedEdges) {
 // differs from the height along the normal line by the first layer's lean against a wall whose
 // curvature is small there, well under 1 %; 5 % is the issue's bound.
 TEST(BoundaryLayer2D, NacaSharpTrailingEdgeGrowsAFanAndItsCellsKeepTheFirstHeight) {
+  HOMESH_REQUIRE_PEER_FILES();
   const MeshResult r = meshPeerCase("2d_bl_naca0012", 4);
   ASSERT_TRUE(r.boundaryLayer.has_value());
   ASSERT_TRUE(r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
-  const Mesh& m = r.mesh;
-  const Eigen::Vector3d te = r.cad->vertexPoint(6);
-  std::int64_t edge = -1;
-  for (std::size_t i = 0; i < m.numNodes(); ++i)
-    if ((point(m, static_cast<std::int64_t>(i)) - te).norm() < 1e-9)
-      edge = static_cast<std::int64_t>(i);
-  ASSERT_GE(edge, 0);
-  const Eigen::Vector3d plane(m.planeNormal[0], m.planeNormal[1], m.planeNormal[2]);
-  const auto angleAt = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-    return std::atan2(a.cross(b).dot(plane), a.dot(b));
-  };
-  // The fans' first layers: triangles with a vertex at the edge, each at most 40 degrees wide.
-  std::size_t fanPieces = 0;
-  double fanAngle = 0.0;
-  for (const ElementBlock& b : m.blocks) {
-    if (b.type != CellType::Triangle) continue;
-    for (std::size_t e = 0; e < b.count(); ++e) {
-      const std::int64_t* v = b.element(e);
-      for (int k = 0; k < 3; ++k)
-        if (v[k] == edge) {
-          const double a = angleAt(point(m, v[(k + 1) % 3]) - te, point(m, v[(k + 2) % 3]) - te);
-          EXPECT_GT(a, 0.0);
-          EXPECT_LE(a, 40.0 * M_PI / 180.0 + 1e-9);
-          fanAngle += a;
-          ++fanPieces;
-        }
-    }
-  }
-  EXPECT_EQ(fanPieces, r.boundaryLayer->fanTriangles);
-  EXPECT_EQ(fanPieces, 5U);  // ceil(163.5 / 40)
-  EXPECT_NEAR(fanAngle * 180.0 / M_PI, 163.5, 1.0);
-  // The first layers on either side of the edge: quadrilaterals with wall (0, 1), top (3, 2).
-  const ReferenceElement& ref = ReferenceElement::get(CellType::Quadrilateral, m.order);
-  const QuadratureRule rule = quadratureRule(CellType::Line, 2 * m.order);
-  Eigen::VectorXd values;
-  Eigen::MatrixXd gradients;
-  std::size_t sides = 0;
-  double worst = 0.0;
-  for (const ElementBlock& b : m.blocks) {
-    if (b.type != CellType::Quadrilateral) continue;
-    for (std::size_t e = 0; e < b.count(); ++e) {
-      const std::int64_t* v = b.element(e);
-      if (v[0] != edge && v[1] != edge) continue;
-      ++sides;
-      for (int q = 0; q < rule.size(); ++q) {
-        Eigen::Vector3d bottom = Eigen::Vector3d::Zero(), top = bottom, tangent = bottom;
-        for (const double eta : {0.0, 1.0}) {
-          const double xi[2] = {rule.points[static_cast<std::size_t>(q)], eta};
-          ref.evaluate(xi, values, gradients);
-          for (int i = 0; i < ref.numNodes(); ++i) {
-            (eta == 0.0 ? bottom : top) += values(i) * point(m, v[i]);
-            if (eta == 0.0) tangent += gradients(i, 0) * point(m, v[i]);
-          }
-        }
-        const double h = std::fabs((top - bottom).dot(plane.cross(tangent).normalized()));
-        worst = std::max(worst, std::fabs(h / (0.05 / 3) - 1.0));
-      }
-    }
-  }
-  EXPECT_EQ(sides, 2U);
+  CornerFan fan;
+  measureCornerFan(r, 6, 0.05 / 3, fan);
+  EXPECT_EQ(fan.pieces, r.boundaryLayer->fanTriangles);
+  EXPECT_EQ(fan.pieces, 5U);  // ceil(163.5 / 40)
+  EXPECT_NEAR(fan.angle * 180.0 / M_PI, 163.5, 1.0);
+  EXPECT_EQ(fan.sides, 2U);
+  const double worst = fan.worstSideHeight;
   EXPECT_LE(worst, 0.05) << "first-layer height beside the trailing edge, worst deviation";
   // The nose (radius 0.0158 against the case's MinDelta of 0.1): its two wall segments, along
   // which the curves turn by more than 60 degrees, are halved before the growth, and their
@@ -657,6 +773,214 @@ TEST(BoundaryLayer2D, NacaSharpTrailingEdgeGrowsAFanAndItsCellsKeepTheFirstHeigh
   EXPECT_EQ(r.layerSplit->cornerCells, 0U);
   EXPECT_LE(r.layerSplit->firstHeightDeviation, 0.05);
   RecordProperty("first_layer_height_worst_deviation_at_trailing_edge", std::to_string(worst));
+}
+
+// Siblings of the peer cases on shapes the tests make themselves, so that the boundary layer
+// stays covered where NekMesh's files are not: the same properties, with bounds that follow from
+// the method (or the issue's 5 % on the first layer's height), not from the peer cases.
+
+// A 1.0 x 0.8 x 0.4 box with a vertical cylindrical hole of radius 0.15 through it, off its
+// centre (OCCT's cylinder: one periodic wall face with a seam), the layer on the hole's wall:
+// 0.05 thick (the hole's wall is 0.25 from the box's sides, more than the 2.5 thicknesses the
+// growth keeps clear: nothing shrinks), 4 layers, progression 1.3, the octree's sizes (MinDelta
+// 0.03, MaxDelta 0.12, EPS 0.1: some 70 wall triangles, 1,400 elements), the optimiser as
+// meshCase runs it. Meshed once per order for the tests that share it.
+constexpr double kHoleHeight = 0.4, kHoleThickness = 0.05, kHoleProgression = 1.3;
+constexpr int kHoleLayers = 4;
+
+struct HoleCase {
+  MeshResult result;
+  std::set<int> walls;  // the curved faces: the hole's wall
+};
+
+const HoleCase& holeInABox(int order) {
+  static std::map<int, std::unique_ptr<HoleCase>> meshed;
+  std::unique_ptr<HoleCase>& slot = meshed[order];
+  if (slot) return *slot;
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(1.0, 0.8, kHoleHeight).Shape();
+  const TopoDS_Shape drill =
+      BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0.45, 0.4, -0.1), gp_Dir(0, 0, 1)), 0.15,
+                               kHoleHeight + 0.2)
+          .Shape();
+  const std::string brep = test::brepText(BRepAlgoAPI_Cut(box, drill).Shape());
+  const CadModel cad = CadModel::fromBrepText(brep);
+  std::set<int> walls;
+  for (int f = 1; f <= cad.numFaces(); ++f)
+    if (!cad.isPlanar(f)) walls.insert(f);
+  MeshingOptions options;
+  options.order = order;
+  options.optimiseIterations = 100;
+  options.threads = 2;
+  SizingParameters sizes;
+  sizes.minDelta = 0.03;
+  sizes.maxDelta = 0.12;
+  sizes.eps = 0.1;
+  options.sizing = sizes;
+  BoundaryLayerParameters layer;
+  layer.faces.assign(walls.begin(), walls.end());
+  layer.thickness = "0.05";
+  layer.layers = kHoleLayers;
+  layer.progression = kHoleProgression;
+  options.boundaryLayer = layer;
+  slot = std::make_unique<HoleCase>(
+      HoleCase{runMeshPipeline(CadSource::brepText(brep, "hole in a box"), options), walls});
+  return *slot;
+}
+
+TEST(BoundaryLayerOnAHole, IsCertifiedValidWithTheRequestedLayersInEveryWallColumn) {
+  const HoleCase& c = holeInABox(2);
+  ASSERT_FALSE(c.walls.empty());
+  for (const int f : c.walls) EXPECT_FALSE(c.result.cad->isPlanar(f)) << "Face" << f;
+  expectValidWithLayersInEveryWallColumn(c.result, c.walls, kHoleLayers);
+}
+
+TEST(BoundaryLayerOnAHole, SplitNodesLieOnTheCadAndTheReportSaysSo) {
+  // The side nodes' move onto the end planes: the first level's shift, at most its share z_1 =
+  // 0.16 of the height, times the sine of the wall normal's lean off the plane, the order-2
+  // wall's normal error (the geometry stage finds 1.5 degrees on this wall): below 0.5 %.
+  expectSplitNodesOnTheCad(holeInABox(2).result, "hole in a box", kHoleLayers, 0.01);
+}
+
+TEST(BoundaryLayerOnAHole, NektarAndGmshFilesCarryThePrismsAndReadBack) {
+  expectNektarAndGmshFilesReadBack(holeInABox(2).result, "hole");
+}
+
+TEST(BoundaryLayerOnAHole, NektarXmlOfTheSplitLayerReadsBackEveryStoredNodeExactly) {
+  const MeshResult& r = holeInABox(4).result;
+  ASSERT_EQ(r.mesh.order, 4);
+  expectNektarXmlStoresEveryNodeExactly(r, "hole4");
+}
+
+// As FirstLayerHeightAlongTheWallNormalIsWithinFivePercent: at order 4 with the optimiser, the
+// first layer's height along the wall normal against thickness x (1 - r) / (1 - r^n) within the
+// issue's 5 % (the method's aim: the split sets each column's first level at z_1 times the
+// height grown, and nothing here is shrunk), and the report's own figure equal to this
+// independent one (the same points, its own normals and search: rounding and the searches'
+// 1e-12 in reference coordinates).
+TEST(BoundaryLayerOnAHole, FirstLayerHeightAlongTheWallNormalIsWithinFivePercentAtOrderFour) {
+  const HoleCase& c = holeInABox(4);
+  const MeshResult& r = c.result;
+  ASSERT_TRUE(r.boundaryLayer.has_value());
+  ASSERT_TRUE(r.layerSplit.has_value());
+  EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
+  EXPECT_TRUE(r.boundaryLayer->shrunk.empty());
+  const double expected =
+      kHoleThickness * (1 - kHoleProgression) / (1 - std::pow(kHoleProgression, kHoleLayers));
+  double worst = 0.0;
+  std::size_t measured = 0;
+  forEachFirstLayerHeight(r, c.walls, [&](const Eigen::Vector3d&, double height) {
+    worst = std::max(worst, std::fabs(height / expected - 1));
+    ++measured;
+  });
+  EXPECT_GT(measured, 0U);
+  EXPECT_LE(worst, 0.05) << "worst relative deviation of the first-layer height";
+  RecordProperty("first_layer_height_worst_relative_deviation", std::to_string(worst));
+  EXPECT_NEAR(r.layerSplit->firstHeightDeviation, worst, 1e-9);
+  EXPECT_EQ(r.layerSplit->cornerCells, 0U);  // a cylinder's wall has no sharp corner
+  EXPECT_GE(r.layerSplit->firstHeightMin, expected * (1 - 0.05));
+  EXPECT_LE(r.layerSplit->firstHeightMax, expected * (1 + 0.05));
+}
+
+// As AtOrderSixTheFirstLayerFollowsTheRaisedWall: above order 4 the pipeline optimises at order
+// 4 and raises the order after (kContinuationOrder); the split's levels then follow the raised
+// wall, so the first layer keeps its height within the issue's 5 % (the report's measure, along
+// the wall normal), and the mesh is certified valid. The optimiser's stop rule holds for any
+// run: "stalled" only once the worst element stopped rising over the stall window (3 sweeps,
+// by 1e-3: pipelineOptimiserOptions in mesh_pipeline.cpp).
+TEST(BoundaryLayerOnAHole, AtOrderSixTheFirstLayerFollowsTheRaisedWall) {
+  const MeshResult& r = holeInABox(6).result;
+  expectRaisedToOrderSixKeepingTheFirstHeight(r);
+}
+
+// A NACA 2412 at 6 degrees in its own box, as a .mcf the test writes into a fresh folder (its
+// path returned): a layer 0.03 thick on the aerofoil (Edge5, Edge6), 3 layers, progression 1.5.
+std::string writeOwnNacaCase() {
+  const auto dir = test::tempDir();
+  const std::string path = (dir / "naca2412.mcf").string();
+  std::ofstream(path) << R"(<NEKTAR>
+  <MESHING>
+    <INFORMATION>
+      <I PROPERTY="CADFile" VALUE="2412" />
+      <I PROPERTY="MeshType" VALUE="2DBndLayer" />
+    </INFORMATION>
+    <PARAMETERS>
+      <P PARAM="MinDelta" VALUE="0.04" />
+      <P PARAM="MaxDelta" VALUE="1.0" />
+      <P PARAM="EPS" VALUE="0.1" />
+      <P PARAM="Order" VALUE="4" />
+      <P PARAM="BndLayerSurfaces" VALUE="5,6" />
+      <P PARAM="BndLayerThickness" VALUE="0.03" />
+      <P PARAM="BndLayerLayers" VALUE="3" />
+      <P PARAM="BndLayerProgression" VALUE="1.5" />
+      <P PARAM="Xmin" VALUE="-1.5" />
+      <P PARAM="Ymin" VALUE="-1.25" />
+      <P PARAM="Xmax" VALUE="2.5" />
+      <P PARAM="Ymax" VALUE="1.25" />
+      <P PARAM="AOA" VALUE="6.0" />
+    </PARAMETERS>
+  </MESHING>
+</NEKTAR>
+)";
+  return path;
+}
+
+// writeOwnNacaCase at order 4 with the optimiser. The same properties as the aerofoil and NACA
+// 0012 peer cases: certified valid, 3 quadrilaterals on every wall line, the first layer's height,
+// and the fan at the sharp trailing edge (Vertex6).
+TEST(BoundaryLayer2D, OwnNacaCaseHasItsLayersItsFirstHeightAndATrailingEdgeFan) {
+  constexpr double kThickness = 0.03, kProgression = 1.5;  // as writeOwnNacaCase says
+  constexpr int kLayers = 3;
+  const std::string path = writeOwnNacaCase();
+  const MeshResult r = meshCase(path, 4);
+  ASSERT_TRUE(r.boundaryLayer.has_value());
+  ASSERT_TRUE(r.layerSplit.has_value());
+  EXPECT_EQ(r.mesh.dim, 2);
+  EXPECT_EQ(r.mesh.order, 4);
+  EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
+  EXPECT_TRUE(r.boundaryLayer->shrunk.empty());
+  const double first = kThickness * (1 - kProgression) / (1 - std::pow(kProgression, kLayers));
+  // The top fixed or at most sliding parallel to the wall: the heights as grown, so the first
+  // layer's (the top's component along the wall normal; the split's, along the normal line)
+  // within the issue's 5 % on every wall line.
+  EXPECT_LE(r.boundaryLayer->release, LayerRelease::Parallel);
+  double worst = 0.0;
+  expectQuadrilateralColumnsOnEveryWallLine(r, {5, 6}, kLayers, first, worst);
+  EXPECT_LE(worst, 0.05) << "first-layer height, worst relative deviation";
+  RecordProperty("first_layer_height_worst_relative_deviation", std::to_string(worst));
+  EXPECT_LE(r.layerSplit->firstHeightDeviation, 0.05);
+  // No cell at a corner: the wall segments are halved until none turns by more than 30 degrees
+  // (the nose), and the one sharp corner, the trailing edge, has its fan.
+  EXPECT_EQ(r.layerSplit->cornerCells, 0U);
+  // The fan: NACA MPTT's surfaces leave the trailing edge at atan(yt'(1) cos theta) either side
+  // of the camber line, theta its slope there (naca_aerofoil.hpp's formulas: yt'(1) = -1.21125
+  // t, tan theta = -2 M / (1 - P)), so the curves' normals there are 180 degrees less that
+  // wedge apart (163.5 here), which the fan fills in ceil(angle / 40 degrees) triangles. Within
+  // a degree: the method reads each curve's direction off a short chord of its B-spline at the
+  // edge (curveTangent), and the splines interpolate the formula's points without its end
+  // tangents (their parametrisation is even stationary there): hundredths of a degree apart.
+  const double camber = std::atan(2 * 0.02 / (1 - 0.4));
+  const double spread = M_PI - 2 * std::atan(1.21125 * 0.12 * std::cos(camber));
+  CornerFan fan;
+  measureCornerFan(r, 6, first, fan);
+  EXPECT_EQ(fan.pieces, r.boundaryLayer->fanTriangles);
+  EXPECT_EQ(fan.pieces, static_cast<std::size_t>(std::ceil(spread / (40.0 * M_PI / 180.0))));
+  EXPECT_NEAR(fan.angle, spread, M_PI / 180.0);
+  EXPECT_EQ(fan.sides, 2U);
+  // The cells beside the edge keep a column along their own wall's normal there: their first
+  // layer's component along the normal differs from its height by the layer's lean against a
+  // wall of small curvature (well under 1 %), within the issue's 5 %.
+  EXPECT_LE(fan.worstSideHeight, 0.05) << "first-layer height beside the trailing edge";
+  RecordProperty("fan_angle_degrees", std::to_string(fan.angle * 180.0 / M_PI));
+  RecordProperty("first_layer_height_worst_deviation_at_trailing_edge",
+                 std::to_string(fan.worstSideHeight));
+}
+
+// writeOwnNacaCase at order 6: optimised at order 4, raised, optimised again (as
+// AtOrderSixTheFirstLayerFollowsTheRaisedWall): certified valid, the first layer's height within
+// the issue's 5 % after the raise, and the optimiser's stop rule.
+TEST(BoundaryLayer2D, OwnNacaCaseAtOrderSixKeepsItsFirstHeightAfterTheRaise) {
+  const MeshResult r = meshCase(writeOwnNacaCase(), 6);
+  expectRaisedToOrderSixKeepingTheFirstHeight(r);
 }
 
 // A 2D macro layer that fans out: four order-4 quadrilaterals on an annulus of inner radius
