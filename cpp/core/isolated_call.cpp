@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <chrono>
@@ -26,6 +27,8 @@ namespace {
 // The child's answer: one kind byte, then the result's bytes or the error's message.
 constexpr char kResult = 'R', kParameter = 'P', kIo = 'I', kCad = 'C', kMeshing = 'M',
                kCancelled = 'X', kOther = 'E', kMemory = 'A';
+// With a start probe, the byte the child sends before the answer once the probe has returned.
+constexpr char kStarted = 'S';
 
 bool writeAll(int fd, const char* data, std::size_t n) {
   while (n > 0) {
@@ -60,6 +63,10 @@ bool writeAll(int fd, const char* data, std::size_t n) {
     rlimit limit{};
     limit.rlim_cur = limit.rlim_max = addressSpaceBytes() + extra;
     setrlimit(RLIMIT_AS, &limit);
+  }
+  if (limits.startProbe) {
+    limits.startProbe();
+    if (!writeAll(fd, &kStarted, 1)) _exit(3);
   }
   char kind = kResult;
   std::string payload;
@@ -121,26 +128,15 @@ std::string signalName(int sig) {
 
 std::string runIsolated(const std::string& what, const IsolationLimits& limits,
                         const std::function<std::string()>& work) {
-  std::array<int, 2> fds{};
-  if (pipe2(fds.data(), O_CLOEXEC) != 0)
-    throw Error("cannot start a process for " + what + ": " + std::strerror(errno));
-  std::fflush(nullptr);
-  const pid_t parent = getpid();
-  const pid_t pid = fork();
-  if (pid < 0) {
-    const int error = errno;
-    ::close(fds[0]);
-    ::close(fds[1]);
-    throw Error("cannot start a process for " + what + ": " + std::strerror(error));
-  }
-  if (pid == 0) {
-    ::close(fds[0]);
-    runChild(fds[1], parent, limits, work);
-  }
-  ::close(fds[1]);
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();  // the budget counts from the first child
+  const bool probed = static_cast<bool>(limits.startProbe);
+  const int attempts = probed ? std::max(1, limits.startAttempts) : 1;
+  std::array<int, 2> fds{-1, -1};
+  pid_t pid = -1;
   // Whatever happens below (an allocation failing, a cancel callback throwing), the child is
   // killed and reaped and the pipe closed; `reaped` once waitpid has run.
-  bool reaped = false;
+  bool reaped = true;
   int status = 0;
   pid_t waited = 0;
   const auto reap = [&](bool kill) {
@@ -156,35 +152,68 @@ std::string runIsolated(const std::string& what, const IsolationLimits& limits,
     ~Guard() { onExit(); }
   } guard{[&] { reap(true); }};
 
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
   std::string bytes;
   std::array<char, 65536> buffer{};
   bool overTime = false, cancelled = false;
-  for (;;) {
-    pollfd in{fds[0], POLLIN, 0};
-    const int ready = poll(&in, 1, 50);
-    if (ready > 0) {
-      const ssize_t n = ::read(fds[0], buffer.data(), buffer.size());
-      if (n > 0) {
-        bytes.append(buffer.data(), static_cast<std::size_t>(n));
-      } else if (n == 0) {
-        break;  // the child closed its end (finished or died)
-      } else if (errno != EINTR) {
-        throw Error("cannot read the result of " + what + ": " + std::strerror(errno));
+  for (int attempt = 1;; ++attempt) {
+    if (pipe2(fds.data(), O_CLOEXEC) != 0)
+      throw Error("cannot start a process for " + what + ": " + std::strerror(errno));
+    std::fflush(nullptr);
+    const pid_t parent = getpid();
+    pid = fork();
+    if (pid < 0) {
+      const int error = errno;
+      ::close(fds[0]);
+      ::close(fds[1]);
+      throw Error("cannot start a process for " + what + ": " + std::strerror(error));
+    }
+    if (pid == 0) {
+      ::close(fds[0]);
+      runChild(fds[1], parent, limits, work);
+    }
+    ::close(fds[1]);
+    reaped = false;
+    const auto forked = Clock::now();
+    const bool lastAttempt = attempt >= attempts;
+    bool started = !probed, stuck = false;
+    bytes.clear();
+    for (;;) {
+      pollfd in{fds[0], POLLIN, 0};
+      const int ready = poll(&in, 1, 50);
+      if (ready > 0) {
+        const ssize_t n = ::read(fds[0], buffer.data(), buffer.size());
+        if (n > 0) {
+          bytes.append(buffer.data(), static_cast<std::size_t>(n));
+          if (!started) {
+            started = bytes[0] == kStarted;
+            if (started) bytes.erase(0, 1);
+          }
+        } else if (n == 0) {
+          break;  // the child closed its end (finished or died)
+        } else if (errno != EINTR) {
+          throw Error("cannot read the result of " + what + ": " + std::strerror(errno));
+        }
+      } else if (ready < 0 && errno != EINTR) {
+        throw Error("cannot wait for " + what + ": " + std::strerror(errno));
       }
-    } else if (ready < 0 && errno != EINTR) {
-      throw Error("cannot wait for " + what + ": " + std::strerror(errno));
+      if (limits.cancelled && limits.cancelled()) {
+        cancelled = true;
+        break;
+      }
+      const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+      if (limits.seconds > 0.0 && elapsed > limits.seconds) {
+        overTime = true;
+        break;
+      }
+      if (!started && !lastAttempt &&
+          std::chrono::duration<double>(Clock::now() - forked).count() > limits.startSeconds) {
+        stuck = true;
+        break;
+      }
     }
-    if (limits.cancelled && limits.cancelled()) {
-      cancelled = true;
-      break;
-    }
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    if (limits.seconds > 0.0 && elapsed > limits.seconds) {
-      overTime = true;
-      break;
-    }
+    if (!stuck) break;
+    reap(true);
+    if (limits.restarted) limits.restarted(attempt);
   }
   reap(cancelled || overTime);
 

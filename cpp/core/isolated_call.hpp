@@ -7,7 +7,12 @@
 // changes in memory is lost; only the returned bytes come back. Stdout and stderr are shared.
 //
 // The work must not need other threads of the caller (their locks may be held forever in the
-// child) and must not start an OpenMP team of more than one thread.
+// child) and must not start an OpenMP team of more than one thread. Where the work needs a lock
+// of a library that other threads of the caller may be inside at the moment of the fork (and
+// that the caller cannot hold across it: OpenCASCADE's error-handler mutex, which every OCCT
+// algorithm on every thread takes), `startProbe` takes that lock once in the child before the
+// work: a child whose probe has not returned within `startSeconds` is stuck on a copy of a lock
+// that no thread will ever release, and is killed and started again.
 #pragma once
 
 #include <cstddef>
@@ -28,6 +33,15 @@ struct IsolationLimits {
   // Address space the child may add to the caller's (its allocations beyond fail with
   // std::bad_alloc); 0: the memory available on the machine when the child starts.
   std::size_t extraBytes = 0;
+  // Run first in the child; the child counts as started once it returns. None: no probe.
+  std::function<void()> startProbe;
+  // With a probe: how long a child may take to start, and how many children are started at
+  // most; the last one is given the whole budget. A wrong guess on a slow machine costs a
+  // start, never a result.
+  double startSeconds = 5.0;
+  int startAttempts = 3;
+  // Told, in the caller, of each child given up before it started (its number, from 1).
+  std::function<void(int)> restarted;
 };
 
 // Runs `work` in a child process and returns the bytes it returned.

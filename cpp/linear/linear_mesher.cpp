@@ -4,11 +4,13 @@
 
 #include <BRepGProp.hxx>
 #include <GProp_GProps.hxx>
+#include <Standard_ErrorHandler.hxx>
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <iomanip>
 #include <limits>
 #include <map>
@@ -280,6 +282,19 @@ IsolationLimits isolationLimits(const LinearMeshOptions& options, double stated 
   limits.statedSeconds = stated;
   limits.budgetName = options.timeLimitName;
   limits.cancelled = options.cancelRequested;
+  // Gmsh runs OpenCASCADE, whose every error handler takes one process-wide mutex. Another
+  // thread of the caller (a second job, FreeCAD's own) may hold it at the fork, and the child's
+  // copy is then never released: eight jobs on four Python threads hung a child until its 600 s
+  // budget about once in 300 starts. The probe takes the mutex once before Gmsh starts, and a
+  // child stuck on it is started again (a fresh copy of the mutex, free by then).
+  limits.startProbe = [] { const Standard_ErrorHandler probe; };
+  limits.restarted = [verbosity = options.verbosity](int child) {
+    if (verbosity > 0)
+      std::fprintf(stderr,
+                   "homesh: note: Gmsh's process %d did not start (an OpenCASCADE lock held by "
+                   "another thread when it was made); started again\n",
+                   child);
+  };
   return limits;
 }
 

@@ -16,7 +16,7 @@ namespace homesh::test {
 // $HOMESH_SHARED_DIR when set, else the `shared` folder beside the source tree.
 inline std::filesystem::path sharedDir() {
   if (const char* env = std::getenv("HOMESH_SHARED_DIR"); env != nullptr && *env != '\0') {
-    return std::filesystem::path(env);
+    return {env};
   }
   return (std::filesystem::path(HOMESH_SOURCE_DIR) / ".." / "shared").lexically_normal();
 }

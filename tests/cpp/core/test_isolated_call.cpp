@@ -2,6 +2,7 @@
 // a crash, a hang, a runaway allocation or a cancel ends the child, never this process.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -120,6 +121,58 @@ TEST(IsolatedCall, CancellingEndsTheChild) {
                              return "";
                            }),
                CancelledError);
+}
+
+// A child whose start hangs on a lock that another thread of this process held at the fork
+// (OpenCASCADE's error-handler mutex did, under concurrent jobs) is killed and started again.
+// The "lock" here is a flag the probe waits on: set when the first child is made, cleared by
+// the parent while it waits for that child, so the first child's copy stays set forever and a
+// later child's copy is clear. However slow the machine, the first child never starts; a later
+// one does (the last one has the whole budget).
+std::atomic<bool> gLockHeld{false};
+
+TEST(IsolatedCall, AChildStuckOnALockCopiedAtTheForkIsStartedAgain) {
+  gLockHeld = true;
+  IsolationLimits limits;
+  limits.startProbe = [] {
+    while (gLockHeld.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  };
+  limits.startSeconds = 0.2;
+  limits.startAttempts = 3;
+  limits.seconds = 600;  // a hang guard: without the restart the first child never answers
+  limits.cancelled = [] {
+    gLockHeld = false;
+    return false;
+  };
+  std::vector<int> restarts;
+  limits.restarted = [&](int child) { restarts.push_back(child); };
+  EXPECT_EQ(runIsolated("the locked work", limits, [] { return std::string("done"); }), "done");
+  ASSERT_FALSE(restarts.empty());
+  EXPECT_EQ(restarts.front(), 1);
+  EXPECT_LE(restarts.size(), 2U);  // the third child, the last, is not given up
+  // Without a probe nothing is restarted, and the answer is the same.
+  limits.startProbe = nullptr;
+  restarts.clear();
+  EXPECT_EQ(runIsolated("the plain work", limits, [] { return std::string("done"); }), "done");
+  EXPECT_TRUE(restarts.empty());
+  // A probe that never returns in any child: the last child waits on, until the budget ends it.
+  gLockHeld = true;
+  limits.cancelled = nullptr;
+  limits.startProbe = [] {
+    while (gLockHeld.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  };
+  limits.seconds = 2.0;
+  std::string message;
+  try {
+    runIsolated("the stuck work", limits, [] { return std::string("done"); });
+  } catch (const MeshingError& e) {
+    message = e.what();
+  }
+  gLockHeld = false;
+  EXPECT_NE(message.find("the stuck work stopped at its time budget of 2 s"), std::string::npos)
+      << message;
+  // At most the first two given up (how many the budget left time for is the machine's).
+  EXPECT_LE(restarts.size(), 2U);
 }
 
 TEST(IsolatedCall, ARunawayAllocationFailsInTheChildOnly) {

@@ -78,7 +78,11 @@ std::string information(const std::string& cad, const std::string& type) {
 std::string parameters(const std::vector<std::pair<std::string, std::string>>& values) {
   std::string out = "    <PARAMETERS>\n";
   for (const auto& [key, value] : values)
-    out += "      <P PARAM=\"" + key + "\"\tVALUE=\"" + value + "\"   />\n";
+    out.append("      <P PARAM=\"")
+        .append(key)
+        .append("\"\tVALUE=\"")
+        .append(value)
+        .append("\"   />\n");
   return out + "    </PARAMETERS>\n\n";
 }
 

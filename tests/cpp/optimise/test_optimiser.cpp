@@ -209,7 +209,7 @@ TEST(Optimiser, TheMadeInputsAreValidAndCurved) {
     EXPECT_EQ(q.invalid + q.undecided, 0U) << m->dim << "D";
     EXPECT_LT(q.scaled.min, 0.9) << m->dim << "D";
     std::size_t fixed = 0;
-    std::vector<const ElementBlock*> cells{&m->blocks[0]};
+    std::vector<const ElementBlock*> cells{m->blocks.data()};
     for (const char c : boundaryNodes(m->numNodes(), cells)) fixed += c != 0 ? 1 : 0;
     EXPECT_GT(fixed, 0U) << m->dim << "D";
     EXPECT_LT(fixed, m->numNodes()) << m->dim << "D";

@@ -896,7 +896,7 @@ TEST(BoundaryLayerOnAHole, AtOrderSixTheFirstLayerFollowsTheRaisedWall) {
 // path returned): a layer 0.03 thick on the aerofoil (Edge5, Edge6), 3 layers, progression 1.5.
 std::string writeOwnNacaCase() {
   const auto dir = test::tempDir();
-  const std::string path = (dir / "naca2412.mcf").string();
+  std::string path = (dir / "naca2412.mcf").string();
   std::ofstream(path) << R"(<NEKTAR>
   <MESHING>
     <INFORMATION>
