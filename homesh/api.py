@@ -257,21 +257,9 @@ def load(path):
     return HighOrderMesh(core)
 
 
-def _sizing(min_delta, max_delta, eps, sources):
-    """The sizing dict the core takes, or None when nothing was asked (automatic sizing)."""
-    if min_delta is None and max_delta is None and eps is None and not sources:
-        return None
-    out = {}
-    for key, value in (("min_delta", min_delta), ("max_delta", max_delta), ("eps", eps)):
-        if value is None:
-            continue
-        if isinstance(value, bool) or not isinstance(value, numbers.Real):
-            raise ParameterError("%s must be a positive number, got %r" % (key, value))
-        if not float(value) > 0.0:
-            raise ParameterError("%s must be a positive number, got %g" % (key, value))
-        out[key] = float(value)
-    out["sources"] = [_source(i + 1, src) for i, src in enumerate(sources or ())]
-    return out
+def _sources(sources):
+    """Refinement source dicts checked field by field (messages name the source and field)."""
+    return [_source(i + 1, src) for i, src in enumerate(sources or ())]
 
 
 _SOURCE_FIELDS = {"segment": ("a", "b", "radius", "delta"), "sphere": ("a", "radius", "delta"),
@@ -329,67 +317,53 @@ def _cad_source(shape, name):
         "shape must be a Part.Shape, a CAD file path or BRep text, got %s" % type(shape).__name__)
 
 
-def predict(shape, min_delta=None, max_delta=None, eps=None, sources=(), write_octree=None,
-            name=None, threads=1, heal=True, solids_only=False, surface=False, auto=False):
+def predict(shape, write_octree=None, name=None, sources=(), **options):
     """The element count the linear mesh of a CAD shape will have, without making it.
 
     Builds the sizing octree (curvature sizes between min_delta and max_delta with sagitta
-    ratio eps, graded by 0.2; None: automatic, see ``homesh mesh --help``) and integrates it.
-    sources: refinement regions, dicts such as ``{"kind": "sphere", "a": (0, 0, 0),
+    ratio eps, graded by 0.2; not given: automatic, see ``homesh mesh --help``) and integrates
+    it. sources: refinement regions, dicts such as ``{"kind": "sphere", "a": (0, 0, 0),
     "radius": 1, "delta": 0.05}``, ``{"kind": "segment", "a": ..., "b": ..., "radius": ...,
     "delta": ...}``, ``{"kind": "box", "a": lo, "b": hi, "delta": ...}`` or ``{"kind":
     "curve", "edge": 3, "radius": ..., "delta": ...}``. write_octree: a .vtu path for the
     octree's leaves and sizes. shape may be a NekMesh .mcf path: its CAD (in metres) and,
-    unless given here, its sizes are used (likewise in :func:`mesh`). heal, solids_only,
-    surface, auto: the CAD check and healing, as for :func:`mesh` (the prediction is of the
-    model meshed; for a surface mesh, of its triangles).
+    unless given here, its sizes are used (likewise in :func:`mesh`). The CAD check and healing
+    are as for :func:`mesh` (the prediction is of the model meshed; for a surface mesh, of its
+    triangles).
 
     Returns the report as a dict: "predicted_elements", "dimension" and "sizing" (parameters,
     integrals and octree statistics).
     """
-    sizing = _sizing(min_delta, max_delta, eps, sources)
-    threads = _check_int("threads", threads)
     octree = "" if write_octree is None else os.fspath(write_octree)
+    given = dict(options, sources=_sources(sources))
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
-        text = _core.predict_brep(value, label, sizing, octree, threads, bool(heal),
-                                  _cad_modes(solids_only, surface, auto))
+        text = _core.predict_brep(value, label, given, octree)
     else:
-        text = _core.predict_file(value, sizing, octree, threads, bool(heal),
-                                  _cad_modes(solids_only, surface, auto))
+        text = _core.predict_file(value, given, octree)
     return json.loads(text)
 
 
-def size_field(shape, min_delta=None, max_delta=None, eps=None, sources=(), name=None,
-               threads=1, heal=True, solids_only=False, surface=False, auto=False):
+def size_field(shape, name=None, sources=(), **options):
     """The sizing octree's leaves inside the model or on its boundary, for drawing the size
     field: a dict of numpy arrays ``centre`` (L, 3), ``half_width`` (L,), ``delta`` (L,), the
     size there, and ``boundary`` (L,) 1 where the model's boundary passes through the leaf,
     with ``predicted_elements``. Arguments as for :func:`predict` (a shape, or BRep text)."""
-    sizing = _sizing(min_delta, max_delta, eps, sources)
-    threads = _check_int("threads", threads)
     kind, value, label = _cad_source(shape, name)
     if kind != "brep":
         raise ParameterError("size_field takes a shape or BRep text, not a file path")
-    return dict(_core.size_field(value, label, sizing, threads, bool(heal),
-                                 _cad_modes(solids_only, surface, auto)))
+    return dict(_core.size_field(value, label, dict(options, sources=_sources(sources))))
 
 
-def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=None,
-         optimise=0, min_delta=None, max_delta=None, eps=None, sources=(), repair_rounds=8,
-         boundary_layer=None, cancel=None, optimise_seconds=0.0, linear_seconds=600.0,
-         heal=True, job_seconds=0.0, solids_only=False, surface=False, auto=False,
-         facet_weight=0.0):
+def mesh(shape, progress=None, cancel=None, name=None, sources=(), boundary_layer=None,
+         **options):
     """Meshes a CAD shape with curved elements of the given order.
 
     shape     a FreeCAD ``Part.Shape`` (or any object with ``exportBrepToString()``), a path to
               a .step/.stp/.iges/.igs/.brep/.brp file, or BRep text.
-    order     polynomial order, 1..10.
-    size      a uniform target element size (a positive length) instead of the sizing octree.
-    min_delta, max_delta, eps, sources
-              sizing octree parameters, as for :func:`predict`; all None (and no size):
-              automatic sizing. ``report()`` then has "predicted_elements" and "sizing".
-    threads   threads the core may use.
+    sources   refinement regions of the sizing octree, as for :func:`predict`. With
+              min_delta, max_delta, eps or sources (and no size), ``report()`` has
+              "predicted_elements" and "sizing"; with none of them, automatic sizing.
     progress  optional ``callable(stage, seconds)``: called with ``seconds=None`` when a stage
               starts and with its duration when it ends. A callable of four parameters,
               ``(stage, seconds, fraction, detail)``, is also called within stages (the linear
@@ -402,112 +376,39 @@ def mesh(shape, order=4, size=None, threads=1, verbosity=0, progress=None, name=
               of a second with :class:`CancelledError`; the core runs with the GIL released.
     name      how error messages call a shape given as an object or BRep text (for example
               the FreeCAD object's label); default "the shape".
-    optimise  > 0: after curving, at most this many sweeps of the variational optimiser
-              (hyperelastic; boundary nodes slide on the CAD), stage "optimise".
-    optimise_seconds
-              > 0: each optimiser run stops after this many seconds with its best state so
-              far (``report()["optimiser"]["stopped"] == "time budget"``); 0: no limit.
-    facet_weight
-              > 0 (0..100; 1 is a good start): once every element is proven valid, the
-              optimiser also keeps the boundary facets' nodes evenly spread as they slide on
-              the CAD, so the curved boundary stays on it between them
-              (``report()["geometry"]``); 0: off.
-    linear_seconds
-              Gmsh's linear meshing runs in a child process (a crash inside Gmsh becomes a
-              :class:`MeshingError`); it is stopped after this many seconds and the job fails
-              naming this limit; 0: no limit. ``report()["notes"]`` says when Gmsh crashed and
-              was run again another way.
-    job_seconds
-              > 0: the whole job's wall-time budget, from loading the CAD. Gmsh and every
-              optimiser run get at most what is left of it, a repair round starts only if what
-              is left covers what the round before took, the geometry check is left out once it
-              is spent, and the best mesh so far is returned (not proven valid, perhaps:
-              check ``quality()``); ``report()["job"]`` has ``"stopped": "time budget"`` and
-              lists what it ``"cut"`` short or ``"skipped"``. Spent before there is a mesh (in
-              the CAD, sizing or linear stage): :class:`MeshingError` naming the stage. 0: no
-              budget.
-    heal      check the CAD after loading and, where the check finds a problem (faces not
-              sewn into a solid, OCCT-invalid shapes, edges or faces far smaller than the model),
-              repair it with OpenCASCADE's shape healing; ``report()["healing"]`` says what was
-              found and done (a healed model's faces are numbered afresh). False: check only.
-    solids_only
-              faces in no solid (a loose shell beside solids, shells sewing cannot close) are
-              left out, and ``report()["healing"]["left_out"]`` and a note say which and where;
-              False: such a model is refused (:class:`CadError` naming the faces).
-    surface   for a model without solids (a shell, faces that do not close): a surface mesh
-              of its faces, triangles curved on the CAD (``dimension`` 2, no plane), sewn
-              where faces meet; ``report()["healing"]["surface"]`` says so. No volume, no
-              optimiser (a note says so when optimise > 0), no boundary layer. False: such a
-              model is refused (:class:`CadError` naming a free edge).
-    auto      for batch runs over files nobody looked at: a model with solids is meshed as
-              with solids_only; one without a solid is sewn into solids where every shell
-              closes (as without auto), else meshed as with surface (planar faces in one
-              plane stay 2D); ``report()["healing"]["automatic"]`` and a note say which.
-              Not with solids_only or surface. False: faces in no solid and open shells are
-              refused by name.
-    repair_rounds
-              at most this many repair rounds (0..20) while elements are not proven valid:
-              each splits the offending linear elements' edges on curved CAD faces (or refines
-              around them), then curves, optimises and checks again (stages "repair 1", ...;
-              ``report()["rounds"]``). 0: none.
     boundary_layer
               a 3D boundary layer: ``{"faces": [1, 8], "thickness": 0.04, "layers": 6,
               "progression": 1.5}`` (faces as FreeCAD numbers them, FaceN; thickness a number
               or an expression of x, y, z such as ``"0.01+0.05*x"``; layers and progression
-              optional, 2 and 2 by default as in NekMesh). A macro prism layer is grown,
-              curved and optimised with the rest, then split (``report()["boundary_layer"]``).
-              For a NekMesh .mcf file, its BndLayer* keys are used when this is None.
+              optional, with the defaults below). A macro prism layer is grown, curved and
+              optimised with the rest, then split (``report()["boundary_layer"]``). For a
+              NekMesh .mcf file, its BndLayer* keys are used when this is None.
 
-    Raises ParameterError, FileError, CadError, MeshingError or CancelledError.
+    The options (keywords, from the one parameter table; None or left out: the default) are
+    listed below. ``optimise=True`` asks for the table's default number of sweeps. Elements
+    still not proven valid after the optimiser go through the repair rounds; a job's time
+    budget (job_seconds) keeps the best mesh so far (``report()["job"]``). Raises
+    ParameterError, FileError, CadError, MeshingError or CancelledError.
     """
-    order, threads, verbosity, optimise, progress, optimise_seconds = _job_arguments(
-        order, threads, verbosity, optimise, progress, cancel, optimise_seconds)
-    repair_rounds = _check_int("repair_rounds", repair_rounds)
-    limits = {"optimise_seconds": optimise_seconds,
-              "linear_seconds": _check_seconds(linear_seconds, "linear_seconds"),
-              "job_seconds": _check_seconds(job_seconds, "job_seconds"),
-              "facet_weight": _check_number(facet_weight, "facet_weight")}
-    if size is not None:
-        if isinstance(size, bool) or not isinstance(size, numbers.Real):
-            raise ParameterError("size must be a positive number, got %r" % (size,))
-        size = float(size)
-        if not size > 0.0:
-            raise ParameterError("size must be a positive length, got %g" % size)
-    sizing = _sizing(min_delta, max_delta, eps, sources)
-    if size is not None and sizing is not None:
-        raise ParameterError("give either size (uniform) or the sizing octree parameters")
-
     layer = _boundary_layer(boundary_layer)
-
+    given = dict(options, sources=_sources(sources), boundary_layer=layer)
+    progress = _progress(progress, cancel)
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
-        core = _core.mesh_brep(value, label, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds, layer, cancel, limits, bool(heal),
-                               _cad_modes(solids_only, surface, auto))
+        core = _core.mesh_brep(value, label, given, progress, cancel)
     else:
-        core = _core.mesh_file(value, order, size, threads, verbosity, progress, optimise,
-                               sizing, repair_rounds, layer, cancel, limits, bool(heal),
-                               _cad_modes(solids_only, surface, auto))
+        core = _core.mesh_file(value, given, progress, cancel)
     return HighOrderMesh(core)
 
 
-def _cad_modes(solids_only, surface, auto):
-    """The core's one string for the CAD modes asked for (conflicts are the core's to name)."""
-    return ",".join(name for name, on in (("solids_only", solids_only), ("surface", surface),
-                                          ("auto", auto)) if on)
-
-
-def _job_arguments(order, threads, verbosity, optimise, progress, cancel, optimise_seconds):
-    """The arguments :func:`mesh` and :func:`curve` share, checked (types here, ranges by the
-    core): order, threads, verbosity, optimise, the progress callable in the core's
-    four-argument form and optimise_seconds."""
+def _progress(progress, cancel):
+    """The progress callable in the core's four-argument form, with the types of progress and
+    cancel checked."""
     if progress is not None and not callable(progress):
         raise ParameterError("progress must be callable")
     if cancel is not None and not isinstance(cancel, _core.CancelToken):
         raise ParameterError("cancel must be a homesh.CancelToken, got %r" % (cancel,))
-    return (_check_int("order", order), _check_int("threads", threads),
-            _check_int("verbosity", verbosity), _check_int("optimise", optimise),
-            _four_argument_progress(progress), _check_seconds(optimise_seconds))
+    return _four_argument_progress(progress)
 
 
 def _four_argument_progress(progress):
@@ -532,8 +433,7 @@ def _four_argument_progress(progress):
     return stages_only
 
 
-def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=None, name=None,
-          optimise=0, cancel=None, optimise_seconds=0.0, job_seconds=0.0, facet_weight=0.0):
+def curve(shape, nodes, tetrahedra, progress=None, cancel=None, name=None, **options):
     """Curves a linear tetrahedral mesh made by another tool (FreeCAD FEM's Gmsh or Netgen
     mesher) on the CAD it was made from.
 
@@ -543,13 +443,12 @@ def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=No
     tetrahedra  (E, 4) 0-based node indices (either orientation; corner nodes only).
 
     Each boundary node is put on the CAD vertex, edge or face it lies on, the mesh is raised to
-    ``order`` with its boundary nodes on the CAD and, with ``optimise`` > 0, optimised with them
-    sliding on it (stages "classify", "high_order", "optimise", ...). progress, cancel,
-    optimise_seconds, job_seconds, facet_weight, threads and name as for :func:`mesh`. Raises ParameterError, CadError or MeshingError (naming the
-    boundary node that lies on no CAD face).
+    ``order`` with its boundary nodes on the CAD and, with ``optimise``, optimised with them
+    sliding on it (stages "classify", "high_order", "optimise", ...). progress, cancel and name
+    as for :func:`mesh`; the options are listed below. Raises ParameterError, CadError or
+    MeshingError (naming the boundary node that lies on no CAD face).
     """
-    order, threads, verbosity, optimise, progress, optimise_seconds = _job_arguments(
-        order, threads, verbosity, optimise, progress, cancel, optimise_seconds)
+    progress = _progress(progress, cancel)
     nodes = np.ascontiguousarray(nodes, dtype=np.float64)
     tetrahedra = np.ascontiguousarray(tetrahedra, dtype=np.int64)
     if nodes.ndim != 2 or nodes.shape[1] != 3:
@@ -557,16 +456,11 @@ def curve(shape, nodes, tetrahedra, order=4, threads=1, verbosity=0, progress=No
     if tetrahedra.ndim != 2 or tetrahedra.shape[1] != 4:
         raise ParameterError("tetrahedra must be an (E, 4) array of corner nodes, got shape %s"
                              % (tetrahedra.shape,))
-    limits = {"optimise_seconds": optimise_seconds,
-              "job_seconds": _check_seconds(job_seconds, "job_seconds"),
-              "facet_weight": _check_number(facet_weight, "facet_weight")}
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
-        core = _core.curve_brep(value, label, nodes, tetrahedra, order, threads, verbosity,
-                                progress, optimise, cancel, limits)
+        core = _core.curve_brep(value, label, nodes, tetrahedra, options, progress, cancel)
     else:
-        core = _core.curve_file(value, nodes, tetrahedra, order, threads, verbosity, progress,
-                                optimise, cancel, limits)
+        core = _core.curve_file(value, nodes, tetrahedra, options, progress, cancel)
     return HighOrderMesh(core)
 
 
@@ -574,8 +468,8 @@ _BOUNDARY_LAYER_KEYS = ("faces", "thickness", "layers", "progression")
 
 
 def _boundary_layer(spec):
-    """The boundary-layer dict the core takes (keys and types checked here, ranges by the
-    core), or None."""
+    """The boundary-layer dict the core takes (keys, faces and thickness checked here, layers
+    and progression by the core), or None."""
     if spec is None:
         return None
     if not isinstance(spec, dict):
@@ -597,13 +491,9 @@ def _boundary_layer(spec):
         raise ParameterError("boundary_layer thickness must be a number or an expression of "
                              "x, y, z, got %r" % (thickness,))
     out["thickness"] = thickness if isinstance(thickness, str) else repr(float(thickness))
-    if "layers" in spec:
-        out["layers"] = _check_int("boundary_layer layers", spec["layers"])
-    if "progression" in spec:
-        r = spec["progression"]
-        if isinstance(r, bool) or not isinstance(r, numbers.Real):
-            raise ParameterError("boundary_layer progression must be a number, got %r" % (r,))
-        out["progression"] = float(r)
+    for key in ("layers", "progression"):  # kind and range: the core's parameter table
+        if key in spec:
+            out[key] = spec[key]
     return out
 
 
@@ -612,11 +502,6 @@ def _check_number(value, name, what="a number"):
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ParameterError("%s must be %s, got %r" % (name, what, value))
     return float(value)
-
-
-def _check_seconds(value, name="optimise_seconds"):
-    """A time limit in seconds: a number (the core checks its range)."""
-    return _check_number(value, name, "a number of seconds")
 
 
 _INT32_MAX = 2**31 - 1
@@ -632,3 +517,44 @@ def _check_int(name, value):
 
 def _cell_dim(element_type):
     return {"line": 1, "tri": 2, "quad": 2}.get(element_type, 3)
+
+
+def _keyword_default(p):
+    """A table entry's default as a Python keyword's: None where 0 is automatic, False for a
+    switchable count (the optimiser is asked for with True or a number)."""
+    if p["zero_is_automatic"]:
+        return None
+    if p["switchable"]:
+        return False
+    if p["kind"] == "boolean":
+        return bool(p["default"])
+    return int(p["default"]) if p["kind"] == "integer" else p["default"]
+
+
+def _document(function, table_function):
+    """Gives ``function`` the table's keywords: a signature that help() and editors show, and a
+    docstring section listing each with its default, range and meaning."""
+    import inspect
+    import textwrap
+    table = {p["key"]: p for p in parameters()}
+    keys = list(_core.option_keys(table_function))
+    signature = inspect.signature(function)
+    fixed = [q for q in signature.parameters.values() if q.kind != q.VAR_KEYWORD]
+    extra = [inspect.Parameter(k, inspect.Parameter.KEYWORD_ONLY,
+                               default=_keyword_default(table[k])) for k in keys]
+    function.__signature__ = signature.replace(parameters=fixed + extra)
+    lines = ["", "    Options:"]
+    for k in keys:
+        p = table[k]
+        head = "%s = %r: %s" % (k, _keyword_default(p), p["range"])
+        if p["zero_is_automatic"]:
+            head += " (None: automatic)"
+        lines.append(textwrap.fill(head + ". " + p["doc"] + ".", 96,
+                                   initial_indent="    ", subsequent_indent="        "))
+    function.__doc__ = (function.__doc__ or "").rstrip() + "\n" + "\n".join(lines) + "\n"
+
+
+_document(mesh, "mesh")
+_document(curve, "curve")
+_document(predict, "sizing")
+_document(size_field, "sizing")

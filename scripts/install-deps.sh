@@ -1,7 +1,7 @@
 #!/bin/sh
 # Installs the Debian 12 packages HOMesh needs to build, run and test (idempotent: does nothing
 # when all are present). Needs root, or sudo. occt-misc is OpenCASCADE's sample data: the CAD
-# corpus benchmark and a repair-round test mesh its files.
+# corpus benchmark and a repair-round test mesh its files. man-db: `man homesh`.
 set -eu
 
 PACKAGES="
@@ -11,7 +11,7 @@ PACKAGES="
   libeigen3-dev libgmsh-dev gmsh zlib1g-dev
   libboost-python-dev libboost-numpy-dev python3-dev python3-numpy
   libgtest-dev python3-pytest python3-meshio python3-vtk9
-  xvfb xauth ccache
+  xvfb xauth ccache man-db
   occt-misc
 "
 

@@ -6,7 +6,9 @@
 #include <map>
 
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/parameters.hpp"
+#include "core/version.hpp"
 #include "optimise/functional.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 
@@ -194,48 +196,48 @@ std::string onlyInput(const std::vector<std::string>& positional, const std::str
   return positional[0];
 }
 
+// The table's options `keys` by their command-line spellings (core/parameters.hpp), into
+// `values`: a Boolean's flag turns its default around, the others take a value checked against
+// the table's range.
+void addTableOptions(OptionTable& table, OptionMap& values,
+                     std::initializer_list<const char*> keys) {
+  for (const char* key : keys) {
+    const ParameterDefinition& p = parameterDefinition(key);
+    const std::string name = p.option;
+    const std::string alias = p.shortOption;
+    const auto names = [&] {
+      std::vector<std::string> n{name};
+      if (!alias.empty()) n.push_back(alias);
+      return n;
+    }();
+    for (const std::string& n : names) {
+      if (p.kind == ParameterKind::Boolean) {
+        const bool on = p.defaultValue == 0.0;
+        table.flag({n.c_str()}, [&values, key, on] { values[key] = on; });
+      } else {
+        table.value({n.c_str()}, [&values, key](const std::string& o, const std::string& v) {
+          values[key] = parseParameter(key, o, v);
+        });
+      }
+    }
+  }
+}
+
+// The CAD modes, which mesh and predict share.
+constexpr std::initializer_list<const char*> kCadModes = {"heal", "solids_only", "surface", "auto"};
+
 MeshCommand parseMesh(const std::vector<std::string>& args) {
   MeshCommand cmd;
   OptionTable table;
   addCommon(table, cmd.common, true, true);
-  table.value({"--order", "-p"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.order = static_cast<int>(parseParameter("order", o, v));
-  });
-  table.value({"--size", "-s"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.size = parseParameter("size", o, v);
-  });
   addSizing(table, cmd.sizing);
+  OptionMap& values = cmd.options;
+  addTableOptions(table, values,
+                  {"order", "size", "optimise", "repair_rounds", "optimise_seconds", "facet_weight",
+                   "linear_seconds", "job_seconds"});
+  addTableOptions(table, values, kCadModes);
   bool optimise = false;
-  std::optional<int> maxiter;
   table.flag({"--optimise", "--optimize"}, [&optimise] { optimise = true; });
-  table.flag({"--no-heal"}, [&cmd] { cmd.heal = false; });
-  table.flag({"--solids-only"}, [&cmd] { cmd.solidsOnly = true; });
-  table.flag({"--surface"}, [&cmd] { cmd.surface = true; });
-  table.flag({"--auto"}, [&cmd] { cmd.automatic = true; });
-  table.value({"--maxiter", "-n"}, [&maxiter](const std::string& o, const std::string& v) {
-    maxiter = parseInteger(o, v);
-    if (*maxiter < 1) throw UsageError{"--maxiter must be >= 1, got " + v};
-  });
-  table.value({"--repair-rounds"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.repairRounds = static_cast<int>(parseParameter("repair_rounds", o, v));
-  });
-  // Options of the optimiser, which runs only with --optimise: given without it they would do
-  // nothing, so they are refused by name (the first one given).
-  std::string optimiserOption;
-  table.value({"--time-limit"}, [&](const std::string& o, const std::string& v) {
-    cmd.timeLimit = parseParameter("optimise_seconds", o, v);
-    if (optimiserOption.empty()) optimiserOption = "--time-limit";
-  });
-  table.value({"--facet-weight"}, [&](const std::string& o, const std::string& v) {
-    cmd.facetWeight = parseParameter("facet_weight", o, v);
-    if (optimiserOption.empty()) optimiserOption = "--facet-weight";
-  });
-  table.value({"--linear-time-limit"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.linearTimeLimit = parseParameter("linear_seconds", o, v);
-  });
-  table.value({"--job-time-limit"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.jobTimeLimit = parseParameter("job_seconds", o, v);
-  });
   table.value({"--bl-faces"},
               [&cmd](const std::string&, const std::string& v) { cmd.blFaces = v; });
   table.value({"--bl-thickness"},
@@ -246,19 +248,25 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   table.value({"--bl-progression"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.blProgression = parseParameter("progression", o, v);
   });
-  table.flag({"--verbose", "-v"}, [&cmd] { ++cmd.verbosity; });
-  table.flag({"-vv"}, [&cmd] { cmd.verbosity += 2; });
+  int verbosity = 0;
+  table.flag({"--verbose", "-v"}, [&verbosity] { ++verbosity; });
+  table.flag({"-vv"}, [&verbosity] { verbosity += 2; });
   cmd.input = onlyInput(table.parse(args, 1, "mesh"), "mesh", "an INPUT CAD or .mcf file");
-  if (maxiter && !optimise) throw UsageError{"--maxiter needs --optimise"};
-  if (!optimiserOption.empty() && !optimise)
-    throw UsageError{optimiserOption + " needs --optimise"};
-  if (cmd.size && (cmd.sizing.anyDelta() || !cmd.sizing.sources.empty()))
+  if (verbosity > 0)
+    values["verbosity"] = static_cast<double>(
+        std::min(verbosity, static_cast<int>(parameterDefinition("verbosity").max)));
+  // The optimiser's options do nothing without it: refused by name (in the table's order).
+  if (!optimise)
+    for (const char* key : {"optimise", "optimise_seconds", "facet_weight"})
+      if (values.count(key) != 0)
+        throw UsageError{std::string(parameterDefinition(key).option) + " needs --optimise"};
+  if (optimise && values.count("optimise") == 0) values["optimise"] = true;  // the table's
+  if (values.count("size") != 0 && (cmd.sizing.anyDelta() || !cmd.sizing.sources.empty()))
     throw UsageError{
         "--size (uniform) cannot be combined with the octree's --min-delta, "
         "--max-delta, --eps or --refine-*"};
-  if (cmd.size && cmd.sizing.writeOctree)
+  if (values.count("size") != 0 && cmd.sizing.writeOctree)
     throw UsageError{"--write-octree needs octree sizing, not --size"};
-  if (optimise) cmd.optimiseIterations = maxiter.value_or(100);
   return cmd;
 }
 
@@ -267,10 +275,7 @@ PredictCommand parsePredict(const std::vector<std::string>& args) {
   OptionTable table;
   addCommon(table, cmd.common, false, true);
   addSizing(table, cmd.sizing);
-  table.flag({"--no-heal"}, [&cmd] { cmd.heal = false; });
-  table.flag({"--solids-only"}, [&cmd] { cmd.solidsOnly = true; });
-  table.flag({"--surface"}, [&cmd] { cmd.surface = true; });
-  table.flag({"--auto"}, [&cmd] { cmd.automatic = true; });
+  addTableOptions(table, cmd.options, kCadModes);
   cmd.input = onlyInput(table.parse(args, 1, "predict"), "predict", "an INPUT CAD or .mcf file");
   return cmd;
 }
@@ -347,6 +352,11 @@ ParsedCommand parseCommandLine(const std::vector<std::string>& args) {
     if (args.size() > 1) parsed.helpTopic = args[1];
     return parsed;
   }
+  if (first == "--man") {  // the manual page, from the same help texts (CMake installs it)
+    parsed.kind = ParsedCommand::Kind::Help;
+    parsed.helpTopic = "--man";
+    return parsed;
+  }
   if (first == "--version" || first == "version") {
     parsed.kind = ParsedCommand::Kind::Version;
     return parsed;
@@ -379,6 +389,56 @@ ParsedCommand parseCommandLine(const std::vector<std::string>& args) {
   return parsed;
 }
 
+// `text` wrapped at `width` columns after a first line that starts at column `first`, every
+// later line indented by `indent`.
+std::string wrapped(const std::string& text, std::size_t first, std::size_t indent,
+                    std::size_t width) {
+  std::string out, line;
+  std::size_t column = first;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find(' ', start);
+    if (end == std::string::npos) end = text.size();
+    const std::string word = text.substr(start, end - start);
+    if (!line.empty() && column + line.size() + 1 + word.size() > width) {
+      out += line + "\n" + std::string(indent, ' ');
+      line.clear();
+      column = indent;
+    }
+    line += (line.empty() ? "" : " ") + word;
+    start = end + 1;
+  }
+  return out + line + "\n";
+}
+
+// The help lines of the table's options `keys` (core/parameters.hpp): spellings, meaning, range
+// and default, as the table states them.
+std::string tableHelp(std::initializer_list<const char*> keys) {
+  constexpr std::size_t kColumn = 22;
+  std::string out;
+  for (const char* key : keys) {
+    const ParameterDefinition& p = parameterDefinition(key);
+    std::string head =
+        *p.shortOption != '\0' ? std::string("  ") + p.shortOption + ", " : std::string(6, ' ');
+    head += p.option;
+    std::string text = p.doc;
+    if (p.kind == ParameterKind::Boolean) {
+      // The flag turns the default around: say which way.
+      text = p.defaultValue != 0.0 ? "turns off what is on unless given: " + text
+                                   : text + " (off unless given)";
+    } else {
+      const bool seconds = std::string(key).find("_seconds") != std::string::npos;
+      head += p.kind == ParameterKind::Integer ? " N" : seconds ? " S" : " X";
+      text += "; " + rangeText(p) + ", default " +
+              (p.zeroIsAutomatic && p.defaultValue == 0.0 ? std::string("automatic")
+                                                          : formatNumber(p.defaultValue));
+    }
+    head += head.size() + 2 <= kColumn ? std::string(kColumn - head.size(), ' ') : "  ";
+    out += head + wrapped(text, head.size(), kColumn, 92);
+  }
+  return out;
+}
+
 std::string usageText(const std::string& topic) {
   if (topic == "mesh")
     return R"(usage: homesh mesh INPUT [options]
@@ -392,66 +452,38 @@ REFINEMENT lines and Order are used; the options below override them.
 Sizes come from the sizing octree: curvature-driven (a chord deviates from the CAD by at
 most EPS x the radius of curvature), between MinDelta and MaxDelta, graded by 0.2 per unit
 length away from curved boundaries. Without sizes: MaxDelta = bounding-box diagonal / 20,
-MinDelta = MaxDelta / 20, EPS = 0.05.
+MinDelta = MaxDelta / 20, EPS = )" +
+           formatNumber(parameterDefault("eps")) + R"(.
 
-options:
-  -p, --order P       polynomial order, 1..10 (default 4, or the .mcf's Order)
-      --max-delta D   largest size (sets octree sizing; --min-delta defaults to D / 20,
-                      --eps to 0.05 unless a .mcf gives them)
-      --min-delta D   smallest size curvature may ask for
-      --eps E         sagitta / radius of curvature, 0 < E <= 1
+options (the parameter table's, which Python and FreeCAD read too):
+)" + tableHelp({"order", "size", "min_delta", "max_delta", "eps"}) +
+           R"(      --optimise      run the variational optimiser after curving (hyperelastic),
+                      boundary nodes sliding on the CAD curves and faces
+)" +
+           tableHelp({"optimise", "optimise_seconds", "facet_weight", "repair_rounds",
+                      "linear_seconds", "job_seconds", "heal", "solids_only", "surface", "auto"}) +
+           R"(
+refinement of the sizing octree:
       --refine-line X1,Y1,Z1,X2,Y2,Z2,R,D    size at most D within R of a segment
       --refine-sphere X,Y,Z,R,D             size at most D within a sphere
       --refine-box X0,Y0,Z0,X1,Y1,Z1,D      size at most D within a box
       --refine-curve N,R,D                  size at most D within R of CAD edge N
       --write-octree FILE.vtu               the octree's leaves with their sizes
-  -s, --size H        a uniform size instead of the octree
-      --optimise      curve the interior with the variational optimiser (hyperelastic),
-                      boundary nodes sliding on the CAD curves and faces
-  -n, --maxiter N     at most N optimiser sweeps (default 100)
-      --repair-rounds N  at most N repair rounds while elements are not proven valid
-                      (split their edges on curved faces, flip slivers away, remesh the
-                      cavity around them, or refine around them; then curve, optimise and
-                      check again); default 8, 0 for none
-      --time-limit S  each optimiser run stops after S seconds with its best state
-                      (report: "stopped": "time budget"); default 0, no limit
-      --facet-weight W  once every element is proven valid, the optimiser also keeps the
-                      boundary facets' nodes evenly spread as they slide, so the curved
-                      boundary stays on the CAD between them (default 0: off; 1 is a good
-                      start; 0..100)
-      --no-heal       check the CAD only; do not sew, fix or merge small edges and faces
-                      (healing runs only when the check finds a problem, and the report's
-                      "healing" says what it found and did)
-      --solids-only   mesh the solids and leave out faces in no solid (a loose shell that
-                      does not close), naming them in a note; without it such a model is
-                      refused, naming those faces
-      --surface       for a model without solids (a shell, faces that do not close): a
-                      surface mesh of its faces, triangles curved on the CAD, sewn where
-                      faces meet; no volume, no optimiser, no boundary layer
-      --auto          for batch runs over files nobody looked at: a model with solids is
-                      meshed as with --solids-only; one without a solid is sewn into solids
-                      where every shell closes (as without --auto), else meshed as with
-                      --surface (planar faces stay 2D); a note says which. Without it, faces
-                      in no solid and open shells are refused by name
-      --linear-time-limit S  Gmsh's linear meshing (in a process of its own) is stopped after
-                      S seconds and the run fails (default 600; 0: no limit)
-      --job-time-limit S  the whole job's wall time: Gmsh and the optimiser get at most what
-                      is left, a repair round starts only if the last one would still fit, and
-                      the best mesh so far is written (report: "job": {"stopped": "time
-                      budget"}); with no mesh yet, one error naming the stage (default 0: none)
-      --bl-faces LIST     boundary layer on these CAD faces (FaceN numbers: 1,8 or 11-12)
+
+boundary layer (the macro layer is curved and optimised with the rest, then split):
+      --bl-faces LIST     on these CAD faces (FaceN numbers: 1,8 or 11-12)
       --bl-thickness T    its total thickness: a number or an expression of x, y, z
-      --bl-layers N       thin layers it is split into (default 2; 1..100)
-      --bl-progression R  height ratio of consecutive layers, from the wall (default 2)
-                      (the macro layer is curved and optimised with the rest, then split)
+)" + tableHelp({"layers", "progression"}) +
+           R"(
+output:
   -o, --output FILE   write the mesh: .msh (Gmsh 4.1), .vtu (VTK), .xml (Nektar++); repeatable
       --binary        binary MSH, raw appended VTU data
       --compressed    compressed Nektar++ XML (B64Z-LittleEndian)
       --group NAME=F1,F2  a named boundary group (faces; 2D: curves) written as one physical
                       group (MSH) / composite (Nektar++ XML) called NAME; repeatable
       --report FILE   write the JSON report ("-" for standard output)
-  -j, --threads N     threads (default 1)
-  -v, --verbose       show Gmsh's warnings (-vv: and its information)
+)" + tableHelp({"threads"}) +
+           R"(  -v, --verbose       show Gmsh's warnings (-vv: and its information)
   -q, --quiet         print nothing but errors
 
 exit status: 0 success, 1 failure (file, CAD or meshing), 2 bad command line or parameter,
@@ -471,8 +503,8 @@ options:
       --write-octree FILE.vtu   the octree's leaves with their sizes (ParaView)
       --no-heal, --solids-only, --surface, --auto   as for 'homesh mesh'
       --report FILE   write the JSON report ("-" for standard output)
-  -j, --threads N     threads (default 1)
-  -q, --quiet         print nothing but errors
+)" + tableHelp({"threads"}) +
+           R"(  -q, --quiet         print nothing but errors
 )";
   if (topic == "quality")
     return R"(usage: homesh quality INPUT [options]
@@ -543,6 +575,40 @@ commands:
   --version       print the version
   --help          this text
 )";
+}
+
+// `text` with what roff would take as its own escaped: backslashes, and a leading dot or quote.
+std::string roffText(const std::string& text) {
+  std::string out;
+  bool lineStart = true;
+  for (const char c : text) {
+    if (lineStart && (c == '.' || c == '\'')) out += "\\&";
+    if (c == '\\')
+      out += "\\e";
+    else if (c == '-')
+      out += "\\-";
+    else
+      out += c;
+    lineStart = c == '\n';
+  }
+  return out;
+}
+
+std::string manPage() {
+  std::string out = ".TH HOMESH 1 \"\" \"homesh " + std::string(kVersion) +
+                    "\" \"User Commands\"\n"
+                    ".SH NAME\nhomesh \\- curved (high-order) meshes from CAD for high-order "
+                    "CFD\n.SH SYNOPSIS\n.nf\n";
+  out += roffText(usageText(""));
+  out += ".fi\n";
+  for (const char* topic : {"mesh", "predict", "quality", "convert", "optimise"}) {
+    out +=
+        std::string(".SH \"HOMESH ") + topic + "\"\n.nf\n" + roffText(usageText(topic)) + ".fi\n";
+  }
+  out +=
+      ".SH \"SEE ALSO\"\nThe manual in the docs/ folder of the HOMesh sources; the Python "
+      "module's help(homesh.mesh), whose options are the same table's.\n";
+  return out;
 }
 
 }  // namespace homesh

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/meshing_options.hpp"
 #include "sizing/refinement_source.hpp"
 
 namespace homesh {
@@ -36,20 +37,11 @@ struct SizingFlags {
 
 struct MeshCommand {
   std::string input;
-  std::optional<int> order;  // unset: the .mcf's Order, else 4
-  std::optional<double> size;
+  // The parameter table's options given (core/parameters.hpp), by key: "order" (unset: the
+  // .mcf's Order, else the table's), "size", "optimise" (--optimise: true, the table's sweeps;
+  // --maxiter N: N), "verbosity" (-v, -vv), "heal", ...; MeshingOptions::apply takes them.
+  OptionMap options;
   SizingFlags sizing;
-  int verbosity = 0;               // -v: 1, -vv: 2
-  int optimiseIterations = 0;      // --optimise: 100, --maxiter N
-  int repairRounds = 8;            // --repair-rounds N, range and default in core/parameters.hpp
-  double timeLimit = 0.0;          // --time-limit S: seconds per optimiser run (0: none)
-  double facetWeight = 0.0;        // --facet-weight W: the optimiser's boundary-facet term
-  bool heal = true;                // --no-heal: the CAD is only checked
-  bool solidsOnly = false;         // --solids-only: faces in no solid are left out
-  bool surface = false;            // --surface: a model without solids gets a surface mesh
-  bool automatic = false;          // --auto: --solids-only or --surface, whichever fits
-  double linearTimeLimit = 600.0;  // --linear-time-limit S: seconds per Gmsh run (0: none)
-  double jobTimeLimit = 0.0;       // --job-time-limit S: seconds for the whole job (0: none)
   // --bl-faces, --bl-thickness, --bl-layers, --bl-progression: a boundary layer (each
   // overrides the .mcf's BndLayer* key).
   std::optional<std::string> blFaces, blThickness;
@@ -67,10 +59,7 @@ struct QualityCommand {
 struct PredictCommand {
   std::string input;
   SizingFlags sizing;
-  bool heal = true;         // --no-heal, as for mesh
-  bool solidsOnly = false;  // --solids-only, as for mesh
-  bool surface = false;     // --surface, as for mesh
-  bool automatic = false;   // --auto, as for mesh
+  OptionMap options;  // the CAD modes given (--no-heal, --solids-only, --surface, --auto)
   CommonOptions common;
 };
 
@@ -104,6 +93,9 @@ struct ParsedCommand {
 
 // argv without the program name. Throws UsageError.
 ParsedCommand parseCommandLine(const std::vector<std::string>& args);
+
+// The manual page (roff) of every command, from the same texts as --help.
+std::string manPage();
 
 std::string usageText(const std::string& topic);
 

@@ -99,15 +99,12 @@ homesh::WriteOptions writeOptions(const homesh::CommonOptions& c) {
 
 // The case from INPUT (CAD file or .mcf) with the command line's sizing flags applied over it.
 homesh::CaseSetup setupWithFlags(const std::string& input, const homesh::SizingFlags& flags,
-                                 const std::optional<double>& size, bool quiet) {
+                                 bool quiet) {
   homesh::CaseSetup setup = homesh::setupCase(input);
   if (!quiet)
     for (const std::string& notice : setup.notices)
       std::fprintf(stderr, "homesh: note: %s\n", notice.c_str());
-  if (size) {
-    setup.options.size = size;
-    setup.options.sizing.reset();
-  } else if (flags.anyDelta() || !flags.sources.empty()) {
+  if (flags.anyDelta() || !flags.sources.empty()) {
     homesh::SizingParameters p = setup.options.sizing.value_or(homesh::SizingParameters{});
     if (flags.minDelta) p.minDelta = *flags.minDelta;
     if (flags.maxDelta) p.maxDelta = *flags.maxDelta;
@@ -140,21 +137,10 @@ void printPrediction(const homesh::SizingResult& s, int dim) {
 int runMesh(const homesh::MeshCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
   checkOutputs(c, cmd.input);
-  homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.sizing, cmd.size, c.quiet);
+  homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.sizing, c.quiet);
   homesh::MeshingOptions& options = setup.options;
-  if (cmd.order) options.order = *cmd.order;
   options.threads = c.threads;
-  options.verbosity = cmd.verbosity;
-  options.optimiseIterations = cmd.optimiseIterations;
-  options.repairRounds = cmd.repairRounds;
-  options.optimiseSeconds = cmd.timeLimit;
-  options.facetWeight = cmd.facetWeight;
-  options.linearSeconds = cmd.linearTimeLimit;
-  options.jobSeconds = cmd.jobTimeLimit;
-  options.heal = cmd.heal;
-  options.solidsOnly = cmd.solidsOnly;
-  options.surface = cmd.surface;
-  options.automatic = cmd.automatic;
+  options.apply(cmd.options);  // over the case's: what the command line gives wins
   if (cmd.blFaces || cmd.blThickness || cmd.blLayers || cmd.blProgression) {
     homesh::BoundaryLayerParameters bl =
         options.boundaryLayer.value_or(homesh::BoundaryLayerParameters{});
@@ -250,12 +236,9 @@ int runMesh(const homesh::MeshCommand& cmd) {
 int runPredict(const homesh::PredictCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
   checkOutputs(c, cmd.input);
-  homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.sizing, std::nullopt, c.quiet);
+  homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.sizing, c.quiet);
   setup.options.threads = c.threads;
-  setup.options.heal = cmd.heal;
-  setup.options.solidsOnly = cmd.solidsOnly;
-  setup.options.surface = cmd.surface;
-  setup.options.automatic = cmd.automatic;
+  setup.options.apply(cmd.options);
   const homesh::SizingResult s = homesh::runSizingStage(setup.source, setup.options);
   const bool toStdout = c.report && *c.report == "-";
   if (!c.quiet) {
@@ -404,7 +387,8 @@ int main(int argc, char** argv) {
     const homesh::ParsedCommand parsed = homesh::parseCommandLine(args);
     switch (parsed.kind) {
       case homesh::ParsedCommand::Kind::Help:
-        std::cout << homesh::usageText(parsed.helpTopic);
+        std::cout << (parsed.helpTopic == "--man" ? homesh::manPage()
+                                                  : homesh::usageText(parsed.helpTopic));
         return 0;
       case homesh::ParsedCommand::Kind::Version:
         std::cout << "homesh " << homesh::kVersion << "\n";

@@ -15,54 +15,85 @@ constexpr double kNoLimit = std::numeric_limits<double>::infinity();
 
 const std::vector<ParameterDefinition>& parameterDefinitions() {
   static const std::vector<ParameterDefinition> table = {
-      {"order", "Order", "--order", "order", ParameterKind::Integer, 1, 10, false, 4, false, "mesh",
-       "Polynomial order of the elements"},
-      {"size", "Size", "--size", "size", ParameterKind::Length, 0, kNoLimit, true, 0, true, "mesh",
-       "Uniform target element size (0 in FreeCAD: the sizing octree)"},
-      {"optimise", "OptimiserIterations", "--maxiter", "optimiser iterations",
-       ParameterKind::Integer, 0, 10000, false, 20, false, "mesh",
+      {"order", "Order", "--order", "-p", "order", ParameterKind::Integer, 1, 10, false, 4, false,
+       false, "mesh", "Polynomial order of the elements"},
+      {"size", "Size", "--size", "-s", "size", ParameterKind::Length, 0, kNoLimit, true, 0, true,
+       false, "mesh", "Uniform target element size (0 or none: the sizing octree)"},
+      {"optimise", "OptimiserIterations", "--maxiter", "-n", "optimiser iterations",
+       ParameterKind::Integer, 0, 10000, false, 100, false, true, "mesh",
        "Most sweeps of the variational optimiser after curving (0: none); it stops earlier "
        "once the mesh is valid and no longer improving"},
-      {"optimise_seconds", "OptimiserTimeLimit", "--time-limit", "optimiser time limit",
-       ParameterKind::Real, 0, kNoLimit, false, 0, false, "mesh",
+      {"optimise_seconds", "OptimiserTimeLimit", "--time-limit", "", "optimiser time limit",
+       ParameterKind::Real, 0, kNoLimit, false, 0, false, false, "mesh",
        "Seconds one optimiser run may take (each of a job's runs); it then stops with the best "
        "state so far and the report says \"stopped\": \"time budget\"; 0: no limit"},
-      {"facet_weight", "FacetWeight", "--facet-weight", "facet weight", ParameterKind::Real, 0, 100,
-       false, 0, false, "mesh",
+      {"facet_weight", "FacetWeight", "--facet-weight", "", "facet weight", ParameterKind::Real, 0,
+       100, false, 0, false, false, "mesh",
        "Weight of the boundary facets' distortion within the CAD surface in the optimiser's "
        "energy (3D meshes), added once every element is proven valid: it keeps a facet's nodes "
        "evenly spread "
        "as they slide, so the curved boundary stays on the CAD between them (0: off; 1 is a "
        "good start)"},
-      {"linear_seconds", "LinearTimeLimit", "--linear-time-limit", "linear meshing time limit",
-       ParameterKind::Real, 0, kNoLimit, false, 600, false, "mesh",
+      {"linear_seconds", "LinearTimeLimit", "--linear-time-limit", "", "linear meshing time limit",
+       ParameterKind::Real, 0, kNoLimit, false, 600, false, false, "mesh",
        "Seconds Gmsh's linear meshing may take (each run, in its own process); it is then "
        "stopped and the job fails naming this limit; 0: no limit"},
-      {"job_seconds", "JobTimeLimit", "--job-time-limit", "job time limit", ParameterKind::Real, 0,
-       kNoLimit, false, 0, false, "mesh",
+      {"job_seconds", "JobTimeLimit", "--job-time-limit", "", "job time limit", ParameterKind::Real,
+       0, kNoLimit, false, 0, false, false, "mesh",
        "Seconds the whole job may take, from loading the CAD: Gmsh and the optimiser get at most "
        "what is left, a repair round starts only if the last one would still fit, and the best "
        "mesh so far is kept (the report's \"job\" says \"stopped\": \"time budget\"); with no "
        "mesh yet, the job fails naming its stage; 0: no limit"},
-      {"repair_rounds", "RepairRounds", "--repair-rounds", "repair rounds", ParameterKind::Integer,
-       0, 20, false, 8, false, "mesh",
+      {"repair_rounds", "RepairRounds", "--repair-rounds", "", "repair rounds",
+       ParameterKind::Integer, 0, 20, false, 8, false, false, "mesh",
        "Most repair rounds while elements are not proven valid (split, flip, remesh or refine "
        "around them, curve, optimise and check again)"},
-      {"threads", "Threads", "--threads", "threads", ParameterKind::Integer, 1, 1024, false, 1,
-       false, "mesh", "Threads the sizing octree and the optimiser use"},
-      {"min_delta", "MinDelta", "--min-delta", "MinDelta", ParameterKind::Length, 0, kNoLimit, true,
-       0, true, "sizing", "Smallest element size, at high curvature"},
-      {"max_delta", "MaxDelta", "--max-delta", "MaxDelta", ParameterKind::Length, 0, kNoLimit, true,
-       0, true, "sizing", "Largest element size"},
-      {"eps", "Eps", "--eps", "EPS", ParameterKind::Real, 0, 1, true, 0.05, false, "sizing",
+      {"threads", "Threads", "--threads", "-j", "threads", ParameterKind::Integer, 1, 1024, false,
+       1, false, false, "mesh", "Threads the sizing octree and the optimiser use"},
+      {"verbosity", "", "--verbose", "-v", "verbosity", ParameterKind::Integer, 0, 2, false, 0,
+       false, false, "mesh",
+       "How much of Gmsh's own output to pass on: 0 none, 1 its warnings, 2 also its "
+       "information (-v, -vv)"},
+      {"heal", "Heal", "--no-heal", "", "heal", ParameterKind::Boolean, 0, 1, false, 1, false,
+       false, "cad",
+       "Check the shape and, where the check finds a problem (faces not sewn into a solid, "
+       "invalid geometry, tiny edges or sliver faces), repair it with OpenCASCADE's shape "
+       "healing before meshing; a healed shape's faces are numbered afresh (the report's "
+       "\"healing\" says what was found and done); off: check only"},
+      {"solids_only", "SolidsOnly", "--solids-only", "", "solids only", ParameterKind::Boolean, 0,
+       1, false, 0, false, false, "cad",
+       "Mesh the solids and leave out faces in no solid (a loose shell that does not close), "
+       "named in the report; off: such a shape is refused, naming those faces"},
+      {"surface", "Surface", "--surface", "", "surface", ParameterKind::Boolean, 0, 1, false, 0,
+       false, false, "cad",
+       "For a shape without solids (a shell, faces that do not close): a surface mesh of its "
+       "faces, triangles curved on the CAD, sewn where faces meet (no volume, no optimiser, no "
+       "boundary layer); off: such a shape is refused, naming a free edge"},
+      {"auto", "AutoMode", "--auto", "", "auto", ParameterKind::Boolean, 0, 1, false, 0, false,
+       false, "cad",
+       "Choose per shape, for batch runs: with solids, as solids only (faces in no solid left "
+       "out and named); without a solid, sewn into solids where every shell closes, else as "
+       "surface; the report says which. Not with solids only or surface"},
+      {"min_delta", "MinDelta", "--min-delta", "", "MinDelta", ParameterKind::Length, 0, kNoLimit,
+       true, 0, true, false, "sizing", "Smallest element size, at high curvature"},
+      {"max_delta", "MaxDelta", "--max-delta", "", "MaxDelta", ParameterKind::Length, 0, kNoLimit,
+       true, 0, true, false, "sizing", "Largest element size"},
+      {"eps", "Eps", "--eps", "", "EPS", ParameterKind::Real, 0, 1, true, 0.05, false, false,
+       "sizing",
        "Sagitta ratio: on a surface of curvature radius R the size is 2 R sqrt(eps (2 - eps))"},
-      {"layers", "Layers", "--bl-layers", "boundary-layer layers", ParameterKind::Integer, 1, 100,
-       false, 2, false, "boundary_layer", "Thin layers the macro layer is split into"},
-      {"progression", "Progression", "--bl-progression", "boundary-layer progression",
-       ParameterKind::Real, 0, 100, true, 2, false, "boundary_layer",
+      {"layers", "Layers", "--bl-layers", "", "boundary-layer layers", ParameterKind::Integer, 1,
+       100, false, 2, false, false, "boundary_layer", "Thin layers the macro layer is split into"},
+      {"progression", "Progression", "--bl-progression", "", "boundary-layer progression",
+       ParameterKind::Real, 0, 100, true, 2, false, false, "boundary_layer",
        "Height ratio of consecutive layers, from the wall"},
   };
   return table;
+}
+
+const ParameterDefinition* findParameter(const std::string& key) {
+  for (const ParameterDefinition& p : parameterDefinitions())
+    if (key == p.key) return &p;
+  return nullptr;
 }
 
 const ParameterDefinition& parameterDefinition(const std::string& key) {
@@ -72,6 +103,7 @@ const ParameterDefinition& parameterDefinition(const std::string& key) {
 }
 
 std::string rangeText(const ParameterDefinition& p) {
+  if (p.kind == ParameterKind::Boolean) return "true or false";
   const bool integer = p.kind == ParameterKind::Integer;
   const std::string what = integer                           ? "an integer"
                            : p.kind == ParameterKind::Length ? "a length"
@@ -87,6 +119,52 @@ bool inRange(const ParameterDefinition& p, double value) {
   if (p.kind == ParameterKind::Integer && value != std::floor(value)) return false;
   if (p.minExclusive ? !(value > p.min) : !(value >= p.min)) return false;
   return value <= p.max;
+}
+
+namespace {
+
+// How a message shows a value that came from outside.
+std::string valueText(const OptionValue& value) {
+  if (const double* x = std::get_if<double>(&value)) return formatNumber(*x);
+  if (const bool* b = std::get_if<bool>(&value)) return *b ? "true" : "false";
+  return "'" + std::get<std::string>(value) + "'";
+}
+
+std::string knownKeys() {
+  std::string out;
+  for (const ParameterDefinition& p : parameterDefinitions()) {
+    if (!out.empty()) out += ", ";
+    out += p.key;
+  }
+  return out;
+}
+
+}  // namespace
+
+double checkedOption(const std::string& key, const OptionValue& value) {
+  const ParameterDefinition* p = findParameter(key);
+  if (p == nullptr)
+    throw ParameterError("unknown option '" + key + "' (options: " + knownKeys() + ")");
+  const auto refuse = [&] {
+    return ParameterError(std::string(p->label) + " must be " + rangeText(*p) + ", got " +
+                          valueText(value));
+  };
+  double number = 0.0;
+  if (const bool* b = std::get_if<bool>(&value)) {
+    if (p->kind == ParameterKind::Boolean) return *b ? 1.0 : 0.0;
+    if (!p->switchable) throw refuse();
+    return *b ? p->defaultValue : 0.0;
+  }
+  if (const double* x = std::get_if<double>(&value)) number = *x;
+  if (p->zeroIsAutomatic && number == 0.0 && std::holds_alternative<double>(value)) return 0.0;
+  if (std::holds_alternative<std::string>(value) || p->kind == ParameterKind::Boolean ||
+      !inRange(*p, number))
+    throw refuse();
+  return number;
+}
+
+double parameterDefault(const std::string& key) {
+  return parameterDefinition(key).defaultValue;
 }
 
 void checkParameter(const std::string& key, double value) {

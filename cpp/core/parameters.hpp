@@ -1,10 +1,12 @@
 // One definition of every user-facing meshing parameter: its Python keyword (also the report's
-// key), FreeCAD property, command-line option, kind, range, default, unit and meaning. The
-// core's option checks, the Python module (homesh.parameters()), the FreeCAD properties and
-// task panels all read this table, so a range is written once.
+// key and the key of an options mapping), FreeCAD property, command-line option, kind, range,
+// default, unit and meaning. The core's option checks (pipeline/meshing_options.hpp), the Python
+// module (homesh.parameters(), the keywords of homesh.mesh), the FreeCAD properties and task
+// panels all read this table, so a default or a range is written once.
 #pragma once
 
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace homesh {
@@ -13,24 +15,33 @@ enum class ParameterKind {
   Integer,  // a whole number in [min, max]
   Real,     // a number in (min, max] when minExclusive, else [min, max]
   Length,   // a length in the model's units, same range rules as Real
+  Boolean,  // on or off (range [0, 1] as numbers)
 };
 
 struct ParameterDefinition {
-  const char* key;       // Python keyword: "order"
-  const char* property;  // FreeCAD property: "Order"
-  const char* option;    // command line: "--order" ("" when the CLI has none)
-  const char* label;     // how messages name it: "order"
+  const char* key;          // Python keyword: "order"
+  const char* property;     // FreeCAD property: "Order" ("" when FreeCAD has none)
+  const char* option;       // command line: "--order" ("" when the CLI has none); for a Boolean,
+                            // the flag that turns its default around ("--no-heal", "--surface")
+  const char* shortOption;  // its one-letter alias on the command line: "-p" ("" for none)
+  const char* label;        // how messages name it: "order"
   ParameterKind kind;
   double min, max;    // max = infinity: no upper bound
   bool minExclusive;  // (min, max] instead of [min, max]
   double defaultValue;
   bool zeroIsAutomatic;  // 0 stands for "choose automatically" (a size from the model)
-  const char* group;     // "mesh", "sizing", "boundary_layer"
+  // An Integer that may also be given as on/off: on stands for the default, off for 0 (the
+  // optimiser: `optimise=True` in Python asks for the default number of sweeps).
+  bool switchable;
+  const char* group;  // "mesh", "sizing", "boundary_layer"
   const char* doc;
 };
 
 // Every parameter, in the order a panel shows them.
 const std::vector<ParameterDefinition>& parameterDefinitions();
+
+// The definition of `key`, or nullptr when the table has none.
+const ParameterDefinition* findParameter(const std::string& key);
 
 // The definition of `key`; throws std::out_of_range for a key that is not in the table (a
 // programming error, not a user's).
@@ -44,5 +55,17 @@ bool inRange(const ParameterDefinition& p, double value);
 
 // Throws ParameterError "<label> must be <rangeText>, got <value>" when `value` is not in range.
 void checkParameter(const std::string& key, double value);
+
+// The table's default of `key` (throws std::out_of_range for a key not in it).
+double parameterDefault(const std::string& key);
+
+// A value as it comes from outside (a Python keyword, a mapping): a number, on/off or text.
+using OptionValue = std::variant<double, bool, std::string>;
+
+// `value` as the number parameter `key` stands for (a Boolean: 1 or 0; a switchable Integer
+// given on/off: its default or 0), checked against the kind and range; throws ParameterError
+// "<label> must be <rangeText>, got <value>" for a value of the wrong kind or out of range, and
+// "unknown option '<key>'" for a key the table does not have.
+double checkedOption(const std::string& key, const OptionValue& value);
 
 }  // namespace homesh

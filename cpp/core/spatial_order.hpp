@@ -3,8 +3,8 @@
 // (Gmsh: by entity, then by edge and face), so elements next to each other in space are far
 // apart in memory and every node visit of the optimiser touches cache lines scattered over its
 // arrays; two CPUs working on such data lose much of the second CPU to memory traffic (the
-// order-2 analysis in bench/README.md). Numbered along the curve, an element's neighbours and
-// nodes sit a few entries away, and a thread's share of the mesh is a few contiguous runs.
+// order-2 analysis in bench/results/history.md). Numbered along the curve, an element's neighbours
+// and nodes sit a few entries away, and a thread's share of the mesh is a few contiguous runs.
 #pragma once
 
 #include <cstddef>

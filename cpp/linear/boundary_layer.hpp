@@ -29,6 +29,7 @@
 
 #include "cad/cad_model.hpp"
 #include "core/mesh.hpp"
+#include "core/parameters.hpp"
 #include "linear/linear_mesher.hpp"
 
 namespace homesh {
@@ -36,9 +37,9 @@ namespace homesh {
 struct BoundaryLayerParameters {
   std::vector<int> faces;  // 1-based CAD faces (FaceN) that carry the layer
   std::string thickness;   // total thickness: a number or an expression of x, y, z
-  // Defaults as NekMesh's: 2 layers, progression 2.
-  int layers = 2;  // thin layers each macro prism is split into, range in core/parameters.hpp
-  double progression = 2.0;  // height ratio of consecutive layers (wall outwards), > 0
+  // Defaults as NekMesh's (core/parameters.hpp).
+  int layers = static_cast<int>(parameterDefault("layers"));  // thin layers per macro prism
+  double progression = parameterDefault("progression");       // consecutive layers' height ratio
 
   // Throws ParameterError naming the parameter (no faces, a thickness that does not parse,
   // layers or progression out of range).

@@ -28,35 +28,6 @@
 
 namespace homesh {
 
-void MeshingOptions::validate() const {
-  checkParameter("order", order);
-  if (size) checkParameter("size", *size);
-  checkParameter("threads", threads);
-  checkParameter("optimise", optimiseIterations);
-  checkParameter("optimise_seconds", optimiseSeconds);
-  checkParameter("facet_weight", facetWeight);
-  checkParameter("linear_seconds", linearSeconds);
-  checkParameter("job_seconds", jobSeconds);
-  checkParameter("repair_rounds", repairRounds);
-  if (boundaryLayer) boundaryLayer->validate();
-  if (surface && boundaryLayer)
-    throw ParameterError(
-        "a boundary layer needs a volume or planar mesh, not a surface mesh "
-        "(--surface)");
-  healing().validate();
-  if (size && !octreeOutput.empty())
-    throw ParameterError("writing the sizing octree needs octree sizing, not a uniform size");
-  if (size && sizing)
-    throw ParameterError(
-        "give either a uniform size or the sizing parameters (MinDelta, MaxDelta, EPS), not both");
-  if (sizing) {
-    SizingParameters check = *sizing;  // automatic values are checked once known
-    if (check.maxDelta == 0.0) check.maxDelta = std::max(1.0, check.minDelta);
-    if (check.minDelta == 0.0) check.minDelta = check.maxDelta;
-    check.validate();
-  }
-}
-
 double defaultMeshSize(const CadModel& cad) {
   return cad.boundingDiagonal() / 20.0;
 }
@@ -78,8 +49,7 @@ CadModel CadSource::load() const {
 SizingParameters defaultSizing(const CadModel& cad) {
   SizingParameters p;
   p.maxDelta = defaultMeshSize(cad);
-  p.minDelta = p.maxDelta / 20.0;
-  p.eps = 0.05;
+  p.minDelta = p.maxDelta / 20.0;  // eps: the table's default (SizingParameters)
   return p;
 }
 

@@ -22,6 +22,7 @@
 #include "io/mesh_writers.hpp"
 #include "linear/boundary_layer.hpp"
 #include "optimise/optimiser.hpp"
+#include "pipeline/meshing_options.hpp"
 #include "pipeline/repair.hpp"
 #include "quality/geometry_accuracy.hpp"
 #include "quality/mesh_quality.hpp"
@@ -36,59 +37,11 @@ namespace homesh {
 // (equispaced nodes of order 8 couple strongly), and the high order only corrects it.
 inline constexpr int kContinuationOrder = 4;
 
-struct MeshingOptions {
-  int order = 4;  // polynomial order, 1..10
-  // Sizes: a uniform target edge length (> 0), or the sizing octree (sizing/sizing_octree.hpp);
-  // with neither, the octree with defaultSizing(cad).
-  std::optional<double> size;
-  std::optional<SizingParameters> sizing;  // 0 deltas: automatic (completeSizing)
-  std::optional<int> expectedDimension;    // 2 or 3 (a .mcf's MeshType): checked on the CAD
-  std::string octreeOutput;                // when set: the octree's leaves, written after sizing
-  int threads = 1;    // threads the stages may use, range in core/parameters.hpp
-  int verbosity = 0;  // 0 silent; 1 Gmsh's warnings; 2 Gmsh's information
-  // > 0: after elevation, at most this many sweeps of the variational optimiser (hyperelastic,
-  // boundary nodes sliding on the CAD; optimise/optimiser.hpp), stopping earlier once the mesh
-  // is proven valid and no longer improving (OptimiserOptions: "energy", or "stalled" with
-  // stall 0.001).
-  int optimiseIterations = 0;
-  double optimiseSeconds = 0.0;  // time limit of each optimiser run (0: none)
-  // The optimiser's boundary-facet term (OptimiserOptions::facetWeight), default and range in
-  // core/parameters.hpp ("facet_weight").
-  double facetWeight = 0.0;
-  // Time limit of each Gmsh run of the linear mesher (0: none), default from the parameter table.
-  double linearSeconds = 600.0;
-  // Wall-time budget of the whole job (0: none), from the start of runMeshPipeline
-  // (core/job_budget.hpp): Gmsh and every optimiser run get at most what is left, repair rounds
-  // stop when the last one would no longer fit, the geometry check is skipped once it is spent.
-  double jobSeconds = 0.0;
-  // Repair rounds (pipeline/repair.hpp) while elements are not proven valid, range in
-  // core/parameters.hpp: each splits the offending linear cells' edges on curved faces (or refines
-  // around them), then curves, optimises and checks again. 0: none.
-  int repairRounds = 8;  // core/parameters.hpp's default (a test checks they agree)
-  // A macro boundary layer on these CAD faces (linear/boundary_layer.hpp), curved and optimised
-  // with the rest and split into its thin layers last (curving/layer_split.hpp).
-  std::optional<BoundaryLayerParameters> boundaryLayer;
-  // CAD healing after loading (cad/cad_healing.hpp); false: the model is only checked.
-  bool heal = true;
-  // Faces in no solid are left out (report: healing "left_out") instead of refusing the model.
-  bool solidsOnly = false;
-  // A model without solids gets a surface mesh of its faces (triangles on the CAD, no volume;
-  // the optimiser and boundary layers do not apply) instead of being refused.
-  bool surface = false;
-  // Each model gets the mode that fits it (solidsOnly with solids, surface without), for batch
-  // runs: HealingOptions::automatic.
-  bool automatic = false;
-  HealingOptions healing() const { return {heal, solidsOnly, surface, automatic}; }
-
-  // Throws ParameterError naming the offending parameter.
-  void validate() const;
-};
-
 // A uniform size giving a coarse mesh: a twentieth of the bounding-box diagonal.
 double defaultMeshSize(const CadModel& cad);
 
 // Automatic sizing for a model given no sizes: MaxDelta = defaultMeshSize, MinDelta =
-// MaxDelta / 20, EPS = 0.05 (a chord deviates from an arc by a twentieth of its radius).
+// MaxDelta / 20, EPS the parameter table's default.
 SizingParameters defaultSizing(const CadModel& cad);
 
 // `p` with an automatic (0) maxDelta set to defaultMeshSize (or minDelta if that is larger)

@@ -1,4 +1,4 @@
-// JSON reports (schema in README.md), shared by the command line and the Python module.
+// JSON reports (fields in docs/report.md), shared by the command line and the Python module.
 #pragma once
 
 #include <cstddef>

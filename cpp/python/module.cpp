@@ -330,149 +330,151 @@ Eigen::Vector3d pointFrom(const bp::object& p, const std::string& what) {
   return {bp::extract<double>(p[0]), bp::extract<double>(p[1]), bp::extract<double>(p[2])};
 }
 
-// Sizing parameters from a dict {"min_delta", "max_delta", "eps": numbers (0 or missing:
-// automatic), "sources": [{"kind": "segment" | "sphere" | "box" | "curve", "a", "b", "radius",
-// "delta", "edge"}, ...]}. homesh/api.py validates the types first.
-SizingParameters sizingFrom(const bp::dict& d) {
-  SizingParameters p;
-  const auto number = [&d](const char* key, double fallback) {
-    const bp::object value = d.get(key);
-    return value.is_none() ? fallback : static_cast<double>(bp::extract<double>(value));
-  };
-  p.minDelta = number("min_delta", 0.0);
-  p.maxDelta = number("max_delta", 0.0);
-  p.eps = number("eps", p.eps);
-  if (d.has_key("sources")) {
-    const bp::object list = d["sources"];
-    for (bp::ssize_t i = 0; i < bp::len(list); ++i) {
-      const bp::dict src = bp::extract<bp::dict>(list[i]);
-      const std::string kind = bp::extract<std::string>(src.get("kind", ""));
-      const std::string which = "source " + std::to_string(i + 1);
-      const double radius = bp::extract<double>(src.get("radius", 0.0));
-      const double delta = bp::extract<double>(src.get("delta", 0.0));
-      if (kind == "segment")
-        p.sources.push_back(RefinementSource::segment(
-            pointFrom(src["a"], which + " a"), pointFrom(src["b"], which + " b"), radius, delta));
-      else if (kind == "sphere")
-        p.sources.push_back(
-            RefinementSource::sphere(pointFrom(src["a"], which + " centre"), radius, delta));
-      else if (kind == "box")
-        p.sources.push_back(RefinementSource::box(pointFrom(src["a"], which + " a"),
-                                                  pointFrom(src["b"], which + " b"), delta));
-      else if (kind == "curve")
-        p.sources.push_back(
-            RefinementSource::curve(bp::extract<int>(src.get("edge", 0)), radius, delta));
-      else {
-        std::string message = which;
-        message += ": kind must be segment, sphere, box or curve, got '";
-        message += kind;
-        message += "'";
-        throw ParameterError(message);
-      }
-    }
+// Refinement sources from a list of dicts [{"kind": "segment" | "sphere" | "box" | "curve", "a",
+// "b", "radius", "delta", "edge"}, ...] (homesh/api.py checks their fields first).
+std::vector<RefinementSource> sourcesFrom(const bp::object& list) {
+  std::vector<RefinementSource> out;
+  for (bp::ssize_t i = 0; i < bp::len(list); ++i) {
+    const bp::dict src = bp::extract<bp::dict>(list[i]);
+    const std::string kind = bp::extract<std::string>(src.get("kind", ""));
+    const std::string which = "source " + std::to_string(i + 1);
+    const double radius = bp::extract<double>(src.get("radius", 0.0));
+    const double delta = bp::extract<double>(src.get("delta", 0.0));
+    if (kind == "segment")
+      out.push_back(RefinementSource::segment(pointFrom(src["a"], which + " a"),
+                                              pointFrom(src["b"], which + " b"), radius, delta));
+    else if (kind == "sphere")
+      out.push_back(
+          RefinementSource::sphere(pointFrom(src["a"], which + " centre"), radius, delta));
+    else if (kind == "box")
+      out.push_back(RefinementSource::box(pointFrom(src["a"], which + " a"),
+                                          pointFrom(src["b"], which + " b"), delta));
+    else if (kind == "curve")
+      out.push_back(RefinementSource::curve(bp::extract<int>(src.get("edge", 0)), radius, delta));
+    else
+      throw ParameterError(which + ": kind must be segment, sphere, box or curve, got '" + kind +
+                           "'");
   }
-  return p;
+  return out;
 }
 
-// The boundary layer of a dict the Python layer checked for its keys and types (homesh/api.py
-// _boundary_layer): "faces" (list of int), "thickness" (text), "layers", "progression".
+// A Python value for parameter `key` as the core takes it (a bool, a real number or text);
+// core/parameters.hpp's checkedOption judges it and names the parameter when it does not fit.
+OptionValue optionValueFrom(const bp::object& value) {
+  PyObject* o = value.ptr();
+  if (PyBool_Check(o)) return o == Py_True;
+  if (PyUnicode_Check(o)) return std::string(bp::extract<std::string>(value));
+  if (PyNumber_Check(o) && !PyComplex_Check(o)) {
+    PyObject* real = PyNumber_Float(o);
+    if (real != nullptr) {
+      const double x = PyFloat_AsDouble(real);
+      Py_DECREF(real);
+      return x;
+    }
+    PyErr_Clear();
+  }
+  // Not a number, on/off or text (a list, an array): its repr, which every kind refuses.
+  return std::string(bp::extract<std::string>(bp::str(value.attr("__repr__")())));
+}
+
+// The boundary layer of a dict the Python layer checked for its keys (homesh/api.py
+// _boundary_layer): "faces" (list of int), "thickness" (text), "layers", "progression" (checked
+// here against the parameter table).
 BoundaryLayerParameters boundaryLayerFrom(const bp::dict& d) {
   BoundaryLayerParameters p;
   const bp::object faces = d["faces"];
   for (bp::ssize_t i = 0; i < bp::len(faces); ++i) p.faces.push_back(bp::extract<int>(faces[i]));
   p.thickness = bp::extract<std::string>(d["thickness"]);
-  if (d.has_key("layers")) p.layers = bp::extract<int>(d["layers"]);
-  if (d.has_key("progression")) p.progression = bp::extract<double>(d["progression"]);
+  if (d.has_key("layers"))
+    p.layers = static_cast<int>(checkedOption("layers", optionValueFrom(d["layers"])));
+  if (d.has_key("progression"))
+    p.progression = checkedOption("progression", optionValueFrom(d["progression"]));
   return p;
 }
 
-// A job's time limits and the optimiser's facet weight from a dict keyed as the parameter table
-// ("optimise_seconds", "linear_seconds", "job_seconds", "facet_weight"; homesh/api.py checked
-// the types); a key left out keeps its default. Ranges are checked by MeshingOptions::validate.
-void applyTimeLimits(MeshingOptions& options, const bp::object& limits) {
-  if (limits.is_none()) return;
-  const bp::dict d = bp::extract<bp::dict>(limits);
-  const auto read = [&d](const char* key, double& value) {
-    if (d.has_key(key)) value = bp::extract<double>(d[key]);
-  };
-  read("optimise_seconds", options.optimiseSeconds);
-  read("linear_seconds", options.linearSeconds);
-  read("job_seconds", options.jobSeconds);
-  read("facet_weight", options.facetWeight);
-}
+// What each front-end function of homesh/api.py takes besides the table's own keys: refinement
+// sources (a list of dicts) and a boundary layer (a dict).
+enum Extras : unsigned { kNoExtras = 0, kSources = 1, kBoundaryLayer = 2 };
 
-// The CAD modes the Python functions pass as one string (Boost.Python's arity limit): a comma
-// list of "solids_only", "surface" and "auto" (HealingOptions), empty for none. Conflicts are
-// HealingOptions::validate's to name.
-void applyCadModes(MeshingOptions& options, const std::string& modes) {
-  std::size_t start = 0;
-  while (start < modes.size()) {
-    std::size_t end = modes.find(',', start);
-    if (end == std::string::npos) end = modes.size();
-    const std::string mode = modes.substr(start, end - start);
-    if (mode == "solids_only")
-      options.solidsOnly = true;
-    else if (mode == "surface")
-      options.surface = true;
-    else if (mode == "auto")
-      options.automatic = true;
+// `base` (the defaults, or a NekMesh case's options) with an options dict keyed as the parameter
+// table applied over it (None: not given), checked once by MeshingOptions::apply; `allowed` lists
+// the table keys the caller has a use for (empty: all that MeshingOptions holds). Sources are
+// added to the base's; a boundary layer replaces the base's.
+MeshingOptions optionsFrom(const bp::dict& d, const std::vector<std::string>& allowed,
+                           unsigned extras, MeshingOptions base = {}) {
+  OptionMap values;
+  bp::object sources, layer;
+  const bp::list keys = d.keys();
+  for (bp::ssize_t i = 0; i < bp::len(keys); ++i) {
+    const std::string key = bp::extract<std::string>(keys[i]);
+    const bp::object value = d[keys[i]];
+    if (value.is_none()) continue;
+    if (key == "sources" && (extras & kSources) != 0)
+      sources = value;
+    else if (key == "boundary_layer" && (extras & kBoundaryLayer) != 0)
+      layer = value;
     else
-      throw ParameterError("unknown CAD mode '" + mode +
-                           "' (expected solids_only, surface or auto)");
-    start = end + 1;
+      values[key] = optionValueFrom(value);
   }
+  MeshingOptions options = std::move(base);
+  options.apply(values, allowed);
+  if (!sources.is_none() && bp::len(sources) > 0) {
+    if (!options.sizing) options.sizing = SizingParameters{};
+    for (RefinementSource& s : sourcesFrom(sources)) options.sizing->sources.push_back(s);
+  }
+  if (!layer.is_none()) options.boundaryLayer = boundaryLayerFrom(bp::extract<bp::dict>(layer));
+  options.validate();
+  return options;
 }
 
-MeshingOptions makeOptions(int order, const bp::object& size, int threads, int verbosity,
-                           int optimise, const bp::object& sizing, int repairRounds,
-                           const bp::object& boundaryLayer, const bp::object& limits,
-                           bool heal = true, const std::string& modes = "") {
-  MeshingOptions options;
-  options.heal = heal;
-  applyCadModes(options, modes);
-  applyTimeLimits(options, limits);
-  if (!boundaryLayer.is_none())
-    options.boundaryLayer = boundaryLayerFrom(bp::extract<bp::dict>(boundaryLayer));
-  options.optimiseIterations = optimise;
-  options.repairRounds = repairRounds;
-  options.order = order;
-  if (!size.is_none()) options.size = bp::extract<double>(size);
-  if (!sizing.is_none()) options.sizing = sizingFrom(bp::extract<bp::dict>(sizing));
-  options.threads = threads;
-  options.verbosity = verbosity;
-  return options;
+// The table keys each front-end function uses (MeshingOptions::fromMap refuses the others).
+const std::vector<std::string> kMeshKeys = {};
+const std::vector<std::string> kCurveKeys = {
+    "order", "threads", "verbosity", "optimise", "optimise_seconds", "job_seconds", "facet_weight"};
+const std::vector<std::string> kSizingKeys = {"threads", "heal",      "solids_only", "surface",
+                                              "auto",    "min_delta", "max_delta",   "eps"};
+
+// The table keys the front-end function `function` ("mesh", "curve", "sizing": predict and
+// size_field) takes, in the table's order, for homesh/api.py's keywords and docstrings.
+bp::list optionKeys(const std::string& function) {
+  const std::vector<std::string>* keys = function == "mesh"     ? &kMeshKeys
+                                         : function == "curve"  ? &kCurveKeys
+                                         : function == "sizing" ? &kSizingKeys
+                                                                : nullptr;
+  if (keys == nullptr)
+    throw ParameterError("option_keys: no function '" + function + "' (mesh, curve or sizing)");
+  bp::list out;
+  for (const ParameterDefinition& p : parameterDefinitions()) {
+    const bool listed = keys->empty() ? MeshingOptions::takes(p.key)
+                                      : std::find(keys->begin(), keys->end(), p.key) != keys->end();
+    if (listed) out.append(std::string(p.key));
+  }
+  return out;
 }
 
 // The sizing octree and prediction of a CAD source: the JSON report of `homesh predict`,
 // and the octree's leaves written to `octreePath` when it is not empty.
-std::string predict(CaseSetup setup, const bp::object& sizing, const std::string& octreePath,
-                    const std::string& input, int threads, bool heal, const std::string& modes) {
-  if (!sizing.is_none()) setup.options.sizing = sizingFrom(bp::extract<bp::dict>(sizing));
-  setup.options.octreeOutput = octreePath;
-  setup.options.threads = threads;
-  setup.options.heal = heal;
-  applyCadModes(setup.options, modes);
+std::string predict(const CaseSetup& setup, const bp::dict& given, const std::string& octreePath,
+                    const std::string& input) {
+  MeshingOptions options = optionsFrom(given, kSizingKeys, kSources, setup.options);
+  options.boundaryLayer.reset();  // the prediction is of the sizing alone
+  options.octreeOutput = octreePath;
   const ReleaseGil nogil;
-  return predictReportJson(runSizingStage(setup.source, setup.options), input);
+  return predictReportJson(runSizingStage(setup.source, options), input);
 }
 
 // The sizing octree's leaves that are not outside the model, as arrays: "centre" (L, 3),
 // "half_width" (L,), "delta" (L,) and "boundary" (L,) uint8 (1: the boundary passes through the
 // leaf), with "predicted_elements". For drawing the size field.
-bp::dict sizeField(const std::string& text, const std::string& name, const bp::object& sizing,
-                   int threads, bool heal, const std::string& modes) {
-  CaseSetup setup;
-  setup.source = CadSource::brepText(text, name);
-  if (!sizing.is_none()) setup.options.sizing = sizingFrom(bp::extract<bp::dict>(sizing));
-  setup.options.threads = threads;
-  setup.options.heal = heal;
-  applyCadModes(setup.options, modes);
+bp::dict sizeField(const std::string& text, const std::string& name, const bp::dict& given) {
+  const CadSource source = CadSource::brepText(text, name);
+  const MeshingOptions options = optionsFrom(given, kSizingKeys, kSources);
   std::vector<double> centre, half, delta;
   std::vector<std::uint8_t> boundary;
   double predicted = 0.0;
   {
     const ReleaseGil nogil;
-    const SizingResult r = runSizingStage(setup.source, setup.options);
+    const SizingResult r = runSizingStage(source, options);
     predicted = r.prediction.elements;
     const SizingOctree& octree = *r.octree;
     for (std::size_t i = 0; i < octree.numLeaves(); ++i) {
@@ -494,24 +496,21 @@ bp::dict sizeField(const std::string& text, const std::string& name, const bp::o
 }
 
 // A CAD file or a NekMesh .mcf case (pipeline/case_setup.hpp).
-std::string predictFile(const std::string& path, const bp::object& sizing,
-                        const std::string& octreePath, int threads, bool heal,
-                        const std::string& modes) {
-  return predict(setupCase(path), sizing, octreePath, path, threads, heal, modes);
+std::string predictFile(const std::string& path, const bp::dict& options,
+                        const std::string& octreePath) {
+  return predict(setupCase(path), options, octreePath, path);
 }
 
-std::string predictBrep(const std::string& text, const std::string& name, const bp::object& sizing,
-                        const std::string& octreePath, int threads, bool heal,
-                        const std::string& modes) {
+std::string predictBrep(const std::string& text, const std::string& name, const bp::dict& options,
+                        const std::string& octreePath) {
   CaseSetup setup;
   setup.source = CadSource::brepText(text, name);
-  return predict(setup, sizing, octreePath, name, threads, heal, modes);
+  return predict(setup, options, octreePath, name);
 }
 
 // The parameter table (core/parameters.hpp) as a list of dicts: key, property, option, label,
-// kind ("integer", "real", "length"), min, max (inf: none), min_exclusive, default,
-// zero_is_automatic, group, doc,
-// range (in words).
+// kind ("integer", "real", "length", "boolean"), min, max (inf: none), min_exclusive, default,
+// zero_is_automatic, switchable, group, doc, range (in words).
 bp::list parameters() {
   bp::list out;
   for (const ParameterDefinition& p : parameterDefinitions()) {
@@ -520,14 +519,16 @@ bp::list parameters() {
     d["property"] = p.property;
     d["option"] = p.option;
     d["label"] = p.label;
-    d["kind"] = p.kind == ParameterKind::Integer  ? "integer"
-                : p.kind == ParameterKind::Length ? "length"
-                                                  : "real";
+    d["kind"] = p.kind == ParameterKind::Integer   ? "integer"
+                : p.kind == ParameterKind::Length  ? "length"
+                : p.kind == ParameterKind::Boolean ? "boolean"
+                                                   : "real";
     d["min"] = p.min;
     d["max"] = p.max;
     d["min_exclusive"] = p.minExclusive;
     d["default"] = p.defaultValue;
     d["zero_is_automatic"] = p.zeroIsAutomatic;
+    d["switchable"] = p.switchable;
     d["group"] = p.group;
     d["doc"] = p.doc;
     d["range"] = rangeText(p);
@@ -588,41 +589,28 @@ std::vector<double> finiteNodes(const bp::object& nodes) {
   return xyz;
 }
 
-// The Python functions' default, read from the one parameter table.
-int defaultRepairRounds() {
-  return static_cast<int>(parameterDefinition("repair_rounds").defaultValue);
-}
-
-// A CAD file or a NekMesh .mcf case: a case's CAD and sizes (unless given here) are used.
-PyMesh meshFile(const std::string& path, int order, const bp::object& size, int threads,
-                int verbosity, bp::object progress, int optimise, const bp::object& sizing,
-                int repairRounds, const bp::object& boundaryLayer, const bp::object& cancel,
-                const bp::object& limits, bool heal, const std::string& modes) {
+// A CAD file or a NekMesh .mcf case: a case's CAD, order, sizes and boundary layer are used
+// where the options do not say otherwise.
+PyMesh meshFile(const std::string& path, const bp::dict& options, bp::object progress,
+                const bp::object& cancel) {
   const CaseSetup setup = setupCase(path);
-  MeshingOptions options = makeOptions(order, size, threads, verbosity, optimise, sizing,
-                                       repairRounds, boundaryLayer, limits, heal, modes);
-  if (!options.size && !options.sizing) options.sizing = setup.options.sizing;
-  if (!options.boundaryLayer) options.boundaryLayer = setup.options.boundaryLayer;
-  options.expectedDimension = setup.options.expectedDimension;
-  return runPipeline(setup.source, options, std::move(progress), cancel);
+  return runPipeline(setup.source,
+                     optionsFrom(options, kMeshKeys, kSources | kBoundaryLayer, setup.options),
+                     std::move(progress), cancel);
 }
 
-PyMesh meshBrep(const std::string& text, const std::string& name, int order, const bp::object& size,
-                int threads, int verbosity, bp::object progress, int optimise,
-                const bp::object& sizing, int repairRounds, const bp::object& boundaryLayer,
-                const bp::object& cancel, const bp::object& limits, bool heal,
-                const std::string& modes) {
+PyMesh meshBrep(const std::string& text, const std::string& name, const bp::dict& options,
+                bp::object progress, const bp::object& cancel) {
   return runPipeline(CadSource::brepText(text, name),
-                     makeOptions(order, size, threads, verbosity, optimise, sizing, repairRounds,
-                                 boundaryLayer, limits, heal, modes),
+                     optionsFrom(options, kMeshKeys, kSources | kBoundaryLayer),
                      std::move(progress), cancel);
 }
 
 // Curves a linear tetrahedral mesh made elsewhere (nodes (N, 3), tetrahedra (E, 4), 0-based) on
 // the CAD of `source` (BRep text or a CAD file): pipeline's curveMeshOnCad.
 PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::object& tets,
-                  int order, int threads, int verbosity, bp::object progress, int optimise,
-                  const bp::object& cancel, const bp::object& limits) {
+                  const bp::dict& given, bp::object progress, const bp::object& cancel) {
+  const MeshingOptions options = optionsFrom(given, kCurveKeys, kNoExtras);
   Mesh linear;
   linear.dim = 3;
   linear.order = 1;
@@ -638,25 +626,21 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::ob
   linear.nodeCadDim.assign(n, 3);
   linear.nodeCadIndex.assign(n, 0);
   linear.nodeCadParam.assign(2 * n, std::numeric_limits<double>::quiet_NaN());
-  const MeshingOptions options = makeOptions(order, bp::object(), threads, verbosity, optimise,
-                                             bp::object(), 0, bp::object(), limits);
   return runObserved(std::move(progress), cancel, [&](PipelineObserver* observer) {
     return curveMeshOnCad(source, linear, options, observer);
   });
 }
 
 PyMesh curveBrep(const std::string& text, const std::string& name, const bp::object& nodes,
-                 const bp::object& tets, int order, int threads, int verbosity, bp::object progress,
-                 int optimise, const bp::object& cancel, const bp::object& limits) {
-  return curveOnCad(CadSource::brepText(text, name), nodes, tets, order, threads, verbosity,
-                    std::move(progress), optimise, cancel, limits);
+                 const bp::object& tets, const bp::dict& options, bp::object progress,
+                 const bp::object& cancel) {
+  return curveOnCad(CadSource::brepText(text, name), nodes, tets, options, std::move(progress),
+                    cancel);
 }
 
 PyMesh curveFile(const std::string& path, const bp::object& nodes, const bp::object& tets,
-                 int order, int threads, int verbosity, bp::object progress, int optimise,
-                 const bp::object& cancel, const bp::object& limits) {
-  return curveOnCad(CadSource::file(path), nodes, tets, order, threads, verbosity,
-                    std::move(progress), optimise, cancel, limits);
+                 const bp::dict& options, bp::object progress, const bp::object& cancel) {
+  return curveOnCad(CadSource::file(path), nodes, tets, options, std::move(progress), cancel);
 }
 
 // Rebuilds a mesh (without CAD) from the arrays PyMesh exposes, and evaluates its quality.
@@ -800,38 +784,26 @@ BOOST_PYTHON_MODULE(_core) {
       .def("optimise", &PyMesh::optimise);
 
   bp::def("mesh_file", &meshFile,
-          (bp::arg("path"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
-           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
-           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = defaultRepairRounds(),
-           bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object(),
-           bp::arg("limits") = bp::object(), bp::arg("heal") = true, bp::arg("cad_modes") = ""));
+          (bp::arg("path"), bp::arg("options"), bp::arg("progress") = bp::object(),
+           bp::arg("cancel") = bp::object()));
   bp::def("mesh_brep", &meshBrep,
-          (bp::arg("text"), bp::arg("name"), bp::arg("order"), bp::arg("size"), bp::arg("threads"),
-           bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise") = 0,
-           bp::arg("sizing") = bp::object(), bp::arg("repair_rounds") = defaultRepairRounds(),
-           bp::arg("boundary_layer") = bp::object(), bp::arg("cancel") = bp::object(),
-           bp::arg("limits") = bp::object(), bp::arg("heal") = true, bp::arg("cad_modes") = ""));
+          (bp::arg("text"), bp::arg("name"), bp::arg("options"), bp::arg("progress") = bp::object(),
+           bp::arg("cancel") = bp::object()));
   bp::def("predict_file", &predictFile,
-          (bp::arg("path"), bp::arg("sizing") = bp::object(), bp::arg("octree_path") = "",
-           bp::arg("threads") = 1, bp::arg("heal") = true, bp::arg("cad_modes") = ""));
+          (bp::arg("path"), bp::arg("options"), bp::arg("octree_path") = ""));
   bp::def("predict_brep", &predictBrep,
-          (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
-           bp::arg("octree_path") = "", bp::arg("threads") = 1, bp::arg("heal") = true,
-           bp::arg("cad_modes") = ""));
+          (bp::arg("text"), bp::arg("name"), bp::arg("options"), bp::arg("octree_path") = ""));
   bp::def("parameters", &parameters);
+  bp::def("option_keys", &optionKeys, (bp::arg("function")));
   bp::def("parameter_in_range", &parameterInRange, (bp::arg("key"), bp::arg("value")));
   bp::def(
       "curve_brep", &curveBrep,
-      (bp::arg("text"), bp::arg("name"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("order"),
-       bp::arg("threads"), bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise"),
-       bp::arg("cancel") = bp::object(), bp::arg("limits") = bp::object()));
+      (bp::arg("text"), bp::arg("name"), bp::arg("nodes"), bp::arg("tetrahedra"),
+       bp::arg("options"), bp::arg("progress") = bp::object(), bp::arg("cancel") = bp::object()));
   bp::def("curve_file", &curveFile,
-          (bp::arg("path"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("order"),
-           bp::arg("threads"), bp::arg("verbosity"), bp::arg("progress"), bp::arg("optimise"),
-           bp::arg("cancel") = bp::object(), bp::arg("limits") = bp::object()));
-  bp::def("size_field", &sizeField,
-          (bp::arg("text"), bp::arg("name"), bp::arg("sizing") = bp::object(),
-           bp::arg("threads") = 1, bp::arg("heal") = true, bp::arg("cad_modes") = ""));
+          (bp::arg("path"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("options"),
+           bp::arg("progress") = bp::object(), bp::arg("cancel") = bp::object()));
+  bp::def("size_field", &sizeField, (bp::arg("text"), bp::arg("name"), bp::arg("options")));
   bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("threads") = 1));
   bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
   bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));

@@ -4,6 +4,7 @@
 
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "core/parameters.hpp"
 
 namespace homesh {
 namespace {
@@ -15,15 +16,12 @@ bool positive(double x) {
 }  // namespace
 
 void SizingParameters::validate() const {
-  if (!positive(minDelta))
-    throw ParameterError("MinDelta must be a positive number, got " + formatNumber(minDelta));
-  if (!positive(maxDelta))
-    throw ParameterError("MaxDelta must be a positive number, got " + formatNumber(maxDelta));
+  checkParameter("min_delta", minDelta);
+  checkParameter("max_delta", maxDelta);
   if (minDelta > maxDelta)
     throw ParameterError("MinDelta (" + formatNumber(minDelta) + ") must not exceed MaxDelta (" +
                          formatNumber(maxDelta) + ")");
-  if (!(eps > 0.0 && eps <= 1.0))
-    throw ParameterError("EPS must lie in (0, 1], got " + formatNumber(eps));
+  checkParameter("eps", eps);
   if (!(thinWall >= 0.0 && thinWall <= 1.0))
     throw ParameterError("the thin-wall sagitta ratio must lie in [0, 1], got " +
                          formatNumber(thinWall));

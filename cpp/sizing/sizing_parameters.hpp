@@ -10,16 +10,17 @@
 
 #include <vector>
 
+#include "core/parameters.hpp"
 #include "sizing/refinement_source.hpp"
 
 namespace homesh {
 
 struct SizingParameters {
   // 0 for minDelta or maxDelta: automatic (completeSizing in pipeline/mesh_pipeline.hpp).
-  double minDelta = 0.0;   // smallest size curvature may ask for (> 0)
-  double maxDelta = 0.0;   // size far from curved boundaries (>= minDelta)
-  double eps = 0.05;       // sagitta relative to the radius of curvature, 0 < eps <= 1
-  double gradation = 0.2;  // largest |d delta / d x| (> 0)
+  double minDelta = 0.0;                 // smallest size curvature may ask for (> 0)
+  double maxDelta = 0.0;                 // size far from curved boundaries (>= minDelta)
+  double eps = parameterDefault("eps");  // sagitta over the radius of curvature
+  double gradation = 0.2;                // largest |d delta / d x| (> 0)
   // Sagitta at most this fraction of the wall's local thickness, in [0, 1]; 0: no such bound
   // (NekMesh's sizing, which a .mcf case keeps). 0.1: on OpenCASCADE's bottle (a 0.6 mm wall
   // with fillets of radius 2.5 mm) the curvature size alone left six elements spanning the

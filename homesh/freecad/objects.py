@@ -24,22 +24,26 @@ TYPE_BOUNDARY_LAYER = "HOMesh::BoundaryLayer"
 _RESULT_PROPERTIES = ("NumNodes", "NumElements", "MinScaledJacobian", "InvalidElements")
 
 
-def make_high_order_mesh(doc, part, order=4, size=0.0, name="HighOrderMesh", sizing=None,
+def make_high_order_mesh(doc, part, order=None, size=None, name="HighOrderMesh", sizing=None,
                          boundary_layer=None, fem_mesh=None):
     """Adds a HighOrderMesh object meshing ``part`` (a document object with a Shape).
 
-    ``size`` 0 means automatic: the sizing octree of ``sizing`` (a Sizing object, see
+    ``order`` and ``size`` left out (None) keep the parameter table's defaults. ``size`` 0
+    means automatic: the sizing octree of ``sizing`` (a Sizing object, see
     :func:`make_sizing`) if given, else the automatic sizing octree (MaxDelta a twentieth of the
-    bounding-box diagonal, MinDelta a twentieth of that, EPS 0.05). ``boundary_layer``: a
-    BoundaryLayer object on faces of ``part`` (:func:`make_boundary_layer`). ``fem_mesh``: a
+    bounding-box diagonal, MinDelta a twentieth of that, EPS the table's default).
+    ``boundary_layer``: a BoundaryLayer object on faces of ``part``
+    (:func:`make_boundary_layer`). ``fem_mesh``: a
     FEM mesh object of ``part`` (FEM's Gmsh or Netgen mesher) to curve instead of meshing
     ``part`` (size, sizing and boundary layer then do not apply). The caller recomputes.
     """
     obj = doc.addObject("App::FeaturePython", name)
     HighOrderMeshProxy(obj)
     obj.Part = part
-    obj.Order = order
-    obj.Size = size
+    if order is not None:
+        obj.Order = order
+    if size is not None:
+        obj.Size = size
     obj.Sizing = sizing
     obj.BoundaryLayer = boundary_layer
     obj.FemMesh = fem_mesh
@@ -126,33 +130,8 @@ class HighOrderMeshProxy(_Proxy, ParameterGuard):
         add_parameter_property(obj, "facet_weight", "Mesh")
         add_parameter_property(obj, "linear_seconds", "Mesh")
         add_parameter_property(obj, "job_seconds", "Mesh")
-        if "Heal" not in have:
-            obj.addProperty("App::PropertyBool", "Heal", "Mesh",
-                            "Check the shape and, where the check finds a problem (faces not "
-                            "sewn into a solid, invalid geometry, tiny edges or sliver faces), "
-                            "repair it with OpenCASCADE's shape healing before meshing; a "
-                            "healed shape's faces are numbered afresh (see the report)")
-            obj.Heal = True
-        if "SolidsOnly" not in have:
-            obj.addProperty("App::PropertyBool", "SolidsOnly", "Mesh",
-                            "Mesh the solids and leave out faces in no solid (a loose shell "
-                            "that does not close), named in the report view; off: such a "
-                            "shape is refused, naming those faces")
-            obj.SolidsOnly = False
-        if "Surface" not in have:
-            obj.addProperty("App::PropertyBool", "Surface", "Mesh",
-                            "For a shape without solids (a shell, faces that do not close): a "
-                            "surface mesh of its faces, triangles curved on the CAD, sewn where "
-                            "faces meet (no volume, no optimiser, no boundary layer); off: such "
-                            "a shape is refused, naming a free edge")
-            obj.Surface = False
-        if "AutoMode" not in have:
-            obj.addProperty("App::PropertyBool", "AutoMode", "Mesh",
-                            "Let HOMesh choose for the shape: with solids, as SolidsOnly (faces "
-                            "in no solid left out and named); without a solid, sewn into solids "
-                            "where every shell closes, else as Surface; the report view says "
-                            "which. Not with SolidsOnly or Surface")
-            obj.AutoMode = False
+        for key in ("heal", "solids_only", "surface", "auto"):
+            add_parameter_property(obj, key, "Mesh")
         add_parameter_property(obj, "repair_rounds", "Mesh")
         add_parameter_property(obj, "threads", "Mesh", " Default: all cores.",
                                default=os.cpu_count() or 1)
@@ -273,10 +252,8 @@ def mesh_arguments(obj, values=None):
                  "facet_weight": get("FacetWeight"),
                  "linear_seconds": get("LinearTimeLimit"),
                  "job_seconds": get("JobTimeLimit"),
-                 "heal": bool(values.get("Heal", getattr(obj, "Heal", True))),
-                 "solids_only": bool(values.get("SolidsOnly", getattr(obj, "SolidsOnly", False))),
-                 "surface": bool(values.get("Surface", getattr(obj, "Surface", False))),
-                 "auto": bool(values.get("AutoMode", getattr(obj, "AutoMode", False))),
+                 "heal": bool(get("Heal")), "solids_only": bool(get("SolidsOnly")),
+                 "surface": bool(get("Surface")), "auto": bool(get("AutoMode")),
                  "repair_rounds": int(get("RepairRounds")), "threads": int(get("Threads"))}
     sizing = values.get("Sizing", getattr(obj, "Sizing", None))
     if arguments["size"] is None and sizing is not None:
@@ -353,11 +330,9 @@ def predicted_elements(obj, job):
                   if k in arguments}
     else:
         sizing = {"min_delta": size, "max_delta": size}
-    report = homesh.predict(job.brep_text, name=job.name, threads=arguments["threads"],
-                            heal=arguments.get("heal", True),
-                            solids_only=arguments.get("solids_only", False),
-                            surface=arguments.get("surface", False),
-                            auto=arguments.get("auto", False), **sizing)
+    cad = {k: arguments[k] for k in ("threads", "heal", "solids_only", "surface", "auto")
+           if k in arguments}
+    report = homesh.predict(job.brep_text, name=job.name, **cad, **sizing)
     return int(report["predicted_elements"])
 
 
@@ -445,20 +420,20 @@ def summary_text(obj, mesh, quality, predicted=None, where=""):
     return text
 
 
-def make_sizing(doc, part, min_delta=0.0, max_delta=0.0, eps=0.05, name="Sizing"):
+def make_sizing(doc, part, min_delta=None, max_delta=None, eps=None, name="Sizing"):
     """Adds a Sizing object for ``part`` (a document object with a Shape): the sizing octree's
     parameters and its predicted element count.
 
-    ``min_delta`` / ``max_delta`` 0 mean automatic (max: bounding-box diagonal / 20, min: max /
-    20). Refinement spheres go in RefinementSpheres (centres), RefinementRadii and
+    Left out (None): the parameter table's defaults. ``min_delta`` / ``max_delta`` 0 mean
+    automatic (max: bounding-box diagonal / 20, min: max / 20). Refinement spheres go in RefinementSpheres (centres), RefinementRadii and
     RefinementDeltas (parallel lists). The caller recomputes.
     """
     obj = doc.addObject("App::FeaturePython", name)
     SizingProxy(obj)
     obj.Part = part
-    obj.MinDelta = min_delta
-    obj.MaxDelta = max_delta
-    obj.Eps = eps
+    for prop, value in (("MinDelta", min_delta), ("MaxDelta", max_delta), ("Eps", eps)):
+        if value is not None:
+            setattr(obj, prop, value)
     if FreeCAD.GuiUp:
         from .viewproviders import ViewProviderSizing
         ViewProviderSizing(obj.ViewObject)
@@ -486,8 +461,9 @@ def sizing_arguments(obj):
     min_delta = obj.MinDelta.Value
     max_delta = obj.MaxDelta.Value
     eps = obj.Eps
-    if not 0.0 < eps <= 1.0:
-        raise ValueError("%s: Eps must lie in (0, 1], got %g" % (obj.Label, eps))
+    if not allowed(definition("Eps"), eps):
+        raise ValueError("%s: Eps must be %s, got %g" % (obj.Label, definition("Eps")["range"],
+                                                         eps))
     if min_delta > 0 and max_delta > 0 and min_delta > max_delta:
         raise ValueError("%s: MinDelta (%g) must not exceed MaxDelta (%g)"
                          % (obj.Label, min_delta, max_delta))
@@ -613,19 +589,22 @@ def prediction_summary(report):
     return text
 
 
-def make_boundary_layer(doc, part, faces, thickness, layers=2, progression=2.0,
+def make_boundary_layer(doc, part, faces, thickness, layers=None, progression=None,
                         name="BoundaryLayer"):
     """Adds a BoundaryLayer object on ``faces`` of ``part`` (FreeCAD's numbers, 1 for Face1, or
     names "Face1"; for a planar shape edges, named "Edge1"): ``thickness`` a length in the model's units or an expression of x, y, z
-    (text), split into ``layers`` layers whose heights grow by ``progression`` from the wall.
+    (text), split into ``layers`` layers whose heights grow by ``progression`` from the wall
+    (left out: the parameter table's defaults).
     Link it from a HighOrderMesh's BoundaryLayer property. The caller recomputes.
     """
     obj = doc.addObject("App::FeaturePython", name)
     BoundaryLayerProxy(obj)
     obj.Faces = (part, [f if isinstance(f, str) else "Face%d" % f for f in faces])
     obj.Thickness = str(thickness)
-    obj.Layers = layers
-    obj.Progression = progression
+    if layers is not None:
+        obj.Layers = layers
+    if progression is not None:
+        obj.Progression = progression
     return obj
 
 

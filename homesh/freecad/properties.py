@@ -13,7 +13,13 @@ import FreeCAD
 from ..api import parameters
 
 _PROPERTY_TYPE = {"integer": "App::PropertyInteger", "real": "App::PropertyFloat",
-                  "length": "App::PropertyDistance"}  # Length would clamp -5 to 0 unsaid
+                  "length": "App::PropertyDistance",  # Length would clamp -5 to 0 unsaid
+                  "boolean": "App::PropertyBool"}
+
+
+def _typed(p, value):
+    """``value`` as the property of table entry ``p`` holds it."""
+    return {"integer": int, "boolean": bool}.get(p["kind"], float)(value)
 
 
 def definition(prop):
@@ -30,10 +36,10 @@ def add_parameter_property(obj, key, group, doc_extra="", default=None):
     p = [d for d in parameters() if d["key"] == key][0]
     if p["property"] in obj.PropertiesList:
         return
-    tip = "%s. %s%s" % (p["doc"], _range_words(p), doc_extra)
+    tip = "%s.%s%s" % (p["doc"], "" if p["kind"] == "boolean" else " " + _range_words(p),
+                        doc_extra)
     obj.addProperty(_PROPERTY_TYPE[p["kind"]], p["property"], group, tip)
-    value = p["default"] if default is None else default
-    setattr(obj, p["property"], int(value) if p["kind"] == "integer" else float(value))
+    setattr(obj, p["property"], _typed(p, p["default"] if default is None else default))
 
 
 def _range_words(p):
@@ -97,5 +103,5 @@ class ParameterGuard:
                       " (or 0 for automatic)" if p["zero_is_automatic"] else "", previous))
         self.refused.append(message)
         FreeCAD.Console.PrintWarning("HOMesh: %s\n" % message)
-        setattr(obj, prop, int(previous) if p["kind"] == "integer" else previous)
+        setattr(obj, prop, _typed(p, previous))
         return False

@@ -104,7 +104,7 @@ def test_planar_face_gives_a_2d_mesh(tmp_path):
     (dict(order=2.5), homesh.ParameterError),
     (dict(order=True), homesh.ParameterError),
     (dict(size=-1), homesh.ParameterError),
-    (dict(size=0), homesh.ParameterError),
+    (dict(size=float("nan")), homesh.ParameterError),  # 0 is automatic, as in FreeCAD
     (dict(size="big"), homesh.ParameterError),
     (dict(threads=0), homesh.ParameterError),
     (dict(threads=100000), homesh.ParameterError),
@@ -367,7 +367,8 @@ def test_the_facet_weight_reaches_the_core_and_is_checked(data):
     assert not np.array_equal(plain.nodes, facets.nodes)
     with pytest.raises(homesh.ParameterError, match="facet weight must be a number from 0 to 100"):
         homesh.mesh(text, order=2, size=0.5, optimise=5, facet_weight=-1.0)
-    with pytest.raises(homesh.ParameterError, match="facet_weight must be a number"):
+    with pytest.raises(homesh.ParameterError,
+                       match="facet weight must be a number from 0 to 100, got '1'"):
         homesh.mesh(text, order=2, size=0.5, optimise=5, facet_weight="1")
 
 
@@ -383,14 +384,44 @@ def test_the_command_line_takes_a_time_limit(homesh_bin, data, tmp_path):
     assert bad.returncode == 2 and "--time-limit must be a number >= 0" in bad.stderr
 
 
-def test_keyword_defaults_are_the_parameter_tables():
-    # mesh()'s plain numeric defaults are written in its signature; the one parameter table is
-    # what the core, the command line and FreeCAD read, so they must agree (optimise differs on
-    # purpose: off in Python, 20 sweeps for a FreeCAD object; size and the sizing keywords use
-    # None for "automatic").
+def test_options_are_checked_once_by_the_parameter_table(data):
+    """The keywords of mesh, curve and predict go to the core as one options mapping: a name
+    the table does not have, a value of the wrong kind or out of range, and a name the function
+    has no use for are refused with one message naming the option."""
+    text = (data / "sphere.brep").read_text()
+    with pytest.raises(homesh.ParameterError, match="unknown option 'ordr'"):
+        homesh.mesh(text, ordr=2)
+    with pytest.raises(homesh.ParameterError,
+                       match="order must be an integer from 1 to 10, got '4'"):
+        homesh.mesh(text, order="4")
+    with pytest.raises(homesh.ParameterError,
+                       match="order must be an integer from 1 to 10, got true"):
+        homesh.mesh(text, order=True)
+    with pytest.raises(homesh.ParameterError, match="heal must be true or false, got 1"):
+        homesh.mesh(text, heal=1)
+    with pytest.raises(homesh.ParameterError,
+                       match=r"option 'size' does not apply here \(options: order, optimise"):
+        homesh.curve(text, [[0, 0, 0]] * 4, [[0, 1, 2, 3]], size=1.0)
+    with pytest.raises(homesh.ParameterError, match="option 'order' does not apply here"):
+        homesh.predict(text, order=2)
+    # The layer's own parameters belong in its dict, not among the job's.
+    with pytest.raises(homesh.ParameterError, match="option 'layers' does not apply here"):
+        homesh.mesh(text, layers=3)
+
+
+def test_keywords_and_their_help_come_from_the_parameter_table(data):
     import inspect
+    table = {p["key"]: p for p in homesh.parameters()}
     signature = inspect.signature(homesh.mesh).parameters
-    table = {p["key"]: p["default"] for p in homesh.parameters()}
-    for key in ("order", "threads", "repair_rounds", "optimise_seconds", "linear_seconds",
-                "job_seconds", "facet_weight"):
-        assert signature[key].default == table[key], key
+    for key in ("order", "repair_rounds", "linear_seconds", "heal", "min_delta"):
+        p = table[key]
+        assert key in homesh.mesh.__doc__ and p["range"] in homesh.mesh.__doc__, key
+        default = signature[key].default
+        assert default is None if p["zero_is_automatic"] else default == p["default"], key
+    assert signature["optimise"].default is False  # asked for with True or a number
+    assert "facet_weight" in inspect.signature(homesh.curve).parameters
+    assert "size" not in inspect.signature(homesh.curve).parameters
+    # optimise=True is the table's number of sweeps, the most a run may take.
+    record = homesh.mesh((data / "sphere.brep").read_text(), order=2, size=0.5,
+                         optimise=True).report()["optimiser"]
+    assert 1 <= record["iterations"] <= table["optimise"]["default"]

@@ -99,7 +99,8 @@ def test_python_repair_rounds():
     for bad in (-1, 21):
         with pytest.raises(homesh.ParameterError, match="repair rounds"):
             homesh.mesh(str(SPHERE_BOX), order=4, size=1.2, repair_rounds=bad)
-    with pytest.raises(homesh.ParameterError, match="repair_rounds"):
+    with pytest.raises(homesh.ParameterError,
+                       match="repair rounds must be an integer from 0 to 20, got 1.5"):
         homesh.mesh(str(SPHERE_BOX), order=4, size=1.2, repair_rounds=1.5)
 
 

@@ -1,6 +1,8 @@
 // Command-line parsing: accepted forms and the error for each bad one.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "cli/arguments.hpp"
 #include "core/parameters.hpp"
 #include "pipeline/mesh_pipeline.hpp"
@@ -10,6 +12,12 @@ namespace {
 
 ParsedCommand parse(const std::vector<std::string>& args) {
   return parseCommandLine(args);
+}
+
+// The number a parsed command line gives for table key `key` (NaN when it gives none).
+double given(const OptionMap& options, const std::string& key) {
+  const auto it = options.find(key);
+  return it == options.end() ? std::nan("") : checkedOption(key, it->second);
 }
 
 std::string usageError(const std::vector<std::string>& args) {
@@ -26,56 +34,77 @@ TEST(Arguments, MeshWithEveryOption) {
                                  "a.msh", "-o", "b.vtu", "--report", "r.json", "-j", "2", "-v"});
   ASSERT_EQ(p.kind, ParsedCommand::Kind::Mesh);
   EXPECT_EQ(p.mesh.input, "part.step");
-  EXPECT_EQ(p.mesh.order, 5);
-  ASSERT_TRUE(p.mesh.size.has_value());
-  EXPECT_DOUBLE_EQ(*p.mesh.size, 0.25);
+  EXPECT_EQ(given(p.mesh.options, "order"), 5);
+  EXPECT_DOUBLE_EQ(given(p.mesh.options, "size"), 0.25);
   EXPECT_EQ(p.mesh.common.outputs, (std::vector<std::string>{"a.msh", "b.vtu"}));
   EXPECT_EQ(p.mesh.common.report.value_or(""), "r.json");
   EXPECT_EQ(p.mesh.common.threads, 2);
-  EXPECT_EQ(p.mesh.verbosity, 1);
+  EXPECT_EQ(given(p.mesh.options, "verbosity"), 1);
+  EXPECT_EQ(given(parse({"mesh", "a.step", "-vv"}).mesh.options, "verbosity"), 2);
+  // Boolean flags turn the table's default around.
+  const OptionMap modes =
+      parse({"mesh", "a.step", "--no-heal", "--solids-only", "--surface", "--auto"}).mesh.options;
+  EXPECT_EQ(given(modes, "heal"), 0.0);
+  for (const char* key : {"solids_only", "surface", "auto"}) EXPECT_EQ(given(modes, key), 1.0);
+  EXPECT_EQ(given(parse({"predict", "a.step", "--no-heal"}).predict.options, "heal"), 0.0);
 }
 
 TEST(Arguments, Defaults) {
   const ParsedCommand p = parse({"mesh", "part.brep"});
-  EXPECT_FALSE(p.mesh.order.has_value());  // 4, or the .mcf's Order
-  EXPECT_FALSE(p.mesh.size.has_value());
+  EXPECT_TRUE(p.mesh.options.empty());  // the table's defaults, or a .mcf's values
   EXPECT_FALSE(p.mesh.sizing.anyDelta());
   EXPECT_TRUE(p.mesh.common.outputs.empty());
 }
 
 TEST(Arguments, RepairRounds) {
-  // The CLI's, the pipeline's and the parameter table's defaults agree.
-  const auto table = static_cast<int>(parameterDefinition("repair_rounds").defaultValue);
-  EXPECT_EQ(table, 8);
-  EXPECT_EQ(parse({"mesh", "part.brep"}).mesh.repairRounds, table);
-  EXPECT_EQ(MeshingOptions{}.repairRounds, table);
-  EXPECT_EQ(parse({"mesh", "part.brep", "--repair-rounds", "0"}).mesh.repairRounds, 0);
-  EXPECT_EQ(parse({"mesh", "part.brep", "--repair-rounds", "20"}).mesh.repairRounds, 20);
+  EXPECT_EQ(
+      given(parse({"mesh", "part.brep", "--repair-rounds", "0"}).mesh.options, "repair_rounds"), 0);
+  EXPECT_EQ(
+      given(parse({"mesh", "part.brep", "--repair-rounds", "20"}).mesh.options, "repair_rounds"),
+      20);
   for (const char* bad : {"-1", "21", "2.5", "x"})
     EXPECT_NE(usageError({"mesh", "part.brep", "--repair-rounds", bad}).find("--repair-rounds"),
               std::string::npos)
         << bad;
 }
 
-TEST(Arguments, FacetWeight) {
-  // The CLI's, the pipeline's, the optimiser's and the parameter table's defaults agree: off.
-  const double table = parameterDefinition("facet_weight").defaultValue;
-  EXPECT_EQ(table, 0.0);
-  EXPECT_EQ(parse({"mesh", "part.brep"}).mesh.facetWeight, table);
-  EXPECT_EQ(MeshingOptions{}.facetWeight, table);
-  EXPECT_EQ(OptimiserOptions{}.facetWeight, table);
-  EXPECT_EQ(parse({"mesh", "part.brep", "--optimise", "--facet-weight", "1.5"}).mesh.facetWeight,
+TEST(Arguments, OptimiserOptionsNeedTheOptimiser) {
+  // --optimise alone: the table's number of sweeps; --maxiter N: N.
+  const OptionMap on = parse({"mesh", "part.brep", "--optimise"}).mesh.options;
+  EXPECT_EQ(given(on, "optimise"), parameterDefault("optimise"));
+  EXPECT_EQ(given(parse({"mesh", "part.brep", "--optimise", "-n", "7"}).mesh.options, "optimise"),
+            7);
+  EXPECT_EQ(given(parse({"mesh", "part.brep", "--optimise", "--facet-weight", "1.5"}).mesh.options,
+                  "facet_weight"),
             1.5);
   // The optimiser's options do nothing without it: refused by name.
   EXPECT_EQ(usageError({"mesh", "part.brep", "--facet-weight", "1.5"}),
             "--facet-weight needs --optimise");
   EXPECT_EQ(usageError({"mesh", "part.brep", "--time-limit", "40"}),
             "--time-limit needs --optimise");
-  EXPECT_EQ(parse({"mesh", "part.brep", "--time-limit", "40", "--optimise"}).mesh.timeLimit, 40.0);
+  EXPECT_EQ(usageError({"mesh", "part.brep", "-n", "5"}), "--maxiter needs --optimise");
+  EXPECT_EQ(given(parse({"mesh", "part.brep", "--time-limit", "40", "--optimise"}).mesh.options,
+                  "optimise_seconds"),
+            40.0);
   for (const char* bad : {"-0.5", "101", "x"})
     EXPECT_NE(usageError({"mesh", "part.brep", "--facet-weight", bad}).find("--facet-weight"),
               std::string::npos)
         << bad;
+}
+
+TEST(Arguments, HelpListsTheTablesOptionsWithTheirRangesAndDefaults) {
+  // The help's words in one line: a range may be wrapped over two.
+  std::string help;
+  for (const char c : usageText("mesh"))
+    if (c != '\n' && !(c == ' ' && !help.empty() && help.back() == ' ')) help += c;
+  for (const ParameterDefinition& p : parameterDefinitions()) {
+    if (*p.option == '\0' || std::string(p.key) == "verbosity") continue;
+    EXPECT_NE(help.find(p.option), std::string::npos) << p.key;
+    if (p.kind != ParameterKind::Boolean) {
+      EXPECT_NE(help.find(rangeText(p)), std::string::npos) << p.key;
+    }
+  }
+  EXPECT_NE(usageText("mesh").find("  -p, --order N"), std::string::npos);
 }
 
 TEST(Arguments, SizingAndPredict) {
@@ -96,7 +125,7 @@ TEST(Arguments, SizingAndPredict) {
   EXPECT_EQ(p.predict.sizing.sources[3].edge, 3);
   EXPECT_EQ(p.predict.sizing.writeOctree.value_or(""), "o.vtu");
   const ParsedCommand m = parse({"mesh", "a.step", "--min-delta", "0.01", "-p", "2"});
-  EXPECT_EQ(m.mesh.order.value_or(0), 2);
+  EXPECT_EQ(given(m.mesh.options, "order"), 2);
   EXPECT_DOUBLE_EQ(m.mesh.sizing.minDelta.value_or(0.0), 0.01);
 }
 

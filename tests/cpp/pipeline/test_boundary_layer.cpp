@@ -575,8 +575,9 @@ TEST(BoundaryLayer, ATangentNeighbourWithoutALayerIsNamed) {
 }
 
 // NekMesh's 3d_bl_cyl case: a cylinder (faces 1 and 8) in a box, thickness 0.04, 6 layers,
-// progression 1.5, at order 2 with the optimiser (as README's example runs it). The meshing runs
-// once for the suite, and only where the peer files are (SetUp skips each test otherwise).
+// progression 1.5, at order 2 with the optimiser (as docs/boundary-layers.md's example runs it).
+// The meshing runs once for the suite, and only where the peer files are (SetUp skips each test
+// otherwise).
 class CylinderCase : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
