@@ -97,7 +97,7 @@ struct OptimiserOptions {
   std::vector<char> regionSeed;
   int regionLayers = 2;  // layers of neighbours (sharing a node) added to the region
   // After each sweep, this many extra Newton steps on the nodes of the elements whose scaled
-  // Jacobian is within focusMargin of the mesh's worst (see sweep() in optimiser.cpp).
+  // Jacobian is within focusMargin of the mesh's worst (see optimise/sweep.hpp).
   int focusPasses = 2;
   double focusMargin = 0.05;
   // Let the nodes on internal interfaces (between elements of different entities, and on
