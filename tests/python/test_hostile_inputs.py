@@ -225,10 +225,12 @@ def test_needle_cone_crash_inside_gmsh_is_contained(homesh_bin, tmp_path):
     # Gmsh 4.8 crashes (SIGSEGV, or an abort from inside an OpenMP region) on this cone with
     # both its default surface algorithm and MeshAdapt: the crash ends Gmsh's child process and
     # homesh reports it; a later Gmsh that meshes it may give a mesh instead. On a loaded
-    # machine Gmsh may still be grinding when the linear stage's default budget runs out: that
-    # ends it as cleanly, and which comes first is the machine's speed, not the code's.
-    r = run([homesh_bin, "mesh", cad("needle.step"), "--order", "2", "-o", tmp_path / "n.msh"],
-            timeout=400)
+    # machine Gmsh may still be grinding when the linear stage's budget runs out: that ends it
+    # as cleanly, and which comes first is the machine's speed, not the code's. The budget here
+    # is several times the tens of seconds Gmsh takes to crash on an idle machine, and keeps a
+    # loaded run from waiting out the default 600 s.
+    r = run([homesh_bin, "mesh", cad("needle.step"), "--order", "2", "--linear-time-limit",
+             "240", "-o", tmp_path / "n.msh"], timeout=400)
     assert r.returncode >= 0, "homesh died of signal %s" % signal.Signals(-r.returncode).name
     if r.returncode != 0:
         error = one_line_error(r, 1, "needle.step", "Gmsh")
