@@ -424,8 +424,10 @@ std::string tableHelp(std::initializer_list<const char*> keys) {
     std::string text = p.doc;
     if (p.kind == ParameterKind::Boolean) {
       // The flag turns the default around: say which way.
-      text = p.defaultValue != 0.0 ? "turns off what is on unless given: " + text
-                                   : text + " (off unless given)";
+      if (p.defaultValue != 0.0)
+        text.insert(0, "turns off what is on unless given: ");
+      else
+        text += " (off unless given)";
     } else {
       const bool seconds = std::string(key).find("_seconds") != std::string::npos;
       head += p.kind == ParameterKind::Integer ? " N" : seconds ? " S" : " X";
@@ -595,10 +597,12 @@ std::string roffText(const std::string& text) {
 }
 
 std::string manPage() {
-  std::string out = ".TH HOMESH 1 \"\" \"homesh " + std::string(kVersion) +
-                    "\" \"User Commands\"\n"
-                    ".SH NAME\nhomesh \\- curved (high-order) meshes from CAD for high-order "
-                    "CFD\n.SH SYNOPSIS\n.nf\n";
+  std::string out = R"(.TH HOMESH 1 "" "homesh )";
+  out += kVersion;
+  out +=
+      "\" \"User Commands\"\n"
+      ".SH NAME\nhomesh \\- curved (high-order) meshes from CAD for high-order "
+      "CFD\n.SH SYNOPSIS\n.nf\n";
   out += roffText(usageText(""));
   out += ".fi\n";
   for (const char* topic : {"mesh", "predict", "quality", "convert", "optimise"}) {

@@ -351,9 +351,13 @@ std::vector<RefinementSource> sourcesFrom(const bp::object& list) {
                                           pointFrom(src["b"], which + " b"), delta));
     else if (kind == "curve")
       out.push_back(RefinementSource::curve(bp::extract<int>(src.get("edge", 0)), radius, delta));
-    else
-      throw ParameterError(which + ": kind must be segment, sphere, box or curve, got '" + kind +
-                           "'");
+    else {
+      std::string message = which;
+      message += ": kind must be segment, sphere, box or curve, got '";
+      message += kind;
+      message += "'";
+      throw ParameterError(message);
+    }
   }
   return out;
 }
@@ -362,9 +366,9 @@ std::vector<RefinementSource> sourcesFrom(const bp::object& list) {
 // core/parameters.hpp's checkedOption judges it and names the parameter when it does not fit.
 OptionValue optionValueFrom(const bp::object& value) {
   PyObject* o = value.ptr();
-  if (PyBool_Check(o)) return o == Py_True;
-  if (PyUnicode_Check(o)) return std::string(bp::extract<std::string>(value));
-  if (PyNumber_Check(o) && !PyComplex_Check(o)) {
+  if (PyBool_Check(o) != 0) return o == Py_True;
+  if (PyUnicode_Check(o) != 0) return std::string(bp::extract<std::string>(value));
+  if (PyNumber_Check(o) != 0 && PyComplex_Check(o) == 0) {
     PyObject* real = PyNumber_Float(o);
     if (real != nullptr) {
       const double x = PyFloat_AsDouble(real);

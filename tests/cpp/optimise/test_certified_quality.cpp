@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <utility>
 #include <vector>
 
 #include "optimiser_parts.hpp"
@@ -25,7 +26,8 @@ struct Measured {
   OptimiserOptions options;
   CertifiedQuality<3> quality{working, owners, options};
   // `converting`: in the working node set's coordinates (where the caller's quality is ignored).
-  explicit Measured(const Mesh& m, bool converting = false) : mesh(m), working(mesh, converting) {
+  explicit Measured(Mesh m, bool converting = false)
+      : mesh(std::move(m)), working(mesh, converting) {
     working.build();
   }
 };

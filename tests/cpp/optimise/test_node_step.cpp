@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <numeric>
+#include <utility>
 #include <vector>
 
 #include "optimise/mesh_topology.hpp"
@@ -35,8 +36,8 @@ struct Stepper {
   std::vector<std::int64_t> free;
   std::vector<std::size_t> all;
 
-  Stepper(const Mesh& m, const CadModel* cad)
-      : mesh(m), working(mesh, cad == nullptr), sliding(working, cad) {
+  Stepper(Mesh m, const CadModel* cad)
+      : mesh(std::move(m)), working(mesh, cad == nullptr), sliding(working, cad) {
     working.build();
     std::vector<char> boundary = boundaryNodes(mesh.numNodes(), {working.blocks[0].cells});
     sliding.choose(boundary, 1);

@@ -40,6 +40,8 @@ struct Cube {
     return std::any_of(va, va + n,
                        [&](std::int64_t x) { return std::find(vb, vb + n, x) != vb + n; });
   }
+  // Not const: the sliding model is built over the working mesh, which it may change.
+  // NOLINTNEXTLINE(readability-make-member-function-const)
   FreeNodes<3> choose(const OptimiserOptions& options) {
     CadSliding<3> sliding(working, nullptr);
     return optimiser::chooseFreeNodes(working, scaled, validity, sliding, options);

@@ -170,10 +170,10 @@ TEST(StopRules, ATimeBudgetIsSpentOnceItsLimitHasPassedAndStaysSpent) {
 // ---- Whole runs: the result names the rule that ended each. ----------------------------------
 
 // A run of the perturbed cube (valid, every node off its optimum) with `options` on one thread.
-OptimiserResult runCube(OptimiserOptions options, Mesh* out = nullptr,
+OptimiserResult runCube(const OptimiserOptions& options, Mesh* out = nullptr,
                         OptimiserObserver* observer = nullptr) {
   Mesh mesh = test::perturbedCube();
-  const OptimiserResult r = optimiseMesh(mesh, options, observer);
+  OptimiserResult r = optimiseMesh(mesh, options, observer);
   if (out != nullptr) *out = std::move(mesh);
   return r;
 }
@@ -342,7 +342,8 @@ TEST(OptimiserStops, TimeBudgetOfTheJobStopsThePipelinesOptimiser) {
     void stageStarted(const std::string& stage) override {
       if (stage == "cad") start_ = std::chrono::steady_clock::now();  // the budget's clock
     }
-    void stageProgress(const std::string& stage, double, const std::string&) override {
+    void stageProgress(const std::string& stage, double /*fraction*/,
+                       const std::string& /*detail*/) override {
       if (stage == "optimise" && !held) {
         held = true;
         std::this_thread::sleep_until(start_ + std::chrono::duration<double>(seconds_));
