@@ -72,22 +72,26 @@ const std::map<std::string, Setter>& setters() {
   return table;
 }
 
-// The keys a caller may give, in the table's order.
-std::string applicableKeys(const std::vector<std::string>& allowed) {
+std::string joined(const std::vector<std::string>& words) {
   std::string out;
-  for (const ParameterDefinition& p : parameterDefinitions()) {
-    const bool listed = allowed.empty()
-                            ? setters().count(p.key) != 0
-                            : std::find(allowed.begin(), allowed.end(), p.key) != allowed.end();
-    if (listed) out += (out.empty() ? "" : ", ") + std::string(p.key);
+  for (const std::string& w : words) {
+    if (!out.empty()) out += ", ";
+    out += w;
   }
   return out;
 }
 
 }  // namespace
 
-bool MeshingOptions::takes(const std::string& key) {
-  return setters().count(key) != 0;
+std::vector<std::string> MeshingOptions::keys(const std::vector<std::string>& allowed) {
+  std::vector<std::string> out;
+  for (const ParameterDefinition& p : parameterDefinitions()) {
+    const bool listed = allowed.empty()
+                            ? setters().count(p.key) != 0
+                            : std::find(allowed.begin(), allowed.end(), p.key) != allowed.end();
+    if (listed) out.emplace_back(p.key);
+  }
+  return out;
 }
 
 void MeshingOptions::apply(const OptionMap& values, const std::vector<std::string>& allowed) {
@@ -100,7 +104,7 @@ void MeshingOptions::apply(const OptionMap& values, const std::vector<std::strin
         allowed.empty() || std::find(allowed.begin(), allowed.end(), key) != allowed.end();
     if (setter == setters().end() || !wanted)
       throw ParameterError("option '" + key +
-                           "' does not apply here (options: " + applicableKeys(allowed) + ")");
+                           "' does not apply here (options: " + joined(keys(allowed)) + ")");
     setter->second(*this, number);
   }
   if (size && !sizes) sizing.reset();  // asked for together, validate() names both

@@ -83,8 +83,9 @@ struct MeshingOptions {
   // The defaults with `values` applied.
   static MeshingOptions fromMap(const OptionMap& values,
                                 const std::vector<std::string>& allowed = {});
-  // Whether apply takes table key `key` (the boundary layer's own keys it does not).
-  static bool takes(const std::string& key);
+  // The table keys apply takes from a caller that has a use for `allowed` (empty: every key it
+  // takes; the boundary layer's own it does not), in the table's order.
+  static std::vector<std::string> keys(const std::vector<std::string>& allowed = {});
 };
 
 }  // namespace homesh

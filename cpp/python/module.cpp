@@ -448,11 +448,7 @@ bp::list optionKeys(const std::string& function) {
   if (keys == nullptr)
     throw ParameterError("option_keys: no function '" + function + "' (mesh, curve or sizing)");
   bp::list out;
-  for (const ParameterDefinition& p : parameterDefinitions()) {
-    const bool listed = keys->empty() ? MeshingOptions::takes(p.key)
-                                      : std::find(keys->begin(), keys->end(), p.key) != keys->end();
-    if (listed) out.append(std::string(p.key));
-  }
+  for (const std::string& key : MeshingOptions::keys(*keys)) out.append(key);
   return out;
 }
 
