@@ -111,33 +111,28 @@ class HighOrderMesh:
         the Jacobian of each curved element."""
         return self._core.element_volumes()
 
-    def optimise(self, functional="hyperelastic", maxiter=100, tolerance=1e-6, threads=1,
-                 region=None, layers=2, focus=2, free_interfaces=False, facet_weight=0.0):
+    def optimise(self, **options):
         """Curves the interior by the variational optimiser, in place, and returns its record.
 
-        ``functional``: "hyperelastic" (default), "linearelastic", "winslow" or "distortion".
-        ``maxiter`` sweeps at most; stops earlier when no node moves more than ``tolerance``
-        times the mean element size. ``region``: move only nodes near elements whose scaled
-        Jacobian is below it (with ``layers`` layers of neighbours). ``focus``: extra passes
-        over the worst elements' nodes after each sweep. On a mesh made from CAD, nodes on CAD
-        curves and faces slide on them (CAD vertices stay); on a mesh read from a file,
-        boundary nodes (and nodes on interfaces between volumes unless ``free_interfaces``)
-        stay fixed. ``facet_weight`` (0 to 100, default 0 = off): on a mesh made from CAD, once
-        every element is proven valid, also keep the sliding boundary facets' nodes evenly
-        spread, so that the curved boundary stays on the CAD between them (as in :func:`mesh`).
+        At most ``optimise`` sweeps (the keyword :func:`mesh` uses for the same count); stops
+        earlier when no node moves more than ``tolerance`` times its smallest element's size.
+        ``region``: move only nodes near elements whose scaled Jacobian is below it (with
+        ``region_layers`` layers of neighbours). ``focus``: extra passes over the worst
+        elements' nodes after each sweep. On a mesh made from CAD, nodes on CAD curves and faces
+        slide on them (CAD vertices stay); on a mesh read from a file, boundary nodes (and nodes
+        on interfaces between volumes unless ``free_interfaces``) stay fixed. ``facet_weight``:
+        on a mesh made from CAD, once every element is proven valid, also keep the sliding
+        boundary facets' nodes evenly spread, so that the curved boundary stays on the CAD
+        between them (as in :func:`mesh`).
 
         The mesh kept is never worse than before in worst scaled Jacobian or invalid count.
         Returns a dict: functional, iterations, converged, stopped (the rule that ended the
-        run: displacement, energy, stalled, iterations, cancelled), kept_iteration, worst_before,
-        worst_after, invalid_before, invalid_after, nodal_worst_before/after (min J / max J at
-        the nodes, NekMesh's measure), seconds, history (per sweep) and more.
+        run: displacement, energy, stalled, iterations, time budget, cancelled),
+        kept_iteration, worst_before, worst_after, invalid_before, invalid_after,
+        nodal_worst_before/after (min J / max J at the nodes, NekMesh's measure), seconds,
+        history (per sweep) and more.
         """
-        region = None if region is None else float(region)
-        core, record = self._core.optimise(
-            str(functional), _check_int("maxiter", maxiter), float(tolerance),
-            _check_int("threads", threads), region, _check_int("layers", layers),
-            _check_int("focus", focus), bool(free_interfaces),
-            _check_number(facet_weight, "facet_weight"))
+        core, record = self._core.optimise(options)
         self.__init__(core)
         return json.loads(record)["optimiser"]
 
@@ -174,17 +169,11 @@ class HighOrderMesh:
                 entities = [entities]
             pairs.append((str(name), [_check_int("group %s entity" % name, e)
                                       for e in entities]))
-        self._core.write(path, bool(binary), bool(compressed), pairs)
-        if path.lower().endswith(".xml"):
-            # Nektar++ rebuilds 3D element interiors from the faces: the solver's geometry is the
-            # file read back, not this mesh. Say so when that geometry is not proven valid.
-            q = read(path).quality()
-            if q["invalid_elements"] + q["undecided_elements"] > 0:
-                warnings.warn(
-                    "%s as Nektar++ builds it (element interiors from the faces): scaled "
-                    "Jacobian min %.4f; %d invalid, %d undecided"
-                    % (path, q["min"], q["invalid_elements"], q["undecided_elements"]),
-                    stacklevel=2)
+        # Nektar++ rebuilds 3D element interiors from the faces: the solver's geometry is the
+        # file read back, not this mesh; the core says so when it is not proven valid.
+        not_proven = self._core.write(path, bool(binary), bool(compressed), pairs)
+        if not_proven:
+            warnings.warn(not_proven, stacklevel=2)
 
     def _save_npz(self, path):
         arrays = {
@@ -215,8 +204,9 @@ _PARAMETERS = None
 def parameters():
     """The core's one parameter table: a list of dicts with key (the keyword of :func:`mesh`),
     property (the FreeCAD property), option (the command line's), label, kind ("integer",
-    "real", "length"), min, max, min_exclusive, default, zero_is_automatic, group, doc and
-    range (in words). The core, the command line and the FreeCAD objects all check against
+    "real", "length", "boolean", "choice"), min, max, min_exclusive, default (a choice's:
+    the index into choices), zero_is_automatic, switchable, group, doc, range (in words) and
+    choices (a choice's names). The core, the command line and the FreeCAD objects all check against
     it."""
     global _PARAMETERS
     if _PARAMETERS is None:
@@ -224,13 +214,13 @@ def parameters():
     return [dict(p) for p in _PARAMETERS]
 
 
-def read(path, threads=1):
+def read(path, **options):
     """Reads a mesh file: .msh (Gmsh 2.2 or 4.1, ASCII or binary), .xml (Nektar++, plain or
     compressed), or FreeCAD FEM's .unv (I-DEAS), .vtk (legacy VTK) and .vtu (VTK XML), linear or
     quadratic, and evaluates its quality. Solids a FEM file lists left-handed (FreeCAD's VTK
     export) are read mirrored: ``report()["notes"]`` says so. Raises FileError naming the file,
     the line or data array and the element."""
-    return HighOrderMesh(_core.read_mesh(os.fspath(path), _check_int("threads", threads)))
+    return HighOrderMesh(_core.read_mesh(os.fspath(path), options))
 
 
 def load(path):
@@ -497,13 +487,6 @@ def _boundary_layer(spec):
     return out
 
 
-def _check_number(value, name, what="a number"):
-    """A real number (the core checks its range); ``what`` names it in the message."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ParameterError("%s must be %s, got %r" % (name, what, value))
-    return float(value)
-
-
 _INT32_MAX = 2**31 - 1
 
 
@@ -528,6 +511,8 @@ def _keyword_default(p):
         return False
     if p["kind"] == "boolean":
         return bool(p["default"])
+    if p["kind"] == "choice":
+        return p["choices"][int(p["default"])]
     return int(p["default"]) if p["kind"] == "integer" else p["default"]
 
 
@@ -558,3 +543,5 @@ _document(mesh, "mesh")
 _document(curve, "curve")
 _document(predict, "sizing")
 _document(size_field, "sizing")
+_document(read, "read")
+_document(HighOrderMesh.optimise, "optimise")

@@ -214,6 +214,15 @@ void addTableOptions(OptionTable& table, OptionMap& values,
       if (p.kind == ParameterKind::Boolean) {
         const bool on = p.defaultValue == 0.0;
         table.flag({n.c_str()}, [&values, key, on] { values[key] = on; });
+      } else if (p.kind == ParameterKind::Choice) {
+        table.value({n.c_str()}, [&values, key](const std::string&, const std::string& v) {
+          values[key] = v;
+          try {
+            checkedOption(key, v);
+          } catch (const ParameterError& e) {
+            throw UsageError{std::string(parameterDefinition(key).option) + ": " + e.what()};
+          }
+        });
       } else {
         table.value({n.c_str()}, [&values, key](const std::string& o, const std::string& v) {
           values[key] = parseParameter(key, o, v);
@@ -222,6 +231,12 @@ void addTableOptions(OptionTable& table, OptionMap& values,
     }
   }
 }
+
+// The options of `homesh optimise` from the table (OptimiserOptions::apply takes them; threads
+// come with the common options).
+constexpr std::initializer_list<const char*> kOptimiseKeys = {
+    "functional",    "optimise", "tolerance",       "region",
+    "region_layers", "focus",    "free_interfaces", "optimise_seconds"};
 
 // The CAD modes, which mesh and predict share.
 constexpr std::initializer_list<const char*> kCadModes = {"heal", "solids_only", "surface", "auto"};
@@ -302,42 +317,11 @@ OptimiseCommand parseOptimise(const std::vector<std::string>& args) {
   OptimiseCommand cmd;
   OptionTable table;
   addCommon(table, cmd.common, true, true);
-  table.value({"--functional", "-f"}, [&cmd](const std::string&, const std::string& v) {
-    try {
-      cmd.functional = functionalName(parseFunctional(v));
-    } catch (const Error& e) {
-      throw UsageError{std::string("--functional: ") + e.what()};
-    }
-  });
-  table.value({"--maxiter", "-n"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.maxIterations = parseInteger(o, v);
-    if (cmd.maxIterations < 0) throw UsageError{"--maxiter must be >= 0, got " + v};
-  });
-  table.value({"--tolerance"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.tolerance = parseNumber(o, v);
-    if (cmd.tolerance < 0.0) throw UsageError{"--tolerance must be >= 0, got " + v};
-  });
+  addTableOptions(table, cmd.options, kOptimiseKeys);
   table.value({"--order", "-p"}, [&cmd](const std::string& o, const std::string& v) {
     cmd.order = static_cast<int>(parseParameter("order", o, v));
   });
-  table.value({"--region"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.regionThreshold = parseNumber(o, v);
-    if (!(*cmd.regionThreshold > 0.0 && *cmd.regionThreshold <= 1.0))
-      throw UsageError{"--region must be a scaled Jacobian in (0, 1], got " + v};
-  });
-  table.value({"--focus"}, [&cmd](const std::string& o, const std::string& v) {
-    cmd.focusPasses = parseInteger(o, v);
-    if (cmd.focusPasses < 0) throw UsageError{"--focus must be >= 0, got " + v};
-  });
-  table.flag({"--free-interfaces"}, [&cmd] { cmd.freeInterfaces = true; });
-  bool layers = false;
-  table.value({"--layers"}, [&cmd, &layers](const std::string& o, const std::string& v) {
-    cmd.regionLayers = parseInteger(o, v);
-    layers = true;
-    if (cmd.regionLayers < 0) throw UsageError{"--layers must be >= 0, got " + v};
-  });
   cmd.input = onlyInput(table.parse(args, 1, "optimise"), "optimise", "an INPUT mesh file");
-  if (layers && !cmd.regionThreshold) throw UsageError{"--layers needs --region"};
   return cmd;
 }
 
@@ -389,6 +373,8 @@ ParsedCommand parseCommandLine(const std::vector<std::string>& args) {
   return parsed;
 }
 
+namespace {
+
 // `text` wrapped at `width` columns after a first line that starts at column `first`, every
 // later line indented by `indent`.
 std::string wrapped(const std::string& text, std::size_t first, std::size_t indent,
@@ -422,7 +408,11 @@ std::string tableHelp(std::initializer_list<const char*> keys) {
         *p.shortOption != '\0' ? std::string("  ") + p.shortOption + ", " : std::string(6, ' ');
     head += p.option;
     std::string text = p.doc;
-    if (p.kind == ParameterKind::Boolean) {
+    if (p.kind == ParameterKind::Choice) {
+      head += " NAME";
+      text += "; " + rangeText(p) + ", default " +
+              choiceNames(p).at(static_cast<std::size_t>(p.defaultValue));
+    } else if (p.kind == ParameterKind::Boolean) {
       // The flag turns the default around: say which way.
       if (p.defaultValue != 0.0)
         text.insert(0, "turns off what is on unless given: ");
@@ -441,9 +431,23 @@ std::string tableHelp(std::initializer_list<const char*> keys) {
   return out;
 }
 
-std::string usageText(const std::string& topic) {
-  if (topic == "mesh")
-    return R"(usage: homesh mesh INPUT [options]
+// The output options of the commands that write meshes.
+std::string outputHelp() {
+  return R"(  -o, --output FILE   write the mesh: .msh (Gmsh 4.1), .vtu (VTK), .xml (Nektar++); repeatable
+      --binary        binary MSH, raw appended VTU data
+      --compressed    compressed Nektar++ XML (B64Z-LittleEndian)
+      --group NAME=F1,F2  a named boundary group (faces; 2D: curves) written as one physical
+                      group (MSH) / composite (Nektar++ XML) called NAME; repeatable
+)";
+}
+
+// Threads and --quiet, which every command takes.
+std::string commonHelp() {
+  return tableHelp({"threads"}) + "  -q, --quiet         print nothing but errors\n";
+}
+
+std::string meshHelp() {
+  return R"(usage: homesh mesh INPUT [options]
 
 Meshes a CAD model (.step .stp .iges .igs .brep .brp) with curved elements of order P:
 a linear tetrahedral mesh (triangles for planar faces) whose boundary nodes are then
@@ -455,16 +459,16 @@ Sizes come from the sizing octree: curvature-driven (a chord deviates from the C
 most EPS x the radius of curvature), between MinDelta and MaxDelta, graded by 0.2 per unit
 length away from curved boundaries. Without sizes: MaxDelta = bounding-box diagonal / 20,
 MinDelta = MaxDelta / 20, EPS = )" +
-           formatNumber(parameterDefault("eps")) + R"(.
+         formatNumber(parameterDefault("eps")) + R"(.
 
 options (the parameter table's, which Python and FreeCAD read too):
 )" + tableHelp({"order", "size", "min_delta", "max_delta", "eps"}) +
-           R"(      --optimise      run the variational optimiser after curving (hyperelastic),
+         R"(      --optimise      run the variational optimiser after curving (hyperelastic),
                       boundary nodes sliding on the CAD curves and faces
 )" +
-           tableHelp({"optimise", "optimise_seconds", "facet_weight", "repair_rounds",
-                      "linear_seconds", "job_seconds", "heal", "solids_only", "surface", "auto"}) +
-           R"(
+         tableHelp({"optimise", "optimise_seconds", "facet_weight", "repair_rounds",
+                    "linear_seconds", "job_seconds", "heal", "solids_only", "surface", "auto"}) +
+         R"(
 refinement of the sizing octree:
       --refine-line X1,Y1,Z1,X2,Y2,Z2,R,D    size at most D within R of a segment
       --refine-sphere X,Y,Z,R,D             size at most D within a sphere
@@ -476,24 +480,20 @@ boundary layer (the macro layer is curved and optimised with the rest, then spli
       --bl-faces LIST     on these CAD faces (FaceN numbers: 1,8 or 11-12)
       --bl-thickness T    its total thickness: a number or an expression of x, y, z
 )" + tableHelp({"layers", "progression"}) +
-           R"(
-output:
-  -o, --output FILE   write the mesh: .msh (Gmsh 4.1), .vtu (VTK), .xml (Nektar++); repeatable
-      --binary        binary MSH, raw appended VTU data
-      --compressed    compressed Nektar++ XML (B64Z-LittleEndian)
-      --group NAME=F1,F2  a named boundary group (faces; 2D: curves) written as one physical
-                      group (MSH) / composite (Nektar++ XML) called NAME; repeatable
-      --report FILE   write the JSON report ("-" for standard output)
+         "\noutput:\n" + outputHelp() +
+         R"(      --report FILE   write the JSON report ("-" for standard output)
 )" + tableHelp({"threads"}) +
-           R"(  -v, --verbose       show Gmsh's warnings (-vv: and its information)
+         R"(  -v, --verbose       show Gmsh's warnings (-vv: and its information)
   -q, --quiet         print nothing but errors
 
 exit status: 0 success, 1 failure (file, CAD or meshing), 2 bad command line or parameter,
 4 the mesh was made (and written) but elements are still not proven valid (the report's
 flagged_elements lists them)
 )";
-  if (topic == "predict")
-    return R"(usage: homesh predict INPUT [options]
+}
+
+std::string predictHelp() {
+  return R"(usage: homesh predict INPUT [options]
 
 Builds the sizing octree of a CAD model or NekMesh case (.mcf) and prints the number of
 elements (tetrahedra, or triangles for planar faces) the linear mesh will have, with the
@@ -505,67 +505,54 @@ options:
       --write-octree FILE.vtu   the octree's leaves with their sizes (ParaView)
       --no-heal, --solids-only, --surface, --auto   as for 'homesh mesh'
       --report FILE   write the JSON report ("-" for standard output)
-)" + tableHelp({"threads"}) +
-           R"(  -q, --quiet         print nothing but errors
-)";
-  if (topic == "quality")
-    return R"(usage: homesh quality INPUT [options]
+)" + commonHelp();
+}
+
+std::string qualityHelp() {
+  return R"(usage: homesh quality INPUT [options]
 
 Prints the quality of a mesh (.msh 2.2 or 4.1, ASCII or binary; .xml Nektar++; FreeCAD FEM's
-.unv, .vtk and .vtu, linear or quadratic): per element type, the certified scaled Jacobian (Bezier bounds, as Gmsh's AnalyseMeshQuality) and the
-distortion against the straight-sided elements, worst, mean and histogram, and the number of
-invalid elements.
+.unv, .vtk and .vtu, linear or quadratic): per element type, the certified scaled Jacobian
+(Bezier bounds, as Gmsh's AnalyseMeshQuality) and the distortion against the straight-sided
+elements, worst, mean and histogram, and the number of invalid elements.
 
 options:
       --report FILE   write the JSON report ("-" for standard output)
       --strict        exit with status 3 if any element is invalid or not proven valid
-  -j, --threads N     threads (default 1)
-  -q, --quiet         print nothing but errors
-)";
-  if (topic == "convert")
-    return R"(usage: homesh convert INPUT -o OUTPUT [options]
+)" + commonHelp();
+}
+
+std::string convertHelp() {
+  return R"(usage: homesh convert INPUT -o OUTPUT [options]
 
 Converts a mesh between Gmsh MSH (2.2/4.1 in, 4.1 out), VTU, Nektar++ XML, and from UNV and
 legacy VTK, with the quality fields.
 
 options:
-  -o, --output FILE   .msh, .vtu or .xml; repeatable
-      --binary        binary MSH, raw appended VTU data
-      --compressed    compressed Nektar++ XML (B64Z-LittleEndian)
-      --group NAME=F1,F2  a named boundary group (faces; 2D: curves) written as one physical
-                      group (MSH) / composite (Nektar++ XML) called NAME; repeatable
-  -j, --threads N     threads (default 1)
-  -q, --quiet         print nothing but errors
-)";
-  if (topic == "optimise" || topic == "optimize")
-    return R"(usage: homesh optimise INPUT [-o OUTPUT] [options]
+)" + outputHelp() +
+         commonHelp();
+}
+
+std::string optimiseHelp() {
+  return R"(usage: homesh optimise INPUT [-o OUTPUT] [options]
 
 Curves the interior of a high-order mesh (.msh 2.2 or 4.1, .xml Nektar++, .unv, .vtk, .vtu) by
-minimising a variational energy node by node (Newton steps, parallel by node colours). Nodes on the
-boundary, on interfaces between volumes and on the file's boundary cells stay fixed. Prints the worst certified scaled Jacobian and the invalid count after every sweep; the
-mesh returned is never worse than the input in either.
+minimising a variational energy node by node (Newton steps, parallel by node colours). Nodes on
+the boundary, on interfaces between volumes and on the file's boundary cells stay fixed. Prints
+the worst certified scaled Jacobian and the invalid count after every sweep; the mesh returned
+is never worse than the input in either.
 
-options:
-  -f, --functional F  hyperelastic (default), linearelastic, winslow, distortion
-  -n, --maxiter N     at most N sweeps (default 100)
-      --tolerance T   stop when no node moves more than T x its smallest element's size (1e-6)
-  -p, --order P       first re-interpolate the mesh at order P (1..10); "never worse" then
-                      compares with the re-interpolated mesh
-      --region Q      move only nodes near elements with scaled Jacobian below Q
-      --layers K      ... and K layers of neighbours around them (default 2)
-      --focus K       after each sweep, K more passes over the nodes of the elements within
-                      0.05 of the worst scaled Jacobian (default 2; 0: plain sweeps)
-      --free-interfaces  also move the nodes on internal interfaces between volumes (as
-                      NekMesh does without CAD; the interface then leaves its geometry)
-  -o, --output FILE   write the mesh: .msh, .vtu, .xml; repeatable
-      --binary        binary MSH, raw appended VTU data
-      --compressed    compressed Nektar++ XML (B64Z-LittleEndian)
-      --group NAME=F1,F2  a named boundary group (faces; 2D: curves) written as one physical
-                      group (MSH) / composite (Nektar++ XML) called NAME; repeatable
-      --report FILE   write the JSON report with "optimiser" ("-" for standard output)
-  -j, --threads N     threads (default 1)
-  -q, --quiet         print nothing but errors
-)";
+options (the parameter table's, which Python's HighOrderMesh.optimise reads too):
+)" + tableHelp(kOptimiseKeys) +
+         "  -p, --order P       first re-interpolate the mesh at order P (" +
+         rangeText(parameterDefinition("order")) + R"();
+                      "never worse" then compares with the re-interpolated mesh
+)" + outputHelp() +
+         R"(      --report FILE   write the JSON report with "optimiser" ("-" for standard output)
+)" + commonHelp();
+}
+
+std::string commandsHelp() {
   return R"(usage: homesh COMMAND [options]
 
 commands:
@@ -577,6 +564,17 @@ commands:
   --version       print the version
   --help          this text
 )";
+}
+
+}  // namespace
+
+std::string usageText(const std::string& topic) {
+  if (topic == "mesh") return meshHelp();
+  if (topic == "predict") return predictHelp();
+  if (topic == "quality") return qualityHelp();
+  if (topic == "convert") return convertHelp();
+  if (topic == "optimise" || topic == "optimize") return optimiseHelp();
+  return commandsHelp();
 }
 
 // `text` with what roff would take as its own escaped: backslashes, and a leading dot or quote.

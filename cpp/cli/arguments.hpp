@@ -17,7 +17,7 @@ struct UsageError {
 
 // Options several commands share.
 struct CommonOptions {
-  int threads = 1;
+  int threads = defaultOf<int>("threads");
   bool quiet = false;
   std::optional<std::string> report;  // "-" is standard output
   std::vector<std::string> outputs;   // -o, repeatable
@@ -70,14 +70,9 @@ struct ConvertCommand {
 
 struct OptimiseCommand {
   std::string input;
-  std::string functional = "hyperelastic";
-  int maxIterations = 100;
-  double tolerance = 1e-6;
-  std::optional<int> order;               // re-interpolate at this order first
-  std::optional<double> regionThreshold;  // --region Q
-  int regionLayers = 2;
-  int focusPasses = 2;
-  bool freeInterfaces = false;
+  std::optional<int> order;  // re-interpolate at this order first
+  // The optimiser's options keyed as the parameter table (OptimiserOptions::apply checks them).
+  OptionMap options;
   CommonOptions common;
 };
 

@@ -20,6 +20,7 @@
 #include "optimise/optimiser.hpp"
 #include "pipeline/case_setup.hpp"
 #include "pipeline/mesh_pipeline.hpp"
+#include "pipeline/nektar_read_back.hpp"
 #include "pipeline/report.hpp"
 
 namespace {
@@ -49,22 +50,15 @@ void writeReport(const std::string& path, const std::string& text) {
   homesh::writeFileAtomically(path, text);
 }
 
-// Nektar++ does not store the interiors of 3D elements: it rebuilds them from the faces (its
-// modified basis without interior modes), so the geometry a solver uses from a Nektar++ file
-// is not the mesh that was certified. Reads each written .xml back as Nektar++ builds it and
-// checks that geometry; returns its elements not proven valid (all files).
+// Reads each written .xml back as Nektar++ builds it (pipeline/nektar_read_back.hpp); returns
+// its elements not proven valid (all files).
 std::size_t checkNektarOutputs(const std::vector<std::string>& outputs, int threads, bool quiet) {
   std::size_t notValid = 0;
   for (const std::string& path : outputs) {
     if (std::filesystem::path(path).extension() != ".xml") continue;
-    const homesh::Mesh solver = homesh::readMesh(path);
-    const homesh::QualitySummary q = homesh::evaluateQuality(solver, threads);
-    notValid += q.invalid + q.undecided;
-    if (!quiet || q.invalid + q.undecided > 0)
-      std::fprintf(stderr,
-                   "homesh: %s as Nektar++ builds it (element interiors from the faces): scaled "
-                   "Jacobian min %.4f; %zu invalid, %zu undecided\n",
-                   path.c_str(), q.scaled.min, q.invalid, q.undecided);
+    const homesh::NektarReadBack check = homesh::checkNektarReadBack(path, threads);
+    notValid += check.invalid + check.undecided;
+    if (!quiet || !check.proven()) std::fprintf(stderr, "homesh: %s\n", check.line().c_str());
   }
   return notValid;
 }
@@ -336,15 +330,10 @@ class SweepLog : public homesh::OptimiserObserver {
 int runOptimise(const homesh::OptimiseCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
   checkOutputs(c, cmd.input);
+  homesh::OptionMap values = cmd.options;
+  values["threads"] = static_cast<double>(c.threads);
   homesh::OptimiserOptions options;
-  options.functional = homesh::parseFunctional(cmd.functional);
-  options.maxIterations = cmd.maxIterations;
-  options.tolerance = cmd.tolerance;
-  options.threads = c.threads;
-  options.regionThreshold = cmd.regionThreshold;
-  options.regionLayers = cmd.regionLayers;
-  options.focusPasses = cmd.focusPasses;
-  options.freeInterfaces = cmd.freeInterfaces;
+  options.apply(values);
   std::vector<std::string> notes;
   homesh::Mesh mesh = readMeshFile(cmd.input, c.quiet, notes);
   if (cmd.order && *cmd.order != mesh.order) mesh = homesh::changeOrder(mesh, *cmd.order, nullptr);

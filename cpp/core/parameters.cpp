@@ -1,5 +1,6 @@
 #include "core/parameters.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -74,6 +75,28 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        "Choose per shape, for batch runs: with solids, as solids only (faces in no solid left "
        "out and named); without a solid, sewn into solids where every shell closes, else as "
        "surface; the report says which. Not with solids only or surface"},
+      {"functional", "", "--functional", "-f", "functional", ParameterKind::Choice, 0, 3, false, 0,
+       false, false, "optimiser", "Energy the optimiser minimises (docs/method.md describes each)",
+       "hyperelastic|linearelastic|winslow|distortion"},
+      {"tolerance", "", "--tolerance", "", "optimiser tolerance", ParameterKind::Real, 0, kNoLimit,
+       false, 1e-6, false, false, "optimiser",
+       "The optimiser stops once no node moves by more than this times its smallest element's "
+       "size"},
+      {"region", "", "--region", "", "region", ParameterKind::Real, 0, 1, false, 0, false, false,
+       "optimiser",
+       "Move only the nodes near elements whose certified scaled Jacobian is below this (0: "
+       "everywhere)"},
+      {"region_layers", "", "--layers", "", "region layers", ParameterKind::Integer, 0, 1000, false,
+       2, false, false, "optimiser",
+       "Layers of neighbouring elements (sharing a node) added around the region"},
+      {"focus", "", "--focus", "", "focus passes", ParameterKind::Integer, 0, 1000, false, 2, false,
+       false, "optimiser",
+       "Extra passes after each sweep over the nodes of the elements within 0.05 of the worst "
+       "scaled Jacobian (0: plain sweeps)"},
+      {"free_interfaces", "", "--free-interfaces", "", "free interfaces", ParameterKind::Boolean, 0,
+       1, false, 0, false, false, "optimiser",
+       "Also move the nodes on internal interfaces between volumes of a mesh without CAD (as "
+       "NekMesh does; the interface then leaves its geometry)"},
       {"min_delta", "MinDelta", "--min-delta", "", "MinDelta", ParameterKind::Length, 0, kNoLimit,
        true, 0, true, false, "sizing", "Smallest element size, at high curvature"},
       {"max_delta", "MaxDelta", "--max-delta", "", "MaxDelta", ParameterKind::Length, 0, kNoLimit,
@@ -102,8 +125,29 @@ const ParameterDefinition& parameterDefinition(const std::string& key) {
   throw std::out_of_range("no parameter '" + key + "'");
 }
 
+std::vector<std::string> choiceNames(const ParameterDefinition& p) {
+  std::vector<std::string> names;
+  if (p.kind != ParameterKind::Choice) return names;
+  std::string name;
+  for (const char* c = p.choices;; ++c) {
+    if (*c == '|' || *c == '\0') {
+      names.push_back(name);
+      name.clear();
+      if (*c == '\0') break;
+    } else {
+      name.push_back(*c);
+    }
+  }
+  return names;
+}
+
 std::string rangeText(const ParameterDefinition& p) {
   if (p.kind == ParameterKind::Boolean) return "true or false";
+  if (p.kind == ParameterKind::Choice) {
+    std::string out = "one of";
+    for (const std::string& name : choiceNames(p)) out += (out.size() > 6 ? ", " : " ") + name;
+    return out;
+  }
   const bool integer = p.kind == ParameterKind::Integer;
   const std::string what = integer                           ? "an integer"
                            : p.kind == ParameterKind::Length ? "a length"
@@ -116,7 +160,8 @@ std::string rangeText(const ParameterDefinition& p) {
 
 bool inRange(const ParameterDefinition& p, double value) {
   if (std::isnan(value)) return false;
-  if (p.kind == ParameterKind::Integer && value != std::floor(value)) return false;
+  const bool whole = p.kind == ParameterKind::Integer || p.kind == ParameterKind::Choice;
+  if (whole && value != std::floor(value)) return false;
   if (p.minExclusive ? !(value > p.min) : !(value >= p.min)) return false;
   return value <= p.max;
 }
@@ -128,6 +173,19 @@ std::string valueText(const OptionValue& value) {
   if (const double* x = std::get_if<double>(&value)) return formatNumber(*x);
   if (const bool* b = std::get_if<bool>(&value)) return *b ? "true" : "false";
   return "'" + std::get<std::string>(value) + "'";
+}
+
+// The index of `name` among a Choice's names, compared in lower case with '-', '_' and spaces
+// left out ("Linear-Elastic" is "linearelastic"); -1 when it is none of them.
+int choiceIndex(const ParameterDefinition& p, const std::string& name) {
+  std::string key;
+  for (const char c : name)
+    if (c != '-' && c != '_' && c != ' ')
+      key.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
+  const std::vector<std::string> names = choiceNames(p);
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == key) return static_cast<int>(i);
+  return -1;
 }
 
 std::string knownKeys() {
@@ -149,6 +207,12 @@ double checkedOption(const std::string& key, const OptionValue& value) {
     return ParameterError(std::string(p->label) + " must be " + rangeText(*p) + ", got " +
                           valueText(value));
   };
+  if (p->kind == ParameterKind::Choice) {
+    const std::string* name = std::get_if<std::string>(&value);
+    const int index = name != nullptr ? choiceIndex(*p, *name) : -1;
+    if (index < 0) throw refuse();
+    return index;
+  }
   double number = 0.0;
   if (const bool* b = std::get_if<bool>(&value)) {
     if (p->kind == ParameterKind::Boolean) return *b ? 1.0 : 0.0;

@@ -5,6 +5,7 @@
 // panels all read this table, so a default or a range is written once.
 #pragma once
 
+#include <map>
 #include <string>
 #include <variant>
 #include <vector>
@@ -16,6 +17,7 @@ enum class ParameterKind {
   Real,     // a number in (min, max] when minExclusive, else [min, max]
   Length,   // a length in the model's units, same range rules as Real
   Boolean,  // on or off (range [0, 1] as numbers)
+  Choice,   // one of the names in `choices`, held as its index (range [0, count - 1])
 };
 
 struct ParameterDefinition {
@@ -33,8 +35,11 @@ struct ParameterDefinition {
   // An Integer that may also be given as on/off: on stands for the default, off for 0 (the
   // optimiser: `optimise=True` in Python asks for the default number of sweeps).
   bool switchable;
-  const char* group;  // "mesh", "sizing", "boundary_layer"
+  const char* group;  // "mesh", "cad", "sizing", "boundary_layer", "optimiser"
   const char* doc;
+  // A Choice's names, '|' between them, in the order of the enum the code keeps them in
+  // ("hyperelastic|linearelastic|..."); the default is an index into them.
+  const char* choices = "";
 };
 
 // Every parameter, in the order a panel shows them.
@@ -47,7 +52,11 @@ const ParameterDefinition* findParameter(const std::string& key);
 // programming error, not a user's).
 const ParameterDefinition& parameterDefinition(const std::string& key);
 
-// "an integer from 1 to 10", "a number in (0, 1]", "a length > 0", "an integer >= 0".
+// A Choice's names, in order (empty for other kinds).
+std::vector<std::string> choiceNames(const ParameterDefinition& p);
+
+// "an integer from 1 to 10", "a number in (0, 1]", "a length > 0", "an integer >= 0",
+// "one of hyperelastic, linearelastic, winslow, distortion".
 std::string rangeText(const ParameterDefinition& p);
 
 // Whether `value` is allowed (an Integer must also be whole; NaN never is).
@@ -59,11 +68,21 @@ void checkParameter(const std::string& key, double value);
 // The table's default of `key` (throws std::out_of_range for a key not in it).
 double parameterDefault(const std::string& key);
 
+// The table's default of `key` as a field's type.
+template <class T>
+T defaultOf(const char* key) {
+  return static_cast<T>(parameterDefault(key));
+}
+
 // A value as it comes from outside (a Python keyword, a mapping): a number, on/off or text.
 using OptionValue = std::variant<double, bool, std::string>;
 
+// Options keyed as the parameter table: {"order": 4.0, "heal": false, ...}.
+using OptionMap = std::map<std::string, OptionValue>;
+
 // `value` as the number parameter `key` stands for (a Boolean: 1 or 0; a switchable Integer
-// given on/off: its default or 0), checked against the kind and range; throws ParameterError
+// given on/off: its default or 0; a Choice given by name, in any case, '-' and '_' ignored: its
+// index), checked against the kind and range; throws ParameterError
 // "<label> must be <rangeText>, got <value>" for a value of the wrong kind or out of range, and
 // "unknown option '<key>'" for a key the table does not have.
 double checkedOption(const std::string& key, const OptionValue& value);

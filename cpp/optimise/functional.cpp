@@ -1,37 +1,15 @@
 #include "optimise/functional.hpp"
 
-#include <algorithm>
-#include <cctype>
-
-#include "core/error.hpp"
+#include "core/parameters.hpp"
 
 namespace homesh {
 
 Functional parseFunctional(const std::string& name) {
-  std::string key;
-  for (const char c : name)
-    if (c != '-' && c != '_' && c != ' ')
-      key.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
-  if (key == "linearelastic") return Functional::LinearElastic;
-  if (key == "hyperelastic") return Functional::Hyperelastic;
-  if (key == "winslow") return Functional::Winslow;
-  if (key == "distortion" || key == "roca") return Functional::Distortion;
-  throw ParameterError("unknown functional '" + name +
-                       "' (expected linearelastic, hyperelastic, winslow or distortion)");
+  return static_cast<Functional>(checkedOption("functional", name));
 }
 
 std::string functionalName(Functional f) {
-  switch (f) {
-    case Functional::LinearElastic:
-      return "linearelastic";
-    case Functional::Hyperelastic:
-      return "hyperelastic";
-    case Functional::Winslow:
-      return "winslow";
-    case Functional::Distortion:
-      return "distortion";
-  }
-  return "hyperelastic";
+  return choiceNames(parameterDefinition("functional")).at(static_cast<std::size_t>(f));
 }
 
 }  // namespace homesh

@@ -31,10 +31,13 @@
 
 namespace homesh {
 
-enum class Functional { LinearElastic, Hyperelastic, Winslow, Distortion };
+// In the order of the parameter table's "functional" choices (core/parameters.hpp), which
+// holds their names and the default.
+enum class Functional { Hyperelastic, LinearElastic, Winslow, Distortion };
 
-// "linearelastic" (also "linear-elastic", "linear_elastic"), "hyperelastic", "winslow",
-// "distortion" (also "roca"). Throws ParameterError naming the accepted values.
+// The functional a name stands for, as the table's "functional" reads it ("hyperelastic",
+// "linearelastic", "winslow", "distortion"; any case, '-' and '_' ignored). Throws
+// ParameterError naming the accepted values.
 Functional parseFunctional(const std::string& name);
 std::string functionalName(Functional f);
 

@@ -31,38 +31,6 @@
 
 namespace homesh {
 
-void OptimiserOptions::validate() const {
-  if (maxIterations < 0)
-    throw ParameterError("maxiter must be >= 0, got " + std::to_string(maxIterations));
-  if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
-    throw ParameterError("tolerance must be a finite number >= 0");
-  if (!(energyTolerance >= 0.0) || !std::isfinite(energyTolerance))
-    throw ParameterError("energy tolerance must be a finite number >= 0");
-  if (!(timeLimit >= 0.0) || !std::isfinite(timeLimit))
-    throw ParameterError("the optimiser's time limit must be a finite number of seconds >= 0");
-  if (!(stall >= 0.0) || !std::isfinite(stall))
-    throw ParameterError("stall must be a finite number >= 0");
-  if (!(stallEnergy >= 0.0) || !std::isfinite(stallEnergy))
-    throw ParameterError("stall energy must be a finite number >= 0");
-  if (stallWindow < 1)
-    throw ParameterError("stall window must be >= 1, got " + std::to_string(stallWindow));
-  if (stuckWindow < 1)
-    throw ParameterError("stuck window must be >= 1, got " + std::to_string(stuckWindow));
-  if (!(activeTolerance >= 0.0) || !std::isfinite(activeTolerance))
-    throw ParameterError("active tolerance must be a finite number >= 0");
-  if (threads < 1 || threads > 1024)
-    throw ParameterError("threads must be between 1 and 1024, got " + std::to_string(threads));
-  if (regionThreshold && !(*regionThreshold > 0.0 && *regionThreshold <= 1.0))
-    throw ParameterError("region threshold must be in (0, 1]");
-  if (regionLayers < 0)
-    throw ParameterError("region layers must be >= 0, got " + std::to_string(regionLayers));
-  if (focusPasses < 0)
-    throw ParameterError("focus passes must be >= 0, got " + std::to_string(focusPasses));
-  if (!(focusMargin >= 0.0) || !std::isfinite(focusMargin))
-    throw ParameterError("focus margin must be a finite number >= 0");
-  checkParameter("facet_weight", facetWeight);
-}
-
 namespace {
 
 using optimiser::CadSliding;

@@ -15,15 +15,6 @@
 
 namespace homesh {
 
-// Options keyed as the parameter table: {"order": 4.0, "heal": false, ...}.
-using OptionMap = std::map<std::string, OptionValue>;
-
-// The table's default of `key` as the field's type.
-template <class T>
-T defaultOf(const char* key) {
-  return static_cast<T>(parameterDefault(key));
-}
-
 struct MeshingOptions {
   int order = defaultOf<int>("order");  // polynomial order
   // Sizes: a uniform target edge length (> 0), or the sizing octree (sizing/sizing_octree.hpp);

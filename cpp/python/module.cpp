@@ -12,6 +12,7 @@
 #include <boost/python/numpy.hpp>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -26,6 +27,7 @@
 #include "io/mesh_readers.hpp"
 #include "pipeline/case_setup.hpp"
 #include "pipeline/mesh_pipeline.hpp"
+#include "pipeline/nektar_read_back.hpp"
 #include "pipeline/report.hpp"
 #include "quality/element_measure.hpp"
 #include "sizing/sizing_octree.hpp"
@@ -185,6 +187,36 @@ CellType cellTypeFromName(const std::string& name) {
   throw ParameterError("unknown element type '" + name + "'");
 }
 
+// A Python value for parameter `key` as the core takes it (a bool, a real number or text);
+// core/parameters.hpp's checkedOption judges it and names the parameter when it does not fit.
+OptionValue optionValueFrom(const bp::object& value) {
+  PyObject* o = value.ptr();
+  if (PyBool_Check(o) != 0) return o == Py_True;
+  if (PyUnicode_Check(o) != 0) return std::string(bp::extract<std::string>(value));
+  if (PyNumber_Check(o) != 0 && PyComplex_Check(o) == 0) {
+    PyObject* real = PyNumber_Float(o);
+    if (real != nullptr) {
+      const double x = PyFloat_AsDouble(real);
+      Py_DECREF(real);
+      return x;
+    }
+    PyErr_Clear();
+  }
+  // Not a number, on/off or text (a list, an array): its repr, which every kind refuses.
+  return std::string(bp::extract<std::string>(bp::str(value.attr("__repr__")())));
+}
+
+// The entries of an options dict keyed as the parameter table, None left out (not given).
+OptionMap optionMapFrom(const bp::dict& d) {
+  OptionMap values;
+  const bp::list keys = d.keys();
+  for (bp::ssize_t i = 0; i < bp::len(keys); ++i) {
+    const bp::object value = d[keys[i]];
+    if (!value.is_none()) values[bp::extract<std::string>(keys[i])] = optionValueFrom(value);
+  }
+  return values;
+}
+
 // The Python-visible mesh: a pipeline result (or a mesh rebuilt from saved arrays).
 class PyMesh {
  public:
@@ -266,8 +298,11 @@ class PyMesh {
     return d;
   }
 
-  // groups: a list of (name, [entity, ...]) pairs (named boundary groups).
-  void write(const std::string& path, bool binary, bool compressed, const bp::list& groups) {
+  // groups: a list of (name, [entity, ...]) pairs (named boundary groups). Returns, for a .xml
+  // whose geometry as Nektar++ builds it is not proven valid, the line saying so
+  // (pipeline/nektar_read_back.hpp); else "".
+  std::string write(const std::string& path, bool binary, bool compressed,
+                    const bp::list& groups) const {
     WriteOptions options;
     options.binary = binary;
     options.compressed = compressed;
@@ -282,6 +317,9 @@ class PyMesh {
     }
     const ReleaseGil nogil;
     writeMeshFiles(*result_, {path}, options);
+    if (std::filesystem::path(path).extension() != ".xml") return "";
+    const NektarReadBack check = checkNektarReadBack(path, result_->options.threads);
+    return check.proven() ? "" : check.line();
   }
 
   np::ndarray elementVolumes() const {
@@ -291,21 +329,12 @@ class PyMesh {
 
   std::string reportJson(const std::string& input) const { return meshReportJson(*result_, input); }
 
-  // A copy of this mesh optimised (optimise/optimiser.hpp), and the optimiser's JSON record.
-  bp::tuple optimise(const std::string& functional, int maxIterations, double tolerance,
-                     int threads, const bp::object& region, int layers, int focus,
-                     bool freeInterfaces, double facetWeight) const {
+  // A copy of this mesh optimised (optimise/optimiser.hpp) with the options of a dict keyed as
+  // the parameter table (OptimiserOptions::apply checks them), and the optimiser's JSON record.
+  bp::tuple optimise(const bp::dict& given) const {
     OptimiserOptions options;
-    options.functional = parseFunctional(functional);
-    options.maxIterations = maxIterations;
-    options.tolerance = tolerance;
-    options.threads = threads;
-    if (!region.is_none()) options.regionThreshold = bp::extract<double>(region)();
-    options.regionLayers = layers;
-    options.focusPasses = focus;
-    options.freeInterfaces = freeInterfaces;
-    options.facetWeight = facetWeight;
-    options.validate();
+    options.apply(optionMapFrom(given));
+    const int threads = options.threads;
     MeshResult copy = *result_;
     OptimiserResult record;
     {
@@ -362,25 +391,6 @@ std::vector<RefinementSource> sourcesFrom(const bp::object& list) {
   return out;
 }
 
-// A Python value for parameter `key` as the core takes it (a bool, a real number or text);
-// core/parameters.hpp's checkedOption judges it and names the parameter when it does not fit.
-OptionValue optionValueFrom(const bp::object& value) {
-  PyObject* o = value.ptr();
-  if (PyBool_Check(o) != 0) return o == Py_True;
-  if (PyUnicode_Check(o) != 0) return std::string(bp::extract<std::string>(value));
-  if (PyNumber_Check(o) != 0 && PyComplex_Check(o) == 0) {
-    PyObject* real = PyNumber_Float(o);
-    if (real != nullptr) {
-      const double x = PyFloat_AsDouble(real);
-      Py_DECREF(real);
-      return x;
-    }
-    PyErr_Clear();
-  }
-  // Not a number, on/off or text (a list, an array): its repr, which every kind refuses.
-  return std::string(bp::extract<std::string>(bp::str(value.attr("__repr__")())));
-}
-
 // The boundary layer of a dict the Python layer checked for its keys (homesh/api.py
 // _boundary_layer): "faces" (list of int), "thickness" (text), "layers", "progression" (checked
 // here against the parameter table).
@@ -406,20 +416,13 @@ enum Extras : unsigned { kNoExtras = 0, kSources = 1, kBoundaryLayer = 2 };
 // added to the base's; a boundary layer replaces the base's.
 MeshingOptions optionsFrom(const bp::dict& d, const std::vector<std::string>& allowed,
                            unsigned extras, MeshingOptions base = {}) {
-  OptionMap values;
-  bp::object sources, layer;
-  const bp::list keys = d.keys();
-  for (bp::ssize_t i = 0; i < bp::len(keys); ++i) {
-    const std::string key = bp::extract<std::string>(keys[i]);
-    const bp::object value = d[keys[i]];
-    if (value.is_none()) continue;
-    if (key == "sources" && (extras & kSources) != 0)
-      sources = value;
-    else if (key == "boundary_layer" && (extras & kBoundaryLayer) != 0)
-      layer = value;
-    else
-      values[key] = optionValueFrom(value);
-  }
+  // The extras this caller takes come out of the dict; the rest are table keys.
+  bp::dict table = bp::extract<bp::dict>(bp::object(d).attr("copy")());
+  const bp::object none;
+  const bp::object sources = (extras & kSources) != 0 ? table.attr("pop")("sources", none) : none;
+  const bp::object layer =
+      (extras & kBoundaryLayer) != 0 ? table.attr("pop")("boundary_layer", none) : none;
+  const OptionMap values = optionMapFrom(table);
   MeshingOptions options = std::move(base);
   options.apply(values, allowed);
   if (!sources.is_none() && bp::len(sources) > 0) {
@@ -437,18 +440,24 @@ const std::vector<std::string> kCurveKeys = {
     "order", "threads", "verbosity", "optimise", "optimise_seconds", "job_seconds", "facet_weight"};
 const std::vector<std::string> kSizingKeys = {"threads", "heal",      "solids_only", "surface",
                                               "auto",    "min_delta", "max_delta",   "eps"};
+const std::vector<std::string> kReadKeys = {"threads"};
 
 // The table keys the front-end function `function` ("mesh", "curve", "sizing": predict and
-// size_field) takes, in the table's order, for homesh/api.py's keywords and docstrings.
+// size_field, "read", "optimise": HighOrderMesh.optimise) takes, in the table's order, for
+// homesh/api.py's keywords and docstrings.
 bp::list optionKeys(const std::string& function) {
   const std::vector<std::string>* keys = function == "mesh"     ? &kMeshKeys
                                          : function == "curve"  ? &kCurveKeys
                                          : function == "sizing" ? &kSizingKeys
+                                         : function == "read"   ? &kReadKeys
                                                                 : nullptr;
-  if (keys == nullptr)
-    throw ParameterError("option_keys: no function '" + function + "' (mesh, curve or sizing)");
+  if (keys == nullptr && function != "optimise")
+    throw ParameterError("option_keys: no function '" + function +
+                         "' (mesh, curve, sizing, read or optimise)");
   bp::list out;
-  for (const std::string& key : MeshingOptions::keys(*keys)) out.append(key);
+  for (const std::string& key :
+       keys != nullptr ? MeshingOptions::keys(*keys) : OptimiserOptions::keys())
+    out.append(key);
   return out;
 }
 
@@ -522,6 +531,7 @@ bp::list parameters() {
     d["kind"] = p.kind == ParameterKind::Integer   ? "integer"
                 : p.kind == ParameterKind::Length  ? "length"
                 : p.kind == ParameterKind::Boolean ? "boolean"
+                : p.kind == ParameterKind::Choice  ? "choice"
                                                    : "real";
     d["min"] = p.min;
     d["max"] = p.max;
@@ -532,6 +542,9 @@ bp::list parameters() {
     d["group"] = p.group;
     d["doc"] = p.doc;
     d["range"] = rangeText(p);
+    bp::list choices;
+    for (const std::string& name : choiceNames(p)) choices.append(name);
+    d["choices"] = choices;
     out.append(d);
   }
   return out;
@@ -675,7 +688,8 @@ PyMesh meshFromArrays(int dim, int order, const bp::object& nodes, const bp::obj
 }
 
 // Reads a mesh file (.msh, .xml) and evaluates its quality.
-PyMesh readMeshFile(const std::string& path, int threads) {
+PyMesh readMeshFile(const std::string& path, const bp::dict& given) {
+  const int threads = MeshingOptions::fromMap(optionMapFrom(given), kReadKeys).threads;
   std::unique_ptr<MeshResult> result = std::make_unique<MeshResult>();
   {
     const ReleaseGil nogil;
@@ -781,7 +795,7 @@ BOOST_PYTHON_MODULE(_core) {
             bp::arg("groups") = bp::list()))
       .def("element_volumes", &PyMesh::elementVolumes)
       .def("report_json", &PyMesh::reportJson)
-      .def("optimise", &PyMesh::optimise);
+      .def("optimise", &PyMesh::optimise, (bp::arg("options")));
 
   bp::def("mesh_file", &meshFile,
           (bp::arg("path"), bp::arg("options"), bp::arg("progress") = bp::object(),
@@ -804,7 +818,7 @@ BOOST_PYTHON_MODULE(_core) {
           (bp::arg("path"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("options"),
            bp::arg("progress") = bp::object(), bp::arg("cancel") = bp::object()));
   bp::def("size_field", &sizeField, (bp::arg("text"), bp::arg("name"), bp::arg("options")));
-  bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("threads") = 1));
+  bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("options") = bp::dict()));
   bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
   bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));
   bp::def("lagrange_basis", &lagrangeBasis, (bp::arg("type"), bp::arg("order"), bp::arg("points")));

@@ -58,7 +58,7 @@ def test_geometry_record_of_a_mesh_made_from_cad(sphere, tmp_path):
 def test_optimising_a_mesh_made_from_cad_remeasures_its_geometry(data):
     m = homesh.mesh(str(data / "sphere.brep"), order=2, size=0.6)
     before = m.geometry()
-    m.optimise(maxiter=2)
+    m.optimise(optimise=2)
     after = m.geometry()  # the boundary slid on the CAD: measured again, same sampling
     assert after is not None and after["samples"] == before["samples"]
     # Nodes on the sphere: the quadratic boundary stays nearer than the chord of an edge 1.5

@@ -93,9 +93,10 @@ TEST(Arguments, OptimiserOptionsNeedTheOptimiser) {
 }
 
 TEST(Arguments, HelpListsTheTablesOptionsWithTheirRangesAndDefaults) {
-  // The help's words in one line: a range may be wrapped over two.
+  // The help's words in one line: a range may be wrapped over two. The optimiser's own options
+  // are `homesh optimise`'s.
   std::string help;
-  for (const char c : usageText("mesh"))
+  for (const char c : usageText("mesh") + usageText("optimise"))
     if (c != '\n' && !(c == ' ' && !help.empty() && help.back() == ' ')) help += c;
   for (const ParameterDefinition& p : parameterDefinitions()) {
     if (*p.option == '\0' || std::string(p.key) == "verbosity") continue;
@@ -105,6 +106,49 @@ TEST(Arguments, HelpListsTheTablesOptionsWithTheirRangesAndDefaults) {
     }
   }
   EXPECT_NE(usageText("mesh").find("  -p, --order N"), std::string::npos);
+}
+
+TEST(Arguments, OptimiseTakesTheTablesOptimiserOptions) {
+  const ParsedCommand p = parse({"optimise",
+                                 "m.msh",
+                                 "-f",
+                                 "winslow",
+                                 "-n",
+                                 "5",
+                                 "--tolerance",
+                                 "1e-4",
+                                 "--region",
+                                 "0.3",
+                                 "--layers",
+                                 "1",
+                                 "--focus",
+                                 "0",
+                                 "--free-interfaces",
+                                 "--time-limit",
+                                 "9",
+                                 "-p",
+                                 "3",
+                                 "-j",
+                                 "2"});
+  ASSERT_EQ(p.kind, ParsedCommand::Kind::Optimise);
+  const OptionMap& o = p.optimise.options;
+  EXPECT_EQ(given(o, "functional"), 2);  // the table's third choice
+  EXPECT_EQ(given(o, "optimise"), 5);
+  EXPECT_EQ(given(o, "tolerance"), 1e-4);
+  EXPECT_EQ(given(o, "region"), 0.3);
+  EXPECT_EQ(given(o, "region_layers"), 1);
+  EXPECT_EQ(given(o, "focus"), 0);
+  EXPECT_EQ(given(o, "free_interfaces"), 1);
+  EXPECT_EQ(given(o, "optimise_seconds"), 9);
+  EXPECT_EQ(p.optimise.order.value_or(0), 3);
+  EXPECT_EQ(p.optimise.common.threads, 2);
+  // Each value is judged as it is read, naming the long option.
+  EXPECT_NE(usageError({"optimise", "m.msh", "-f", "spring"}).find("--functional: functional"),
+            std::string::npos);
+  EXPECT_NE(usageError({"optimise", "m.msh", "--focus", "-1"}).find("--focus must be"),
+            std::string::npos);
+  EXPECT_NE(usageError({"optimise", "m.msh", "--region", "2"}).find("--region must be"),
+            std::string::npos);
 }
 
 TEST(Arguments, SizingAndPredict) {

@@ -16,7 +16,9 @@ TEST(Parameters, KeysPropertiesAndOptionsAreUnique) {
   std::set<std::string> keys, properties, options;
   for (const ParameterDefinition& p : parameterDefinitions()) {
     EXPECT_TRUE(keys.insert(p.key).second) << p.key;
-    EXPECT_TRUE(properties.insert(p.property).second) << p.property;
+    if (*p.property != '\0') {
+      EXPECT_TRUE(properties.insert(p.property).second) << p.property;
+    }
     if (*p.option != '\0') {
       EXPECT_TRUE(options.insert(p.option).second) << p.option;
     }

@@ -1,0 +1,90 @@
+#include "optimise/optimiser_options.hpp"
+
+#include <cmath>
+#include <functional>
+#include <map>
+
+#include "core/error.hpp"
+
+namespace homesh {
+
+void OptimiserOptions::validate() const {
+  checkParameter("optimise", maxIterations);
+  checkParameter("tolerance", tolerance);
+  checkParameter("optimise_seconds", timeLimit);
+  checkParameter("threads", threads);
+  if (regionThreshold) checkParameter("region", *regionThreshold);
+  checkParameter("region_layers", regionLayers);
+  checkParameter("focus", focusPasses);
+  checkParameter("facet_weight", facetWeight);
+  // The internal rules' settings (not user-facing: no table rows).
+  if (!(energyTolerance >= 0.0) || !std::isfinite(energyTolerance))
+    throw ParameterError("energy tolerance must be a finite number >= 0");
+  if (!(stall >= 0.0) || !std::isfinite(stall))
+    throw ParameterError("stall must be a finite number >= 0");
+  if (!(stallEnergy >= 0.0) || !std::isfinite(stallEnergy))
+    throw ParameterError("stall energy must be a finite number >= 0");
+  if (stallWindow < 1)
+    throw ParameterError("stall window must be >= 1, got " + std::to_string(stallWindow));
+  if (stuckWindow < 1)
+    throw ParameterError("stuck window must be >= 1, got " + std::to_string(stuckWindow));
+  if (!(activeTolerance >= 0.0) || !std::isfinite(activeTolerance))
+    throw ParameterError("active tolerance must be a finite number >= 0");
+  if (!(focusMargin >= 0.0) || !std::isfinite(focusMargin))
+    throw ParameterError("focus margin must be a finite number >= 0");
+}
+
+namespace {
+
+// Where each table key goes in OptimiserOptions, given its checked number.
+using Setter = std::function<void(OptimiserOptions&, double)>;
+const std::map<std::string, Setter>& setters() {
+  static const std::map<std::string, Setter> table = {
+      {"optimise", [](OptimiserOptions& o, double v) { o.maxIterations = static_cast<int>(v); }},
+      {"optimise_seconds", [](OptimiserOptions& o, double v) { o.timeLimit = v; }},
+      {"facet_weight", [](OptimiserOptions& o, double v) { o.facetWeight = v; }},
+      {"threads", [](OptimiserOptions& o, double v) { o.threads = static_cast<int>(v); }},
+      {"functional",
+       [](OptimiserOptions& o, double v) { o.functional = static_cast<Functional>(v); }},
+      {"tolerance", [](OptimiserOptions& o, double v) { o.tolerance = v; }},
+      {"region",
+       [](OptimiserOptions& o, double v) {
+         o.regionThreshold = v > 0.0 ? std::optional<double>(v) : std::nullopt;
+       }},
+      {"region_layers",
+       [](OptimiserOptions& o, double v) { o.regionLayers = static_cast<int>(v); }},
+      {"focus", [](OptimiserOptions& o, double v) { o.focusPasses = static_cast<int>(v); }},
+      {"free_interfaces", [](OptimiserOptions& o, double v) { o.freeInterfaces = v != 0.0; }},
+  };
+  return table;
+}
+
+}  // namespace
+
+std::vector<std::string> OptimiserOptions::keys() {
+  std::vector<std::string> out;
+  for (const ParameterDefinition& p : parameterDefinitions())
+    if (setters().count(p.key) != 0) out.emplace_back(p.key);
+  return out;
+}
+
+void OptimiserOptions::apply(const OptionMap& values) {
+  for (const auto& [key, value] : values) {
+    const double number = checkedOption(key, value);  // unknown keys and bad values named here
+    const auto setter = setters().find(key);
+    if (setter == setters().end()) {
+      std::string known;
+      for (const std::string& k : keys()) known += (known.empty() ? "" : ", ") + k;
+      throw ParameterError("option '" + key +
+                           "' does not apply to the optimiser (options: " + known + ")");
+    }
+    setter->second(*this, number);
+  }
+  // A neighbourhood of nothing: the user meant a region and left it out.
+  if (values.count("region_layers") != 0 && !regionThreshold)
+    throw ParameterError(std::string(parameterDefinition("region_layers").label) + " need a " +
+                         parameterDefinition("region").label + " (a scaled Jacobian > 0)");
+  validate();
+}
+
+}  // namespace homesh
