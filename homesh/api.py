@@ -77,9 +77,19 @@ class HighOrderMesh:
         return self._single_block().cad_entity
 
     def __repr__(self):
-        return "<HighOrderMesh order %d: %d nodes, %s>" % (
-            self.order, len(self.nodes),
-            ", ".join("%d %s" % (len(b.elements), b.element_type) for b in self.element_blocks))
+        return "<HighOrderMesh: %s>" % self.headline()
+
+    def headline(self):
+        """One line: nodes, elements and order, the certified scaled Jacobian's min and mean,
+        and whether every element is proven valid (else how many are not, and where on the CAD).
+        The command line prints the same line; a FreeCAD mesh object's Status starts with it."""
+        return self._core.headline()
+
+    def summary(self):
+        """What the job that made this mesh has to say, the lines ``homesh mesh`` prints: what
+        healing did, notes, the sizing and prediction, :meth:`headline`, the boundary layer,
+        each repair round and the job's time budget (a list of str)."""
+        return list(self._core.summary_lines())
 
     @property
     def num_nodes(self):

@@ -20,6 +20,7 @@
 #include "optimise/optimiser.hpp"
 #include "pipeline/case_setup.hpp"
 #include "pipeline/mesh_pipeline.hpp"
+#include "pipeline/mesh_summary.hpp"
 #include "pipeline/nektar_read_back.hpp"
 #include "pipeline/report.hpp"
 
@@ -114,18 +115,8 @@ homesh::CaseSetup setupWithFlags(const std::string& input, const homesh::SizingF
 }
 
 void printPrediction(const homesh::SizingResult& s, int dim) {
-  const homesh::OctreeStatistics& st = s.octree->statistics();
-  const homesh::SizingParameters& p = s.octree->parameters();
-  std::fprintf(stderr,
-               "homesh: sizing octree: MinDelta %g, MaxDelta %g, EPS %g, %zu sources; %zu leaves "
-               "(%zu inside, %zu boundary), depth %d, %zu boundary samples (%zu curved, %zu on "
-               "thin walls, %zu on curves of narrow faces), smallest size %g, %.3f s\n",
-               p.minDelta, p.maxDelta, p.eps, p.sources.size(), st.leaves, st.insideLeaves,
-               st.boundaryLeaves, st.maxLevel, st.boundarySamples, st.sizedSamples,
-               st.thinWallSamples, st.narrowFaceSamples, st.smallestDelta, s.seconds);
-  std::fprintf(stderr, "homesh: predicted %.0f %s (%s %g)\n", s.prediction.elements,
-               dim == 3 ? "tetrahedra" : "triangles", dim == 3 ? "domain volume" : "domain area",
-               s.prediction.domainMeasure);
+  for (const std::string& line : homesh::predictionLines(s, dim))
+    std::fprintf(stderr, "homesh: %s\n", line.c_str());
 }
 
 int runMesh(const homesh::MeshCommand& cmd) {
@@ -149,60 +140,8 @@ int runMesh(const homesh::MeshCommand& cmd) {
   homesh::MeshResult result = homesh::runMeshPipeline(setup.source, options, observer);
   if (!c.outputs.empty()) homesh::writeMeshOutputs(result, c.outputs, writeOptions(c), observer);
   if (!c.quiet) {
-    for (const std::string& action : result.healing.actions)
-      std::fprintf(stderr, "homesh: healed the CAD: %s\n", action.c_str());
-    if (result.healing.renumbered)
-      std::fprintf(stderr,
-                   "homesh: note: face numbers are the healed model's (%d faces, were %d)\n",
-                   result.healing.facesAfter, result.healing.facesBefore);
-    for (const std::string& note : result.notes)
-      std::fprintf(stderr, "homesh: note: %s\n", note.c_str());
-    if (result.sizing) printPrediction(*result.sizing, result.mesh.dim);
-    std::fprintf(stderr,
-                 "homesh: %zu nodes, %zu elements of order %d; scaled Jacobian min %.4f mean "
-                 "%.4f; %zu invalid\n",
-                 result.mesh.numNodes(), result.mesh.numElements(), result.mesh.order,
-                 result.quality.scaled.min, result.quality.scaled.mean, result.quality.invalid);
-    if (result.boundaryLayer && result.layerSplit) {
-      const homesh::BoundaryLayerRecord& b = *result.boundaryLayer;
-      const homesh::LayerSplitStats& s = *result.layerSplit;
-      std::fprintf(stderr,
-                   "homesh: boundary layer: %zu macro %s split into %d layers, height %g to %g, "
-                   "first layer %g to %g (worst %.2f %% off); shrunk on %zu %s; macro mesh worst "
-                   "%.4f\n",
-                   b.cells, result.mesh.dim == 3 ? "prisms" : "quadrilaterals", b.parameters.layers,
-                   b.thicknessMin, b.thicknessMax, s.firstHeightMin, s.firstHeightMax,
-                   100.0 * s.firstHeightDeviation, b.shrunk.size(),
-                   result.mesh.dim == 3 ? "faces" : "curves",
-                   result.macroQuality ? result.macroQuality->scaled.min : 0.0);
-    }
-    for (std::size_t k = 0; k < result.rounds.size(); ++k) {
-      const homesh::RepairRound& r = result.rounds[k];
-      if (!r.failure.empty()) {
-        std::fprintf(stderr, "homesh: repair %zu: %s %zu elements failed: %s\n", k + 1,
-                     r.action.c_str(), r.elements, r.failure.c_str());
-        continue;
-      }
-      std::fprintf(stderr,
-                   "homesh: repair %zu: %zu invalid, %zu undecided, worst %.4f -> %s %zu "
-                   "elements -> %zu invalid, %zu undecided, worst %.4f (%zu elements, %zu "
-                   "reused)%s\n",
-                   k + 1, r.invalid, r.undecided, r.worst, r.action.c_str(), r.elements,
-                   r.invalidAfter, r.undecidedAfter, r.worstAfter, r.meshElements, r.reused,
-                   r.kept ? "" : ", not kept");
-    }
-    if (result.job.stopped()) {
-      const auto list = [](const std::vector<std::string>& stages) {
-        std::string text;
-        for (const std::string& s : stages) text += (text.empty() ? "" : ", ") + s;
-        return text.empty() ? std::string("none") : text;
-      };
-      std::fprintf(stderr,
-                   "homesh: the job time limit of %g s stopped it (stopped: time budget): cut "
-                   "short: %s; left out: %s\n",
-                   result.job.timeLimit, list(result.job.cut).c_str(),
-                   list(result.job.skipped).c_str());
-    }
+    for (const std::string& line : homesh::meshSummaryLines(result))
+      std::fprintf(stderr, "homesh: %s\n", line.c_str());
     if (cmd.sizing.writeOctree)
       std::fprintf(stderr, "homesh: wrote %s\n", cmd.sizing.writeOctree->c_str());
     for (const std::string& path : c.outputs)

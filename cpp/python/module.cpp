@@ -27,6 +27,7 @@
 #include "io/mesh_readers.hpp"
 #include "pipeline/case_setup.hpp"
 #include "pipeline/mesh_pipeline.hpp"
+#include "pipeline/mesh_summary.hpp"
 #include "pipeline/nektar_read_back.hpp"
 #include "pipeline/report.hpp"
 #include "quality/element_measure.hpp"
@@ -328,6 +329,14 @@ class PyMesh {
   }
 
   std::string reportJson(const std::string& input) const { return meshReportJson(*result_, input); }
+
+  // pipeline/mesh_summary.hpp's lines and headline, as the CLI prints them.
+  bp::list summaryLines() const {
+    bp::list out;
+    for (const std::string& line : meshSummaryLines(*result_)) out.append(line);
+    return out;
+  }
+  std::string headline() const { return qualityHeadline(result_->mesh, result_->quality); }
 
   // A copy of this mesh optimised (optimise/optimiser.hpp) with the options of a dict keyed as
   // the parameter table (OptimiserOptions::apply checks them), and the optimiser's JSON record.
@@ -795,6 +804,8 @@ BOOST_PYTHON_MODULE(_core) {
             bp::arg("groups") = bp::list()))
       .def("element_volumes", &PyMesh::elementVolumes)
       .def("report_json", &PyMesh::reportJson)
+      .def("summary_lines", &PyMesh::summaryLines)
+      .def("headline", &PyMesh::headline)
       .def("optimise", &PyMesh::optimise, (bp::arg("options")));
 
   bp::def("mesh_file", &meshFile,

@@ -42,6 +42,24 @@ def test_quality_and_report(sphere):
     json.dumps(report)
 
 
+def test_summary_is_the_command_lines(sphere, homesh_bin, data):
+    """One writer of the summary: the CLI prints the lines Python's summary() returns, and
+    repr() and FreeCAD's status start from the same headline."""
+    from conftest import run
+    r = run([homesh_bin, "mesh", str(data / "sphere.brep"), "--order", "3", "--size", "0.4"])
+    assert r.returncode == 0, r.stderr
+    printed = [line[len("homesh: "):] for line in r.stderr.splitlines()]
+    headline = sphere.headline()
+    assert headline.endswith("all elements proven valid")
+    assert headline.startswith("%d nodes, %d elements of order 3; scaled Jacobian min "
+                               % (sphere.num_nodes, sphere.num_elements))
+    assert headline in printed and headline in sphere.summary()
+    # The sizing lines carry their time: compare the rest.
+    timeless = [s for s in sphere.summary() if not s.startswith("sizing octree")]
+    assert all(s in printed for s in timeless), (timeless, printed)
+    assert repr(sphere) == "<HighOrderMesh: %s>" % headline
+
+
 def test_geometry_record_of_a_mesh_made_from_cad(sphere, tmp_path):
     g = sphere.geometry()
     assert g == sphere.report()["geometry"]

@@ -1,0 +1,98 @@
+#include "pipeline/mesh_summary.hpp"
+
+#include <cstdio>
+
+#include "pipeline/report.hpp"
+
+namespace homesh {
+
+namespace {
+
+// printf into a std::string (the lines are short; 512 bytes hold the longest).
+template <class... Args>
+std::string formatted(const char* format, Args... args) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, format, args...);
+  return buf;
+}
+
+std::string boundaryLayerLine(const MeshResult& result) {
+  const BoundaryLayerRecord& b = *result.boundaryLayer;
+  const LayerSplitStats& s = *result.layerSplit;
+  const bool solid = result.mesh.dim == 3;
+  return formatted(
+      "boundary layer: %zu macro %s split into %d layers, height %g to %g, first layer %g to %g "
+      "(worst %.2f %% off); shrunk on %zu %s; macro mesh worst %.4f",
+      b.cells, solid ? "prisms" : "quadrilaterals", b.parameters.layers, b.thicknessMin,
+      b.thicknessMax, s.firstHeightMin, s.firstHeightMax, 100.0 * s.firstHeightDeviation,
+      b.shrunk.size(), solid ? "faces" : "curves",
+      result.macroQuality ? result.macroQuality->scaled.min : 0.0);
+}
+
+std::string repairLine(std::size_t k, const RepairRound& r) {
+  if (!r.failure.empty())
+    return formatted("repair %zu: %s %zu elements failed: %s", k + 1, r.action.c_str(), r.elements,
+                     r.failure.c_str());
+  return formatted(
+      "repair %zu: %zu invalid, %zu undecided, worst %.4f -> %s %zu elements -> %zu invalid, %zu "
+      "undecided, worst %.4f (%zu elements, %zu reused)%s",
+      k + 1, r.invalid, r.undecided, r.worst, r.action.c_str(), r.elements, r.invalidAfter,
+      r.undecidedAfter, r.worstAfter, r.meshElements, r.reused, r.kept ? "" : ", not kept");
+}
+
+std::string listed(const std::vector<std::string>& stages) {
+  std::string text;
+  for (const std::string& s : stages) text += (text.empty() ? "" : ", ") + s;
+  return text.empty() ? std::string("none") : text;
+}
+
+}  // namespace
+
+std::string qualityHeadline(const Mesh& mesh, const QualitySummary& quality) {
+  std::string line = formatted(
+      "%zu nodes, %zu elements of order %d; scaled Jacobian min %.4f mean %.4f; ", mesh.numNodes(),
+      mesh.numElements(), mesh.order, quality.scaled.min, quality.scaled.mean);
+  if (quality.invalid + quality.undecided == 0) return line + "all elements proven valid";
+  line += formatted("NOT VALID: %zu invalid, %zu undecided", quality.invalid, quality.undecided);
+  const std::string where = notValidLocation(mesh, quality);
+  return where.empty() ? line : line + " " + where;
+}
+
+std::vector<std::string> predictionLines(const SizingResult& s, int dim) {
+  const OctreeStatistics& st = s.octree->statistics();
+  const SizingParameters& p = s.octree->parameters();
+  return {formatted("sizing octree: MinDelta %g, MaxDelta %g, EPS %g, %zu sources; %zu leaves "
+                    "(%zu inside, %zu boundary), depth %d, %zu boundary samples (%zu curved, %zu "
+                    "on thin walls, %zu on curves of narrow faces), smallest size %g, %.3f s",
+                    p.minDelta, p.maxDelta, p.eps, p.sources.size(), st.leaves, st.insideLeaves,
+                    st.boundaryLeaves, st.maxLevel, st.boundarySamples, st.sizedSamples,
+                    st.thinWallSamples, st.narrowFaceSamples, st.smallestDelta, s.seconds),
+          formatted("predicted %.0f %s (%s %g)", s.prediction.elements,
+                    dim == 3 ? "tetrahedra" : "triangles",
+                    dim == 3 ? "domain volume" : "domain area", s.prediction.domainMeasure)};
+}
+
+std::vector<std::string> meshSummaryLines(const MeshResult& result) {
+  std::vector<std::string> lines;
+  for (const std::string& action : result.healing.actions)
+    lines.push_back("healed the CAD: " + action);
+  if (result.healing.renumbered)
+    lines.push_back(formatted("note: face numbers are the healed model's (%d faces, were %d)",
+                              result.healing.facesAfter, result.healing.facesBefore));
+  for (const std::string& note : result.notes) lines.push_back("note: " + note);
+  if (result.sizing)
+    for (std::string& line : predictionLines(*result.sizing, result.mesh.dim))
+      lines.push_back(std::move(line));
+  lines.push_back(qualityHeadline(result.mesh, result.quality));
+  if (result.boundaryLayer && result.layerSplit) lines.push_back(boundaryLayerLine(result));
+  for (std::size_t k = 0; k < result.rounds.size(); ++k)
+    lines.push_back(repairLine(k, result.rounds[k]));
+  if (result.job.stopped())
+    lines.push_back(formatted(
+        "the job time limit of %g s stopped it (stopped: time budget): cut short: %s; left out: "
+        "%s",
+        result.job.timeLimit, listed(result.job.cut).c_str(), listed(result.job.skipped).c_str()));
+  return lines;
+}
+
+}  // namespace homesh
