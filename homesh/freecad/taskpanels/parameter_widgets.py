@@ -4,8 +4,8 @@ core's parameter table.
 The .ui file states the layout only: a spin box or check box named after a table property
 (Order, MinDelta, Heal ...) is that parameter, and a label named after it plus "Label" is its
 row label. Everything else a widget shows of a parameter comes from the table when the panel
-opens: the label (the table's label), the range, the decimals, the unit, the tooltip (doc and
-range) and the object's value. Gui only.
+opens: the label (the table's label), the range, the decimals, the unit (mm for a length), the
+tooltip (doc and range) and the object's value. Gui only.
 """
 
 import FreeCADGui
@@ -66,8 +66,8 @@ def _configure_spin_box(widget, p):
         widget.setSingleStep(0.1 if p["kind"] == "length" else 0.01)
         if p["kind"] == "length":
             widget.setSuffix(" mm")  # FreeCAD's internal length unit, App::PropertyDistance's
-        elif seconds:
-            widget.setSuffix(" s")
+        # Seconds carry no suffix: " s" pushed "600.0" out of the narrow field; the table's doc,
+        # the tooltip, starts with "Seconds".
     if p["zero_is_automatic"]:
         # "auto": the panel's narrow field showed "automatic" as "tomatic"; the tooltip says it.
         widget.setSpecialValueText("auto")
