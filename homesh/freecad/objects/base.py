@@ -1,8 +1,6 @@
-"""What every HOMesh document object proxy shares: persistence of its type alone, and the view
-provider its factory attaches when the GUI is up. No Qt: view providers are imported only then.
+"""What every HOMesh document object proxy shares: persistence of its type alone. (Each
+factory attaches its view provider when the GUI is up, importing viewproviders.py only then.)
 """
-
-import FreeCAD
 
 
 class Proxy:
@@ -21,10 +19,3 @@ class Proxy:
     def loads(self, state):
         self.__setstate__(state)
 
-
-def attach_view_provider(obj, name):
-    """Gives ``obj`` the view provider class ``name`` of viewproviders.py when the GUI is up
-    (headless, objects have no ViewObject)."""
-    if FreeCAD.GuiUp:
-        from .. import viewproviders
-        getattr(viewproviders, name)(obj.ViewObject)

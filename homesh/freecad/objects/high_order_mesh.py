@@ -12,7 +12,7 @@ from ..meshing import (DEFAULT_ELEMENT_LIMIT, LargeMeshError, apply_result,
                        check_element_limit, job_for)
 from ..object_types import TYPE_HIGH_ORDER_MESH
 from ..properties import ParameterGuard, add_parameter_property
-from .base import Proxy, attach_view_provider
+from .base import Proxy
 
 
 def make_high_order_mesh(doc, part, order=None, size=None, name="HighOrderMesh", sizing=None,
@@ -38,7 +38,9 @@ def make_high_order_mesh(doc, part, order=None, size=None, name="HighOrderMesh",
     obj.Sizing = sizing
     obj.BoundaryLayer = boundary_layer
     obj.FemMesh = fem_mesh
-    attach_view_provider(obj, "ViewProviderHighOrderMesh")
+    if FreeCAD.GuiUp:  # headless, objects have no ViewObject
+        from ..viewproviders import ViewProviderHighOrderMesh
+        ViewProviderHighOrderMesh(obj.ViewObject)
     return obj
 
 

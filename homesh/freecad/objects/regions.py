@@ -15,7 +15,7 @@ import FreeCAD
 
 from ..arguments import group_entities, region_sources
 from ..object_types import TYPE_BOUNDARY_GROUP, TYPE_MESH_REGION
-from .base import Proxy, attach_view_provider
+from .base import Proxy
 
 
 def make_mesh_region(doc, mesh, references, size, distance=0.0, name="MeshRegion"):
@@ -27,7 +27,9 @@ def make_mesh_region(doc, mesh, references, size, distance=0.0, name="MeshRegion
     obj.Size = size
     obj.Distance = distance
     mesh.Regions = list(mesh.Regions) + [obj]
-    attach_view_provider(obj, "ViewProviderIconOnly")
+    if FreeCAD.GuiUp:  # headless, objects have no ViewObject
+        from ..viewproviders import ViewProviderIconOnly
+        ViewProviderIconOnly(obj.ViewObject)
     return obj
 
 
@@ -40,7 +42,9 @@ def make_boundary_group(doc, mesh, references, group_name, name="BoundaryGroup")
     obj.GroupName = group_name
     obj.Label = group_name
     mesh.Groups = list(mesh.Groups) + [obj]
-    attach_view_provider(obj, "ViewProviderIconOnly")
+    if FreeCAD.GuiUp:  # headless, objects have no ViewObject
+        from ..viewproviders import ViewProviderIconOnly
+        ViewProviderIconOnly(obj.ViewObject)
     return obj
 
 

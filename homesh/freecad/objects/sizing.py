@@ -9,7 +9,7 @@ from ..arguments import cad_modes, sizing_arguments
 from ..meshing import prediction_summary
 from ..object_types import TYPE_SIZING
 from ..properties import ParameterGuard, add_parameter_property
-from .base import Proxy, attach_view_provider
+from .base import Proxy
 
 
 def make_sizing(doc, part, min_delta=None, max_delta=None, eps=None, name="Sizing"):
@@ -26,7 +26,9 @@ def make_sizing(doc, part, min_delta=None, max_delta=None, eps=None, name="Sizin
     for prop, value in (("MinDelta", min_delta), ("MaxDelta", max_delta), ("Eps", eps)):
         if value is not None:
             setattr(obj, prop, value)
-    attach_view_provider(obj, "ViewProviderSizing")
+    if FreeCAD.GuiUp:  # headless, objects have no ViewObject
+        from ..viewproviders import ViewProviderSizing
+        ViewProviderSizing(obj.ViewObject)
     return obj
 
 
