@@ -1,8 +1,8 @@
-"""A HighOrderMesh object's meshing, without a document of its own: its properties (or a task
-panel's values) made into a :class:`job.MeshJob` (``homesh.mesh``, or ``homesh.curve`` for a
-FEM mesh), the element count predicted and checked against its ElementLimit, and a finished
-job's mesh and results written back to the object. Used by the object's recompute and by its
-task panel alike. No Qt.
+"""A HighOrderMesh object's meshing, apart from the document objects themselves: its
+properties (or a task panel's values) made into a :class:`job.MeshJob` (``homesh.mesh``, or
+``homesh.curve`` for a FEM mesh), the element count predicted and checked against its
+ElementLimit, and a finished job's mesh and results written back to the object. Used by the
+object's recompute and by its task panel alike; creates no objects, no transactions, no Qt.
 """
 
 import FreeCAD
