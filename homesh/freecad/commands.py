@@ -4,7 +4,10 @@ import FreeCAD
 import FreeCADGui
 
 from . import resources
-from .objects import TYPE_HIGH_ORDER_MESH, is_sizing
+from .fem import fem_shape_object, is_fem_mesh
+from .object_types import is_high_order_mesh, is_sizing
+from .stored_mesh import get_mesh
+from .taskpanels import last_panel
 
 
 def _selected_sizing_object():
@@ -48,7 +51,6 @@ def _edit_and_mesh(obj):
 
 def active_panel():
     """The HOMesh task panel being shown, if any."""
-    from .taskpanels import last_panel
     return last_panel() if FreeCADGui.Control.activeDialog() else None
 
 
@@ -150,9 +152,7 @@ class CommandBoundaryLayer:
             return
         part, faces = selected
         thickness = "%.4g" % (part.Shape.BoundBox.DiagonalLength / 100.0)
-        meshes = [o for o in part.Document.Objects
-                  if getattr(getattr(o, "Proxy", None), "Type", None) == TYPE_HIGH_ORDER_MESH
-                  and o.Part == part]
+        meshes = [o for o in part.Document.Objects if is_high_order_mesh(o) and o.Part == part]
         link = (["App.ActiveDocument.getObject(%r).BoundaryLayer = _layer" % meshes[0].Name]
                 if len(meshes) == 1 else [])
         _do_commands("Boundary layer", [
@@ -163,7 +163,6 @@ class CommandBoundaryLayer:
 
 def _selected_fem_mesh():
     """The selected FEM mesh object whose shape is known, or None."""
-    from .fem import fem_shape_object, is_fem_mesh
     selection = FreeCADGui.Selection.getSelection()
     if len(selection) == 1 and is_fem_mesh(selection[0]) and \
             fem_shape_object(selection[0]) is not None:
@@ -173,8 +172,7 @@ def _selected_fem_mesh():
 
 def _selected_high_order_mesh():
     selection = FreeCADGui.Selection.getSelection()
-    if len(selection) == 1 and getattr(getattr(selection[0], "Proxy", None), "Type", None) == \
-            TYPE_HIGH_ORDER_MESH:
+    if len(selection) == 1 and is_high_order_mesh(selection[0]):
         return selection[0]
     return None
 
@@ -196,7 +194,6 @@ class CommandCurveFemMesh:
         return FreeCAD.ActiveDocument is not None and _selected_fem_mesh() is not None
 
     def Activated(self):
-        from .fem import fem_shape_object
         fem = _selected_fem_mesh()
         if fem is None:
             FreeCAD.Console.PrintError("HOMesh: select one FEM mesh object made from a shape\n")
@@ -223,7 +220,6 @@ class CommandToFemMesh:
         }
 
     def IsActive(self):
-        from .objects import get_mesh
         obj = _selected_high_order_mesh()
         return obj is not None and get_mesh(obj) is not None
 
@@ -252,9 +248,7 @@ def _selected_subshapes(kinds):
 
 
 def _mesh_of(part):
-    meshes = [o for o in part.Document.Objects
-              if getattr(getattr(o, "Proxy", None), "Type", None) == TYPE_HIGH_ORDER_MESH
-              and o.Part == part]
+    meshes = [o for o in part.Document.Objects if is_high_order_mesh(o) and o.Part == part]
     return meshes[0] if len(meshes) == 1 else None
 
 

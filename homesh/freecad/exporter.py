@@ -4,11 +4,13 @@ composites."""
 
 import FreeCAD
 
+from .arguments import mesh_groups
+from .object_types import is_high_order_mesh
+from .stored_mesh import get_mesh
+
 
 def export(objects, filename):
-    from .objects import TYPE_HIGH_ORDER_MESH, get_mesh
-    meshes = [o for o in objects
-              if getattr(getattr(o, "Proxy", None), "Type", None) == TYPE_HIGH_ORDER_MESH]
+    meshes = [o for o in objects if is_high_order_mesh(o)]
     if len(meshes) != 1:
         FreeCAD.Console.PrintError("HOMesh: select exactly one high-order mesh to export\n")
         return
@@ -18,7 +20,6 @@ def export(objects, filename):
             "HOMesh: %s has no valid mesh (never computed, or its last recompute failed): "
             "nothing exported\n" % meshes[0].Label)
         return
-    from .regions import mesh_groups
     import homesh
     try:
         groups = mesh_groups(meshes[0])

@@ -20,6 +20,8 @@ import tempfile
 
 import numpy as np
 
+from .stored_mesh import get_mesh
+
 # SMESH's node k is Gmsh's node _SMESH_FROM_GMSH[type][k] (order 2; order 1: the first corners).
 # Tetrahedra: SMESH corners (g0, g2, g1, g3); SMESH edges (0,1) (1,2) (2,0) (0,3) (1,3) (2,3) are
 # Gmsh's edges (0,2) (1,2) (0,1) (0,3) (2,3) (1,3), Gmsh's nodes 6, 5, 4, 7, 8, 9.
@@ -134,7 +136,6 @@ def to_fem_mesh(mesh):
 def make_fem_mesh_object(doc, obj, name=None):
     """A ``Fem::FemMeshObject`` in ``doc`` holding the mesh of HighOrderMesh ``obj`` at order 2
     at most (FEM's solvers and post-processing take it)."""
-    from .objects import get_mesh
     mesh = get_mesh(obj)
     if mesh is None:
         raise ValueError("%s has no mesh (recompute it first)" % obj.Label)

@@ -36,13 +36,15 @@ def add_parameter_property(obj, key, group, doc_extra="", default=None):
     p = [d for d in parameters() if d["key"] == key][0]
     if p["property"] in obj.PropertiesList:
         return
-    tip = "%s.%s%s" % (p["doc"], "" if p["kind"] == "boolean" else " " + _range_words(p),
+    tip = "%s.%s%s" % (p["doc"], "" if p["kind"] == "boolean" else " " + range_words(p),
                         doc_extra)
     obj.addProperty(_PROPERTY_TYPE[p["kind"]], p["property"], group, tip)
     setattr(obj, p["property"], _typed(p, p["default"] if default is None else default))
 
 
-def _range_words(p):
+def range_words(p):
+    """The allowed values of table entry ``p`` in words, for tooltips ("Allowed: <range>[, or 0
+    for automatic].")."""
     words = "Allowed: %s" % p["range"]
     if p["zero_is_automatic"]:
         words += ", or 0 for automatic"

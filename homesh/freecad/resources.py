@@ -1,4 +1,5 @@
-"""Paths of the workbench's resources (icons), found relative to this package.
+"""Paths of the workbench's resources (icons, task panel layouts), found relative to this
+package.
 
 Works both in the source tree and in the staged/installed Mod folder, where Resources/ sits
 beside the homesh package. Importing this module does not load the compiled core.
@@ -12,3 +13,8 @@ RESOURCES = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
 
 def icon(name="homesh.svg"):
     return os.path.join(RESOURCES, "icons", name)
+
+
+def ui(name):
+    """The Qt Designer file of a task panel (Resources/ui/<name>)."""
+    return os.path.join(RESOURCES, "ui", name)

@@ -13,6 +13,10 @@ the element count.
 """
 
 from . import resources
+from .arguments import cad_modes, sizing_arguments
+from .meshing import not_valid
+from .object_types import TYPE_BOUNDARY_GROUP, type_of
+from .stored_mesh import get_mesh
 
 DISPLAY_MODES = ["Surface with edges", "Surface", "Wireframe"]
 SHOW = ["Boundary", "Elements below threshold", "Invalid elements"]
@@ -210,7 +214,6 @@ class ViewProviderHighOrderMesh(_Stateless, _EditsWithTaskPanel):
     def rebuild(self):
         """Rebuilds the scene from the object's mesh (after a recompute or a reload) and the
         display properties."""
-        from .objects import get_mesh
         from .. import tessellation
         obj = self.Object
         vobj = obj.ViewObject
@@ -263,7 +266,6 @@ class ViewProviderHighOrderMesh(_Stateless, _EditsWithTaskPanel):
         return mode
 
     def getIcon(self):
-        from .objects import not_valid
         obj = getattr(self, "Object", None)
         if obj is not None and "InvalidElements" in obj.PropertiesList and not_valid(obj):
             return resources.icon("homesh_mesh_invalid.svg")
@@ -324,7 +326,6 @@ class ViewProviderSizing(_Stateless, _EditsWithTaskPanel):
         if vobj is None or not vobj.ShowSizeField or obj.PredictedElements <= 0:
             return
         import homesh
-        from .objects import cad_modes, sizing_arguments
         try:
             shape = obj.Part.Shape
             field = homesh.size_field(shape, name=obj.Part.Label, **cad_modes(shape),
@@ -373,8 +374,7 @@ class ViewProviderIconOnly(_Stateless):
         self.Object = vobj.Object
 
     def getIcon(self):
-        from .regions import TYPE_BOUNDARY_GROUP
-        kind = getattr(getattr(getattr(self, "Object", None), "Proxy", None), "Type", "")
+        kind = type_of(getattr(self, "Object", None))
         return resources.icon("homesh_group.svg" if kind == TYPE_BOUNDARY_GROUP
                               else "homesh_region.svg")
 

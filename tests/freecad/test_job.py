@@ -12,7 +12,7 @@ import FreeCAD
 
 import homesh
 import homesh.freecad
-from homesh.freecad import objects
+from homesh.freecad import meshing
 
 from fixtures import box_with_hole
 
@@ -28,7 +28,7 @@ class MeshJobs(unittest.TestCase):
         FreeCAD.closeDocument(self.doc.Name)
 
     def test_a_job_runs_beside_the_calling_thread_and_reports_its_sweeps(self):
-        job = objects.job_for(self.obj).start()
+        job = meshing.job_for(self.obj).start()
         self.assertIsNot(job._thread, threading.current_thread())
         polls = 0
         while not job.done:
@@ -58,14 +58,14 @@ class MeshJobs(unittest.TestCase):
         needle.Shape = Part.makeCone(0.01, 0.0, 100.0)
         mesh = homesh.freecad.make_high_order_mesh(self.doc, needle, order=2)
         mesh.LinearTimeLimit = 2
-        job = objects.job_for(mesh).start()
+        job = meshing.job_for(mesh).start()
         job.wait(900)  # a hang guard: wait() returns as soon as the job ends
         job.poll()
         # The message proves that the limit ended Gmsh: left alone it grinds on and crashes.
         self.assertIsInstance(job.error, homesh.MeshingError)
         self.assertIn("stopped at its time budget of 2 s", str(job.error))
         mesh.LinearTimeLimit = 600
-        job = objects.job_for(mesh).start()
+        job = meshing.job_for(mesh).start()
         while job.stage != "linear" and not job.done:
             job.poll()
             time.sleep(0.01)
@@ -78,7 +78,7 @@ class MeshJobs(unittest.TestCase):
         # CancelledError proves the cancel ended it: Gmsh alone would crash (MeshingError).
         self.assertIsInstance(job.error, homesh.CancelledError)
         # The process is intact: the next job meshes.
-        job = objects.job_for(self.obj).start()
+        job = meshing.job_for(self.obj).start()
         job.wait(300)
         job.poll()
         self.assertIsNone(job.error)
@@ -87,7 +87,7 @@ class MeshJobs(unittest.TestCase):
 
     def test_cancel_ends_the_job_at_its_next_check(self):
         self.obj.Order = 6  # long enough to be caught in the optimiser
-        job = objects.job_for(self.obj).start()
+        job = meshing.job_for(self.obj).start()
         while not job.stage.startswith("optimise") and not job.done:
             job.poll()
             time.sleep(0.01)

@@ -10,7 +10,7 @@ import FreeCAD
 
 import homesh
 import homesh.freecad
-from homesh.freecad import objects
+from homesh.freecad import meshing, properties
 
 from fixtures import box_with_hole
 
@@ -47,7 +47,7 @@ class RefusedValues(unittest.TestCase):
         FreeCAD.closeDocument(self.doc.Name)
 
     def check_property(self, obj, prop):
-        p = objects.definition(prop)
+        p = properties.definition(prop)
         before = objects_value(obj, prop)
         for value in _out_of_range(p):
             count = len(obj.Proxy.refused)
@@ -94,8 +94,8 @@ class RefusedValues(unittest.TestCase):
         # size the linear mesher can afford agrees with what it makes (the sizing tests hold
         # the prediction to 10 %; here 20 % for the curved hole at a coarse size).
         mesh.Size = 0.4
-        job = objects.job_for(mesh)
-        predicted = objects.predicted_elements(mesh, job)
+        job = meshing.job_for(mesh)
+        predicted = meshing.predicted_elements(mesh, job)
         mesh.ElementLimit = 0
         self.doc.recompute()
         self.assertTrue(mesh.isValid())

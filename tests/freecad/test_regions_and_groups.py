@@ -12,7 +12,7 @@ import numpy as np
 
 import homesh
 import homesh.freecad
-from homesh.freecad import exporter, regions
+from homesh.freecad import arguments, exporter, object_types
 
 from fixtures import box_with_hole
 
@@ -81,7 +81,7 @@ class RegionsAndGroups(unittest.TestCase):
         homesh.freecad.make_boundary_group(
             self.doc, mesh, [(self.part, [f for f in faces if f != wall])], "farfield")
         self.doc.recompute()
-        self.assertEqual(regions.mesh_groups(mesh),
+        self.assertEqual(arguments.mesh_groups(mesh),
                          {"wall": [int(wall[4:])],
                           "farfield": sorted(int(f[4:]) for f in faces if f != wall)})
         for ext in ("msh", "xml"):
@@ -118,7 +118,7 @@ class RegionsAndGroups(unittest.TestCase):
         mesh = self.doc.getObject(name)
         (region,) = mesh.Regions
         (group,) = mesh.Groups
-        self.assertEqual(region.Proxy.Type, regions.TYPE_MESH_REGION)
+        self.assertEqual(region.Proxy.Type, object_types.TYPE_MESH_REGION)
         self.assertEqual((region.Size.Value, region.Distance.Value), (0.2, 0.3))
         self.assertEqual(list(region.References[0][1]), ["Edge1", "Vertex1"])
         self.assertEqual(group.GroupName, "wall")
@@ -141,10 +141,10 @@ class RegionsAndGroups(unittest.TestCase):
         group = homesh.freecad.make_boundary_group(self.doc, mesh, [(self.part, ["Edge1"])],
                                                    "wall")
         with self.assertRaisesRegex(ValueError, "wall: 'Edge1' is not a face"):
-            regions.group_entities(group)
+            arguments.group_entities(group)
         group.GroupName = " "
         with self.assertRaisesRegex(ValueError, "GroupName is empty"):
-            regions.group_entities(group)
+            arguments.group_entities(group)
 
 
 if __name__ == "__main__":

@@ -9,7 +9,8 @@ screenshots of (to $HOMESH_SCREENSHOT_DIR):
    run, histogram.png). These are counts of events, not durations: the largest gap between
    the timer's firings is printed, and bench/gui_responsiveness records it.
 2. The mesh is drawn in the quality colours with its legend (view.png, window.png).
-3. Stop (and Escape) during an order-6 job ends it with CancelledError and leaves the object
+3. The task panels are their .ui files' forms (Resources/ui/), with labels, ranges, tooltips
+   and values filled from the parameter table. Stop (and Escape) during an order-6 job ends it with CancelledError and leaves the object
    exactly as it was (the latency is printed, not asserted); the sizing panel predicts for typed values before applying them, and the size
    field is drawn (sizing.png).
 4. A mesh with invalid elements carries the warning icon and Status, and Show "Invalid
@@ -41,7 +42,7 @@ try:
     sys.path.insert(0, os.path.join(os.environ["HOMESH_TESTS_DIR"], "freecad"))
     from fixtures import box_with_hole
     import homesh.freecad
-    from homesh.freecad import commands, objects
+    from homesh.freecad import arguments, commands
 
     app = QtWidgets.QApplication.instance()
     window = FreeCADGui.getMainWindow()
@@ -86,6 +87,27 @@ try:
             print("HOMesh GUI: largest gap %.3f s, during %s" % worst)
         seen = {t[1:] for t in stamps if t is not None}
         return worst[0], sum(1 for t in stamps if t is not None), len(seen)
+
+    from homesh.api import parameters
+    TABLE = {p["property"]: p for p in parameters() if p["property"]}
+
+    def check_form_from_table(panel, form_name, obj, prop):
+        """The panel is its .ui file's form (the root's name is stated there alone) and the
+        widget of ``prop`` shows the parameter table's label, range, doc and the object's
+        value."""
+        assert panel.form.objectName() == form_name, panel.form.objectName()
+        p = TABLE[prop]
+        widget = panel.widgets[prop]
+        label = panel.form.findChild(QtWidgets.QLabel, prop + "Label")
+        expected = p["label"][:1].upper() + p["label"][1:]
+        assert label is not None and label.text() == expected, (prop, label and label.text())
+        high = p["max"] if p["max"] != float("inf") else 1e9
+        assert widget.maximum() == min(high, 2 ** 31 - 1), (prop, widget.maximum(), p["max"])
+        assert p["doc"] in widget.toolTip() and p["range"] in widget.toolTip(), widget.toolTip()
+        value = getattr(obj, prop)
+        assert widget.value() == float(getattr(value, "Value", value)), (prop, widget.value())
+        print("HOMesh GUI: %s from %s: %s %r, up to %g" % (prop, form_name, expected,
+                                                          widget.value(), widget.maximum()))
 
     doc = FreeCAD.newDocument("Smoke")
     cut = box_with_hole(doc)
@@ -195,6 +217,12 @@ try:
     nodes_before = homesh.freecad.get_mesh(mesh).nodes.copy()
     FreeCADGui.ActiveDocument.setEdit(mesh.Name)
     panel = commands.active_panel()
+    for prop in ("Order", "OptimiserIterations", "JobTimeLimit"):
+        check_form_from_table(panel, "HighOrderMeshPanel", mesh, prop)
+    panel.form.grab().save(os.path.join(out, "task_panel.png"))
+    flag = panel.flags["SolidsOnly"]
+    assert flag.text() == "Solids only" == TABLE["SolidsOnly"]["label"].capitalize()
+    assert TABLE["SolidsOnly"]["doc"] in flag.toolTip(), flag.toolTip()
     panel.widgets["Order"].setValue(6)
     job = panel.mesh()
     assert job is not None
@@ -229,7 +257,7 @@ try:
     # The CAD check's switches are check boxes whose values reach the job's arguments.
     assert panel.flags["Heal"].isChecked() and not panel.flags["SolidsOnly"].isChecked()
     panel.flags["SolidsOnly"].setChecked(True)
-    assert objects.mesh_arguments(mesh, panel.values())["solids_only"] is True
+    assert arguments.mesh_arguments(mesh, panel.values())["solids_only"] is True
     panel.flags["SolidsOnly"].setChecked(False)
     FreeCADGui.Control.closeDialog()
     settle()
@@ -239,6 +267,9 @@ try:
     doc.recompute()
     FreeCADGui.ActiveDocument.setEdit(sizing.Name)
     sizing_panel = commands.active_panel()
+    for prop in ("Eps", "MaxDelta"):
+        check_form_from_table(sizing_panel, "SizingPanel", sizing, prop)
+    sizing_panel.form.grab().save(os.path.join(out, "sizing_panel.png"))
     default_count = sizing.PredictedElements
     sizing_panel.widgets["MaxDelta"].setValue(0.2)
     finer = sizing_panel.predict()
