@@ -98,8 +98,7 @@ def apply_result(obj, mesh, predicted=None, touch=True, values=None, npz_path=No
     obj.UndecidedElements = int(quality["undecided_elements"])
     report = job_report(mesh)
     notes = report.get("notes", [])
-    obj.Status = summary_text(obj, mesh, quality, predicted,
-                              report.get("quality", {}).get("where", ""))
+    obj.Status = summary_text(obj, mesh, predicted)
     if not_valid(obj):
         FreeCAD.Console.PrintWarning("HOMesh: %s\n" % obj.Status)
     else:
@@ -126,20 +125,13 @@ def job_report(mesh):
         return {}
 
 
-def summary_text(obj, mesh, quality, predicted=None, where=""):
-    """``where``: the report's quality "where" (the CAD faces elements not proven valid
-    touch: "at Face7 (18 elements), Face3 (6)")."""
-    text = ("%s: %d nodes, %d elements of order %d, worst scaled Jacobian %.3f"
-            % (obj.Label, mesh.num_nodes, mesh.num_elements, mesh.order, quality["min"]))
+def summary_text(obj, mesh, predicted=None):
+    """The object's label, the core's headline of the mesh (the line ``homesh mesh`` prints:
+    counts, certified quality, and where elements not proven valid lie on the CAD) and the
+    predicted linear element count."""
+    text = "%s: %s" % (obj.Label, mesh.headline())
     if predicted:
-        text += ", %d linear elements predicted" % predicted
-    if quality["invalid_elements"] or quality["undecided_elements"]:
-        text += (": NOT VALID, %d invalid and %d undecided elements (worst %.3g)"
-                 % (quality["invalid_elements"], quality["undecided_elements"], quality["min"]))
-        if where:
-            text += " " + where
-    else:
-        text += ", all elements proven valid"
+        text += "; %d linear elements predicted" % predicted
     return text
 
 
