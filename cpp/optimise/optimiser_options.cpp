@@ -73,10 +73,12 @@ void OptimiserOptions::apply(const OptionMap& values) {
     const double number = checkedOption(key, value);  // unknown keys and bad values named here
     const auto setter = setters().find(key);
     if (setter == setters().end()) {
-      std::string known;
-      for (const std::string& k : keys()) known += (known.empty() ? "" : ", ") + k;
-      throw ParameterError("option '" + key +
-                           "' does not apply to the optimiser (options: " + known + ")");
+      std::string message = "option '" + key + "' does not apply to the optimiser (options: ";
+      for (const std::string& k : keys()) {
+        if (message.back() != ' ') message += ", ";
+        message += k;
+      }
+      throw ParameterError(message + ")");
     }
     setter->second(*this, number);
   }
