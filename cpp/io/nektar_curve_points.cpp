@@ -49,18 +49,18 @@ void toEvenlySpaced(GeometrySections& g, int order, const std::string& path) {
     return out;
   };
   for (auto& [id, c] : g.edgeCurves) {
-    if (c.type == nektar::kEvenlySpaced) continue;
-    if (c.type != nektar::kGaussLobattoLegendre)
+    if (c.type == kEvenlySpaced) continue;
+    if (c.type != kGaussLobattoLegendre)
       failGeometry(path,
                    "edge " + std::to_string(id) + "'s curve has " + c.type + ", not supported");
     c.points = resample(c.points);
-    c.type = nektar::kEvenlySpaced;
+    c.type = kEvenlySpaced;
   }
   std::vector<int> dropped;
   for (auto& [id, c] : g.faceCurves) {
-    if (c.type == nektar::kEvenlySpaced || c.type == nektar::kTriEvenlySpaced) continue;
+    if (c.type == kEvenlySpaced || c.type == kTriEvenlySpaced) continue;
     const bool quad = c.points.size() == n * n;
-    if (quad && c.type == nektar::kGaussLobattoLegendre) {
+    if (quad && c.type == kGaussLobattoLegendre) {
       std::vector<Point> rows;  // the first direction resampled, row by row
       rows.reserve(n * n);
       for (std::size_t i = 0; i < n; ++i) {
@@ -78,9 +78,9 @@ void toEvenlySpaced(GeometrySections& g, int order, const std::string& path) {
         for (std::size_t i = 0; i < n; ++i) out[i * n + j] = resampled[i];
       }
       c.points = std::move(out);
-      c.type = nektar::kEvenlySpaced;
-    } else if (!quad && c.type == "NodalTriElec" && nektar::hasTriElecPoints(order)) {
-      const Eigen::MatrixXd& m = nektar::triElecToEvenlySpaced(order);
+      c.type = kEvenlySpaced;
+    } else if (!quad && c.type == "NodalTriElec" && hasTriElecPoints(order)) {
+      const Eigen::MatrixXd& m = triElecToEvenlySpaced(order);
       if (c.points.size() != static_cast<std::size_t>(m.rows()))
         failGeometry(path, "face " + std::to_string(id) + "'s curve has " +
                                std::to_string(c.points.size()) + " points; a triangle of order " +
@@ -90,7 +90,7 @@ void toEvenlySpaced(GeometrySections& g, int order, const std::string& path) {
         for (std::size_t k = 0; k < out.size(); ++k)
           out[r] += m(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) * c.points[k];
       c.points = std::move(out);
-      c.type = nektar::kTriEvenlySpaced;
+      c.type = kTriEvenlySpaced;
     } else if (!quad && (c.type == "NodalTriElec" || c.type == "NodalTriFekete")) {
       dropped.push_back(id);
     } else {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <sstream>
+#include <utility>
 
 #include "core/error.hpp"
 #include "core/format.hpp"
@@ -19,24 +20,25 @@ using Point = Eigen::Vector3d;
 // The name of a Nektar++ 5.x PointsType value as a compressed CURVED record stores it.
 std::string pointsTypeName(std::int64_t value) {
   switch (value) {
-    case nektar::kEvenlySpacedId:
-      return nektar::kEvenlySpaced;
-    case nektar::kTriEvenlySpacedId:
-      return nektar::kTriEvenlySpaced;
-    case nektar::kGaussLobattoLegendreId:
-      return nektar::kGaussLobattoLegendre;
-    case nektar::kTriElecId:
+    case kEvenlySpacedId:
+      return kEvenlySpaced;
+    case kTriEvenlySpacedId:
+      return kTriEvenlySpaced;
+    case kGaussLobattoLegendreId:
+      return kGaussLobattoLegendre;
+    case kTriElecId:
       return "NodalTriElec";
-    case nektar::kTriFeketeId:
+    case kTriFeketeId:
       return "NodalTriFekete";
     default:
       return "points type " + std::to_string(value);
   }
 }
 
+// Reads the sections of one file into tables; every failure names the file (failGeometry).
 class SectionReader {
  public:
-  explicit SectionReader(const std::string& path) : path_(path) {}
+  explicit SectionReader(std::string path) : path_(std::move(path)) {}
 
   [[noreturn]] void fail(const std::string& what) const { failGeometry(path_, what); }
 
@@ -62,7 +64,7 @@ class SectionReader {
   std::vector<int> parseIdList(const std::string& list, const std::string& where,
                                std::size_t limit) const;
 
-  const std::string& path_;
+  std::string path_;
   GeometrySections g_;
 };
 
@@ -165,11 +167,11 @@ template <class Record>
 std::vector<Record> SectionReader::records(const XmlElement& e, bool tagged) const {
   if (tagged && !e.has("COMPRESSED"))
     fail("<" + e.name + "> is not compressed like the rest of the file");
-  if (tagged && e.attribute("COMPRESSED") != nektar::kCompressed)
+  if (tagged && e.attribute("COMPRESSED") != kCompressed)
     fail("unsupported compression '" + excerpt(e.attribute("COMPRESSED")) + "'");
   std::string bytes;
   try {
-    bytes = nektar::decode(e.text);
+    bytes = decode(e.text);
   } catch (const IoError& error) {
     fail("<" + e.name + ">: " + error.what());
   }
@@ -180,7 +182,7 @@ std::vector<Record> SectionReader::records(const XmlElement& e, bool tagged) con
 
 void SectionReader::readVertices(const XmlElement& section) {
   if (section.has("COMPRESSED")) {
-    for (const auto& v : records<nektar::Vertex>(section)) {
+    for (const auto& v : records<Vertex>(section)) {
       const int id = toId(v.id, "a vertex record's id");
       if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
         fail("vertex " + std::to_string(id) + " has a coordinate that is not finite");
@@ -198,7 +200,7 @@ void SectionReader::readVertices(const XmlElement& section) {
 
 void SectionReader::readEdges(const XmlElement& section) {
   if (section.has("COMPRESSED")) {
-    for (const auto& e : records<nektar::Edge>(section))
+    for (const auto& e : records<Edge>(section))
       g_.edges[toId(e.id, "an edge record's id")] = {toId(e.v0, "an edge's vertex"),
                                                      toId(e.v1, "an edge's vertex")};
     return;
@@ -229,9 +231,9 @@ void SectionReader::readFaces(const XmlElement& section) {
         }
       };
       if (tri)
-        take(records<nektar::Entity<3>>(*child));
+        take(records<Entity<3>>(*child));
       else
-        take(records<nektar::Entity<4>>(*child));
+        take(records<Entity<4>>(*child));
     } else {
       const int id = idAttribute(*child);
       add(id, ids(child->text, tri ? 3 : 4, "face " + std::to_string(id)));
@@ -273,10 +275,10 @@ void SectionReader::readElements(const XmlElement& section) {
           add(toId(r.id, "an element record's id"), parts);
         }
       };
-      if (n == 3) take(records<nektar::Entity<3>>(*child));
-      if (n == 4) take(records<nektar::Entity<4>>(*child));
-      if (n == 5) take(records<nektar::Entity<5>>(*child));
-      if (n == 6) take(records<nektar::Entity<6>>(*child));
+      if (n == 3) take(records<Entity<3>>(*child));
+      if (n == 4) take(records<Entity<4>>(*child));
+      if (n == 5) take(records<Entity<5>>(*child));
+      if (n == 6) take(records<Entity<6>>(*child));
     } else {
       const int id = idAttribute(*child);
       add(id, ids(child->text, static_cast<std::size_t>(n), "element " + std::to_string(id)));
@@ -294,11 +296,11 @@ void SectionReader::readCurves(const XmlElement& section) {
     const XmlElement* pointsElement = data->child("POINTS");
     if (indexElement == nullptr || pointsElement == nullptr) fail("DATAPOINTS is incomplete");
     const auto index = records<std::int64_t>(*indexElement, false);
-    const auto points = records<nektar::Vertex>(*pointsElement, false);
+    const auto points = records<Vertex>(*pointsElement, false);
     for (const char* kind : {"E", "F"}) {
       const XmlElement* info = section.child(kind);
       if (info == nullptr) continue;
-      for (const auto& c : records<nektar::CurvedInfo>(*info, false)) {
+      for (const auto& c : records<CurvedInfo>(*info, false)) {
         const int entity = toId(c.entityId, "a curve's entity");
         const std::string what =
             std::string(kind[0] == 'E' ? "edge " : "face ") + std::to_string(entity) + "'s curve";
@@ -331,7 +333,7 @@ void SectionReader::readCurves(const XmlElement& section) {
     const std::vector<double> v = numbers(child->text, what);
     if (v.size() % 3 != 0) fail(what + " has a point with fewer than 3 coordinates");
     CurveRecord c;
-    c.type = child->attribute("TYPE", nektar::kEvenlySpaced);
+    c.type = child->attribute("TYPE", kEvenlySpaced);
     for (std::size_t k = 0; k + 2 < v.size(); k += 3)
       c.points.emplace_back(v[k], v[k + 1], v[k + 2]);
     (edge ? g_.edgeCurves : g_.faceCurves)[entity] = c;
