@@ -620,6 +620,199 @@ CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& r
 
 namespace {
 
+const char* const kSolidsOnlyOption = "--solids-only (Python solids_only=True, FreeCAD SolidsOnly)";
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// A model of faces alone whose faces all lie in one plane (a 2D case).
+bool planarFaces(const CadModel& cad, int withFaces) {
+  if (withFaces != 0 || cad.numFaces() == 0) return false;
+  try {
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    return modelMeshDimension(cad, normal) == 2 && !normal.isZero();
+  } catch (const CadError&) {  // (OCCT could not give a face's plane: reported below)
+    return false;
+  }
+}
+
+// The check's findings. A check that fails (OCCT cannot measure an edge, say) is recorded, not
+// fatal: the model is then meshed as it is, and a stage that cannot handle it says so.
+Findings checkModel(const CadModel& cad, double diagonal, bool faces, HealingRecord& record) {
+  Findings found;
+  try {
+    found = withOcctErrors("checking " + cad.sourceName(), [&] {
+      return inspect(occtShape(cad), diagonal, faces, record.problems);
+    });
+  } catch (const CadError& e) {
+    record.problems.push_back(std::string("the check failed: ") + e.what());
+  }
+  return found;
+}
+
+// Sews, fixes and merges what the check found; `cad` becomes the healed model if that changed
+// anything.
+void healFindings(CadModel& cad, const Findings& found, double diagonal, bool solidsOnly,
+                  HealingRecord& record) {
+  const TopoDS_Shape healed = withOcctErrors("healing " + cad.sourceName(), [&] {
+    return heal(occtShape(cad), found, diagonal, solidsOnly, record);
+  });
+  if (!record.changed()) return;
+  record.renumbered = !sameNumbering(occtShape(cad), healed, 10.0 * record.tolerance);
+  cad = cadModelFromShape(healed, cad.sourceName());
+  record.facesAfter = cad.numFaces();
+  record.solidsAfter = cad.numSolids();
+}
+
+// A solid that is still open, or has no volume, cannot be meshed: say where.
+void refuseUnmeshableSolids(const CadModel& cad, const TopTools_IndexedMapOfShape& solids,
+                            const TopTools_IndexedMapOfShape& edges, double diagonal,
+                            const std::string& healingNote) {
+  for (int s = 1; s <= solids.Extent(); ++s) {
+    const int edge = firstFreeEdge(solids(s), edges);
+    if (edge != 0)
+      throw CadError(cad.sourceName() + ": " + cadEntityName(3, s) + " is not closed (" +
+                     cadEntityName(1, edge) + " bounds only one of its faces)" + healingNote);
+    double volume = 0.0;
+    if (hasNoVolume(solids(s), diagonal, volume))
+      throw CadError(cad.sourceName() + ": " + cadEntityName(3, s) + " has no volume (" +
+                     formatNumber(volume) + " for a bounding-box diagonal of " +
+                     formatNumber(diagonal) + "): a zero-thickness solid cannot be meshed");
+  }
+}
+
+// A model without solids meshed as a surface: its faces sewn (when healing is on) and the
+// surface described in the record.
+CadModel surfaceModel(CadModel cad, const TopoDS_Shape& original, bool enabled,
+                      HealingRecord& record) {
+  if (cad.numFaces() == 0)
+    throw CadError(cad.sourceName() + " has no face: nothing for a surface mesh");
+  if (enabled && cad.numFaces() > 1) {
+    const TopoDS_Shape& shape = occtShape(cad);
+    const TopoDS_Shape sewn = withOcctErrors("sewing " + cad.sourceName(), [&] {
+      return sewSurface(shape, 10.0 * record.tolerance, record);
+    });
+    if (!sewn.IsSame(shape)) {
+      cad = cadModelFromShape(sewn, cad.sourceName());
+      record.renumbered = !sameNumbering(original, sewn, 10.0 * record.tolerance);
+      record.facesAfter = cad.numFaces();
+    }
+  }
+  const int open = freeEdgeCount(occtShape(cad));
+  record.surface = "a surface mesh of its " + std::to_string(cad.numFaces()) +
+                   (cad.numFaces() == 1 ? " face" : " faces") +
+                   " (no solid: triangles on the faces, no volume" +
+                   (open > 0 ? "; " + std::to_string(open) +
+                                   (open == 1 ? " edge bounds" : " edges bound") + " only one face"
+                             : std::string("; the faces close")) +
+                   ")";
+  return cad;
+}
+
+// Faces that close into no solid and are not planar: NoSolidError, naming the option that meshes
+// the shells that did close.
+[[noreturn]] void refuseNoSolid(const CadModel& cad, const TopTools_IndexedMapOfShape& edges,
+                                const std::string& healingNote, const HealingOptions& options,
+                                const HealingRecord& record) {
+  const int edge = firstFreeEdge(occtShape(cad), edges);
+  // Some shells closed: the option that meshes them and leaves the others out is worth naming.
+  const std::string notClosed =
+      cad.numFaces() == 1 ? std::string("its one face does not close")
+                          : "its " + std::to_string(cad.numFaces()) + " faces do not close";
+  // (Automatic mode's note leaves the edge out: it is numbered in this attempt's model.)
+  throw NoSolidError(
+      notClosed + healingNote,
+      cad.sourceName() + " is not a closed solid: it has no solid, and " + notClosed +
+          (edge != 0 ? " (" + cadEntityName(1, edge) + " bounds only one face)" : "") +
+          healingNote +
+          "; HOMesh meshes solids, planar faces in one plane (2D), or the faces alone "
+          "as a surface mesh: --surface (Python surface=True, FreeCAD Surface)" +
+          (record.sewnSolids > 0 && !options.solidsOnly
+               ? "; " + std::string(kSolidsOnlyOption) + " meshes the closed shells alone"
+               : std::string()));
+}
+
+// The solids' faces that the loose faces copy (each loose face on one of them), sorted; empty
+// unless every loose face is such a copy.
+std::vector<int> copiedFaces(const CadModel& cad, const LooseFaces& loose, double tolerance) {
+  std::vector<int> copied;
+  std::set<int> copies;
+  for (const CoincidentFaces& c : withOcctErrors("checking " + cad.sourceName(), [&] {
+         return coincidentFaces(occtShape(cad), tolerance);
+       }))
+    if (c.solidB == 0 && copies.insert(c.faceB).second) copied.push_back(c.faceA);
+  if (copies.size() != loose.indices.size()) copied.clear();
+  std::sort(copied.begin(), copied.end());
+  return copied;
+}
+
+// Faces beside the solids would not be meshed: refused, or (solidsOnly, or copies of the
+// solids' faces) left out and recorded.
+void leaveOutLooseFaces(CadModel& cad, const LooseFaces& loose, const TopoDS_Shape& original,
+                        const TopTools_IndexedMapOfShape& edges, const HealingOptions& options,
+                        HealingRecord& record) {
+  const TopoDS_Shape kept = solidsOf(occtShape(cad));
+  const bool one = loose.indices.size() == 1;
+  // Face and edge names only while they are the file's own (healing changed nothing).
+  const bool ownNumbers = !record.changed();
+  const int edge = ownNumbers ? firstFreeEdge(loose.faces, edges) : 0;
+  const std::string which = std::to_string(loose.indices.size()) + (one ? " face" : " faces") +
+                            (ownNumbers ? " (" + faceNames(loose.indices) + ")" : std::string()) +
+                            " in no solid, within " + boxText(loose.faces);
+  const std::string what =
+      which + (edge != 0 ? (one ? ": it does not close (" : ": they do not close (") +
+                               cadEntityName(1, edge) + " bounds only one face)"
+                         : "");
+  // Loose faces that all lie on faces of the solids (a surface model exported beside its
+  // body, as Gmsh's shell_sewing demo writes it) are copies: leaving them out loses nothing.
+  const std::vector<int> copied =
+      ownNumbers ? copiedFaces(cad, loose, 10.0 * record.tolerance) : std::vector<int>{};
+  if ((!options.solidsOnly && copied.empty()) || count(kept, TopAbs_FACE) == 0)
+    throw CadError(cad.sourceName() + ": " + what +
+                   (!options.enabled ? "; healing is off (it may close them)"
+                    : record.sewing.empty()
+                        ? std::string()
+                        : "; healing could not make a solid of them (" + record.sewing + ")") +
+                   (options.solidsOnly ? "; and no solid has a face"
+                                       : "; close them in the CAD, or mesh the solids alone: " +
+                                             std::string(kSolidsOnlyOption)));
+  record.leftOut = what + (record.sewing.empty() ? std::string() : " (" + record.sewing + ")");
+  if (!copied.empty()) {
+    record.leftOut = which + ": " + (one ? "a copy of " : "copies of ") + faceNames(copied) +
+                     " of the solids; nothing of the model is lost";
+    record.leftOutCopies = true;
+  }
+  cad = cadModelFromShape(kept, cad.sourceName());
+  record.renumbered =
+      !sameNumbering(original, occtShape(cad), 10.0 * record.tolerance, /*fewer=*/true);
+  record.facesAfter = cad.numFaces();
+  record.solidsAfter = cad.numSolids();
+}
+
+// Solids that touch on faces of their own (not one shared face) are meshed apart there: a
+// warning names the first pairs.
+void warnTouchingSolids(const CadModel& cad, HealingRecord& record) {
+  std::vector<CoincidentFaces> pairs = withOcctErrors("checking " + cad.sourceName(), [&] {
+    return coincidentFaces(occtShape(cad), 10.0 * record.tolerance);
+  });
+  pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
+                             [](const CoincidentFaces& c) { return c.solidB == 0; }),
+              pairs.end());
+  std::string where;
+  for (std::size_t k = 0; k < pairs.size() && k < 3; ++k)
+    where += (k == 0 ? "" : ", ") + cadEntityName(3, pairs[k].solidA) + " and " +
+             cadEntityName(3, pairs[k].solidB) + " (" + cadEntityName(2, pairs[k].faceA) + " on " +
+             cadEntityName(2, pairs[k].faceB) + ")";
+  if (pairs.size() > 3) where += " and " + std::to_string(pairs.size() - 3) + " more pairs";
+  if (!pairs.empty())
+    record.warnings.push_back(
+        "solids lie against each other on faces they do not share: " + where +
+        "; each is meshed with its own nodes there, so the mesh does not conform across "
+        "them (fuse them first for one conforming mesh: FreeCAD Part > Boolean > Boolean "
+        "fragments)");
+}
+
 CadModel healAs(CadModel cad, const HealingOptions& options, HealingRecord& record) {
   const auto start = std::chrono::steady_clock::now();
   const bool enabled = options.enabled;
@@ -639,171 +832,28 @@ CadModel healAs(CadModel cad, const HealingOptions& options, HealingRecord& reco
                    "model of faces alone; without it the solids get a volume mesh");
   // Faces not meant to be sewn into a solid: planar ones in one plane (a 2D case), or any when
   // a surface mesh is asked for.
-  bool planar = false;
-  if (withFaces == 0 && cad.numFaces() > 0) {
-    try {
-      Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-      planar = modelMeshDimension(cad, normal) == 2 && !normal.isZero();
-    } catch (const CadError&) {  // (OCCT could not give a face's plane: reported below)
-    }
-  }
+  const bool planar = planarFaces(cad, withFaces);
   const bool faces = planar || (options.surface && withFaces == 0);
-  // A check that fails (OCCT cannot measure an edge, say) is recorded, not fatal: the model is
-  // then meshed as it is, and a stage that cannot handle it says so.
-  Findings found;
-  try {
-    found = withOcctErrors("checking " + cad.sourceName(), [&] {
-      return inspect(occtShape(cad), diagonal, faces, record.problems);
-    });
-  } catch (const CadError& e) {
-    record.problems.push_back(std::string("the check failed: ") + e.what());
-  }
-  if (enabled && found.any()) {
-    const TopoDS_Shape healed = withOcctErrors("healing " + cad.sourceName(), [&] {
-      return heal(occtShape(cad), found, diagonal, options.solidsOnly, record);
-    });
-    if (record.changed()) {
-      record.renumbered = !sameNumbering(occtShape(cad), healed, 10.0 * record.tolerance);
-      cad = cadModelFromShape(healed, cad.sourceName());
-      record.facesAfter = cad.numFaces();
-      record.solidsAfter = cad.numSolids();
-    }
-  }
-  record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // A solid that is still open cannot be meshed: say where.
-  const TopoDS_Shape& shape = occtShape(cad);
+  const Findings found = checkModel(cad, diagonal, faces, record);
+  if (enabled && found.any()) healFindings(cad, found, diagonal, options.solidsOnly, record);
+  record.seconds = secondsSince(start);
   TopTools_IndexedMapOfShape edges, solids;
-  TopExp::MapShapes(shape, TopAbs_EDGE, edges);
-  TopExp::MapShapes(shape, TopAbs_SOLID, solids);
-  const std::string healed =
+  TopExp::MapShapes(occtShape(cad), TopAbs_EDGE, edges);
+  TopExp::MapShapes(occtShape(cad), TopAbs_SOLID, solids);
+  const std::string healingNote =
       enabled ? "; healing could not close it" +
                     (record.sewing.empty() ? std::string() : " (" + record.sewing + ")")
               : "; healing is off (it may close it)";
-  for (int s = 1; s <= solids.Extent(); ++s) {
-    const int edge = firstFreeEdge(solids(s), edges);
-    if (edge != 0)
-      throw CadError(cad.sourceName() + ": " + cadEntityName(3, s) + " is not closed (" +
-                     cadEntityName(1, edge) + " bounds only one of its faces)" + healed);
-    double volume = 0.0;
-    if (hasNoVolume(solids(s), diagonal, volume))
-      throw CadError(cad.sourceName() + ": " + cadEntityName(3, s) + " has no volume (" +
-                     formatNumber(volume) + " for a bounding-box diagonal of " +
-                     formatNumber(diagonal) + "): a zero-thickness solid cannot be meshed");
-  }
-  const std::string solidsOnlyOption =
-      "--solids-only (Python solids_only=True, FreeCAD SolidsOnly)";
+  refuseUnmeshableSolids(cad, solids, edges, diagonal, healingNote);
   if (solids.Extent() == 0 && faces && !planar) {
-    if (cad.numFaces() == 0)
-      throw CadError(cad.sourceName() + " has no face: nothing for a surface mesh");
-    if (enabled && cad.numFaces() > 1) {
-      const TopoDS_Shape sewn = withOcctErrors("sewing " + cad.sourceName(), [&] {
-        return sewSurface(shape, 10.0 * record.tolerance, record);
-      });
-      if (!sewn.IsSame(shape)) {
-        cad = cadModelFromShape(sewn, cad.sourceName());
-        record.renumbered = !sameNumbering(original, sewn, 10.0 * record.tolerance);
-        record.facesAfter = cad.numFaces();
-      }
-    }
-    const int open = freeEdgeCount(occtShape(cad));
-    record.surface =
-        "a surface mesh of its " + std::to_string(cad.numFaces()) +
-        (cad.numFaces() == 1 ? " face" : " faces") +
-        " (no solid: triangles on the faces, no volume" +
-        (open > 0 ? "; " + std::to_string(open) + (open == 1 ? " edge bounds" : " edges bound") +
-                        " only one face"
-                  : std::string("; the faces close")) +
-        ")";
-    record.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    cad = surfaceModel(std::move(cad), original, enabled, record);
+    record.seconds = secondsSince(start);
     return cad;
   }
-  if (solids.Extent() == 0 && !planar) {
-    const int edge = firstFreeEdge(shape, edges);
-    // Some shells closed: the option that meshes them and leaves the others out is worth naming.
-    const std::string notClosed =
-        cad.numFaces() == 1 ? std::string("its one face does not close")
-                            : "its " + std::to_string(cad.numFaces()) + " faces do not close";
-    // (Automatic mode's note leaves the edge out: it is numbered in this attempt's model.)
-    throw NoSolidError(
-        notClosed + healed,
-        cad.sourceName() + " is not a closed solid: it has no solid, and " + notClosed +
-            (edge != 0 ? " (" + cadEntityName(1, edge) + " bounds only one face)" : "") + healed +
-            "; HOMesh meshes solids, planar faces in one plane (2D), or the faces alone "
-            "as a surface mesh: --surface (Python surface=True, FreeCAD Surface)" +
-            (record.sewnSolids > 0 && !options.solidsOnly
-                 ? "; " + solidsOnlyOption + " meshes the closed shells alone"
-                 : std::string()));
-  }
-  // Faces beside the solids would not be meshed: refused, or left out and recorded.
-  const LooseFaces loose = solids.Extent() > 0 ? facesInNoSolid(shape) : LooseFaces{};
-  if (!loose.indices.empty()) {
-    const TopoDS_Shape kept = solidsOf(shape);
-    const bool one = loose.indices.size() == 1;
-    // Face and edge names only while they are the file's own (healing changed nothing).
-    const bool ownNumbers = !record.changed();
-    const int edge = ownNumbers ? firstFreeEdge(loose.faces, edges) : 0;
-    const std::string which = std::to_string(loose.indices.size()) + (one ? " face" : " faces") +
-                              (ownNumbers ? " (" + faceNames(loose.indices) + ")" : std::string()) +
-                              " in no solid, within " + boxText(loose.faces);
-    const std::string what =
-        which + (edge != 0 ? (one ? ": it does not close (" : ": they do not close (") +
-                                 cadEntityName(1, edge) + " bounds only one face)"
-                           : "");
-    // Loose faces that all lie on faces of the solids (a surface model exported beside its
-    // body, as Gmsh's shell_sewing demo writes it) are copies: leaving them out loses nothing.
-    std::vector<int> copied;  // the solids' faces they copy
-    if (ownNumbers) {
-      std::set<int> copies;
-      for (const CoincidentFaces& c : withOcctErrors("checking " + cad.sourceName(), [&] {
-             return coincidentFaces(shape, 10.0 * record.tolerance);
-           }))
-        if (c.solidB == 0 && copies.insert(c.faceB).second) copied.push_back(c.faceA);
-      if (copies.size() != loose.indices.size()) copied.clear();
-      std::sort(copied.begin(), copied.end());
-    }
-    if ((!options.solidsOnly && copied.empty()) || count(kept, TopAbs_FACE) == 0)
-      throw CadError(cad.sourceName() + ": " + what +
-                     (!enabled ? "; healing is off (it may close them)"
-                      : record.sewing.empty()
-                          ? std::string()
-                          : "; healing could not make a solid of them (" + record.sewing + ")") +
-                     (options.solidsOnly ? "; and no solid has a face"
-                                         : "; close them in the CAD, or mesh the solids alone: " +
-                                               solidsOnlyOption));
-    record.leftOut = what + (record.sewing.empty() ? std::string() : " (" + record.sewing + ")");
-    if (!copied.empty()) {
-      record.leftOut = which + ": " + (one ? "a copy of " : "copies of ") + faceNames(copied) +
-                       " of the solids; nothing of the model is lost";
-      record.leftOutCopies = true;
-    }
-    cad = cadModelFromShape(kept, cad.sourceName());
-    record.renumbered =
-        !sameNumbering(original, occtShape(cad), 10.0 * record.tolerance, /*fewer=*/true);
-    record.facesAfter = cad.numFaces();
-    record.solidsAfter = cad.numSolids();
-  }
-  // Solids that touch on faces of their own (not one shared face) are meshed apart there.
-  if (cad.numSolids() > 1) {
-    std::vector<CoincidentFaces> pairs = withOcctErrors("checking " + cad.sourceName(), [&] {
-      return coincidentFaces(occtShape(cad), 10.0 * record.tolerance);
-    });
-    pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
-                               [](const CoincidentFaces& c) { return c.solidB == 0; }),
-                pairs.end());
-    std::string where;
-    for (std::size_t k = 0; k < pairs.size() && k < 3; ++k)
-      where += (k == 0 ? "" : ", ") + cadEntityName(3, pairs[k].solidA) + " and " +
-               cadEntityName(3, pairs[k].solidB) + " (" + cadEntityName(2, pairs[k].faceA) +
-               " on " + cadEntityName(2, pairs[k].faceB) + ")";
-    if (pairs.size() > 3) where += " and " + std::to_string(pairs.size() - 3) + " more pairs";
-    if (!pairs.empty())
-      record.warnings.push_back(
-          "solids lie against each other on faces they do not share: " + where +
-          "; each is meshed with its own nodes there, so the mesh does not conform across "
-          "them (fuse them first for one conforming mesh: FreeCAD Part > Boolean > Boolean "
-          "fragments)");
-  }
+  if (solids.Extent() == 0 && !planar) refuseNoSolid(cad, edges, healingNote, options, record);
+  const LooseFaces loose = solids.Extent() > 0 ? facesInNoSolid(occtShape(cad)) : LooseFaces{};
+  if (!loose.indices.empty()) leaveOutLooseFaces(cad, loose, original, edges, options, record);
+  if (cad.numSolids() > 1) warnTouchingSolids(cad, record);
   return cad;
 }
 

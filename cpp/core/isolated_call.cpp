@@ -16,7 +16,9 @@
 #include <cstdio>
 #include <cstring>
 #include <new>
+#include <optional>
 #include <sstream>
+#include <string>
 
 #include "core/format.hpp"
 #include "core/system_memory.hpp"
@@ -124,117 +126,122 @@ std::string signalName(int sig) {
   }
 }
 
-}  // namespace
+using Clock = std::chrono::steady_clock;
 
-std::string runIsolated(const std::string& what, const IsolationLimits& limits,
-                        const std::function<std::string()>& work) {
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();  // the budget counts from the first child
-  const bool probed = static_cast<bool>(limits.startProbe);
-  const int attempts = probed ? std::max(1, limits.startAttempts) : 1;
-  std::array<int, 2> fds{-1, -1};
-  pid_t pid = -1;
-  // Whatever happens below (an allocation failing, a cancel callback throwing), the child is
-  // killed and reaped and the pipe closed; `reaped` once waitpid has run.
-  bool reaped = true;
-  int status = 0;
-  pid_t waited = 0;
-  const auto reap = [&](bool kill) {
-    if (reaped) return;
-    ::close(fds[0]);
-    if (kill) ::kill(pid, SIGKILL);
-    while ((waited = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
-    }
-    reaped = true;
-  };
-  struct Guard {
-    std::function<void()> onExit;
-    ~Guard() { onExit(); }
-  } guard{[&] { reap(true); }};
-
-  std::string bytes;
-  std::array<char, 65536> buffer{};
-  bool overTime = false, cancelled = false;
-  for (int attempt = 1;; ++attempt) {
+// A forked child running `work` and the read end of the pipe it answers on. Whatever happens
+// while it runs (an allocation failing, a cancel callback throwing), the child is killed and
+// reaped and the pipe closed when this is dropped.
+class Child {
+ public:
+  Child(const std::string& what, const IsolationLimits& limits,
+        const std::function<std::string()>& work) {
+    std::array<int, 2> fds{-1, -1};
     if (pipe2(fds.data(), O_CLOEXEC) != 0)
       throw Error("cannot start a process for " + what + ": " + std::strerror(errno));
     std::fflush(nullptr);
     const pid_t parent = getpid();
-    pid = fork();
-    if (pid < 0) {
+    pid_ = fork();
+    if (pid_ < 0) {
       const int error = errno;
       ::close(fds[0]);
       ::close(fds[1]);
       throw Error("cannot start a process for " + what + ": " + std::strerror(error));
     }
-    if (pid == 0) {
+    if (pid_ == 0) {
       ::close(fds[0]);
       runChild(fds[1], parent, limits, work);
     }
     ::close(fds[1]);
-    reaped = false;
-    const auto forked = Clock::now();
-    const bool lastAttempt = attempt >= attempts;
-    bool started = !probed, stuck = false;
-    bytes.clear();
-    for (;;) {
-      pollfd in{fds[0], POLLIN, 0};
-      const int ready = poll(&in, 1, 50);
-      if (ready > 0) {
-        const ssize_t n = ::read(fds[0], buffer.data(), buffer.size());
-        if (n > 0) {
-          bytes.append(buffer.data(), static_cast<std::size_t>(n));
-          if (!started) {
-            started = bytes[0] == kStarted;
-            if (started) bytes.erase(0, 1);
-          }
-        } else if (n == 0) {
-          break;  // the child closed its end (finished or died)
-        } else if (errno != EINTR) {
-          throw Error("cannot read the result of " + what + ": " + std::strerror(errno));
-        }
-      } else if (ready < 0 && errno != EINTR) {
-        throw Error("cannot wait for " + what + ": " + std::strerror(errno));
-      }
-      if (limits.cancelled && limits.cancelled()) {
-        cancelled = true;
-        break;
-      }
-      const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-      if (limits.seconds > 0.0 && elapsed > limits.seconds) {
-        overTime = true;
-        break;
-      }
-      if (!started && !lastAttempt &&
-          std::chrono::duration<double>(Clock::now() - forked).count() > limits.startSeconds) {
-        stuck = true;
-        break;
-      }
-    }
-    if (!stuck) break;
-    reap(true);
-    if (limits.restarted) limits.restarted(attempt);
+    fd_ = fds[0];
+    reaped_ = false;
   }
-  reap(cancelled || overTime);
+  ~Child() { reap(true); }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+  Child(Child&&) = delete;
+  Child& operator=(Child&&) = delete;
 
-  if (cancelled) throw CancelledError("cancelled during " + what);
-  if (overTime)
-    throw BudgetExceeded(
-        what + " stopped at its time budget of " +
-        formatNumber(limits.statedSeconds > 0.0 ? limits.statedSeconds : limits.seconds) + " s" +
-        (limits.budgetName.empty() ? "" : " (" + limits.budgetName + ")"));
-  if (waited == pid && WIFSIGNALED(status)) {
-    const int sig = WTERMSIG(status);
+  int fd() const { return fd_; }
+  // Closes the pipe and waits for the child, killing it first if `kill`; once only.
+  void reap(bool kill) {
+    if (reaped_) return;
+    ::close(fd_);
+    if (kill) ::kill(pid_, SIGKILL);
+    while ((waited_ = waitpid(pid_, &status_, 0)) < 0 && errno == EINTR) {
+    }
+    reaped_ = true;
+  }
+  // The child's wait status once reaped, if waitpid gave it.
+  std::optional<int> status() const {
+    return waited_ == pid_ ? std::optional<int>(status_) : std::nullopt;
+  }
+
+ private:
+  pid_t pid_ = -1;
+  int fd_ = -1;
+  bool reaped_ = true;
+  int status_ = 0;
+  pid_t waited_ = 0;
+};
+
+// How the wait for a child's answer ended.
+enum class WaitEnd { Closed, Stuck, Cancelled, OverTime };
+
+// Reads the child's answer into `bytes` until it closes its end, the caller cancels, the budget
+// (counted from `start`) is spent, or (`awaitStart`, not the last attempt) the start probe has
+// not returned within limits.startSeconds.
+WaitEnd readAnswer(const Child& child, const std::string& what, const IsolationLimits& limits,
+                   Clock::time_point start, bool awaitStart, bool lastAttempt, std::string& bytes) {
+  const auto forked = Clock::now();
+  std::array<char, 65536> buffer{};
+  bool started = !awaitStart;
+  bytes.clear();
+  for (;;) {
+    pollfd in{child.fd(), POLLIN, 0};
+    const int ready = poll(&in, 1, 50);
+    if (ready > 0) {
+      const ssize_t n = ::read(child.fd(), buffer.data(), buffer.size());
+      if (n > 0) {
+        bytes.append(buffer.data(), static_cast<std::size_t>(n));
+        if (!started) {
+          started = bytes[0] == kStarted;
+          if (started) bytes.erase(0, 1);
+        }
+      } else if (n == 0) {
+        return WaitEnd::Closed;  // the child closed its end (finished or died)
+      } else if (errno != EINTR) {
+        throw Error("cannot read the result of " + what + ": " + std::strerror(errno));
+      }
+    } else if (ready < 0 && errno != EINTR) {
+      throw Error("cannot wait for " + what + ": " + std::strerror(errno));
+    }
+    if (limits.cancelled && limits.cancelled()) return WaitEnd::Cancelled;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    if (limits.seconds > 0.0 && elapsed > limits.seconds) return WaitEnd::OverTime;
+    if (!started && !lastAttempt &&
+        std::chrono::duration<double>(Clock::now() - forked).count() > limits.startSeconds)
+      return WaitEnd::Stuck;
+  }
+}
+
+// A child that died by a signal or ended without an answer: the error that says so.
+void throwIfNoAnswer(const std::string& what, std::optional<int> status, const std::string& bytes) {
+  if (status && WIFSIGNALED(*status)) {
+    const int sig = WTERMSIG(*status);
     if (sig == SIGKILL)
       throw OutOfMemory(what + " was killed (" + signalName(sig) +
                         "), most likely by the system for lack of memory");
     throw ChildCrashed(what + " crashed (" + signalName(sig) + ")");
   }
-  if (bytes.empty() || (waited == pid && WIFEXITED(status) && WEXITSTATUS(status) != 0))
+  if (bytes.empty() || (status && WIFEXITED(*status) && WEXITSTATUS(*status) != 0))
     throw ChildCrashed(what + " ended without a result" +
-                       (waited == pid && WIFEXITED(status)
-                            ? " (exit status " + std::to_string(WEXITSTATUS(status)) + ")"
+                       (status && WIFEXITED(*status)
+                            ? " (exit status " + std::to_string(WEXITSTATUS(*status)) + ")"
                             : std::string()));
+}
+
+// The child's answer: its result, or its error thrown again with its type.
+std::string unpackAnswer(const std::string& what, const std::string& bytes) {
   const char kind = bytes[0];
   std::string payload = bytes.substr(1);
   switch (kind) {
@@ -258,6 +265,35 @@ std::string runIsolated(const std::string& what, const IsolationLimits& limits,
     default:
       throw Error(what + " failed: " + payload);
   }
+}
+
+}  // namespace
+
+std::string runIsolated(const std::string& what, const IsolationLimits& limits,
+                        const std::function<std::string()>& work) {
+  const auto start = Clock::now();  // the budget counts from the first child
+  const bool probed = static_cast<bool>(limits.startProbe);
+  const int attempts = probed ? std::max(1, limits.startAttempts) : 1;
+  std::string bytes;
+  std::optional<Child> child;
+  WaitEnd end = WaitEnd::Closed;
+  for (int attempt = 1;; ++attempt) {
+    child.emplace(what, limits, work);
+    end = readAnswer(*child, what, limits, start, probed, attempt >= attempts, bytes);
+    if (end != WaitEnd::Stuck) break;
+    child.reset();  // killed and reaped before the next attempt starts
+    if (limits.restarted) limits.restarted(attempt);
+  }
+  child->reap(end == WaitEnd::Cancelled || end == WaitEnd::OverTime);
+
+  if (end == WaitEnd::Cancelled) throw CancelledError("cancelled during " + what);
+  if (end == WaitEnd::OverTime)
+    throw BudgetExceeded(
+        what + " stopped at its time budget of " +
+        formatNumber(limits.statedSeconds > 0.0 ? limits.statedSeconds : limits.seconds) + " s" +
+        (limits.budgetName.empty() ? "" : " (" + limits.budgetName + ")"));
+  throwIfNoAnswer(what, child->status(), bytes);
+  return unpackAnswer(what, bytes);
 }
 
 }  // namespace homesh

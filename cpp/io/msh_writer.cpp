@@ -6,6 +6,8 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "cad/cad_model.hpp"
 #include "core/error.hpp"
@@ -95,56 +97,58 @@ void writeEntities(MshSink& out, const std::map<EntityKey, Box>& entities,
   out.text() << "$EndEntities\n";
 }
 
-}  // namespace
-
-void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields,
-                bool binary, const std::vector<NamedGroup>& named) {
-  mesh.checkConsistency();
-  checkCellFields(mesh, fields);
-  const std::size_t n = mesh.numNodes();
-
-  // Entities: from node classification and element entities.
-  std::map<EntityKey, Box> entities;
+// The Gmsh entities of a mesh: their boxes, their nodes and their physical groups.
+struct MshEntities {
+  std::map<EntityKey, Box> boxes;
   std::map<EntityKey, std::vector<std::size_t>> nodesOf;
-  for (std::size_t i = 0; i < n; ++i) {
-    const EntityKey key{mesh.nodeCadDim[i], entityTag(mesh.nodeCadIndex[i])};
-    entities[key].add(&mesh.xyz[3 * i]);
-    nodesOf[key].push_back(i);
-  }
-  // Physical group of each entity with cells: its own ("FaceN"), or its named group's.
-  std::map<EntityKey, int> physical;
+  std::map<EntityKey, int> physical;  // entity -> physical group tag
   std::map<EntityKey, std::string> physicalNames;
+};
+
+// Entities from node classification and element entities; the physical group of each entity
+// with cells is its own ("FaceN").
+MshEntities collectEntities(const Mesh& mesh) {
+  MshEntities m;
+  for (std::size_t i = 0; i < mesh.numNodes(); ++i) {
+    const EntityKey key{mesh.nodeCadDim[i], entityTag(mesh.nodeCadIndex[i])};
+    m.boxes[key].add(&mesh.xyz[3 * i]);
+    m.nodesOf[key].push_back(i);
+  }
   for (const ElementBlock& block : mesh.blocks) {
     const int dim = cellDimension(block.type);
     for (std::size_t e = 0; e < block.count(); ++e) {
       const EntityKey key{dim, entityTag(block.entity[e])};
-      if (physical.emplace(key, key.second).second)
-        physicalNames[key] = cadEntityName(dim, key.second);
-      Box& box = entities[key];
+      if (m.physical.emplace(key, key.second).second)
+        m.physicalNames[key] = cadEntityName(dim, key.second);
+      Box& box = m.boxes[key];
       const std::int64_t* nodes = block.element(e);
       for (int k = 0; k < cellNumVertices(block.type); ++k) box.add(&mesh.xyz[3 * nodes[k]]);
     }
   }
+  return m;
+}
 
-  if (!named.empty()) {
-    const int dim = mesh.dim - 1;
-    int next = 0;
-    for (const auto& [key, box] : entities)
-      if (key.first == dim) next = std::max(next, key.second);
-    for (const NamedGroup& g : named) {
-      ++next;
-      for (const int entity : g.entities) {
-        const EntityKey key{dim, entityTag(entity)};
-        physicalNames.erase(key);
-        physical[key] = next;
-      }
-      physicalNames[{dim, next}] = g.name;
+// Boundary entities of a named group move to one new physical group of that name, tagged
+// after the largest boundary entity tag.
+void applyNamedGroups(int meshDim, const std::vector<NamedGroup>& named, MshEntities& m) {
+  if (named.empty()) return;
+  const int dim = meshDim - 1;
+  int next = 0;
+  for (const auto& [key, box] : m.boxes)
+    if (key.first == dim) next = std::max(next, key.second);
+  for (const NamedGroup& g : named) {
+    ++next;
+    for (const int entity : g.entities) {
+      const EntityKey key{dim, entityTag(entity)};
+      m.physicalNames.erase(key);
+      m.physical[key] = next;
     }
+    m.physicalNames[{dim, next}] = g.name;
   }
+}
 
-  AtomicFile file(path, binary);
-  std::ostream& os = file.stream();
-  MshSink out(os, binary);
+void writeHeader(std::ostream& os, bool binary,
+                 const std::map<EntityKey, std::string>& physicalNames) {
   os << "$MeshFormat\n4.1 " << (binary ? 1 : 0) << " 8\n";
   if (binary) {
     const std::int32_t one = 1;  // tells readers the byte order
@@ -156,9 +160,12 @@ void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<Cel
   for (const auto& [key, name] : physicalNames)
     os << key.first << " " << key.second << " \"" << name << "\"\n";
   os << "$EndPhysicalNames\n";
-  writeEntities(out, entities, physical);
+}
 
-  os << "$Nodes\n";
+void writeNodes(MshSink& out, const Mesh& mesh,
+                const std::map<EntityKey, std::vector<std::size_t>>& nodesOf) {
+  const std::size_t n = mesh.numNodes();
+  out.text() << "$Nodes\n";
   out.size(nodesOf.size());
   out.size(n);
   out.size(1);
@@ -179,17 +186,21 @@ void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<Cel
       out.endLine();
     }
   }
-  if (binary) os << '\n';
-  os << "$EndNodes\n";
+  if (out.binary()) out.text() << '\n';
+  out.text() << "$EndNodes\n";
+}
 
-  // Element blocks per (entity, type); tags: cells of dimension mesh.dim first, in block order,
-  // so that element tag k+1 carries field value k.
-  struct Group {
-    int dim, tag, type, nodesPerElement;
-    std::vector<std::pair<std::size_t, const std::int64_t*>> elements;  // (tag, nodes)
-  };
-  std::map<std::array<int, 3>, Group> groups;
-  std::size_t total = 0, nextTag = 1;
+// One MSH element block: the elements of one type on one entity.
+struct ElementGroup {
+  int dim, tag, type, nodesPerElement;
+  std::vector<std::pair<std::size_t, const std::int64_t*>> elements;  // (tag, nodes)
+};
+
+// Element blocks per (entity, type); tags: cells of dimension mesh.dim first, in block order,
+// so that element tag k+1 carries field value k.
+std::map<std::array<int, 3>, ElementGroup> groupElements(const Mesh& mesh) {
+  std::map<std::array<int, 3>, ElementGroup> groups;
+  std::size_t nextTag = 1;
   std::vector<const ElementBlock*> ordered;
   for (const ElementBlock& b : mesh.blocks)
     if (cellDimension(b.type) == mesh.dim) ordered.push_back(&b);
@@ -200,16 +211,21 @@ void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<Cel
     const int type = gmshElementType(block->type, block->order);
     for (std::size_t e = 0; e < block->count(); ++e) {
       const int tag = entityTag(block->entity[e]);
-      Group& g = groups[{dim, tag, type}];
+      ElementGroup& g = groups[{dim, tag, type}];
       g.dim = dim;
       g.tag = tag;
       g.type = type;
       g.nodesPerElement = block->nodesPerElement();
       g.elements.emplace_back(nextTag++, block->element(e));
-      ++total;
     }
   }
-  os << "$Elements\n";
+  return groups;
+}
+
+void writeElements(MshSink& out, const std::map<std::array<int, 3>, ElementGroup>& groups) {
+  std::size_t total = 0;
+  for (const auto& [key, g] : groups) total += g.elements.size();
+  out.text() << "$Elements\n";
   out.size(groups.size());
   out.size(total);
   out.size(1);
@@ -227,19 +243,39 @@ void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<Cel
       out.endLine();
     }
   }
-  if (binary) os << '\n';
-  os << "$EndElements\n";
+  if (out.binary()) out.text() << '\n';
+  out.text() << "$EndElements\n";
+}
 
+void writeElementData(MshSink& out, const std::vector<CellField>& fields) {
   for (const CellField& f : fields) {
-    os << "$ElementData\n1\n\"" << f.name << "\"\n1\n0\n3\n0\n1\n" << f.values.size() << "\n";
+    out.text() << "$ElementData\n1\n\"" << f.name << "\"\n1\n0\n3\n0\n1\n"
+               << f.values.size() << "\n";
     for (std::size_t k = 0; k < f.values.size(); ++k) {
       out.integer(static_cast<int>(k + 1));
       out.real(f.values[k]);
       out.endLine();
     }
-    if (binary) os << '\n';
-    os << "$EndElementData\n";
+    if (out.binary()) out.text() << '\n';
+    out.text() << "$EndElementData\n";
   }
+}
+
+}  // namespace
+
+void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<CellField>& fields,
+                bool binary, const std::vector<NamedGroup>& named) {
+  mesh.checkConsistency();
+  checkCellFields(mesh, fields);
+  MshEntities entities = collectEntities(mesh);
+  applyNamedGroups(mesh.dim, named, entities);
+  AtomicFile file(path, binary);
+  MshSink out(file.stream(), binary);
+  writeHeader(file.stream(), binary, entities.physicalNames);
+  writeEntities(out, entities.boxes, entities.physical);
+  writeNodes(out, mesh, entities.nodesOf);
+  writeElements(out, groupElements(mesh));
+  writeElementData(out, fields);
   file.commit();
 }
 

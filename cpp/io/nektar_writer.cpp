@@ -353,18 +353,7 @@ void writeEntities(std::ostream& os, char tag,
   }
 }
 
-}  // namespace
-
-void writeNektarXml(const Mesh& mesh, const std::string& path, bool compressed,
-                    const std::vector<NamedGroup>& groups) {
-  mesh.checkConsistency();
-  const Builder b(mesh);
-  AtomicFile file(path, false);
-  std::ostream& os = file.stream();
-  os << "<?xml version=\"1.0\" encoding=\"utf-8\" ?>\n<NEKTAR>\n";
-  os << "  <GEOMETRY DIM=\"" << mesh.dim << "\" SPACE=\"3\">\n";
-
-  // VERTEX and EDGE.
+void writeVerticesAndEdges(std::ostream& os, const Mesh& mesh, const Builder& b, bool compressed) {
   if (compressed) {
     std::vector<nektar::Vertex> vs;
     for (std::size_t i = 0; i < b.vertexNode.size(); ++i) {
@@ -376,31 +365,33 @@ void writeNektarXml(const Mesh& mesh, const std::string& path, bool compressed,
     for (std::size_t i = 0; i < b.edges.size(); ++i)
       es.push_back({static_cast<std::int64_t>(i), b.edges[i][0], b.edges[i][1]});
     os << "    " << compressedTag("EDGE") << blob(es) << "</EDGE>\n";
-  } else {
-    os << "    <VERTEX>\n";
-    for (std::size_t i = 0; i < b.vertexNode.size(); ++i) {
-      const double* x = &mesh.xyz[3 * b.vertexNode[i]];
-      os << "      <V ID=\"" << i << "\">" << number(x[0]) << ' ' << number(x[1]) << ' '
-         << number(x[2]) << "</V>\n";
-    }
-    os << "    </VERTEX>\n    <EDGE>\n";
-    for (std::size_t i = 0; i < b.edges.size(); ++i)
-      os << "      <E ID=\"" << i << "\">" << b.edges[i][0] << ' ' << b.edges[i][1] << "</E>\n";
-    os << "    </EDGE>\n";
+    return;
   }
-
-  // FACE (3D): triangles, then quadrilaterals.
-  if (mesh.dim == 3) {
-    std::vector<std::pair<int, std::vector<int>>> tris, quads;
-    for (std::size_t i = 0; i < b.faces.size(); ++i)
-      (b.faces[i].triangle ? tris : quads).emplace_back(static_cast<int>(i), b.faces[i].edges);
-    os << "    <FACE>\n";
-    writeEntities<3>(os, 'T', tris, compressed);
-    writeEntities<4>(os, 'Q', quads, compressed);
-    os << "    </FACE>\n";
+  os << "    <VERTEX>\n";
+  for (std::size_t i = 0; i < b.vertexNode.size(); ++i) {
+    const double* x = &mesh.xyz[3 * b.vertexNode[i]];
+    os << "      <V ID=\"" << i << "\">" << number(x[0]) << ' ' << number(x[1]) << ' '
+       << number(x[2]) << "</V>\n";
   }
+  os << "    </VERTEX>\n    <EDGE>\n";
+  for (std::size_t i = 0; i < b.edges.size(); ++i)
+    os << "      <E ID=\"" << i << "\">" << b.edges[i][0] << ' ' << b.edges[i][1] << "</E>\n";
+  os << "    </EDGE>\n";
+}
 
-  // ELEMENT, by kind in Nektar++'s order.
+// FACE (3D only): triangles, then quadrilaterals.
+void writeFaces(std::ostream& os, const Builder& b, bool compressed) {
+  std::vector<std::pair<int, std::vector<int>>> tris, quads;
+  for (std::size_t i = 0; i < b.faces.size(); ++i)
+    (b.faces[i].triangle ? tris : quads).emplace_back(static_cast<int>(i), b.faces[i].edges);
+  os << "    <FACE>\n";
+  writeEntities<3>(os, 'T', tris, compressed);
+  writeEntities<4>(os, 'Q', quads, compressed);
+  os << "    </FACE>\n";
+}
+
+// ELEMENT, by kind in Nektar++'s order.
+void writeElements(std::ostream& os, const Builder& b, bool compressed) {
   os << "    <ELEMENT>\n";
   std::map<CellType, std::vector<std::pair<int, std::vector<int>>>> byType;
   for (std::size_t i = 0; i < b.elements.size(); ++i)
@@ -411,15 +402,19 @@ void writeNektarXml(const Mesh& mesh, const std::string& path, bool compressed,
   writeEntities<3>(os, 'T', byType[CellType::Triangle], compressed);
   writeEntities<4>(os, 'Q', byType[CellType::Quadrilateral], compressed);
   os << "    </ELEMENT>\n";
+}
 
-  // CURVED: edges, then faces (3D) or elements (2D).
-  struct Curve {
-    bool edge;
-    int entity;
-    const std::vector<Point>* points;
-    bool nodalTriangle;
-  };
-  std::vector<Curve> curves;
+// One CURVED entry: an edge's, a face's (3D) or an element's (2D) points.
+struct CurveEntry {
+  bool edge;
+  int entity;
+  const std::vector<Point>* points;
+  bool nodalTriangle;
+};
+
+// The curves in CURVED's order: edges, then faces (3D) or elements (2D).
+std::vector<CurveEntry> curveEntries(const Builder& b) {
+  std::vector<CurveEntry> curves;
   for (std::size_t i = 0; i < b.edges.size(); ++i)
     if (b.edgeCurved[i]) curves.push_back({true, static_cast<int>(i), &b.edgePoints[i], false});
   for (std::size_t i = 0; i < b.faces.size(); ++i)
@@ -429,45 +424,52 @@ void writeNektarXml(const Mesh& mesh, const std::string& path, bool compressed,
     if (b.elements[i].curved)
       curves.push_back({false, static_cast<int>(i), &b.elements[i].points,
                         b.elements[i].type == CellType::Triangle});
-  if (!curves.empty()) {
-    if (compressed) {
-      std::vector<nektar::CurvedInfo> edgeInfo, faceInfo;
-      std::vector<std::int64_t> index;
-      std::vector<nektar::Vertex> points;
-      for (const Curve& c : curves) {
-        auto& info = c.edge ? edgeInfo : faceInfo;
-        info.push_back({static_cast<std::int64_t>(info.size()), c.entity,
-                        static_cast<std::int64_t>(c.points->size()), 0,
-                        static_cast<std::int64_t>(index.size()),
-                        c.nodalTriangle ? nektar::kTriEvenlySpacedId : nektar::kEvenlySpacedId});
-        for (const Point& pt : *c.points) {
-          index.push_back(static_cast<std::int64_t>(points.size()));
-          points.push_back({static_cast<std::int64_t>(points.size()), pt.x(), pt.y(), pt.z()});
-        }
-      }
-      os << "    " << compressedTag("CURVED") << "\n";
-      if (!edgeInfo.empty()) os << "      <E>" << blob(edgeInfo) << "</E>\n";
-      if (!faceInfo.empty()) os << "      <F>" << blob(faceInfo) << "</F>\n";
-      os << "      <DATAPOINTS ID=\"0\">\n        <INDEX>" << blob(index)
-         << "</INDEX>\n        <POINTS>" << blob(points) << "</POINTS>\n      </DATAPOINTS>\n";
-      os << "    </CURVED>\n";
-    } else {
-      os << "    <CURVED>\n";
-      int id = 0;
-      for (const Curve& c : curves) {
-        os << "      <" << (c.edge ? 'E' : 'F') << " ID=\"" << id++ << "\" "
-           << (c.edge ? "EDGEID" : "FACEID") << "=\"" << c.entity << "\" NUMPOINTS=\""
-           << c.points->size() << "\" TYPE=\""
-           << (c.nodalTriangle ? nektar::kTriEvenlySpaced : nektar::kEvenlySpaced) << "\">";
-        for (const Point& pt : *c.points)
-          os << number(pt.x()) << ' ' << number(pt.y()) << ' ' << number(pt.z()) << "   ";
-        os << "</" << (c.edge ? 'E' : 'F') << ">\n";
-      }
-      os << "    </CURVED>\n";
+  return curves;
+}
+
+// Compressed CURVED: the curves' records, the index of their points and the points.
+void writeCompressedCurves(std::ostream& os, const std::vector<CurveEntry>& curves) {
+  std::vector<nektar::CurvedInfo> edgeInfo, faceInfo;
+  std::vector<std::int64_t> index;
+  std::vector<nektar::Vertex> points;
+  for (const CurveEntry& c : curves) {
+    auto& info = c.edge ? edgeInfo : faceInfo;
+    info.push_back({static_cast<std::int64_t>(info.size()), c.entity,
+                    static_cast<std::int64_t>(c.points->size()), 0,
+                    static_cast<std::int64_t>(index.size()),
+                    c.nodalTriangle ? nektar::kTriEvenlySpacedId : nektar::kEvenlySpacedId});
+    for (const Point& pt : *c.points) {
+      index.push_back(static_cast<std::int64_t>(points.size()));
+      points.push_back({static_cast<std::int64_t>(points.size()), pt.x(), pt.y(), pt.z()});
     }
   }
+  os << "    " << compressedTag("CURVED") << "\n";
+  if (!edgeInfo.empty()) os << "      <E>" << blob(edgeInfo) << "</E>\n";
+  if (!faceInfo.empty()) os << "      <F>" << blob(faceInfo) << "</F>\n";
+  os << "      <DATAPOINTS ID=\"0\">\n        <INDEX>" << blob(index)
+     << "</INDEX>\n        <POINTS>" << blob(points) << "</POINTS>\n      </DATAPOINTS>\n";
+  os << "    </CURVED>\n";
+}
 
-  // COMPOSITE: elements by kind and CAD entity, then boundary groups; DOMAIN: the elements.
+void writePlainCurves(std::ostream& os, const std::vector<CurveEntry>& curves) {
+  os << "    <CURVED>\n";
+  int id = 0;
+  for (const CurveEntry& c : curves) {
+    os << "      <" << (c.edge ? 'E' : 'F') << " ID=\"" << id++ << "\" "
+       << (c.edge ? "EDGEID" : "FACEID") << "=\"" << c.entity << "\" NUMPOINTS=\""
+       << c.points->size() << "\" TYPE=\""
+       << (c.nodalTriangle ? nektar::kTriEvenlySpaced : nektar::kEvenlySpaced) << "\">";
+    for (const Point& pt : *c.points)
+      os << number(pt.x()) << ' ' << number(pt.y()) << ' ' << number(pt.z()) << "   ";
+    os << "</" << (c.edge ? 'E' : 'F') << ">\n";
+  }
+  os << "    </CURVED>\n";
+}
+
+// COMPOSITE: elements by kind and CAD entity, then boundary groups. Returns the element
+// composites' ids (the DOMAIN).
+std::vector<int> writeComposites(std::ostream& os, const Mesh& mesh, const Builder& b,
+                                 const std::vector<NamedGroup>& groups) {
   os << "    <COMPOSITE>\n";
   int composite = 0;
   std::vector<int> domain;
@@ -497,13 +499,42 @@ void writeNektarXml(const Mesh& mesh, const std::string& path, bool compressed,
        << "\"> " << boundaryLetter << '[' << idList(ids) << "] </C>\n";
   }
   os << "    </COMPOSITE>\n";
-  os << "    <DOMAIN> C[" << idList(domain) << "] </DOMAIN>\n";
-  os << "  </GEOMETRY>\n";
+  return domain;
+}
+
+void writeExpansions(std::ostream& os, int order, const std::vector<int>& domain) {
   os << "  <EXPANSIONS>\n";
   for (const int c : domain)
-    os << "    <E COMPOSITE=\"C[" << c << "]\" NUMMODES=\"" << mesh.order + 1
+    os << "    <E COMPOSITE=\"C[" << c << "]\" NUMMODES=\"" << order + 1
        << "\" TYPE=\"MODIFIED\" FIELDS=\"u\" />\n";
-  os << "  </EXPANSIONS>\n</NEKTAR>\n";
+  os << "  </EXPANSIONS>\n";
+}
+
+}  // namespace
+
+void writeNektarXml(const Mesh& mesh, const std::string& path, bool compressed,
+                    const std::vector<NamedGroup>& groups) {
+  mesh.checkConsistency();
+  const Builder b(mesh);
+  AtomicFile file(path, false);
+  std::ostream& os = file.stream();
+  os << "<?xml version=\"1.0\" encoding=\"utf-8\" ?>\n<NEKTAR>\n";
+  os << "  <GEOMETRY DIM=\"" << mesh.dim << "\" SPACE=\"3\">\n";
+  writeVerticesAndEdges(os, mesh, b, compressed);
+  if (mesh.dim == 3) writeFaces(os, b, compressed);
+  writeElements(os, b, compressed);
+  const std::vector<CurveEntry> curves = curveEntries(b);
+  if (!curves.empty()) {
+    if (compressed)
+      writeCompressedCurves(os, curves);
+    else
+      writePlainCurves(os, curves);
+  }
+  const std::vector<int> domain = writeComposites(os, mesh, b, groups);
+  os << "    <DOMAIN> C[" << idList(domain) << "] </DOMAIN>\n";
+  os << "  </GEOMETRY>\n";
+  writeExpansions(os, mesh.order, domain);
+  os << "</NEKTAR>\n";
   file.commit();
 }
 

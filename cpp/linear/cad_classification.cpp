@@ -144,10 +144,8 @@ std::string describe(const Eigen::Vector3d& p) {
   return s.str();
 }
 
-}  // namespace
-
-Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
-                   CadClassificationStats* stats) {
+// The tetrahedra of `linear`, refusing a mesh or CAD that cannot be put together.
+const ElementBlock& checkedTetrahedra(const Mesh& linear, const CadModel& cad) {
   if (linear.dim != 3 || linear.order != 1)
     throw ParameterError("only a linear (order 1) tetrahedral mesh can be put on the CAD");
   const ElementBlock* tets = nullptr;
@@ -158,8 +156,11 @@ Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
   if (cad.numSolids() != 1)
     throw ParameterError("the CAD must be one solid to put a mesh on it, " + cad.sourceName() +
                          " has " + std::to_string(cad.numSolids()));
-  if (!(tolerance > 0.0)) tolerance = 1e-5 * cad.boundingDiagonal();
+  return *tets;
+}
 
+// The nodes of `linear`, all inside solid 1 until the boundary is classified.
+Mesh nodesInSolid(const Mesh& linear) {
   Mesh mesh;
   mesh.dim = 3;
   mesh.order = 1;
@@ -168,12 +169,13 @@ Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
   mesh.nodeCadDim.assign(n, 3);
   mesh.nodeCadIndex.assign(n, 1);
   mesh.nodeCadParam.assign(2 * n, kNaN);
+  return mesh;
+}
 
-  // Positive tetrahedra, and their faces that no other tetrahedron shares, pointing out.
-  ElementBlock cells;
-  cells.type = CellType::Tetrahedron;
-  cells.nodes = tets->nodes;
-  cells.entity.assign(tets->count(), 1);
+// Makes the tetrahedra of `cells` positive and returns their faces that no other tetrahedron
+// shares, pointing out.
+std::vector<Face> orientAndFindBoundary(const Mesh& mesh, ElementBlock& cells) {
+  const std::size_t n = mesh.numNodes();
   std::map<Face, std::pair<int, Face>> faces;  // sorted face -> (count, outward face)
   for (std::size_t e = 0; e < cells.count(); ++e) {
     std::int64_t* t = cells.nodes.data() + 4 * e;
@@ -204,9 +206,13 @@ Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
                            " tetrahedra: the mesh is not a manifold volume");
     if (entry.first == 1) boundary.push_back(entry.second);
   }
+  return boundary;
+}
 
-  // Boundary nodes on the CAD (snapped onto it: within the tolerance of where they were).
-  const Classifier classifier(cad, tolerance);
+// Boundary nodes on the CAD (snapped onto it: within the tolerance of where they were).
+CadClassificationStats placeBoundaryNodes(Mesh& mesh, const std::vector<Face>& boundary,
+                                          const Classifier& classifier, const CadModel& cad) {
+  const std::size_t n = mesh.numNodes();
   std::vector<char> onBoundary(n, 0);
   for (const Face& f : boundary)
     for (const std::int64_t v : f) onBoundary[static_cast<std::size_t>(v)] = 1;
@@ -233,64 +239,103 @@ Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
     ++(place.dim == 0 ? s.onVertices : place.dim == 1 ? s.onEdges : s.onFaces);
     s.maxDistance = std::max(s.maxDistance, place.distance);
   }
+  return s;
+}
 
-  // Boundary triangles on the face their nodes share; segments on the edge theirs share.
+// The CAD face a boundary triangle lies on: the one its nodes share (nearest its centroid when
+// several do).
+int faceOfTriangle(const Face& f, const Mesh& mesh, const Classifier& classifier,
+                   const CadModel& cad) {
+  std::set<int> common = classifier.facesOf(mesh.nodeCadDim[f[0]], mesh.nodeCadIndex[f[0]]);
+  for (int k = 1; k < 3; ++k) {
+    const std::set<int> other = classifier.facesOf(mesh.nodeCadDim[f[k]], mesh.nodeCadIndex[f[k]]);
+    std::set<int> both;
+    std::set_intersection(common.begin(), common.end(), other.begin(), other.end(),
+                          std::inserter(both, both.begin()));
+    common = std::move(both);
+  }
+  const Eigen::Vector3d centroid =
+      (nodePoint(mesh, f[0]) + nodePoint(mesh, f[1]) + nodePoint(mesh, f[2])) / 3.0;
+  if (common.empty())
+    throw MeshingError("the boundary triangle of nodes " + std::to_string(f[0] + 1) + ", " +
+                       std::to_string(f[1] + 1) + ", " + std::to_string(f[2] + 1) + " near " +
+                       describe(centroid) + " spans more than one face of " + cad.sourceName() +
+                       ": the mesh does not follow the CAD's faces");
+  int face = *common.begin();
+  if (common.size() > 1) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const int c : common) {
+      const double d = cad.projectOnSurface(c, centroid).distance;
+      if (d < nearest) nearest = d, face = c;
+    }
+  }
+  return face;
+}
+
+// The CAD edge the segment (a, b) lies on, or 0 when it lies on none.
+int edgeOfSegment(std::int64_t a, std::int64_t b, const Mesh& mesh, const Classifier& classifier,
+                  const CadModel& cad, double tolerance) {
+  const std::set<int> ea = classifier.edgesOf(mesh.nodeCadDim[a], mesh.nodeCadIndex[a]);
+  const std::set<int> eb = classifier.edgesOf(mesh.nodeCadDim[b], mesh.nodeCadIndex[b]);
+  std::vector<int> shared;
+  std::set_intersection(ea.begin(), ea.end(), eb.begin(), eb.end(), std::back_inserter(shared));
+  if (shared.empty()) return 0;
+  // A chord of its edge bulges from it by at most 0.29 of its length for arcs up to 120
+  // degrees; a segment across a face between two vertices of one edge (a cap of two
+  // half circles) lies 0.5 of its length away: not on the edge.
+  const Eigen::Vector3d pa = nodePoint(mesh, a), pb = nodePoint(mesh, b);
+  const Eigen::Vector3d mid = 0.5 * (pa + pb);
+  int edge = 0;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const int e : shared) {
+    if (cad.isDegenerated(e)) continue;
+    const double d = cad.projectOnCurve(e, mid).distance;
+    if (d < nearest) nearest = d, edge = e;
+  }
+  if (edge == 0 || nearest > 0.3 * (pb - pa).norm() + tolerance) return 0;
+  return edge;
+}
+
+// Boundary triangles on the face their nodes share; segments on the edge theirs share.
+std::pair<ElementBlock, ElementBlock> boundaryCells(const Mesh& mesh,
+                                                    const std::vector<Face>& boundary,
+                                                    const Classifier& classifier,
+                                                    const CadModel& cad, double tolerance) {
   ElementBlock tris, lines;
   tris.type = CellType::Triangle;
   lines.type = CellType::Line;
   std::set<std::pair<std::int64_t, std::int64_t>> seen;
   for (const Face& f : boundary) {
-    std::set<int> common = classifier.facesOf(mesh.nodeCadDim[f[0]], mesh.nodeCadIndex[f[0]]);
-    for (int k = 1; k < 3; ++k) {
-      const std::set<int> other =
-          classifier.facesOf(mesh.nodeCadDim[f[k]], mesh.nodeCadIndex[f[k]]);
-      std::set<int> both;
-      std::set_intersection(common.begin(), common.end(), other.begin(), other.end(),
-                            std::inserter(both, both.begin()));
-      common = std::move(both);
-    }
-    const Eigen::Vector3d centroid =
-        (nodePoint(mesh, f[0]) + nodePoint(mesh, f[1]) + nodePoint(mesh, f[2])) / 3.0;
-    if (common.empty())
-      throw MeshingError("the boundary triangle of nodes " + std::to_string(f[0] + 1) + ", " +
-                         std::to_string(f[1] + 1) + ", " + std::to_string(f[2] + 1) + " near " +
-                         describe(centroid) + " spans more than one face of " + cad.sourceName() +
-                         ": the mesh does not follow the CAD's faces");
-    int face = *common.begin();
-    if (common.size() > 1) {
-      double nearest = std::numeric_limits<double>::infinity();
-      for (const int c : common) {
-        const double d = cad.projectOnSurface(c, centroid).distance;
-        if (d < nearest) nearest = d, face = c;
-      }
-    }
+    const int face = faceOfTriangle(f, mesh, classifier, cad);
     tris.nodes.insert(tris.nodes.end(), f.begin(), f.end());
     tris.entity.push_back(face);
     for (int k = 0; k < 3; ++k) {
       std::int64_t a = f[k], b = f[(k + 1) % 3];
       if (!seen.insert({std::min(a, b), std::max(a, b)}).second) continue;
-      const std::set<int> ea = classifier.edgesOf(mesh.nodeCadDim[a], mesh.nodeCadIndex[a]);
-      const std::set<int> eb = classifier.edgesOf(mesh.nodeCadDim[b], mesh.nodeCadIndex[b]);
-      std::vector<int> shared;
-      std::set_intersection(ea.begin(), ea.end(), eb.begin(), eb.end(), std::back_inserter(shared));
-      if (shared.empty()) continue;
-      // A chord of its edge bulges from it by at most 0.29 of its length for arcs up to 120
-      // degrees; a segment across a face between two vertices of one edge (a cap of two
-      // half circles) lies 0.5 of its length away: not on the edge.
-      const Eigen::Vector3d pa = nodePoint(mesh, a), pb = nodePoint(mesh, b);
-      const Eigen::Vector3d mid = 0.5 * (pa + pb);
-      int edge = 0;
-      double nearest = std::numeric_limits<double>::infinity();
-      for (const int e : shared) {
-        if (cad.isDegenerated(e)) continue;
-        const double d = cad.projectOnCurve(e, mid).distance;
-        if (d < nearest) nearest = d, edge = e;
-      }
-      if (edge == 0 || nearest > 0.3 * (pb - pa).norm() + tolerance) continue;
+      const int edge = edgeOfSegment(a, b, mesh, classifier, cad, tolerance);
+      if (edge == 0) continue;
       lines.nodes.insert(lines.nodes.end(), {a, b});
       lines.entity.push_back(edge);
     }
   }
+  return {std::move(tris), std::move(lines)};
+}
+
+}  // namespace
+
+Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
+                   CadClassificationStats* stats) {
+  const ElementBlock& tets = checkedTetrahedra(linear, cad);
+  if (!(tolerance > 0.0)) tolerance = 1e-5 * cad.boundingDiagonal();
+  Mesh mesh = nodesInSolid(linear);
+  ElementBlock cells;
+  cells.type = CellType::Tetrahedron;
+  cells.nodes = tets.nodes;
+  cells.entity.assign(tets.count(), 1);
+  const std::vector<Face> boundary = orientAndFindBoundary(mesh, cells);
+  const Classifier classifier(cad, tolerance);
+  CadClassificationStats s = placeBoundaryNodes(mesh, boundary, classifier, cad);
+  auto [tris, lines] = boundaryCells(mesh, boundary, classifier, cad, tolerance);
   s.boundaryTriangles = tris.count();
   s.boundarySegments = lines.count();
   mesh.blocks = {std::move(cells), std::move(tris), std::move(lines)};

@@ -91,6 +91,174 @@ std::set<std::pair<int, std::int64_t>> nonManifoldVertices(
   return bad;
 }
 
+// The cells around each node: those around node n are around[start[n] .. start[n + 1]).
+struct CellsAroundNodes {
+  std::vector<std::size_t> start, around;
+};
+
+CellsAroundNodes cellsAroundNodes(const ElementBlock& tets, std::size_t numNodes) {
+  const std::size_t count = tets.count();
+  CellsAroundNodes a;
+  a.start.assign(numNodes + 1, 0);
+  for (std::size_t c = 0; c < count; ++c)
+    for (int i = 0; i < 4; ++i) ++a.start[static_cast<std::size_t>(tets.element(c)[i]) + 1];
+  std::partial_sum(a.start.begin(), a.start.end(), a.start.begin());
+  a.around.resize(a.start.back());
+  std::vector<std::size_t> fill(a.start.begin(), a.start.end() - 1);
+  for (std::size_t c = 0; c < count; ++c)
+    for (int i = 0; i < 4; ++i) a.around[fill[static_cast<std::size_t>(tets.element(c)[i])]++] = c;
+  return a;
+}
+
+// Marks every cell of `solid` around `node`.
+void markAround(std::int64_t node, int solid, const ElementBlock& tets,
+                const CellsAroundNodes& cellsAround, std::vector<char>& marked) {
+  const auto n = static_cast<std::size_t>(node);
+  for (std::size_t k = cellsAround.start[n]; k < cellsAround.start[n + 1]; ++k)
+    if (tets.entity[cellsAround.around[k]] == solid) marked[cellsAround.around[k]] = 1;
+}
+
+// Grows the marked cells where their surface is not a closed 2-manifold (cavities touching at an
+// edge or a vertex, a cell hanging on by an edge): all of the solid's cells around such a vertex
+// join. Returns the closed surface.
+std::map<std::pair<int, Triangle>, Triangle> growToClosedSurface(
+    const ElementBlock& tets, const CellsAroundNodes& cellsAround, std::size_t requested,
+    std::vector<char>& marked) {
+  constexpr int kGrowthPasses = 8;
+  for (int pass = 0;; ++pass) {
+    std::map<std::pair<int, Triangle>, Triangle> surface = cavitySurface(tets, marked);
+    const auto bad = nonManifoldVertices(surface);
+    if (bad.empty()) return surface;
+    if (pass == kGrowthPasses)
+      throw MeshingError("the cavity around " + std::to_string(requested) +
+                         " cells did not become a closed manifold surface in " +
+                         std::to_string(kGrowthPasses) + " passes");
+    for (const auto& [solid, node] : bad) markAround(node, solid, tets, cellsAround, marked);
+  }
+}
+
+// Connected cavities: marked cells of one solid joined through shared faces, by the root cell
+// keyed by their union-find root.
+std::map<std::size_t, std::vector<std::size_t>> connectedCavities(const ElementBlock& tets,
+                                                                  const std::vector<char>& marked) {
+  const std::size_t count = tets.count();
+  std::vector<std::size_t> parent(count);
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto root = [&parent](std::size_t c) {
+    while (parent[c] != c) c = parent[c] = parent[parent[c]];
+    return c;
+  };
+  std::map<std::pair<int, Triangle>, std::size_t> firstCell;
+  for (std::size_t c = 0; c < count; ++c) {
+    if (marked[c] == 0) continue;
+    const std::int64_t* v = tets.element(c);
+    for (const auto& f : kOutwardFaces) {
+      const auto [it, fresh] = firstCell.emplace(
+          std::make_pair(tets.entity[c], sortedKey({v[f[0]], v[f[1]], v[f[2]]})), c);
+      if (!fresh) parent[root(c)] = root(it->second);
+    }
+  }
+  std::map<std::size_t, std::vector<std::size_t>> cavities;  // root -> cells
+  for (std::size_t c = 0; c < count; ++c)
+    if (marked[c] != 0) cavities[root(c)].push_back(c);
+  return cavities;
+}
+
+// A cavity's surface as a mesh of its own nodes alone, so that a fill (and its copy to and from
+// a child process, isolated) costs the cavity's size, not the model's.
+struct CavityPatch {
+  Mesh local;
+  std::vector<std::int64_t> toWork;  // local node -> node of the mesh
+  std::vector<Triangle> boundary;    // in local nodes
+};
+
+CavityPatch cavityPatch(const Mesh& mesh,
+                        const std::map<std::pair<int, Triangle>, Triangle>& surface, int solid,
+                        const std::set<Triangle>& own) {
+  CavityPatch patch;
+  std::map<std::int64_t, std::int64_t> toLocal;
+  for (const auto& [key, t] : surface) {
+    if (key.first != solid || own.count(key.second) == 0) continue;
+    Triangle mapped{};
+    for (int i = 0; i < 3; ++i) {
+      const std::int64_t n = t[static_cast<std::size_t>(i)];
+      auto [it, fresh] = toLocal.emplace(n, static_cast<std::int64_t>(patch.toWork.size()));
+      if (fresh) {
+        const auto k = static_cast<std::size_t>(n);
+        patch.local.addNode(&mesh.xyz[3 * k], mesh.nodeCadDim[k], mesh.nodeCadIndex[k],
+                            mesh.nodeCadParam[2 * k], mesh.nodeCadParam[2 * k + 1]);
+        patch.toWork.push_back(n);
+      }
+      mapped[static_cast<std::size_t>(i)] = it->second;
+    }
+    patch.boundary.push_back(mapped);
+  }
+  return patch;
+}
+
+// The cells of one cavity filled again by Gmsh, their nodes (new ones added to `work`) in
+// `work`'s numbering; refused unless every cell is positive and they fill the cavity's volume.
+ElementBlock fillCavity(const Mesh& mesh, Mesh& work, const ElementBlock& tets,
+                        const std::map<std::pair<int, Triangle>, Triangle>& surface,
+                        const std::vector<std::size_t>& members, int solid,
+                        LinearMeshOptions fillOptions) {
+  std::set<Triangle> own;  // the cavity's faces, as keys
+  double removed = 0.0, longest = 0.0;
+  for (const std::size_t c : members) {
+    const std::int64_t* v = tets.element(c);
+    removed += simplexVolume(mesh, v);
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j)
+        longest = std::max(longest, (nodePoint(mesh, v[i]) - nodePoint(mesh, v[j])).norm());
+    for (const auto& f : kOutwardFaces) own.insert(sortedKey({v[f[0]], v[f[1]], v[f[2]]}));
+  }
+  CavityPatch patch = cavityPatch(mesh, surface, solid, own);
+  // Sizes from the surface: no cap below the cavity's longest edge.
+  fillOptions.sizeField = nullptr;
+  fillOptions.size = longest;
+  const std::string what =
+      "a cavity of " + std::to_string(members.size()) + " cells in Solid" + std::to_string(solid);
+  ElementBlock cavityCells = fillTetrahedra(patch.local, patch.boundary, fillOptions, solid,
+                                            {what, " (its surface is closed)"});
+  const Mesh& local = patch.local;
+  std::vector<std::int64_t>& toWork = patch.toWork;
+  for (std::size_t n = toWork.size(); n < local.numNodes(); ++n)
+    toWork.push_back(work.addNode(&local.xyz[3 * n], local.nodeCadDim[n], local.nodeCadIndex[n],
+                                  local.nodeCadParam[2 * n], local.nodeCadParam[2 * n + 1]));
+  for (std::int64_t& n : cavityCells.nodes) n = toWork[static_cast<std::size_t>(n)];
+  double filled = 0.0;
+  for (std::size_t c = 0; c < cavityCells.count(); ++c) {
+    const double v = simplexVolume(work, cavityCells.element(c));
+    if (!(v > 0.0))
+      throw MeshingError("Gmsh's fill of " + what + " has a cell of non-positive volume");
+    filled += v;
+  }
+  // The two sums cover one polyhedron: they differ by rounding only (a few units of the last
+  // place per cell), far below this bound unless Gmsh filled something else.
+  if (std::abs(filled - removed) > 1e-9 * removed * static_cast<double>(members.size() + 10))
+    throw MeshingError("Gmsh's fill of " + what + " has volume " + std::to_string(filled) +
+                       " where the cavity has " + std::to_string(removed));
+  return cavityCells;
+}
+
+// The cells that stay, in their order, then the fills'.
+void replaceMarkedCells(Mesh& work, const std::vector<char>& marked, const ElementBlock& added) {
+  for (ElementBlock& b : work.blocks) {
+    if (b.type != CellType::Tetrahedron || cellDimension(b.type) != 3) continue;
+    ElementBlock kept;
+    kept.type = b.type;
+    kept.order = b.order;
+    for (std::size_t c = 0; c < b.count(); ++c) {
+      if (marked[c] != 0) continue;
+      kept.nodes.insert(kept.nodes.end(), b.element(c), b.element(c) + 4);
+      kept.entity.push_back(b.entity[c]);
+    }
+    kept.nodes.insert(kept.nodes.end(), added.nodes.begin(), added.nodes.end());
+    kept.entity.insert(kept.entity.end(), added.entity.begin(), added.entity.end());
+    b = std::move(kept);
+  }
+}
+
 }  // namespace
 
 CavityOutcome remeshCavities(Mesh& mesh, const std::vector<std::size_t>& cells,
@@ -106,154 +274,37 @@ CavityOutcome remeshCavities(Mesh& mesh, const std::vector<std::size_t>& cells,
   CavityOutcome outcome;
   if (cells.empty()) return outcome;
 
-  // Cells around each node.
-  std::vector<std::size_t> start(mesh.numNodes() + 1, 0);
-  for (std::size_t c = 0; c < count; ++c)
-    for (int i = 0; i < 4; ++i) ++start[static_cast<std::size_t>(tets.element(c)[i]) + 1];
-  std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<std::size_t> around(start.back()), fill(start.begin(), start.end() - 1);
-  for (std::size_t c = 0; c < count; ++c)
-    for (int i = 0; i < 4; ++i) around[fill[static_cast<std::size_t>(tets.element(c)[i])]++] = c;
-
   // The cavity: every cell of the requested cell's solid that shares a vertex with it.
+  const CellsAroundNodes cellsAround = cellsAroundNodes(tets, mesh.numNodes());
   std::vector<char> marked(count, 0);
-  const auto take = [&](std::int64_t node, int solid) {
-    const auto n = static_cast<std::size_t>(node);
-    for (std::size_t k = start[n]; k < start[n + 1]; ++k)
-      if (tets.entity[around[k]] == solid) marked[around[k]] = 1;
-  };
   for (const std::size_t c : cells)
-    for (int i = 0; i < 4; ++i) take(tets.element(c)[i], tets.entity[c]);
+    for (int i = 0; i < 4; ++i)
+      markAround(tets.element(c)[i], tets.entity[c], tets, cellsAround, marked);
+  const std::map<std::pair<int, Triangle>, Triangle> surface =
+      growToClosedSurface(tets, cellsAround, cells.size(), marked);
 
-  // Grown where its surface is not a closed 2-manifold (cavities touching at an edge or a vertex,
-  // a cell hanging on by an edge): all of the solid's cells around such a vertex join.
-  constexpr int kGrowthPasses = 8;
-  std::map<std::pair<int, Triangle>, Triangle> surface;
-  for (int pass = 0;; ++pass) {
-    surface = cavitySurface(tets, marked);
-    const auto bad = nonManifoldVertices(surface);
-    if (bad.empty()) break;
-    if (pass == kGrowthPasses)
-      throw MeshingError("the cavity around " + std::to_string(cells.size()) +
-                         " cells did not become a closed manifold surface in " +
-                         std::to_string(kGrowthPasses) + " passes");
-    for (const auto& [solid, node] : bad) take(node, solid);
-  }
-
-  // Connected cavities: marked cells of one solid joined through shared faces.
-  std::vector<std::size_t> parent(count);
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto root = [&parent](std::size_t c) {
-    while (parent[c] != c) c = parent[c] = parent[parent[c]];
-    return c;
-  };
-  {
-    std::map<std::pair<int, Triangle>, std::size_t> firstCell;
-    for (std::size_t c = 0; c < count; ++c) {
-      if (marked[c] == 0) continue;
-      const std::int64_t* v = tets.element(c);
-      for (const auto& f : kOutwardFaces) {
-        const auto [it, fresh] = firstCell.emplace(
-            std::make_pair(tets.entity[c], sortedKey({v[f[0]], v[f[1]], v[f[2]]})), c);
-        if (!fresh) parent[root(c)] = root(it->second);
-      }
-    }
-  }
-  std::map<std::size_t, std::vector<std::size_t>> cavities;  // root -> cells
-  for (std::size_t c = 0; c < count; ++c)
-    if (marked[c] != 0) cavities[root(c)].push_back(c);
-
-  // Each cavity filled again, on a copy: a failure leaves the mesh as it was. Gmsh gets a mesh
-  // of the cavity's surface nodes alone, so that a fill (and its copy to and from a child
-  // process, isolated) costs the cavity's size, not the model's; all the fills share
-  // options.timeLimit.
+  // Each cavity filled again, on a copy: a failure leaves the mesh as it was. All the fills
+  // share options.timeLimit.
   Mesh work = mesh;
   ElementBlock added;
   added.type = CellType::Tetrahedron;
   const auto started = std::chrono::steady_clock::now();
-  for (const auto& [rootCell, members] : cavities) {
-    const int solid = tets.entity[rootCell];
-    std::set<Triangle> own;  // the cavity's faces, as keys
-    double removed = 0.0, longest = 0.0;
-    for (const std::size_t c : members) {
-      const std::int64_t* v = tets.element(c);
-      removed += simplexVolume(mesh, v);
-      for (int i = 0; i < 4; ++i)
-        for (int j = i + 1; j < 4; ++j)
-          longest = std::max(longest, (nodePoint(mesh, v[i]) - nodePoint(mesh, v[j])).norm());
-      for (const auto& f : kOutwardFaces) own.insert(sortedKey({v[f[0]], v[f[1]], v[f[2]]}));
-    }
-    Mesh local;
-    std::map<std::int64_t, std::int64_t> toLocal;
-    std::vector<std::int64_t> toWork;  // local node -> node of `work`
-    std::vector<Triangle> boundary;
-    for (const auto& [key, t] : surface) {
-      if (key.first != solid || own.count(key.second) == 0) continue;
-      Triangle mapped{};
-      for (int i = 0; i < 3; ++i) {
-        const std::int64_t n = t[static_cast<std::size_t>(i)];
-        auto [it, fresh] = toLocal.emplace(n, static_cast<std::int64_t>(toWork.size()));
-        if (fresh) {
-          const auto k = static_cast<std::size_t>(n);
-          local.addNode(&mesh.xyz[3 * k], mesh.nodeCadDim[k], mesh.nodeCadIndex[k],
-                        mesh.nodeCadParam[2 * k], mesh.nodeCadParam[2 * k + 1]);
-          toWork.push_back(n);
-        }
-        mapped[static_cast<std::size_t>(i)] = it->second;
-      }
-      boundary.push_back(mapped);
-    }
-    // Sizes from the surface: no cap below the cavity's longest edge.
+  for (const auto& [rootCell, members] : connectedCavities(tets, marked)) {
     LinearMeshOptions fillOptions = options;
-    fillOptions.sizeField = nullptr;
-    fillOptions.size = longest;
     if (options.timeLimit > 0.0) {
       const double spent =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       fillOptions.timeLimit = std::max(options.timeLimit - spent, 1e-3);
     }
-    const std::string what =
-        "a cavity of " + std::to_string(members.size()) + " cells in Solid" + std::to_string(solid);
-    ElementBlock cavityCells =
-        fillTetrahedra(local, boundary, fillOptions, solid, {what, " (its surface is closed)"});
-    for (std::size_t n = toWork.size(); n < local.numNodes(); ++n)
-      toWork.push_back(work.addNode(&local.xyz[3 * n], local.nodeCadDim[n], local.nodeCadIndex[n],
-                                    local.nodeCadParam[2 * n], local.nodeCadParam[2 * n + 1]));
-    for (std::int64_t& n : cavityCells.nodes) n = toWork[static_cast<std::size_t>(n)];
-    double filled = 0.0;
-    for (std::size_t c = 0; c < cavityCells.count(); ++c) {
-      const double v = simplexVolume(work, cavityCells.element(c));
-      if (!(v > 0.0))
-        throw MeshingError("Gmsh's fill of " + what + " has a cell of non-positive volume");
-      filled += v;
-    }
-    // The two sums cover one polyhedron: they differ by rounding only (a few units of the last
-    // place per cell), far below this bound unless Gmsh filled something else.
-    if (std::abs(filled - removed) > 1e-9 * removed * static_cast<double>(members.size() + 10))
-      throw MeshingError("Gmsh's fill of " + what + " has volume " + std::to_string(filled) +
-                         " where the cavity has " + std::to_string(removed));
+    const ElementBlock cavityCells =
+        fillCavity(mesh, work, tets, surface, members, tets.entity[rootCell], fillOptions);
     added.nodes.insert(added.nodes.end(), cavityCells.nodes.begin(), cavityCells.nodes.end());
     added.entity.insert(added.entity.end(), cavityCells.entity.begin(), cavityCells.entity.end());
     outcome.cellsRemoved += members.size();
     outcome.cellsAdded += cavityCells.count();
     ++outcome.cavities;
   }
-
-  // The cells that stay, in their order, then the fills'.
-  for (ElementBlock& b : work.blocks) {
-    if (b.type != CellType::Tetrahedron || cellDimension(b.type) != 3) continue;
-    ElementBlock kept;
-    kept.type = b.type;
-    kept.order = b.order;
-    for (std::size_t c = 0; c < b.count(); ++c) {
-      if (marked[c] != 0) continue;
-      kept.nodes.insert(kept.nodes.end(), b.element(c), b.element(c) + 4);
-      kept.entity.push_back(b.entity[c]);
-    }
-    kept.nodes.insert(kept.nodes.end(), added.nodes.begin(), added.nodes.end());
-    kept.entity.insert(kept.entity.end(), added.entity.begin(), added.entity.end());
-    b = std::move(kept);
-  }
+  replaceMarkedCells(work, marked, added);
   work.checkConsistency();
   mesh = std::move(work);
   return outcome;
