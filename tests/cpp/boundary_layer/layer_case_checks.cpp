@@ -2,22 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <functional>
 #include <map>
-#include <memory>
 #include <set>
-#include <sstream>
+#include <string>
 #include <vector>
 
-#include "boundary_layer/boundary_layer.hpp"
-#include "boundary_layer/layer_blend.hpp"
-#include "boundary_layer/layer_cells.hpp"
-#include "boundary_layer/layer_split.hpp"
-#include "core/error.hpp"
-#include "core/expression.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 #include "io/mesh_readers.hpp"

@@ -4,30 +4,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <functional>
-#include <map>
-#include <memory>
 #include <set>
-#include <sstream>
+#include <string>
 #include <vector>
 
 #include "boundary_layer/boundary_layer.hpp"
-#include "boundary_layer/layer_blend.hpp"
-#include "boundary_layer/layer_cells.hpp"
-#include "boundary_layer/layer_split.hpp"
 #include "core/error.hpp"
-#include "core/expression.hpp"
-#include "element/quadrature.hpp"
-#include "element/reference_element.hpp"
-#include "io/mesh_readers.hpp"
-#include "io/mesh_writers.hpp"
 #include "layer_case_checks.hpp"
-#include "optimise/optimiser.hpp"
-#include "peer_data.hpp"
-#include "pipeline/case_setup.hpp"
+#include "linear/linear_mesher.hpp"
 #include "pipeline/mesh_pipeline.hpp"
-#include "pipeline/report.hpp"
 #include "quality/mesh_quality.hpp"
 #include "test_support.hpp"
 
