@@ -13,10 +13,10 @@
 #include <unordered_map>
 #include <vector>
 
+#include "boundary_layer/layer_cells.hpp"
 #include "core/error.hpp"
 #include "curving/curve_node_placement.hpp"
 #include "curving/face_node_placement.hpp"
-#include "curving/layer_split.hpp"
 #include "element/reference_element.hpp"
 
 namespace homesh {

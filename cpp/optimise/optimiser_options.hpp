@@ -75,7 +75,7 @@ struct OptimiserOptions {
   // no longer follows its geometry exactly.
   bool freeInterfaces = defaultOf<bool>("free_interfaces");
   // Nodes that stay where they are (1 per node; empty: none), whatever their kind: a macro
-  // boundary layer keeps the shape its growth gave it (linear/boundary_layer.hpp).
+  // boundary layer keeps the shape its growth gave it (boundary_layer/boundary_layer.hpp).
   std::vector<char> fixedNodes;
   // Nodes that move only perpendicular to a direction (3 values per node, NaN for a node
   // without one; empty: none): a macro boundary layer's top, released around invalid

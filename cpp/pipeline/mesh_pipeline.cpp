@@ -8,6 +8,9 @@
 #include <map>
 #include <sstream>
 
+#include "boundary_layer/layer_blend.hpp"
+#include "boundary_layer/layer_cells.hpp"
+#include "boundary_layer/layer_normals.hpp"
 #include "cad/face_cusps.hpp"
 #include "cad/model_dimension.hpp"
 #include "core/error.hpp"

@@ -14,13 +14,13 @@
 #include <utility>
 #include <vector>
 
+#include "boundary_layer/boundary_layer.hpp"
+#include "boundary_layer/layer_split.hpp"
 #include "cad/cad_healing.hpp"
 #include "cad/cad_model.hpp"
 #include "cad/naca_aerofoil.hpp"
 #include "core/mesh.hpp"
-#include "curving/layer_split.hpp"
 #include "io/mesh_writers.hpp"
-#include "linear/boundary_layer.hpp"
 #include "optimise/optimiser.hpp"
 #include "pipeline/meshing_options.hpp"
 #include "pipeline/repair.hpp"

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "boundary_layer/layer_parameters.hpp"
 #include "cad/cad_healing.hpp"
 #include "core/parameters.hpp"
-#include "linear/boundary_layer.hpp"
 #include "sizing/sizing_parameters.hpp"
 
 namespace homesh {
@@ -44,8 +44,8 @@ struct MeshingOptions {
   // core/parameters.hpp: each splits the offending linear cells' edges on curved faces (or refines
   // around them), then curves, optimises and checks again. 0: none.
   int repairRounds = defaultOf<int>("repair_rounds");
-  // A macro boundary layer on these CAD faces (linear/boundary_layer.hpp), curved and optimised
-  // with the rest and split into its thin layers last (curving/layer_split.hpp).
+  // A macro boundary layer on these CAD faces (boundary_layer/boundary_layer.hpp), curved and
+  // optimised with the rest and split into its thin layers last (boundary_layer/layer_split.hpp).
   std::optional<BoundaryLayerParameters> boundaryLayer;
   // CAD healing after loading (cad/cad_healing.hpp); false: the model is only checked.
   bool heal = defaultOf<bool>("heal");

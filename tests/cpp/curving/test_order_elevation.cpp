@@ -5,8 +5,8 @@
 #include <cmath>
 #include <set>
 
+#include "boundary_layer/layer_blend.hpp"
 #include "core/error.hpp"
-#include "curving/layer_split.hpp"
 #include "curving/order_elevation.hpp"
 #include "element/reference_element.hpp"
 #include "linear/linear_mesher.hpp"

@@ -141,7 +141,7 @@ std::string writeMadeCase(const std::string& name, const std::filesystem::path& 
 }
 
 // The case's linear mesh without its boundary layer: what the sizing predicts (a layer takes the
-// place of some of the predicted elements; its own tests are pipeline/test_boundary_layer.cpp).
+// place of some of the predicted elements; its own tests are under boundary_layer/).
 MeshResult meshCase(const std::string& mcf, int order = 1) {
   CaseSetup setup = setupCase(mcf);
   setup.options.order = order;

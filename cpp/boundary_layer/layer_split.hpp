@@ -1,7 +1,7 @@
 // Splits a curved macro boundary layer into thin layers (../shared/DESIGN.md section 8).
 //
 // Every prism is split across its wall-normal reference direction (the wall is its triangle
-// 0, 1, 2, as linear/boundary_layer.hpp makes it) at the coordinates z_0 = 0 < ... < z_n = 1;
+// 0, 1, 2, as boundary_layer.hpp makes it) at the coordinates z_0 = 0 < ... < z_n = 1;
 // each new node is the macro prism's own curved map at its reference point, so each thin prism
 // is a sub-map of the macro one (valid where the macro prism is, its Jacobian scaled by
 // z_{k+1} - z_k). With the heights the layer was grown to, the levels are set per column of
@@ -14,6 +14,8 @@
 // interpolated point, which lies within the macro element's interpolation error of it). Tetrahedra
 // and triangles are kept, but a 2D fan's triangles (layerFanTriangles), each split into 2n - 1
 // triangles on its columns' levels.
+//
+// The split's parts (internal): layer_splitter.hpp and the files it names.
 #pragma once
 
 #include <cstddef>
@@ -25,16 +27,6 @@
 #include "core/mesh.hpp"
 
 namespace homesh {
-
-// Whether the block holds a macro layer's cells: prisms in 3D, quadrilaterals in 2D (whose
-// other quadrilaterals, in 3D, are the layer's sides on the CAD).
-bool isLayerCell(const Mesh& mesh, const ElementBlock& block);
-
-// In 2D, per element of `block`, 1 for a triangle of a macro layer's fan (at a sharp convex corner
-// of the wall, linear/boundary_layer.hpp): a triangle with a vertex on the wall of a layer
-// quadrilateral (the fill never reaches the wall); that vertex is the fan's corner, the two
-// others tops of its columns. All 0 for any other block, and in 3D.
-std::vector<char> layerFanTriangles(const Mesh& mesh, const ElementBlock& block);
 
 struct LayerSplitStats {
   std::size_t prisms = 0, quadrilaterals = 0, lines = 0;  // macro elements split
@@ -57,20 +49,6 @@ struct LayerSplitStats {
   double firstHeightMin = 0.0, firstHeightMax = 0.0, firstHeightDeviation = 0.0;
 };
 
-// Shapes a freshly elevated macro layer after its curved wall: each high-order node of a cell's
-// top (but its vertices) goes to the wall's node below it, offset by the height and direction
-// interpolated from the vertices' climbs (the top runs parallel to the wall and meets the top
-// vertices; the direction is the wall's normal, in 2D with `cad` the CAD curve's own at the wall
-// node, corrected by the vertices' climbs against the same normals there), then the nodes
-// between wall and top go to the blend (1 - t) W + t T at the same
-// wall position, t the node's level, so each cell's first split layer has its share of the
-// height everywhere. Cells: prisms (3D), quadrilaterals (2D). Nodes on a CAD face (the layer's
-// sides in 3D) are projected back onto it (with `cad`; without, they stay); nodes on CAD curves
-// stay. With `tops` false, only the inner nodes are placed (after the optimiser has moved the
-// tops). Straight-sided tops and inner nodes fold the layer where the wall bulges by a large
-// share of its height (a coarse wall around a cylinder).
-void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops = true);
-
 // The heights a split keeps: `grown`, grownLayerHeights of the linear mesh the layer was grown
 // in (whose vertex ids the macro mesh keeps); the columns whose top nodes are in `plain` are
 // split at z unchanged (where an adjusted column made a thin cell invalid).
@@ -89,13 +67,6 @@ Mesh splitBoundaryLayer(const Mesh& macro, const std::vector<double>& z, const C
 // (an index among the split mesh's elements, in block order: `layers` thin cells per macro cell,
 // 2 layers - 1 per fan triangle) came from; nothing for an element outside the layer.
 void keepColumnsPlain(const Mesh& macro, int layers, std::size_t element, LayerHeights& heights);
-
-// Per node (3 values): for the nodes of a macro layer's top (prisms' and, in 2D,
-// quadrilaterals' far side), the unit wall normal below them (averaged over the cells sharing
-// the node); NaN for every other node and for nodes above a sharp corner (the cells' normals
-// spread by more than about 30 degrees: they may move freely). OptimiserOptions::normalLocked
-// takes it.
-std::vector<double> layerTopNormals(const Mesh& mesh);
 
 // Per node of a linear mesh with a macro layer: the distance from each wall vertex to its top
 // vertex (the height grown there), NaN for every other node.

@@ -1,0 +1,125 @@
+#include "boundary_layer/layer_blend.hpp"
+
+#include <Eigen/Core>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <vector>
+
+#include "boundary_layer/layer_cells.hpp"
+#include "boundary_layer/layer_normals.hpp"
+#include "element/reference_element.hpp"
+
+namespace homesh {
+
+void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops) {
+  std::vector<char> done(mesh.numNodes(), 0);
+  const auto setOnCad = [&](std::size_t id, const Eigen::Vector3d& x) {
+    if (mesh.dim == 3 && mesh.nodeCadDim[id] == 2 && cad != nullptr) {
+      std::optional<std::array<double, 2>> guess;
+      if (std::isfinite(mesh.nodeCadParam[2 * id]) && std::isfinite(mesh.nodeCadParam[2 * id + 1]))
+        guess = std::array<double, 2>{mesh.nodeCadParam[2 * id], mesh.nodeCadParam[2 * id + 1]};
+      const SurfaceProjection proj = cad->projectOnSurface(mesh.nodeCadIndex[id], x, guess);
+      for (std::size_t d = 0; d < 3; ++d)
+        mesh.xyz[3 * id + d] = proj.point(static_cast<Eigen::Index>(d));
+      mesh.nodeCadParam[2 * id] = proj.u;
+      mesh.nodeCadParam[2 * id + 1] = proj.v;
+      return;
+    }
+    for (std::size_t d = 0; d < 3; ++d) mesh.xyz[3 * id + d] = x(static_cast<Eigen::Index>(d));
+  };
+  // Nodes this may place: inside the domain, or (3D, with the CAD) on a face, projected back.
+  const auto movable = [&](std::size_t id) {
+    return mesh.nodeCadDim[id] == mesh.dim ||
+           (mesh.dim == 3 && mesh.nodeCadDim[id] == 2 && cad != nullptr);
+  };
+  for (int pass = tops ? 0 : 1; pass < 2; ++pass)  // tops first: the inner levels blend to them
+    for (const ElementBlock& b : mesh.blocks) {
+      // The layer's cells: prisms (wall 0, 1, 2, tops 3, 4, 5), in 2D quadrilaterals (wall 0,
+      // 1, tops 3, 2); the lattice axis across the layer is the last.
+      if (!isLayerCell(mesh, b) || b.order < 2) continue;
+      const bool prism = b.type == CellType::Prism;
+      const int p = b.order;
+      const int walls = prism ? 3 : 2;
+      const std::size_t across = prism ? 2 : 1;
+      const ReferenceElement& ref = ReferenceElement::get(b.type, p);
+      const std::map<LatticePoint, int> index = latticeIndex(ref);
+      for (std::size_t e = 0; e < b.count(); ++e) {
+        const std::int64_t* v = b.element(e);
+        const auto x = [&](std::int64_t n) {
+          return Eigen::Vector3d(&mesh.xyz[3 * static_cast<std::size_t>(n)]);
+        };
+        const auto top = [&](int k) { return prism ? v[k + 3] : v[3 - k]; };
+        for (int r = 0; r < ref.numNodes(); ++r) {
+          const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
+          const auto id = static_cast<std::size_t>(v[r]);
+          const bool vertex =
+              prism ? (c[0] == 0 || c[0] == p) && (c[1] == 0 || c[1] == p) && c[0] + c[1] <= p
+                    : c[0] == 0 || c[0] == p;
+          if (c[across] == 0 || !movable(id) || done[id] != 0 || (pass == 0) != (c[across] == p))
+            continue;
+          if (pass == 0 && vertex) continue;
+          done[id] = 1;
+          LatticePoint wallPoint = c;
+          wallPoint[across] = 0;
+          const std::int64_t w = v[index.at(wallPoint)];
+          if (pass == 0) {
+            // The top is the wall node offset along the wall's own normal there, corrected by
+            // the vertices' deviations of their climbs from the wall normal (interpolated), by
+            // the interpolated height: parallel to the curved wall, meeting the top vertices.
+            const double l[3] = {prism ? double(p - c[0] - c[1]) / p : double(p - c[0]) / p,
+                                 double(c[0]) / p, prism ? double(c[1]) / p : 0.0};
+            const double corner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+            Eigen::Vector3d rise = Eigen::Vector3d::Zero();
+            double h = 0.0;
+            for (int k = 0; k < walls; ++k) {
+              rise += l[k] * (x(top(k)) - x(v[k]));
+              h += l[k] * (x(top(k)) - x(v[k])).norm();
+            }
+            // In 2D the CAD curve's own normals where the wall nodes are on it: the wall's
+            // polynomial tilts its normal by degrees near the ends of a short wall around a
+            // tight tip (T106's trailing edge, 3 degrees on a wall 0.0035 long), which the
+            // top, 0.053 away, turns into a fold.
+            const int curve = mesh.dim == 2 && cad != nullptr && mesh.nodeCadDim[w] == 1
+                                  ? mesh.nodeCadIndex[w]
+                                  : 0;
+            std::array<Eigen::Vector3d, 3> atCorner;
+            Eigen::Vector3d direction = Eigen::Vector3d::Zero();
+            bool exact = curve > 0;
+            if (exact) {
+              const double near = mesh.nodeCadParam[2 * static_cast<std::size_t>(w)];
+              direction = curveNormal(mesh, *cad, w, curve, near, rise);
+              for (int k = 0; k < walls; ++k)
+                atCorner[static_cast<std::size_t>(k)] =
+                    curveNormal(mesh, *cad, v[k], curve, near, x(top(k)) - x(v[k]));
+              exact = !direction.isZero() && !atCorner[0].isZero() && !atCorner[1].isZero();
+            }
+            if (!exact) {
+              direction =
+                  wallNormal(mesh, ref, v, double(c[0]) / p, prism ? double(c[1]) / p : 0.0, rise);
+              for (int k = 0; k < walls; ++k)
+                atCorner[static_cast<std::size_t>(k)] =
+                    wallNormal(mesh, ref, v, corner[k][0], corner[k][1], x(top(k)) - x(v[k]));
+            }
+            for (int k = 0; k < walls; ++k) {
+              const Eigen::Vector3d climb = x(top(k)) - x(v[k]);
+              direction += l[k] * (climb.normalized() - atCorner[static_cast<std::size_t>(k)]);
+            }
+            if (!(direction.norm() > 0.0)) continue;
+            setOnCad(id, x(w) + h * direction.normalized());
+            continue;
+          }
+          LatticePoint topPoint = c;
+          topPoint[across] = p;
+          const std::int64_t t = v[index.at(topPoint)];
+          const double s = double(c[across]) / p;
+          setOnCad(id, (1.0 - s) * x(w) + s * x(t));
+        }
+      }
+    }
+}
+
+}  // namespace homesh

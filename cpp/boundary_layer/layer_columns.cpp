@@ -1,0 +1,87 @@
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "boundary_layer/layer_splitter.hpp"
+
+namespace homesh::layer_splitting {
+
+double LayerSplitter::grownHeight(const std::int64_t* v, int walls, const double* l) const {
+  if (grown_ == nullptr) return std::nan("");
+  double h = 0.0;
+  for (int k = 0; k < walls; ++k) {
+    const auto id = static_cast<std::size_t>(v[k]);
+    h += l[k] * (id < grown_->size() ? (*grown_)[id] : std::nan(""));
+  }
+  return h;
+}
+
+const Column& LayerSplitter::column(const ElementBlock& b, const std::map<LatticePoint, int>& index,
+                                    const std::int64_t* v, LatticePoint c) {
+  const std::size_t across = b.type == CellType::Prism ? 2 : 1;
+  c[across] = 0;
+  const std::int64_t w = v[index.at(c)];
+  c[across] = p_;
+  const std::int64_t topNode = v[index.at(c)];
+  const auto found = columns_.find(topNode);
+  if (found != columns_.end()) return found->second;
+  Column col;
+  col.levels = z_;
+  const bool prism = b.type == CellType::Prism;
+  const double l[3] = {prism ? double(p_ - c[0] - c[1]) / p_ : double(p_ - c[0]) / p_,
+                       double(c[0]) / p_, prism ? double(c[1]) / p_ : 0.0};
+  const double target = grownHeight(v, wallVertices(b), l);
+  const auto normal = normals_.find(topNode);
+  if (n_ > 1 && plain_.count(topNode) == 0 && std::isfinite(target) && target > 0.0 &&
+      normal != normals_.end() && normal->second.sum.norm() > 0.0) {
+    const Eigen::Vector3d x0(&macro_.xyz[3 * static_cast<std::size_t>(w)]);
+    const Eigen::Vector3d rise =
+        Eigen::Vector3d(&macro_.xyz[3 * static_cast<std::size_t>(topNode)]) - x0;
+    const Eigen::Vector3d n = normal->second.sum.normalized();
+    const double height = rise.dot(n);
+    if (height > 0.0) {
+      const double first = setFirstLevel(col, z_[1] * target / height);
+      // Only where the column leans by less than kMaxShiftLean: at a sharp corner the column
+      // follows the corner's bisector by design, and no shift gives both walls their height.
+      // (Where the adjusted column makes a thin cell invalid, the pipeline splits it plain.)
+      const Eigen::Vector3d lean = rise - height * n;
+      if (lean.norm() < kMaxShiftLean * height) col.shift = -first * lean;
+    }
+  }
+  return columns_.emplace(topNode, std::move(col)).first->second;
+}
+
+double LayerSplitter::setFirstLevel(Column& col, double wanted) const {
+  const double z1 = z_[1];
+  const double first = std::clamp(wanted, 0.5 * z1, std::min(2.0 * z1, 0.5 * (z1 + z_[2])));
+  for (std::size_t k = 1; k + 1 < col.levels.size(); ++k)
+    col.levels[k] = first + (z_[k] - z1) * (1.0 - first) / (1.0 - z1);
+  return first;
+}
+
+const Column& LayerSplitter::fanColumn(std::int64_t corner, std::int64_t top) {
+  const auto found = columns_.find(top);
+  if (found != columns_.end()) return found->second;
+  Column col;
+  col.levels = z_;
+  const auto c = static_cast<std::size_t>(corner);
+  const double target = grown_ != nullptr && c < grown_->size() ? (*grown_)[c] : std::nan("");
+  const double height = (Eigen::Vector3d(&macro_.xyz[3 * static_cast<std::size_t>(top)]) -
+                         Eigen::Vector3d(&macro_.xyz[3 * c]))
+                            .norm();
+  if (n_ > 1 && plain_.count(top) == 0 && std::isfinite(target) && target > 0.0 && height > 0.0)
+    setFirstLevel(col, z_[1] * target / height);
+  return columns_.emplace(top, std::move(col)).first->second;
+}
+
+bool LayerSplitter::atCorner(std::int64_t top) const {
+  const auto n = normals_.find(top);
+  return n != normals_.end() && n->second.sharp();
+}
+
+}  // namespace homesh::layer_splitting

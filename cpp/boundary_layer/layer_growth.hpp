@@ -1,0 +1,118 @@
+// The parts both boundary-layer growers share (internal to boundary_layer/: layer_grower_3d,
+// layer_grower_2d, wall_segment_split): the constants they follow, node positions and points
+// for messages, a node's parameter and a curve's tangent on the CAD, the shrink loop that
+// lowers heights until no check flags a node, and the record of the heights grown.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "boundary_layer/layer_parameters.hpp"
+#include "boundary_layer/layer_record.hpp"
+#include "cad/cad_model.hpp"
+#include "core/error.hpp"
+#include "core/format.hpp"
+#include "core/mesh.hpp"
+
+namespace homesh::layer_growth {
+
+using Vec = Eigen::Vector3d;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+constexpr int kNormalSmoothing = 10;  // relaxation passes of the growth directions
+constexpr double kVisibility = 0.2;   // a direction must see every facet around it this much
+// A layer face and a face without a layer whose CAD normals at a common node are within 6
+// degrees (|cos| above this) meet tangentially: the layer cannot climb the other face there.
+constexpr double kTangentFaces = 0.9945;
+constexpr int kMaxShrinkPasses = 40;     // 0.7^40 ~ 6e-7: a layer that thin is no layer
+constexpr double kShrinkStep = 0.7;      // height factor of a node flagged in a pass
+constexpr double kGrading = 1.25;        // neighbouring heights differ at most by this ratio
+constexpr double kMinPrismCorner = 0.1;  // scaled Jacobian at every prism corner
+constexpr double kRayReach = 2.5;        // thicknesses along the normal that must stay clear
+
+// Node i's position.
+inline Vec at(const Mesh& m, std::int64_t i) {
+  return {m.xyz[3 * i], m.xyz[3 * i + 1], m.xyz[3 * i + 2]};
+}
+
+// "(x, y, z)" for messages.
+std::string pointText(const Vec& x);
+
+// Node `id`'s parameter on CAD curve `curve`: its own where it lies on that curve, the
+// vertex's on the curve where it is a CAD vertex (the end nearest `near` on a closed curve),
+// else its projection's.
+double parameterOnCurve(const Mesh& mesh, const CadModel& cad, int curve, std::int64_t id,
+                        std::optional<double> near = std::nullopt);
+
+// The CAD curve's unit tangent at parameter t, pointing towards parameter `towards`: a chord a
+// thousandth of the span long (not the derivative, which vanishes where the parametrisation
+// does: the NACA splines' cosine spacing at their ends; shorter chords there drown in rounding).
+Vec curveTangent(const CadModel& cad, int curve, double t, double towards);
+
+// Shrinks the flagged wall nodes (Node: factor, full, neighbours) by kShrinkStep and grades the
+// rest (no height more than kGrading times a neighbour's), re-placing every node with
+// `placeAll`, until `offenders` (node index -> why) flags none. Returns the passes taken; throws
+// MeshingError with `describe(node)` (where the layer is) after kMaxShrinkPasses.
+template <class Node, class Offenders, class PlaceAll, class Describe>
+int shrinkUntilClear(std::vector<Node>& nodes, Offenders offenders, PlaceAll placeAll,
+                     Describe describe) {
+  placeAll();
+  for (int pass = 0;; ++pass) {
+    const std::map<std::size_t, std::string> bad = offenders();
+    if (bad.empty()) return pass;
+    if (pass == kMaxShrinkPasses) {
+      const Node& w = nodes[bad.begin()->first];
+      throw MeshingError("the boundary layer on " + describe(w) + ": " + bad.begin()->second +
+                         " even at " + formatNumber(w.factor) + " of the thickness");
+    }
+    for (const auto& [i, why] : bad) nodes[i].factor *= kShrinkStep;
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (Node& w : nodes)
+        for (const std::size_t n : w.neighbours) {
+          const double cap = kGrading * nodes[n].factor * nodes[n].full;
+          if (w.factor * w.full > cap * (1.0 + 1e-12)) {
+            w.factor = cap / w.full;
+            changed = true;
+          }
+        }
+    }
+    placeAll();
+  }
+}
+
+// The record's macro heights, first-layer heights and shrink entries (per layer face or curve,
+// `entity(node)`: the smallest factor, where, how many nodes) from the grown wall nodes.
+template <class Node, class Entity>
+void recordHeights(BoundaryLayerRecord& record, const BoundaryLayerParameters& p, const Mesh& mesh,
+                   const std::vector<Node>& nodes, Entity entity) {
+  record.parameters = p;
+  record.wallNodes = nodes.size();
+  record.thicknessMin = std::numeric_limits<double>::infinity();
+  record.thicknessMax = 0.0;
+  std::map<int, LayerShrink> shrunk;
+  for (const Node& w : nodes) {
+    const double h = (w.top - at(mesh, w.id)).norm();
+    record.thicknessMin = std::min(record.thicknessMin, h);
+    record.thicknessMax = std::max(record.thicknessMax, h);
+    if (w.factor >= 0.999) continue;
+    LayerShrink& s = shrunk[entity(w)];
+    s.face = entity(w);
+    ++s.nodes;
+    if (s.nodes == 1 || w.factor < s.factor) {
+      s.factor = w.factor;
+      const Vec x = at(mesh, w.id);
+      s.where = {x.x(), x.y(), x.z()};
+    }
+  }
+  for (auto& [face, s] : shrunk) record.shrunk.push_back(s);
+}
+
+}  // namespace homesh::layer_growth

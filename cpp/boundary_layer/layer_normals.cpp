@@ -1,0 +1,63 @@
+#include "boundary_layer/layer_normals.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <optional>
+
+#include "core/error.hpp"
+#include "curving/curve_node_placement.hpp"
+
+namespace homesh {
+
+Eigen::Vector3d wallNormal(const Mesh& mesh, const ReferenceElement& ref, const std::int64_t* v,
+                           double a, double b, const Eigen::Vector3d& towards) {
+  const bool prism = ref.type() == CellType::Prism;
+  const double xi[3] = {a, prism ? b : 0.0, 0.0};
+  Eigen::VectorXd values;
+  Eigen::MatrixXd gradients;
+  ref.evaluate(xi, values, gradients);
+  Eigen::Vector3d du = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
+  for (int i = 0; i < ref.numNodes(); ++i) {
+    const Eigen::Vector3d x(&mesh.xyz[3 * static_cast<std::size_t>(v[i])]);
+    du += gradients(i, 0) * x;
+    if (prism) dv += gradients(i, 1) * x;
+  }
+  const Eigen::Vector3d plane(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
+  Eigen::Vector3d n = prism ? du.cross(dv) : plane.cross(du);
+  if (!(n.norm() > 0.0)) return Eigen::Vector3d::Zero();
+  n.normalize();
+  return n.dot(towards) < 0.0 ? Eigen::Vector3d(-n) : n;
+}
+
+Eigen::Vector3d curveNormal(const Mesh& mesh, const CadModel& cad, std::int64_t node, int curve,
+                            double near, const Eigen::Vector3d& towards) {
+  try {
+    const double t = nodeCurveParameter(
+        cad, mesh, node, curve, std::isfinite(near) ? std::optional<double>(near) : std::nullopt);
+    const Eigen::Vector3d plane(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
+    Eigen::Vector3d n = plane.cross(cad.evaluateCurve(curve, t).d1);
+    if (!(n.norm() > 0.0)) return Eigen::Vector3d::Zero();
+    n.normalize();
+    return n.dot(towards) < 0.0 ? Eigen::Vector3d(-n) : n;
+  } catch (const Error&) {
+    return Eigen::Vector3d::Zero();
+  }
+}
+
+std::vector<double> layerTopNormals(const Mesh& mesh) {
+  std::map<std::int64_t, NormalSum> tops;
+  forEachColumn(
+      mesh, [&](std::int64_t, std::int64_t top, const Eigen::Vector3d& n) { tops[top].add(n); });
+  std::vector<double> normals(3 * mesh.numNodes(), std::nan(""));
+  for (const auto& [id, n] : tops) {
+    // Above a sharp corner the column follows the corner's bisector and no plane keeps both
+    // walls' heights: free.
+    if (n.sharp() || !(n.sum.norm() > 0.0)) continue;
+    const Eigen::Vector3d unit = n.sum.normalized();
+    for (std::size_t d = 0; d < 3; ++d)
+      normals[3 * static_cast<std::size_t>(id) + d] = unit(static_cast<Eigen::Index>(d));
+  }
+  return normals;
+}
+
+}  // namespace homesh

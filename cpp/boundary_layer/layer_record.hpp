@@ -1,0 +1,51 @@
+// What growing a boundary layer made: the macro heights, where it had to be grown thinner than
+// asked, its cells, and how far the optimiser later let its top move (BoundaryLayerRecord, the
+// report's "boundary_layer").
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "boundary_layer/layer_parameters.hpp"
+
+namespace homesh {
+
+// Where the layer was grown thinner than asked: per face, the smallest factor and where.
+struct LayerShrink {
+  int face = 0;
+  std::array<double, 3> where{};  // the wall node with the smallest factor
+  double factor = 1.0;            // grown height / asked thickness there
+  std::size_t nodes = 0;          // wall nodes of the face whose height was reduced
+};
+
+// How far the optimiser let a macro layer's top move (BoundaryLayerRecord::release).
+enum class LayerRelease { None, Parallel, Sides, Free };
+// "none", "parallel", "parallel_and_sides", "free"
+const char* layerReleaseName(LayerRelease release);
+
+struct BoundaryLayerRecord {
+  BoundaryLayerParameters parameters;
+  double thicknessMin = 0, thicknessMax = 0;  // macro heights grown at the wall nodes
+  // (The first split layer's height, as measured, is the split's: LayerSplitStats.)
+  std::vector<LayerShrink> shrunk;
+  std::size_t cells = 0;  // macro cells: prisms (3D), quadrilaterals (2D)
+  // 2D: triangles of the fans at sharp convex corners of the wall (a column per wall curve's
+  // normal there and between them, instead of one along the bisector): part of the layer, split
+  // into thin triangles (layer_split.hpp).
+  std::size_t fanTriangles = 0;
+  // 2D: wall segments halved before the growth, where the curve turns by more than 30 degrees
+  // along one.
+  std::size_t wallSplits = 0;
+  std::size_t sideQuadrilaterals = 0, wallNodes = 0;
+  int shrinkPasses = 0;
+  // The optimiser keeps the macro layer as grown unless elements stay invalid; then it lets the
+  // layer's top move around them, first parallel to the wall (the heights stay; its nodes on
+  // the layer's side faces fixed, then sliding on them), then, if still needed, freely (the split
+  // then sets its levels per column so that the first layer keeps its height where it can; the
+  // outer layers absorb the change).
+  LayerRelease release = LayerRelease::None;
+  double seconds = 0.0;
+};
+
+}  // namespace homesh

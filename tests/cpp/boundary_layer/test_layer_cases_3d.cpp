@@ -1,0 +1,257 @@
+// The 3D layer through the whole pipeline: NekMesh's 3d_bl_cyl (peer files) and a box with a
+// cylindrical hole made in the test, certified valid with their layers, the first layer's height,
+// the split's nodes on the CAD, the files read back, and the raise to order 6.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "boundary_layer/boundary_layer.hpp"
+#include "boundary_layer/layer_split.hpp"
+#include "layer_case_checks.hpp"
+#include "optimise/optimiser.hpp"
+#include "peer_data.hpp"
+#include "pipeline/case_setup.hpp"
+#include "pipeline/mesh_pipeline.hpp"
+#include "test_support.hpp"
+
+namespace homesh {
+namespace {
+
+// NekMesh's 3d_bl_cyl case: a cylinder (faces 1 and 8) in a box, thickness 0.04, 6 layers,
+// progression 1.5, at order 2 with the optimiser (as docs/boundary-layers.md's example runs it).
+// The meshing runs once for the suite, and only where the peer files are (SetUp skips each test
+// otherwise).
+class CylinderCase : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (test::havePeerFiles()) result_ = new MeshResult(meshPeerCase("3d_bl_cyl", 2));
+  }
+  static void TearDownTestSuite() {
+    delete result_;
+    result_ = nullptr;
+  }
+  void SetUp() override {
+    HOMESH_REQUIRE_PEER_FILES();
+    ASSERT_NE(result_, nullptr);
+  }
+  static MeshResult* result_;
+};
+MeshResult* CylinderCase::result_ = nullptr;
+
+TEST_F(CylinderCase, IsCertifiedValidWithTheRequestedLayersInEveryWallColumn) {
+  expectValidWithLayersInEveryWallColumn(*result_, {1, 8}, 6);
+}
+
+TEST_F(CylinderCase, SplitNodesLieOnTheCadAndTheReportSaysSo) {
+  // The side nodes' move onto the end planes: measured 0.27 % of the layer's height at order 2
+  // (rounding alone before the first level's shift).
+  expectSplitNodesOnTheCad(*result_, "3d_bl_cyl.mcf", 6, 0.01);
+}
+
+TEST_F(CylinderCase, NektarAndGmshFilesCarryThePrismsAndReadBack) {
+  expectNektarAndGmshFilesReadBack(*result_, "cyl");
+}
+
+// The order-4 cylinder, without the optimiser (the geometry as split; the optimiser is not the
+// point), written as Nektar++ XML and read back.
+TEST(BoundaryLayer, NektarXmlOfTheSplitLayerReadsBackEveryStoredNodeExactly) {
+  HOMESH_REQUIRE_PEER_FILES();
+  CaseSetup setup = setupCase(test::peerFile("meshgen/3d_bl_cyl.mcf"));
+  setup.options.order = 4;
+  setup.options.optimiseIterations = 0;
+  setup.options.repairRounds = 0;
+  const MeshResult r = runMeshPipeline(setup.source, setup.options);
+  ASSERT_EQ(r.mesh.order, 4);
+  expectNektarXmlStoresEveryNodeExactly(r, "cyl4");
+}
+
+// The first layer's height, measured along the wall's normal at the wall triangles' quadrature
+// points, against thickness x (1 - r) / (1 - r^n): within the 5 % everywhere, on the
+// acceptance's path (order 4, the optimiser on). This coarse case leaves one tetrahedron on the
+// layer's top invalid with the layer fixed, so the optimiser lets the top slide parallel to the
+// wall around it, and the split sets each column's levels from the grown height (measured:
+// 4.1 %, against 9.7 % with the levels alone and 13 % with the top moving freely). The
+// report's own figure (LayerSplitStats) is checked against this independent one.
+constexpr double kEndBand = 0.05;
+TEST(BoundaryLayer, FirstLayerHeightAlongTheWallNormalIsWithinFivePercent) {
+  HOMESH_REQUIRE_PEER_FILES();
+  const MeshResult r = meshPeerCase("3d_bl_cyl", 4);
+  ASSERT_TRUE(r.boundaryLayer.has_value());
+  ASSERT_TRUE(r.layerSplit.has_value());
+  EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
+  const double expected = 0.04 * (1 - 1.5) / (1 - std::pow(1.5, 6));
+  double worst = 0.0, worstNearEnds = 0.0;
+  std::size_t measured = 0;
+  forEachFirstLayerHeight(r, {1, 8}, [&](const Eigen::Vector3d& bottom, double height) {
+    const double dev = std::fabs(height / expected - 1);
+    const bool nearEnd = bottom.z() < kEndBand || bottom.z() > 0.5 - kEndBand;
+    (nearEnd ? worstNearEnds : worst) = std::max(nearEnd ? worstNearEnds : worst, dev);
+    ++measured;
+  });
+  EXPECT_GT(measured, 0U);
+  EXPECT_LE(worst, 0.05) << "worst relative deviation of the first-layer height";
+  RecordProperty("first_layer_height_worst_relative_deviation", std::to_string(worst));
+  EXPECT_LE(worstNearEnds, 0.05) << "near the end planes";
+  RecordProperty("first_layer_height_worst_near_the_ends", std::to_string(worstNearEnds));
+  // The report measures the same at the same points (with its own normals and its own search):
+  // equal to what rounding and the searches' tolerance (1e-12 in reference coordinates) leave.
+  EXPECT_NEAR(r.layerSplit->firstHeightDeviation, std::max(worst, worstNearEnds), 1e-9);
+  EXPECT_EQ(r.layerSplit->firstHeightOffNormal, 0U);
+  EXPECT_EQ(r.layerSplit->cornerCells, 0U);  // the cylinder's wall has no sharp corner
+  EXPECT_LE(r.layerSplit->firstHeightMin, expected * (1 + 0.05));
+  EXPECT_GE(r.layerSplit->firstHeightMin, expected * (1 - 0.05));
+}
+
+// Above order 4 the pipeline optimises at order 4 and raises the order after; the layer's inner
+// nodes are then placed straight between the raised wall and the top again, which the split's
+// levels assume, and the raise keeps the top's edges on the layer's sides (the cylinder's end
+// faces) as the low order shaped them, parallel to the wall. Without the first the cylinder's
+// first layer at order 6 was 47 % off its height; without the second 16 %, where the raise had
+// placed those edges afresh, straight across the end faces: the top sagged to 0.018 above the
+// wall where the layer is 0.04 thick. With both, 0.00 % (the levels are set per column, and the
+// columns now have the height grown); 0.05 is what the 2D cases hold.
+TEST(BoundaryLayer, AtOrderSixTheFirstLayerFollowsTheRaisedWall) {
+  HOMESH_REQUIRE_PEER_FILES();
+  const MeshResult r = meshPeerCase("3d_bl_cyl", 6);
+  ASSERT_TRUE(r.layerSplit.has_value());
+  EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
+  EXPECT_GT(r.layerSplit->firstHeightMeasured, 0U);
+  EXPECT_LE(r.layerSplit->firstHeightDeviation, 0.05);
+  RecordProperty("first_layer_height_worst_deviation",
+                 std::to_string(r.layerSplit->firstHeightDeviation));
+  // The order-6 optimiser's first sweep after the raise lifts the worst element from 0.24 to
+  // 0.29; the second lowers it to 0.27 while it lowers the energy elsewhere, and it climbs back
+  // from there (0.35 after 37 sweeps). The stall rule used to stop at the fourth sweep, the worst
+  // still rising, because three sweeps had not beaten the first's. "stalled" now also needs the
+  // worst to have stopped rising within the window: the pipeline's stall of 1e-3 over 3 sweeps
+  // (pipelineOptimiserOptions in mesh_pipeline.cpp).
+  ASSERT_TRUE(r.optimiser.has_value());
+  expectStalledOnlyOnceTheWorstStoppedRising(*r.optimiser);
+  EXPECT_GT(r.optimiser->worstAfter, r.optimiser->worstBefore);
+}
+
+// Siblings of the peer cases on shapes the tests make themselves, so that the boundary layer
+// stays covered where NekMesh's files are not: the same properties, with bounds that follow from
+// the method (or the 5 % on the first layer's height), not from the peer cases.
+
+// A 1.0 x 0.8 x 0.4 box with a vertical cylindrical hole of radius 0.15 through it, off its
+// centre (OCCT's cylinder: one periodic wall face with a seam), the layer on the hole's wall:
+// 0.05 thick (the hole's wall is 0.25 from the box's sides, more than the 2.5 thicknesses the
+// growth keeps clear: nothing shrinks), 4 layers, progression 1.3, the octree's sizes (MinDelta
+// 0.03, MaxDelta 0.12, EPS 0.1: some 70 wall triangles, 1,400 elements), the optimiser as
+// meshCase runs it. Meshed once per order for the tests that share it.
+constexpr double kHoleHeight = 0.4, kHoleThickness = 0.05, kHoleProgression = 1.3;
+constexpr int kHoleLayers = 4;
+
+struct HoleCase {
+  MeshResult result;
+  std::set<int> walls;  // the curved faces: the hole's wall
+};
+
+const HoleCase& holeInABox(int order) {
+  static std::map<int, std::unique_ptr<HoleCase>> meshed;
+  std::unique_ptr<HoleCase>& slot = meshed[order];
+  if (slot) return *slot;
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(1.0, 0.8, kHoleHeight).Shape();
+  const TopoDS_Shape drill =
+      BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0.45, 0.4, -0.1), gp_Dir(0, 0, 1)), 0.15,
+                               kHoleHeight + 0.2)
+          .Shape();
+  const std::string brep = test::brepText(BRepAlgoAPI_Cut(box, drill).Shape());
+  const CadModel cad = CadModel::fromBrepText(brep);
+  std::set<int> walls;
+  for (int f = 1; f <= cad.numFaces(); ++f)
+    if (!cad.isPlanar(f)) walls.insert(f);
+  MeshingOptions options;
+  options.order = order;
+  options.optimiseIterations = 100;
+  options.threads = 2;
+  SizingParameters sizes;
+  sizes.minDelta = 0.03;
+  sizes.maxDelta = 0.12;
+  sizes.eps = 0.1;
+  options.sizing = sizes;
+  BoundaryLayerParameters layer;
+  layer.faces.assign(walls.begin(), walls.end());
+  layer.thickness = "0.05";
+  layer.layers = kHoleLayers;
+  layer.progression = kHoleProgression;
+  options.boundaryLayer = layer;
+  slot = std::make_unique<HoleCase>(
+      HoleCase{runMeshPipeline(CadSource::brepText(brep, "hole in a box"), options), walls});
+  return *slot;
+}
+
+TEST(BoundaryLayerOnAHole, IsCertifiedValidWithTheRequestedLayersInEveryWallColumn) {
+  const HoleCase& c = holeInABox(2);
+  ASSERT_FALSE(c.walls.empty());
+  for (const int f : c.walls) EXPECT_FALSE(c.result.cad->isPlanar(f)) << "Face" << f;
+  expectValidWithLayersInEveryWallColumn(c.result, c.walls, kHoleLayers);
+}
+
+TEST(BoundaryLayerOnAHole, SplitNodesLieOnTheCadAndTheReportSaysSo) {
+  // The side nodes' move onto the end planes: the first level's shift, at most its share z_1 =
+  // 0.16 of the height, times the sine of the wall normal's lean off the plane, the order-2
+  // wall's normal error (the geometry stage finds 1.5 degrees on this wall): below 0.5 %.
+  expectSplitNodesOnTheCad(holeInABox(2).result, "hole in a box", kHoleLayers, 0.01);
+}
+
+TEST(BoundaryLayerOnAHole, NektarAndGmshFilesCarryThePrismsAndReadBack) {
+  expectNektarAndGmshFilesReadBack(holeInABox(2).result, "hole");
+}
+
+TEST(BoundaryLayerOnAHole, NektarXmlOfTheSplitLayerReadsBackEveryStoredNodeExactly) {
+  const MeshResult& r = holeInABox(4).result;
+  ASSERT_EQ(r.mesh.order, 4);
+  expectNektarXmlStoresEveryNodeExactly(r, "hole4");
+}
+
+// As FirstLayerHeightAlongTheWallNormalIsWithinFivePercent: at order 4 with the optimiser, the
+// first layer's height along the wall normal against thickness x (1 - r) / (1 - r^n) within the
+// issue's 5 % (the method's aim: the split sets each column's first level at z_1 times the
+// height grown, and nothing here is shrunk), and the report's own figure equal to this
+// independent one (the same points, its own normals and search: rounding and the searches'
+// 1e-12 in reference coordinates).
+TEST(BoundaryLayerOnAHole, FirstLayerHeightAlongTheWallNormalIsWithinFivePercentAtOrderFour) {
+  const HoleCase& c = holeInABox(4);
+  const MeshResult& r = c.result;
+  ASSERT_TRUE(r.boundaryLayer.has_value());
+  ASSERT_TRUE(r.layerSplit.has_value());
+  EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
+  EXPECT_TRUE(r.boundaryLayer->shrunk.empty());
+  const double expected =
+      kHoleThickness * (1 - kHoleProgression) / (1 - std::pow(kHoleProgression, kHoleLayers));
+  double worst = 0.0;
+  std::size_t measured = 0;
+  forEachFirstLayerHeight(r, c.walls, [&](const Eigen::Vector3d&, double height) {
+    worst = std::max(worst, std::fabs(height / expected - 1));
+    ++measured;
+  });
+  EXPECT_GT(measured, 0U);
+  EXPECT_LE(worst, 0.05) << "worst relative deviation of the first-layer height";
+  RecordProperty("first_layer_height_worst_relative_deviation", std::to_string(worst));
+  EXPECT_NEAR(r.layerSplit->firstHeightDeviation, worst, 1e-9);
+  EXPECT_EQ(r.layerSplit->cornerCells, 0U);  // a cylinder's wall has no sharp corner
+  EXPECT_GE(r.layerSplit->firstHeightMin, expected * (1 - 0.05));
+  EXPECT_LE(r.layerSplit->firstHeightMax, expected * (1 + 0.05));
+}
+
+// As AtOrderSixTheFirstLayerFollowsTheRaisedWall: above order 4 the pipeline optimises at order
+// 4 and raises the order after (kContinuationOrder); the split's levels then follow the raised
+// wall, so the first layer keeps its height within the 5 % (the report's measure, along
+// the wall normal), and the mesh is certified valid. The optimiser's stop rule holds for any
+// run: "stalled" only once the worst element stopped rising over the stall window (3 sweeps,
+// by 1e-3: pipelineOptimiserOptions in mesh_pipeline.cpp).
+TEST(BoundaryLayerOnAHole, AtOrderSixTheFirstLayerFollowsTheRaisedWall) {
+  const MeshResult& r = holeInABox(6).result;
+  expectRaisedToOrderSixKeepingTheFirstHeight(r);
+}
+
+}  // namespace
+}  // namespace homesh

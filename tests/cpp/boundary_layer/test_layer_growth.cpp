@@ -1,0 +1,115 @@
+// Growing the macro layer (boundary_layer.hpp): a thin gap shrinking it and the record saying
+// where, and the faces, thicknesses and tangent neighbours it refuses, named.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "boundary_layer/boundary_layer.hpp"
+#include "core/error.hpp"
+#include "layer_case_checks.hpp"
+#include "linear/linear_mesher.hpp"
+#include "pipeline/mesh_pipeline.hpp"
+#include "quality/mesh_quality.hpp"
+#include "test_support.hpp"
+
+namespace homesh {
+namespace {
+
+// A plate 2 x 2 x 0.1 with a layer of 0.06 asked on both large faces (5: z = 0, 6: z = 0.1):
+// the two layers would overlap, so both are shrunk, and the report says where and by how much.
+TEST(BoundaryLayer, AThinGapShrinksTheLayerAndTheRecordSaysWhere) {
+  const CadModel cad = test::toModel(test::box(2.0, 2.0, 0.1));
+  const LinearMeshOptions fill = LinearMeshOptions::uniform(0.4);
+  const Mesh volume = generateLinearMesh(cad, fill);
+  BoundaryLayerParameters p;
+  p.faces = {5, 6};
+  p.thickness = "0.06";
+  BoundaryLayerRecord record;
+  const Mesh mesh = growBoundaryLayer(volume, cad, p, fill, record);
+  ASSERT_EQ(record.shrunk.size(), 2U);
+  for (const LayerShrink& s : record.shrunk) {
+    EXPECT_TRUE(s.face == 5 || s.face == 6);
+    EXPECT_LT(s.factor, 0.7);  // 2.5 heights must fit in the 0.1 gap: at most 0.04 of 0.06
+    EXPECT_GT(s.factor, 0.0);
+    EXPECT_GT(s.nodes, 0U);
+    EXPECT_NEAR(s.where[2], s.face == 5 ? 0.0 : 0.1, 1e-12);
+  }
+  EXPECT_LE(record.thicknessMax, 0.04);
+  EXPECT_GT(record.thicknessMin, 0.0);
+  // Every prism positive at its corners, the tops of both layers apart, the whole linear mesh
+  // certified valid, and the sides on the plate's edges as quadrilaterals.
+  std::size_t prisms = 0, quads = 0;
+  for (const ElementBlock& b : mesh.blocks) {
+    if (b.type == CellType::Quadrilateral) quads += b.count();
+    if (b.type != CellType::Prism) continue;
+    prisms += b.count();
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      const std::int64_t* v = b.element(e);
+      for (int k = 0; k < 3; ++k) {
+        const double wallZ = point(mesh, v[k]).z();
+        const double topZ = point(mesh, v[k + 3]).z();
+        EXPECT_GT(std::fabs(topZ - wallZ), 0.0);
+        EXPECT_LT(std::fabs(topZ - 0.05), 0.05 - 1e-3);  // the top inside the plate
+      }
+    }
+  }
+  EXPECT_EQ(prisms, record.cells);
+  EXPECT_GT(quads, 0U);
+  EXPECT_EQ(quads, record.sideQuadrilaterals);
+  const QualitySummary q = evaluateQuality(mesh);
+  EXPECT_EQ(q.invalid + q.undecided, 0U);
+}
+
+TEST(BoundaryLayer, MissingFacesAndBadThicknessesAreNamed) {
+  const CadModel cad = test::toModel(test::box(1.0, 1.0, 1.0));
+  const LinearMeshOptions fill = LinearMeshOptions::uniform(0.5);
+  const Mesh volume = generateLinearMesh(cad, fill);
+  BoundaryLayerParameters p;
+  p.faces = {9};
+  p.thickness = "0.1";
+  BoundaryLayerRecord record;
+  try {
+    growBoundaryLayer(volume, cad, p, fill, record);
+    ADD_FAILURE();
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("face 9"), std::string::npos) << e.what();
+  }
+  p.faces = {1};
+  p.thickness = "0.1 - x";  // negative beyond x = 0.1: face 1 lies at x = 0, so fine there
+  EXPECT_NO_THROW(growBoundaryLayer(volume, cad, p, fill, record));
+  p.faces = {2};  // x = 1: the thickness is -0.9 there
+  try {
+    growBoundaryLayer(volume, cad, p, fill, record);
+    ADD_FAILURE();
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("Face2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("must be positive"), std::string::npos) << e.what();
+  }
+}
+
+// The bracket's hole (Face3) runs into Face1 tangentially: no height of prism is valid there,
+// and the message says which face should carry the layer too.
+TEST(BoundaryLayer, ATangentNeighbourWithoutALayerIsNamed) {
+  MeshingOptions options;  // automatic sizing, as `homesh mesh` without sizes
+  options.order = 1;
+  BoundaryLayerParameters p;
+  p.faces = {3, 6};
+  p.thickness = "0.5";
+  options.boundaryLayer = p;
+  try {
+    runMeshPipeline(CadSource::file(std::string(HOMESH_SOURCE_DIR) + "/examples/bracket.step"),
+                    options);
+    ADD_FAILURE();
+  } catch (const MeshingError& e) {
+    EXPECT_NE(std::string(e.what()).find("meets Face1, which has no layer, (nearly) tangentially"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace homesh
