@@ -1,6 +1,6 @@
 #!/bin/sh
-# clang-format check and clang-tidy on our C++ (needs a configured ./build for
-# compile_commands.json). Exit status 1 if either reports anything.
+# clang-format check, clang-tidy and the size limits on our C++ (needs a configured ./build for
+# compile_commands.json). Exit status 1 if any reports anything.
 set -eu
 cd "$(dirname "$0")/.."
 [ -f build/compile_commands.json ] || scripts/build.sh build
@@ -11,4 +11,6 @@ clang-format --dry-run --Werror $files || status=1
 # Only diagnostics located in our files count (the analyser also walks into Eigen's headers).
 clang-tidy -p build --quiet $(echo "$files" | grep '\.cpp$') 2>/dev/null |
   grep -E "^$(pwd)/(cpp|tests|bench)/.*(warning|error):" && status=1
+# The size limits: no file under cpp/ over 900 lines, no function over 120.
+python3 scripts/check-sizes.py || status=1
 exit $status
