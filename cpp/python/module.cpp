@@ -21,13 +21,13 @@
 #include "core/error.hpp"
 #include "core/parameters.hpp"
 #include "core/version.hpp"
+#include "element/element_measure.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 #include "io/mesh_readers.hpp"
 #include "pipeline/case_setup.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
-#include "quality/element_measure.hpp"
 #include "sizing/sizing_octree.hpp"
 
 namespace bp = boost::python;
