@@ -230,11 +230,11 @@ std::optional<OptimiserResult> optimiseAt(CurveRun& run, int order, Mesh& mesh, 
   std::vector<char> fresh;  // the optimiser's region seed: empty for the whole mesh
   if (before != nullptr) fresh = reusePrevious(run, order, mesh, *before);
   const MeshingOptions& options = run.options;
-  if (options.optimiseIterations <= 0) return std::optional<OptimiserResult>();
+  if (options.optimiseIterations <= 0) return std::nullopt;
   const std::string where = run.round.empty() ? std::string(stage) : run.round + " " + stage;
   if (run.budget.spent()) {
     run.budget.skip(where);
-    return std::optional<OptimiserResult>();
+    return std::nullopt;
   }
   std::optional<StageClock> clock;
   run.startClock(clock, stage);
