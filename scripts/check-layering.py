@@ -15,15 +15,16 @@ import sys
 # element/ (shapes, bases, node sets, the element's map and measure) serves every stage.
 # quality/ sits below optimise/ although the pipeline runs the optimiser first: the optimiser
 # keeps and focuses its states by the certified quality (quality/bezier_jacobian.hpp), while
-# quality measures any mesh without knowing what made it.
+# quality measures any mesh without knowing what made it. boundary_layer/ (the macro layer grown
+# on the linear mesh, blended and split on the curved one) shares curving/'s rank: elevation asks
+# which cells are layer cells, and the split places its nodes on the CAD's curves as elevation does.
 ORDER = [
     ["core"],
     ["element"],
     ["cad"],
     ["sizing"],
     ["linear"],
-    ["boundary_layer"],
-    ["curving"],
+    ["curving", "boundary_layer"],
     ["quality"],
     ["optimise"],
     ["io"],
