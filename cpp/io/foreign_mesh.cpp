@@ -7,8 +7,8 @@
 #include <utility>
 
 #include "core/error.hpp"
+#include "element/element_measure.hpp"
 #include "element/node_ordering.hpp"
-#include "quality/element_measure.hpp"
 
 namespace homesh {
 namespace {

@@ -17,6 +17,7 @@
 #include "core/first_failure.hpp"
 #include "core/parameters.hpp"
 #include "core/spatial_order.hpp"
+#include "element/jacobian_sampler.hpp"
 #include "element/reference_element.hpp"
 #include "optimise/cad_sliding.hpp"
 #include "optimise/certified_quality.hpp"
@@ -26,7 +27,6 @@
 #include "optimise/stop_rules.hpp"
 #include "optimise/sweep.hpp"
 #include "optimise/working_mesh.hpp"
-#include "quality/jacobian_sampler.hpp"
 #include "quality/mesh_quality.hpp"
 
 namespace homesh {

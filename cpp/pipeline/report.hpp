@@ -1,43 +1,17 @@
-// JSON reports (fields in docs/report.md), shared by the command line and the Python module.
+// JSON reports of the pipeline (fields in docs/report.md), shared by the command line and the
+// Python module: `homesh mesh` (a MeshResult) and `homesh predict` (a SizingResult), built on the
+// quality report's parts (io/quality_report.hpp, included here for the callers of both).
 #pragma once
 
-#include <cstddef>
 #include <string>
 #include <vector>
 
-#include "core/mesh.hpp"
 #include "io/json_writer.hpp"
-#include "optimise/optimiser.hpp"
+#include "io/quality_report.hpp"
 #include "pipeline/mesh_pipeline.hpp"
-#include "quality/mesh_quality.hpp"
+#include "pipeline/repair.hpp"
 
 namespace homesh {
-
-// Appends "quality": {...} (scaled Jacobian and distortion with histograms, invalid and
-// undecided counts, certified, per cell type, and the first kMaxFlaggedElements elements not
-// proven valid) to an open JSON object.
-inline constexpr std::size_t kMaxFlaggedElements = 100;
-void appendQuality(JsonWriter& json, const Mesh& mesh, const QualitySummary& quality);
-
-// Where the elements not proven valid lie on the CAD, for a message: "at Face12 (5 elements),
-// Face40 (3), Edge7 (1), inside Solid1 (2)". An element counts at every CAD face its nodes lie
-// on; one with no node on a face counts at the curves it touches, and one with neither inside its
-// own entity (3D: solid; 2D: face). Entities with most elements come first, at most
-// `maxEntities` named and the rest counted. Empty when every element is valid or the mesh has no
-// CAD classification (read from a file).
-std::string notValidLocation(const Mesh& mesh, const QualitySummary& quality,
-                             std::size_t maxEntities = 6);
-
-// "invalid", "undecided" or "valid".
-const char* validityName(Validity v);
-
-// Appends "elements" (cells of the mesh dimension by type) and "boundary" (lower cells).
-void appendCounts(JsonWriter& json, const Mesh& mesh);
-
-// Appends "geometry": the largest and mean distance of boundary sample points to their CAD entity
-// (absolute and relative to the model's diagonal), the largest and mean angle between mesh and
-// CAD normals, the sample counts and where the worst distance and angle were found.
-void appendGeometry(JsonWriter& json, const GeometryAccuracy& geometry);
 
 // Appends "boundary_layer": the parameters, the macro heights grown, the first split layer's
 // height, where the layer was shrunk (per face: smallest factor, where, how many wall nodes),
@@ -56,20 +30,5 @@ std::string meshReportJson(const MeshResult& result, const std::string& input);
 
 // Appends "rounds": one record per repair round (pipeline/repair.hpp), in order; [] when none ran.
 void appendRepairRounds(JsonWriter& json, const std::vector<RepairRound>& rounds);
-
-// The report of `homesh quality`: input, order, counts, quality, and "notes" (what reading the
-// file changed, from readMesh).
-std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
-                              const std::string& input, const std::vector<std::string>& notes = {});
-
-// Appends "optimiser": {functional, iterations, worst_before, worst_after, invalid_before,
-// invalid_after, seconds, ...} with the per-sweep history.
-void appendOptimiser(JsonWriter& json, const OptimiserResult& result,
-                     const std::string& key = "optimiser");
-
-// The report of `homesh optimise`: the quality report of the result plus "optimiser".
-std::string optimiseReportJson(const Mesh& mesh, const QualitySummary& quality,
-                               const OptimiserResult& result, const std::string& input,
-                               const std::vector<std::string>& notes = {});
 
 }  // namespace homesh

@@ -22,6 +22,7 @@
 #include "core/error.hpp"
 #include "core/parameters.hpp"
 #include "core/version.hpp"
+#include "element/element_measure.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 #include "io/mesh_readers.hpp"
@@ -30,7 +31,6 @@
 #include "pipeline/mesh_summary.hpp"
 #include "pipeline/nektar_read_back.hpp"
 #include "pipeline/report.hpp"
-#include "quality/element_measure.hpp"
 #include "sizing/sizing_octree.hpp"
 
 namespace bp = boost::python;

@@ -21,8 +21,8 @@
 
 #include <Eigen/Core>
 
+#include "element/jacobian_sampler.hpp"
 #include "element/reference_element.hpp"
-#include "quality/jacobian_sampler.hpp"
 
 namespace homesh {
 

@@ -13,7 +13,7 @@
 #include <Eigen/Core>
 
 #include "core/cell_type.hpp"
-#include "quality/jacobian_sampler.hpp"
+#include "element/jacobian_sampler.hpp"
 
 namespace homesh {
 

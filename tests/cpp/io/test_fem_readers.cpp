@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "element/element_measure.hpp"
 #include "element/node_ordering.hpp"
 #include "io/mesh_readers.hpp"
-#include "quality/element_measure.hpp"
 #include "quality/mesh_quality.hpp"
 #include "test_support.hpp"
 

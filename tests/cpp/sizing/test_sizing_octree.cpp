@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "io/octree_export.hpp"
 #include "peer_data.hpp"
 #include "sizing/element_count.hpp"
-#include "sizing/octree_export.hpp"
 #include "sizing/sizing_octree.hpp"
 #include "test_support.hpp"
 

@@ -1,4 +1,4 @@
-#include "sizing/octree_export.hpp"
+#include "io/octree_export.hpp"
 
 #include <array>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "quality/jacobian_sampler.hpp"
+#include "element/jacobian_sampler.hpp"
 
 #include <Eigen/Geometry>
 

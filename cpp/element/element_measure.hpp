@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "core/mesh.hpp"
-#include "quality/jacobian_sampler.hpp"
+#include "element/jacobian_sampler.hpp"
 
 namespace homesh {
 

@@ -1,10 +1,10 @@
-#include "quality/element_measure.hpp"
+#include "element/element_measure.hpp"
 
+#include <array>
 #include <memory>
 
 #include "element/cell_table_cache.hpp"
 #include "element/quadrature.hpp"
-#include "quality/mesh_quality.hpp"
 
 namespace homesh {
 namespace {
@@ -63,7 +63,8 @@ std::vector<double> elementMeasures(const Mesh& mesh) {
       for (int i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c) x(i, c) = mesh.xyz[3 * b.element(e)[i] + c];
       // A surface mesh's cells: their curved area (|x_xi1 x x_xi2|), not its projection.
-      const Eigen::Vector3d normal = cellNormal(mesh, b.element(e));
+      const std::array<double, 3> n3 = mesh.cellNormal(b.element(e));
+      const Eigen::Vector3d normal(n3[0], n3[1], n3[2]);
       out.push_back(elementMeasure(b.type, b.order, x,
                                    mesh.dim == 2 && !mesh.isSurface() ? &normal : nullptr));
     }
