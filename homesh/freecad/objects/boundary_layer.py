@@ -7,8 +7,8 @@ import FreeCAD
 
 from ..arguments import boundary_layer_arguments
 from ..object_types import TYPE_BOUNDARY_LAYER
-from ..properties import ParameterGuard, add_parameter_property
-from .base import Proxy
+from ..properties import add_parameter_property
+from .base import GuardedProxy
 
 
 def make_boundary_layer(doc, part, faces, thickness, layers=None, progression=None,
@@ -30,16 +30,11 @@ def make_boundary_layer(doc, part, faces, thickness, layers=None, progression=No
     return obj
 
 
-class BoundaryLayerProxy(Proxy, ParameterGuard):
+class BoundaryLayerProxy(GuardedProxy):
     """Proxy of an App::FeaturePython holding a boundary layer's parameters; recomputing checks
     them and gives the first layer's height (for a constant thickness)."""
 
     Type = TYPE_BOUNDARY_LAYER
-
-    def __init__(self, obj):
-        obj.Proxy = self
-        self.add_properties(obj)
-        self.remember(obj)
 
     @staticmethod
     def add_properties(obj):
@@ -62,13 +57,6 @@ class BoundaryLayerProxy(Proxy, ParameterGuard):
             if prop not in have:
                 obj.addProperty(kind, prop, "Result", doc)
             obj.setEditorMode(prop, 1)  # read-only
-
-    def onDocumentRestored(self, obj):
-        self.add_properties(obj)
-        self.remember(obj)
-
-    def onChanged(self, obj, prop):
-        self.guard(obj, prop)
 
     def execute(self, obj):
         try:

@@ -11,8 +11,8 @@ import FreeCAD
 from ..meshing import (DEFAULT_ELEMENT_LIMIT, LargeMeshError, apply_result,
                        check_element_limit, job_for)
 from ..object_types import TYPE_HIGH_ORDER_MESH
-from ..properties import ParameterGuard, add_parameter_property
-from .base import Proxy
+from ..properties import add_parameter_property
+from .base import GuardedProxy
 
 
 def make_high_order_mesh(doc, part, order=None, size=None, name="HighOrderMesh", sizing=None,
@@ -44,7 +44,7 @@ def make_high_order_mesh(doc, part, order=None, size=None, name="HighOrderMesh",
     return obj
 
 
-class HighOrderMeshProxy(Proxy, ParameterGuard):
+class HighOrderMeshProxy(GuardedProxy):
     """Proxy of an App::FeaturePython that meshes its ``Part`` with curved elements.
 
     Recomputing meshes synchronously without the GUI, and on a worker thread behind a
@@ -55,10 +55,8 @@ class HighOrderMeshProxy(Proxy, ParameterGuard):
     Type = TYPE_HIGH_ORDER_MESH
 
     def __init__(self, obj):
-        obj.Proxy = self
         self.mesh = None
-        self.add_properties(obj)
-        self.remember(obj)
+        super().__init__(obj)
 
     @staticmethod
     def add_properties(obj):
@@ -127,11 +125,7 @@ class HighOrderMeshProxy(Proxy, ParameterGuard):
 
     def onDocumentRestored(self, obj):
         self.mesh = None
-        self.add_properties(obj)
-        self.remember(obj)
-
-    def onChanged(self, obj, prop):
-        self.guard(obj, prop)
+        super().onDocumentRestored(obj)
 
     def execute(self, obj):
         import homesh

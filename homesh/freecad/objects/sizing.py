@@ -8,8 +8,8 @@ import FreeCAD
 from ..arguments import cad_modes, sizing_arguments
 from ..meshing import prediction_summary
 from ..object_types import TYPE_SIZING
-from ..properties import ParameterGuard, add_parameter_property
-from .base import Proxy
+from ..properties import add_parameter_property
+from .base import GuardedProxy
 
 
 def make_sizing(doc, part, min_delta=None, max_delta=None, eps=None, name="Sizing"):
@@ -32,7 +32,7 @@ def make_sizing(doc, part, min_delta=None, max_delta=None, eps=None, name="Sizin
     return obj
 
 
-class SizingProxy(Proxy, ParameterGuard):
+class SizingProxy(GuardedProxy):
     """Proxy of an App::FeaturePython holding the sizing octree's parameters for its ``Part``;
     recomputing predicts the element count (:func:`homesh.predict`).
 
@@ -42,11 +42,6 @@ class SizingProxy(Proxy, ParameterGuard):
 
     Type = TYPE_SIZING
     GRADATION = 0.2  # fixed in the core: sizes change by at most 0.2 per unit distance
-
-    def __init__(self, obj):
-        obj.Proxy = self
-        self.add_properties(obj)
-        self.remember(obj)
 
     @staticmethod
     def add_properties(obj):
@@ -84,13 +79,6 @@ class SizingProxy(Proxy, ParameterGuard):
                 obj.addProperty(kind, prop, "Result", doc)
         for prop in ("Gradation", "PredictedElements", "OctreeLeaves", "SmallestSize", "Status"):
             obj.setEditorMode(prop, 1)  # read-only
-
-    def onDocumentRestored(self, obj):
-        self.add_properties(obj)
-        self.remember(obj)
-
-    def onChanged(self, obj, prop):
-        self.guard(obj, prop)
 
     def execute(self, obj):
         import homesh
