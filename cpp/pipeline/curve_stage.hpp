@@ -10,11 +10,11 @@
 #include <optional>
 #include <string>
 
+#include "boundary_layer/boundary_layer.hpp"
+#include "boundary_layer/layer_split.hpp"
 #include "cad/cad_model.hpp"
 #include "core/job_budget.hpp"
 #include "core/mesh.hpp"
-#include "boundary_layer/layer_split.hpp"
-#include "boundary_layer/boundary_layer.hpp"
 #include "optimise/optimiser.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "quality/mesh_quality.hpp"

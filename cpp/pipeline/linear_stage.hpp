@@ -8,9 +8,9 @@
 #include <optional>
 #include <string>
 
+#include "boundary_layer/boundary_layer.hpp"
 #include "core/job_budget.hpp"
 #include "core/mesh.hpp"
-#include "boundary_layer/boundary_layer.hpp"
 #include "linear/linear_mesher.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 
