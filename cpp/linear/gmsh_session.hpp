@@ -12,6 +12,7 @@
 #include <Standard_Failure.hxx>
 
 #include "core/error.hpp"
+#include "core/parameters.hpp"
 
 namespace homesh {
 
@@ -20,7 +21,8 @@ class GmshSession {
   // verbosity 0: silent; 1: Gmsh's errors and warnings; 2: and its information. Gmsh's own
   // terminal output (stdout) stays off: its messages are collected and written to stderr when
   // the session ends, so that stdout stays clean for a report.
-  explicit GmshSession(int verbosity = 0, int threads = 1);
+  explicit GmshSession(int verbosity = defaultOf<int>("verbosity"),
+                       int threads = defaultOf<int>("threads"));
   // The same with the exclusive right to Gmsh already held (holdGmsh), as in a child process
   // forked while its parent held it.
   GmshSession(std::unique_lock<std::mutex> held, int verbosity, int threads);

@@ -38,6 +38,7 @@
 #include <Eigen/Core>
 
 #include "core/mesh.hpp"
+#include "core/parameters.hpp"
 #include "optimise/functional.hpp"
 #include "optimise/optimiser_options.hpp"
 #include "quality/mesh_quality.hpp"
@@ -153,6 +154,6 @@ class NodeEnergyProbe {
 };
 
 // min over the mesh of (min J / max J over each element's nodes).
-double nodalScaledJacobian(const Mesh& mesh, int threads = 1);
+double nodalScaledJacobian(const Mesh& mesh, int threads = defaultOf<int>("threads"));
 
 }  // namespace homesh

@@ -20,6 +20,7 @@
 #include "cad/cad_model.hpp"
 #include "cad/naca_aerofoil.hpp"
 #include "core/mesh.hpp"
+#include "core/parameters.hpp"
 #include "io/mesh_writers.hpp"
 #include "optimise/optimiser.hpp"
 #include "pipeline/meshing_options.hpp"
@@ -67,7 +68,8 @@ struct SizingResult {
 // Throws ParameterError (bad parameters, or a prediction above kMaxPredictedElements: sizes
 // far too small for the model) or CadError.
 inline constexpr double kMaxPredictedElements = 5e7;
-SizingResult runSizing(const CadModel& cad, const SizingParameters& params, int threads = 1);
+SizingResult runSizing(const CadModel& cad, const SizingParameters& params,
+                       int threads = defaultOf<int>("threads"));
 
 // Bytes the stages after sizing are predicted to need for `elements` linear elements of
 // dimension `dim` curved to `order`: a fixed 50 MB plus 160 bytes per element node (measured:

@@ -25,6 +25,7 @@
 
 #include "cad/cad_model.hpp"
 #include "core/mesh.hpp"
+#include "core/parameters.hpp"
 
 namespace homesh {
 
@@ -52,6 +53,7 @@ struct GeometryAccuracy {
 // curve in ElementBlock::entity, nodes their parameters) on `threads` threads.
 // Throws Error when a boundary cell names an entity the model does not have, CadError when the
 // CAD cannot be evaluated.
-GeometryAccuracy measureGeometryAccuracy(const Mesh& mesh, const CadModel& cad, int threads = 1);
+GeometryAccuracy measureGeometryAccuracy(const Mesh& mesh, const CadModel& cad,
+                                         int threads = defaultOf<int>("threads"));
 
 }  // namespace homesh

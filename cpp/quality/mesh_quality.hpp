@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/mesh.hpp"
+#include "core/parameters.hpp"
 #include "quality/bezier_jacobian.hpp"
 
 namespace homesh {
@@ -112,7 +113,7 @@ struct KnownQuality {
 // Evaluates every element on `threads` threads (the result does not depend on their number),
 // taking from `known` the values of the elements it has unchanged (the result is the same as
 // without it). Throws Error for a mesh without elements.
-QualitySummary evaluateQuality(const Mesh& mesh, int threads = 1,
+QualitySummary evaluateQuality(const Mesh& mesh, int threads = defaultOf<int>("threads"),
                                const KnownQuality* known = nullptr);
 
 }  // namespace homesh

@@ -19,6 +19,8 @@
 
 #include <string>
 
+#include "core/parameters.hpp"
+
 namespace homesh {
 
 class SizingOctree;
@@ -35,6 +37,7 @@ struct ElementCountPrediction {
 };
 
 // Uses up to `threads` threads.
-ElementCountPrediction predictElementCount(const SizingOctree& tree, int threads = 1);
+ElementCountPrediction predictElementCount(const SizingOctree& tree,
+                                           int threads = defaultOf<int>("threads"));
 
 }  // namespace homesh

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/parameters.hpp"
 #include "sizing/boundary_sampling.hpp"
 #include "sizing/sizing_parameters.hpp"
 
@@ -51,7 +52,8 @@ class SizingOctree {
 
   // Uses up to `threads` threads. Throws ParameterError (bad parameters, sizes too small for
   // the model), CadError (no solid and not planar, OCCT failure).
-  static SizingOctree build(const CadModel& cad, const SizingParameters& params, int threads = 1);
+  static SizingOctree build(const CadModel& cad, const SizingParameters& params,
+                            int threads = defaultOf<int>("threads"));
 
   // The size at x (model coordinates). Thread-safe.
   double delta(const Eigen::Vector3d& x) const;

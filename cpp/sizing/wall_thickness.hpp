@@ -7,6 +7,7 @@
 
 #include <vector>
 
+#include "core/parameters.hpp"
 #include "sizing/boundary_sampling.hpp"
 #include "sizing/sizing_parameters.hpp"
 
@@ -21,7 +22,8 @@ namespace homesh {
 // internal samples are never the far side either.
 // Uses up to `threads` threads; the result does not depend on their number.
 std::vector<double> wallThickness(const std::vector<BoundarySample>& samples,
-                                  const std::vector<double>& reach, int threads = 1);
+                                  const std::vector<double>& reach,
+                                  int threads = defaultOf<int>("threads"));
 
 // The thin-wall bound of the sizing (SizingParameters::thinWall): at each curved wall sample of
 // radius R = 1 / curvature and thickness t, the size becomes the chord whose sagitta is
@@ -30,6 +32,6 @@ std::vector<double> wallThickness(const std::vector<BoundarySample>& samples,
 // minDelta all along). The thickness is searched only as far as it could change a size. Returns how
 // many samples it made smaller; with thinWall 0, none.
 std::size_t applyThinWallSizes(std::vector<BoundarySample>& samples, const SizingParameters& params,
-                               int threads = 1);
+                               int threads = defaultOf<int>("threads"));
 
 }  // namespace homesh
