@@ -146,48 +146,6 @@ std::vector<double> parseList(const std::string& option, const std::string& text
   return values;
 }
 
-void addSizing(OptionTable& table, SizingFlags& f) {
-  table.value({"--min-delta"}, [&f](const std::string& o, const std::string& v) {
-    f.minDelta = parseParameter("min_delta", o, v);
-  });
-  table.value({"--max-delta"}, [&f](const std::string& o, const std::string& v) {
-    f.maxDelta = parseParameter("max_delta", o, v);
-  });
-  table.value({"--eps"}, [&f](const std::string& o, const std::string& v) {
-    f.eps = parseParameter("eps", o, v);
-  });
-  const auto check = [](const std::string& o, const RefinementSource& s) {
-    try {
-      s.validate(o);
-    } catch (const Error& e) {
-      throw UsageError{e.what()};
-    }
-    return s;
-  };
-  table.value({"--refine-line"}, [&f, check](const std::string& o, const std::string& v) {
-    const auto x = parseList(o, v, 8, "X1,Y1,Z1,X2,Y2,Z2,R,D");
-    f.sources.push_back(
-        check(o, RefinementSource::segment({x[0], x[1], x[2]}, {x[3], x[4], x[5]}, x[6], x[7])));
-  });
-  table.value({"--refine-sphere"}, [&f, check](const std::string& o, const std::string& v) {
-    const auto x = parseList(o, v, 5, "X,Y,Z,R,D");
-    f.sources.push_back(check(o, RefinementSource::sphere({x[0], x[1], x[2]}, x[3], x[4])));
-  });
-  table.value({"--refine-box"}, [&f, check](const std::string& o, const std::string& v) {
-    const auto x = parseList(o, v, 7, "X0,Y0,Z0,X1,Y1,Z1,D");
-    f.sources.push_back(
-        check(o, RefinementSource::box({x[0], x[1], x[2]}, {x[3], x[4], x[5]}, x[6])));
-  });
-  table.value({"--refine-curve"}, [&f, check](const std::string& o, const std::string& v) {
-    const auto x = parseList(o, v, 3, "EDGE,R,D");
-    if (x[0] < 1 || x[0] != std::floor(x[0]))
-      throw UsageError{o + ": the edge number must be a whole number >= 1, got '" + v + "'"};
-    f.sources.push_back(check(o, RefinementSource::curve(static_cast<int>(x[0]), x[1], x[2])));
-  });
-  table.value({"--write-octree"},
-              [&f](const std::string&, const std::string& v) { f.writeOctree = v; });
-}
-
 std::string onlyInput(const std::vector<std::string>& positional, const std::string& command,
                       const char* what) {
   if (positional.empty()) throw UsageError{"'homesh " + command + "' needs " + what};
@@ -232,6 +190,42 @@ void addTableOptions(OptionTable& table, OptionMap& values,
   }
 }
 
+// The octree's sizes (rows of the table, into `values`) and its refinement sources and octree
+// output (flags of their own).
+void addSizing(OptionTable& table, SizingFlags& f, OptionMap& values) {
+  addTableOptions(table, values, {"min_delta", "max_delta", "eps"});
+  const auto check = [](const std::string& o, const RefinementSource& s) {
+    try {
+      s.validate(o);
+    } catch (const Error& e) {
+      throw UsageError{e.what()};
+    }
+    return s;
+  };
+  table.value({"--refine-line"}, [&f, check](const std::string& o, const std::string& v) {
+    const auto x = parseList(o, v, 8, "X1,Y1,Z1,X2,Y2,Z2,R,D");
+    f.sources.push_back(
+        check(o, RefinementSource::segment({x[0], x[1], x[2]}, {x[3], x[4], x[5]}, x[6], x[7])));
+  });
+  table.value({"--refine-sphere"}, [&f, check](const std::string& o, const std::string& v) {
+    const auto x = parseList(o, v, 5, "X,Y,Z,R,D");
+    f.sources.push_back(check(o, RefinementSource::sphere({x[0], x[1], x[2]}, x[3], x[4])));
+  });
+  table.value({"--refine-box"}, [&f, check](const std::string& o, const std::string& v) {
+    const auto x = parseList(o, v, 7, "X0,Y0,Z0,X1,Y1,Z1,D");
+    f.sources.push_back(
+        check(o, RefinementSource::box({x[0], x[1], x[2]}, {x[3], x[4], x[5]}, x[6])));
+  });
+  table.value({"--refine-curve"}, [&f, check](const std::string& o, const std::string& v) {
+    const auto x = parseList(o, v, 3, "EDGE,R,D");
+    if (x[0] < 1 || x[0] != std::floor(x[0]))
+      throw UsageError{o + ": the edge number must be a whole number >= 1, got '" + v + "'"};
+    f.sources.push_back(check(o, RefinementSource::curve(static_cast<int>(x[0]), x[1], x[2])));
+  });
+  table.value({"--write-octree"},
+              [&f](const std::string&, const std::string& v) { f.writeOctree = v; });
+}
+
 // The options of `homesh optimise` from the table (OptimiserOptions::apply takes them; threads
 // come with the common options).
 constexpr std::initializer_list<const char*> kOptimiseKeys = {
@@ -245,8 +239,8 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   MeshCommand cmd;
   OptionTable table;
   addCommon(table, cmd.common, true, true);
-  addSizing(table, cmd.sizing);
   OptionMap& values = cmd.options;
+  addSizing(table, cmd.sizing, values);
   addTableOptions(table, values,
                   {"order", "size", "optimise", "repair_rounds", "optimise_seconds", "facet_weight",
                    "linear_seconds", "job_seconds"});
@@ -276,12 +270,6 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
       if (values.count(key) != 0)
         throw UsageError{std::string(parameterDefinition(key).option) + " needs --optimise"};
   if (optimise && values.count("optimise") == 0) values["optimise"] = true;  // the table's
-  if (values.count("size") != 0 && (cmd.sizing.anyDelta() || !cmd.sizing.sources.empty()))
-    throw UsageError{
-        "--size (uniform) cannot be combined with the octree's --min-delta, "
-        "--max-delta, --eps or --refine-*"};
-  if (values.count("size") != 0 && cmd.sizing.writeOctree)
-    throw UsageError{"--write-octree needs octree sizing, not --size"};
   return cmd;
 }
 
@@ -289,7 +277,7 @@ PredictCommand parsePredict(const std::vector<std::string>& args) {
   PredictCommand cmd;
   OptionTable table;
   addCommon(table, cmd.common, false, true);
-  addSizing(table, cmd.sizing);
+  addSizing(table, cmd.sizing, cmd.options);
   addTableOptions(table, cmd.options, kCadModes);
   cmd.input = onlyInput(table.parse(args, 1, "predict"), "predict", "an INPUT CAD or .mcf file");
   return cmd;

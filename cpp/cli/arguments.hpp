@@ -29,10 +29,8 @@ struct CommonOptions {
 
 // Sizing flags shared by `mesh` and `predict`: they override a .mcf's values.
 struct SizingFlags {
-  std::optional<double> minDelta, maxDelta, eps;
   std::vector<RefinementSource> sources;   // --refine-line, -sphere, -box, -curve
   std::optional<std::string> writeOctree;  // --write-octree FILE.vtu
-  bool anyDelta() const { return minDelta || maxDelta || eps; }
 };
 
 struct MeshCommand {

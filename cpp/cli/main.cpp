@@ -92,25 +92,28 @@ homesh::WriteOptions writeOptions(const homesh::CommonOptions& c) {
   return w;
 }
 
-// The case from INPUT (CAD file or .mcf) with the command line's sizing flags applied over it.
-homesh::CaseSetup setupWithFlags(const std::string& input, const homesh::SizingFlags& flags,
-                                 bool quiet) {
+// The case from INPUT (CAD file or .mcf) with the command line's options over it: the table's
+// (`values`, checked by MeshingOptions::apply), then the refinement sources and octree output;
+// the rules between options (a uniform size or octree sizing, ...) are the core's validate().
+homesh::CaseSetup setupWithFlags(const std::string& input, const homesh::OptionMap& values,
+                                 const homesh::SizingFlags& flags, const homesh::CommonOptions& c) {
   homesh::CaseSetup setup = homesh::setupCase(input);
-  if (!quiet)
+  if (!c.quiet)
     for (const std::string& notice : setup.notices)
       std::fprintf(stderr, "homesh: note: %s\n", notice.c_str());
-  if (flags.anyDelta() || !flags.sources.empty()) {
-    homesh::SizingParameters p = setup.options.sizing.value_or(homesh::SizingParameters{});
-    if (flags.minDelta) p.minDelta = *flags.minDelta;
-    if (flags.maxDelta) p.maxDelta = *flags.maxDelta;
-    if (flags.eps) p.eps = *flags.eps;
+  homesh::MeshingOptions& options = setup.options;
+  options.threads = c.threads;
+  options.apply(values);  // over the case's: what the command line gives wins
+  if (!flags.sources.empty()) {
+    homesh::SizingParameters p = options.sizing.value_or(homesh::SizingParameters{});
     p.sources.insert(p.sources.end(), flags.sources.begin(), flags.sources.end());
-    setup.options.sizing = p;
+    options.sizing = p;
   }
   if (flags.writeOctree) {
     homesh::checkMeshOutputPath(*flags.writeOctree);
-    setup.options.octreeOutput = *flags.writeOctree;
+    options.octreeOutput = *flags.writeOctree;
   }
+  options.validate();
   return setup;
 }
 
@@ -122,10 +125,8 @@ void printPrediction(const homesh::SizingResult& s, int dim) {
 int runMesh(const homesh::MeshCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
   checkOutputs(c, cmd.input);
-  homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.sizing, c.quiet);
+  homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.options, cmd.sizing, c);
   homesh::MeshingOptions& options = setup.options;
-  options.threads = c.threads;
-  options.apply(cmd.options);  // over the case's: what the command line gives wins
   if (cmd.blFaces || cmd.blThickness || cmd.blLayers || cmd.blProgression) {
     homesh::BoundaryLayerParameters bl =
         options.boundaryLayer.value_or(homesh::BoundaryLayerParameters{});
@@ -169,9 +170,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
 int runPredict(const homesh::PredictCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
   checkOutputs(c, cmd.input);
-  homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.sizing, c.quiet);
-  setup.options.threads = c.threads;
-  setup.options.apply(cmd.options);
+  homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.options, cmd.sizing, c);
   const homesh::SizingResult s = homesh::runSizingStage(setup.source, setup.options);
   const bool toStdout = c.report && *c.report == "-";
   if (!c.quiet) {

@@ -1,10 +1,11 @@
-// Formatting for messages: numbers in their shortest natural form ("-1", "0.25", "1e-09"), and
-// text from files made safe to quote in a one-line message.
+// Formatting for messages: numbers in their shortest natural form ("-1", "0.25", "1e-09"), lists
+// joined with commas, and text from files made safe to quote in a one-line message.
 #pragma once
 
 #include <cstddef>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace homesh {
 
@@ -12,6 +13,13 @@ inline std::string formatNumber(double value) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.6g", value);
   return buf;
+}
+
+// "a, b, c": the words of a list in a message.
+inline std::string joined(const std::vector<std::string>& words) {
+  std::string out;
+  for (const std::string& w : words) out += (out.empty() ? "" : ", ") + w;
+  return out;
 }
 
 // At most `max` characters of `text`, control characters (newlines included) shown as '?', and

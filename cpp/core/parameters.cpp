@@ -144,9 +144,7 @@ std::vector<std::string> choiceNames(const ParameterDefinition& p) {
 std::string rangeText(const ParameterDefinition& p) {
   if (p.kind == ParameterKind::Boolean) return "true or false";
   if (p.kind == ParameterKind::Choice) {
-    std::string out = "one of";
-    for (const std::string& name : choiceNames(p)) out += (out.size() > 6 ? ", " : " ") + name;
-    return out;
+    return "one of " + joined(choiceNames(p));
   }
   const bool integer = p.kind == ParameterKind::Integer;
   const std::string what = integer                           ? "an integer"
@@ -188,21 +186,13 @@ int choiceIndex(const ParameterDefinition& p, const std::string& name) {
   return -1;
 }
 
-std::string knownKeys() {
-  std::string out;
-  for (const ParameterDefinition& p : parameterDefinitions()) {
-    if (!out.empty()) out += ", ";
-    out += p.key;
-  }
-  return out;
-}
-
 }  // namespace
 
 double checkedOption(const std::string& key, const OptionValue& value) {
   const ParameterDefinition* p = findParameter(key);
   if (p == nullptr)
-    throw ParameterError("unknown option '" + key + "' (options: " + knownKeys() + ")");
+    throw ParameterError("unknown option '" + key + "' (options: " +
+                         joined(tableKeys([](const std::string&) { return true; })) + ")");
   const auto refuse = [&] {
     return ParameterError(std::string(p->label) + " must be " + rangeText(*p) + ", got " +
                           valueText(value));
@@ -236,6 +226,13 @@ void checkParameter(const std::string& key, double value) {
   if (!inRange(p, value))
     throw ParameterError(std::string(p.label) + " must be " + rangeText(p) + ", got " +
                          formatNumber(value));
+}
+
+std::vector<std::string> tableKeys(const std::function<bool(const std::string&)>& wanted) {
+  std::vector<std::string> keys;
+  for (const ParameterDefinition& p : parameterDefinitions())
+    if (wanted(p.key)) keys.emplace_back(p.key);
+  return keys;
 }
 
 }  // namespace homesh

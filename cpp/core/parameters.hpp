@@ -5,10 +5,15 @@
 // panels all read this table, so a default or a range is written once.
 #pragma once
 
+#include <algorithm>
+#include <functional>
 #include <map>
 #include <string>
 #include <variant>
 #include <vector>
+
+#include "core/error.hpp"
+#include "core/format.hpp"
 
 namespace homesh {
 
@@ -86,5 +91,45 @@ using OptionMap = std::map<std::string, OptionValue>;
 // "<label> must be <rangeText>, got <value>" for a value of the wrong kind or out of range, and
 // "unknown option '<key>'" for a key the table does not have.
 double checkedOption(const std::string& key, const OptionValue& value);
+
+// The table's keys, in its order, that `wanted` accepts.
+std::vector<std::string> tableKeys(const std::function<bool(const std::string&)>& wanted);
+
+// Where each key of the table goes in a front end's options struct T, given its checked number.
+template <class T>
+using OptionSetters = std::map<std::string, std::function<void(T&, double)>>;
+
+// The keys applyOptions takes: those of `allowed` or, when it is empty, those with a setter; in
+// the table's order.
+template <class T>
+std::vector<std::string> optionKeys(const OptionSetters<T>& setters,
+                                    const std::vector<std::string>& allowed = {}) {
+  return tableKeys([&](const std::string& key) {
+    return allowed.empty() ? setters.count(key) != 0
+                           : std::find(allowed.begin(), allowed.end(), key) != allowed.end();
+  });
+}
+
+// Gives each of `values`, checked by checkedOption (which names unknown keys and bad values), to
+// its setter. A key without a setter, or one `allowed` (when not empty) leaves out, is refused:
+// "option '<key>' does not apply <where> (options: <optionKeys>)".
+template <class T>
+void applyOptions(T& target, const OptionMap& values, const OptionSetters<T>& setters,
+                  const std::vector<std::string>& allowed, const std::string& where) {
+  for (const auto& [key, value] : values) {
+    const double number = checkedOption(key, value);
+    const auto setter = setters.find(key);
+    const bool wanted =
+        allowed.empty() || std::find(allowed.begin(), allowed.end(), key) != allowed.end();
+    if (setter == setters.end() || !wanted) {
+      std::string message = "option '" + key + "' does not apply ";
+      message += where;
+      message += " (options: ";
+      message += joined(optionKeys(setters, allowed));
+      throw ParameterError(message + ")");
+    }
+    setter->second(target, number);
+  }
+}
 
 }  // namespace homesh

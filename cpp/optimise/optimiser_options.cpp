@@ -1,8 +1,6 @@
 #include "optimise/optimiser_options.hpp"
 
 #include <cmath>
-#include <functional>
-#include <map>
 
 #include "core/error.hpp"
 
@@ -37,9 +35,8 @@ void OptimiserOptions::validate() const {
 namespace {
 
 // Where each table key goes in OptimiserOptions, given its checked number.
-using Setter = std::function<void(OptimiserOptions&, double)>;
-const std::map<std::string, Setter>& setters() {
-  static const std::map<std::string, Setter> table = {
+const OptionSetters<OptimiserOptions>& setters() {
+  static const OptionSetters<OptimiserOptions> table = {
       {"optimise", [](OptimiserOptions& o, double v) { o.maxIterations = static_cast<int>(v); }},
       {"optimise_seconds", [](OptimiserOptions& o, double v) { o.timeLimit = v; }},
       {"facet_weight", [](OptimiserOptions& o, double v) { o.facetWeight = v; }},
@@ -62,26 +59,11 @@ const std::map<std::string, Setter>& setters() {
 }  // namespace
 
 std::vector<std::string> OptimiserOptions::keys() {
-  std::vector<std::string> out;
-  for (const ParameterDefinition& p : parameterDefinitions())
-    if (setters().count(p.key) != 0) out.emplace_back(p.key);
-  return out;
+  return optionKeys(setters());
 }
 
 void OptimiserOptions::apply(const OptionMap& values) {
-  for (const auto& [key, value] : values) {
-    const double number = checkedOption(key, value);  // unknown keys and bad values named here
-    const auto setter = setters().find(key);
-    if (setter == setters().end()) {
-      std::string message = "option '" + key + "' does not apply to the optimiser (options: ";
-      for (const std::string& k : keys()) {
-        if (message.back() != ' ') message += ", ";
-        message += k;
-      }
-      throw ParameterError(message + ")");
-    }
-    setter->second(*this, number);
-  }
+  applyOptions(*this, values, setters(), {}, "to the optimiser");
   // A neighbourhood of nothing: the user meant a region and left it out.
   if (values.count("region_layers") != 0 && !regionThreshold)
     throw ParameterError(std::string(parameterDefinition("region_layers").label) + " need a " +

@@ -146,16 +146,6 @@ void checkPredictedMemory(double elements, int order, int dim, const std::string
   }
 }
 
-void StageTimings::add(const std::string& stage, double s) {
-  seconds.emplace_back(stage, s);
-}
-
-double StageTimings::total() const {
-  double t = 0.0;
-  for (const auto& [stage, s] : seconds) t += s;
-  return t;
-}
-
 namespace {
 
 // The "cad" stage: the model loaded and healed (what healing did in result.healing and notes).
@@ -337,27 +327,6 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
   result.lowOrderOptimiser = std::move(state.lowOrderOptimiser);
   finishJob(result, budget, observer, true);
   return result;
-}
-
-std::vector<CellField> qualityFields(const QualitySummary& quality) {
-  CellField scaled{"scaled_jacobian", quality.scaledJacobian};
-  scaled.values.insert(scaled.values.end(), quality.boundaryScaledJacobian.begin(),
-                       quality.boundaryScaledJacobian.end());
-  CellField distortion{"distortion", quality.distortion};
-  distortion.values.insert(distortion.values.end(), quality.boundaryDistortion.begin(),
-                           quality.boundaryDistortion.end());
-  // 1 proven valid, -1 invalid, 0 undecided; boundary cells have no verdict (NaN).
-  CellField validity{"validity", {}};
-  for (const Validity v : quality.validity)
-    validity.values.push_back(v == Validity::Valid ? 1.0 : v == Validity::Invalid ? -1.0 : 0.0);
-  validity.values.resize(scaled.values.size(), std::numeric_limits<double>::quiet_NaN());
-  return {scaled, distortion, validity};
-}
-
-void writeMeshFiles(const MeshResult& result, const std::vector<std::string>& paths,
-                    const WriteOptions& options) {
-  const std::vector<CellField> fields = qualityFields(result.quality);
-  for (const std::string& path : paths) writeMesh(result.mesh, path, fields, options);
 }
 
 void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,

@@ -21,10 +21,11 @@
 #include "cad/naca_aerofoil.hpp"
 #include "core/mesh.hpp"
 #include "core/parameters.hpp"
-#include "io/mesh_writers.hpp"
 #include "optimise/optimiser.hpp"
+#include "pipeline/curved_mesh.hpp"
 #include "pipeline/meshing_options.hpp"
 #include "pipeline/repair.hpp"
+#include "pipeline/stage_records.hpp"
 #include "quality/geometry_accuracy.hpp"
 #include "quality/mesh_quality.hpp"
 #include "sizing/element_count.hpp"
@@ -56,14 +57,6 @@ SizingParameters resolveSizing(const std::optional<SizingParameters>& requested,
 // Throws ParameterError when `expected` (2 or 3, from a .mcf's MeshType) is set and the model
 // gets the other kind of mesh (cad/model_dimension.hpp).
 void checkMeshDimension(const CadModel& cad, std::optional<int> expected);
-
-// The sizing octree of a model and the element count it predicts.
-struct SizingResult {
-  std::shared_ptr<const SizingOctree> octree;
-  ElementCountPrediction prediction;
-  double seconds = 0.0;   // octree and prediction
-  HealingRecord healing;  // runSizingStage: what the CAD check found and healing did
-};
 
 // Throws ParameterError (bad parameters, or a prediction above kMaxPredictedElements: sizes
 // far too small for the model) or CadError.
@@ -115,13 +108,6 @@ struct CadSource {
 // runMeshPipeline's first stages.
 SizingResult runSizingStage(const CadSource& source, const MeshingOptions& options);
 
-// Wall-clock seconds per stage, in the order the stages ran.
-struct StageTimings {
-  std::vector<std::pair<std::string, double>> seconds;
-  void add(const std::string& stage, double s);
-  double total() const;
-};
-
 // Receives progress; may ask to stop, which is honoured when a stage starts or ends, between
 // the linear mesher's dimensions and between the optimiser's colour groups (the run then throws
 // CancelledError and returns nothing). Every call comes from the thread that runs the pipeline;
@@ -136,47 +122,6 @@ class PipelineObserver {
                              const std::string& /*detail*/) {}
   virtual void stageFinished(const std::string& /*stage*/, double /*seconds*/) {}
   virtual bool cancelRequested() { return false; }
-};
-
-// What a job's time budget (MeshingOptions::jobSeconds) did: the report's "job".
-struct JobRecord {
-  double timeLimit = 0.0;  // the budget, seconds (0: none)
-  // The job's wall time: from the start of the pipeline to its end, plus the "output" stage
-  // when writeMeshOutputs wrote the mesh.
-  double seconds = 0.0;
-  // What the budget kept back at the end for the stages that always run (JobBudget::reserve):
-  // a job it stopped took at least timeLimit less this.
-  double reserved = 0.0;
-  std::vector<std::string> cut;      // stages the budget stopped early ("optimise", "repair 2")
-  std::vector<std::string> skipped;  // stages it left out ("repair 3", "geometry")
-  bool stopped() const { return !cut.empty() || !skipped.empty(); }
-};
-
-struct MeshResult {
-  std::shared_ptr<const CadModel> cad;
-  Mesh mesh;
-  QualitySummary quality;
-  std::optional<OptimiserResult> optimiser;  // when the optimiser ran
-  // Above kContinuationOrder: the optimiser's run at that order that the mesh started from.
-  std::optional<OptimiserResult> lowOrderOptimiser;
-  std::optional<SizingResult> sizing;        // when the sizes came from the octree
-  std::optional<GeometryAccuracy> geometry;  // boundary against the CAD (a mesh made from CAD)
-  std::vector<RepairRound> rounds;           // the repair rounds run, in order
-  // Tangent ears split in the linear meshes Gmsh made, before curving (tangentEarSplits in
-  // pipeline/repair.hpp), over the first mesh and the refine rounds' meshes.
-  std::size_t tangentEars = 0;
-  // With a boundary layer: how the macro layer of the kept mesh was grown, the certified
-  // quality of its macro (unsplit) mesh, and how it was split.
-  std::optional<BoundaryLayerRecord> boundaryLayer;
-  std::optional<QualitySummary> macroQuality;
-  std::optional<LayerSplitStats> layerSplit;
-  StageTimings timings;
-  MeshingOptions options;
-  HealingRecord healing;  // what the CAD check found and healing did
-  // What a stage had to do otherwise than asked (Gmsh crashed and was run again another way;
-  // the job's time budget ended the repair rounds).
-  std::vector<std::string> notes;
-  JobRecord job;
 };
 
 // Runs every stage: CAD, sizing, linear mesh, boundary layer (optional: "boundary_layer"),
@@ -206,15 +151,6 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
 // repair rounds and no boundary layer (ParameterError when one is asked for).
 MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOptions options,
                           PipelineObserver* observer = nullptr);
-
-// The per-cell quality fields written beside the mesh: scaled Jacobian and distortion (for
-// boundary cells, their own measures: see quality/mesh_quality.hpp).
-std::vector<CellField> qualityFields(const QualitySummary& quality);
-
-// Writes the mesh to each path (format from the extension) and records the "output" timing.
-// Writes the mesh and its quality fields to each path (format from the extension).
-void writeMeshFiles(const MeshResult& result, const std::vector<std::string>& paths,
-                    const WriteOptions& options = {});
 
 // writeMeshFiles as the pipeline's last stage: records its "output" timing in the result.
 void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,

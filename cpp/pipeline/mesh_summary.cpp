@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "core/format.hpp"
 #include "pipeline/report.hpp"
 
 namespace homesh {
@@ -16,17 +17,17 @@ std::string formatted(const char* format, Args... args) {
   return buf;
 }
 
-std::string boundaryLayerLine(const MeshResult& result) {
-  const BoundaryLayerRecord& b = *result.boundaryLayer;
-  const LayerSplitStats& s = *result.layerSplit;
-  const bool solid = result.mesh.dim == 3;
+std::string boundaryLayerLine(const StageRecords& records, int dim) {
+  const BoundaryLayerRecord& b = *records.boundaryLayer;
+  const LayerSplitStats& s = *records.layerSplit;
+  const bool solid = dim == 3;
   return formatted(
       "boundary layer: %zu macro %s split into %d layers, height %g to %g, first layer %g to %g "
       "(worst %.2f %% off); shrunk on %zu %s; macro mesh worst %.4f",
       b.cells, solid ? "prisms" : "quadrilaterals", b.parameters.layers, b.thicknessMin,
       b.thicknessMax, s.firstHeightMin, s.firstHeightMax, 100.0 * s.firstHeightDeviation,
       b.shrunk.size(), solid ? "faces" : "curves",
-      result.macroQuality ? result.macroQuality->scaled.min : 0.0);
+      records.macroQuality ? records.macroQuality->scaled.min : 0.0);
 }
 
 std::string repairLine(std::size_t k, const RepairRound& r) {
@@ -41,9 +42,7 @@ std::string repairLine(std::size_t k, const RepairRound& r) {
 }
 
 std::string listed(const std::vector<std::string>& stages) {
-  std::string text;
-  for (const std::string& s : stages) text += (text.empty() ? "" : ", ") + s;
-  return text.empty() ? std::string("none") : text;
+  return stages.empty() ? std::string("none") : joined(stages);
 }
 
 }  // namespace
@@ -72,26 +71,28 @@ std::vector<std::string> predictionLines(const SizingResult& s, int dim) {
                     dim == 3 ? "domain volume" : "domain area", s.prediction.domainMeasure)};
 }
 
-std::vector<std::string> meshSummaryLines(const MeshResult& result) {
+std::vector<std::string> meshSummaryLines(const CurvedMesh& curved, const StageRecords& records) {
   std::vector<std::string> lines;
-  for (const std::string& action : result.healing.actions)
+  for (const std::string& action : records.healing.actions)
     lines.push_back("healed the CAD: " + action);
-  if (result.healing.renumbered)
+  if (records.healing.renumbered)
     lines.push_back(formatted("note: face numbers are the healed model's (%d faces, were %d)",
-                              result.healing.facesAfter, result.healing.facesBefore));
-  for (const std::string& note : result.notes) lines.push_back("note: " + note);
-  if (result.sizing)
-    for (std::string& line : predictionLines(*result.sizing, result.mesh.dim))
+                              records.healing.facesAfter, records.healing.facesBefore));
+  for (const std::string& note : records.notes) lines.push_back("note: " + note);
+  if (records.sizing)
+    for (std::string& line : predictionLines(*records.sizing, curved.mesh.dim))
       lines.push_back(std::move(line));
-  lines.push_back(qualityHeadline(result.mesh, result.quality));
-  if (result.boundaryLayer && result.layerSplit) lines.push_back(boundaryLayerLine(result));
-  for (std::size_t k = 0; k < result.rounds.size(); ++k)
-    lines.push_back(repairLine(k, result.rounds[k]));
-  if (result.job.stopped())
+  lines.push_back(qualityHeadline(curved.mesh, curved.quality));
+  if (records.boundaryLayer && records.layerSplit)
+    lines.push_back(boundaryLayerLine(records, curved.mesh.dim));
+  for (std::size_t k = 0; k < records.rounds.size(); ++k)
+    lines.push_back(repairLine(k, records.rounds[k]));
+  if (records.job.stopped())
     lines.push_back(formatted(
         "the job time limit of %g s stopped it (stopped: time budget): cut short: %s; left out: "
         "%s",
-        result.job.timeLimit, listed(result.job.cut).c_str(), listed(result.job.skipped).c_str()));
+        records.job.timeLimit, listed(records.job.cut).c_str(),
+        listed(records.job.skipped).c_str()));
   return lines;
 }
 

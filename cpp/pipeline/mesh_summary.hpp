@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/mesh.hpp"
-#include "pipeline/mesh_pipeline.hpp"
+#include "pipeline/stage_records.hpp"
 #include "quality/mesh_quality.hpp"
 
 namespace homesh {
@@ -22,6 +22,9 @@ std::vector<std::string> predictionLines(const SizingResult& sizing, int dim);
 
 // Everything a meshing job has to say, in order: what healing did, the notes, the sizing and
 // prediction, the headline, the boundary layer, each repair round and the job's time budget.
-std::vector<std::string> meshSummaryLines(const MeshResult& result);
+std::vector<std::string> meshSummaryLines(const CurvedMesh& curved, const StageRecords& records);
+inline std::vector<std::string> meshSummaryLines(const MeshResult& result) {
+  return meshSummaryLines(result, result);
+}
 
 }  // namespace homesh

@@ -1,7 +1,6 @@
 #include "pipeline/meshing_options.hpp"
 
 #include <algorithm>
-#include <functional>
 
 #include "core/error.hpp"
 
@@ -27,7 +26,8 @@ void MeshingOptions::validate() const {
     throw ParameterError("writing the sizing octree needs octree sizing, not a uniform size");
   if (size && sizing)
     throw ParameterError(
-        "give either a uniform size or the sizing parameters (MinDelta, MaxDelta, EPS), not both");
+        "give either a uniform size or octree sizing (MinDelta, MaxDelta, EPS, refinement "
+        "sources), not both");
   if (sizing) {
     SizingParameters check = *sizing;  // automatic values are checked once known
     if (check.maxDelta == 0.0) check.maxDelta = std::max(1.0, check.minDelta);
@@ -44,9 +44,8 @@ SizingParameters& sizingOf(MeshingOptions& o) {
 }
 
 // Where each table key goes in MeshingOptions, given its checked number.
-using Setter = std::function<void(MeshingOptions&, double)>;
-const std::map<std::string, Setter>& setters() {
-  static const std::map<std::string, Setter> table = {
+const OptionSetters<MeshingOptions>& setters() {
+  static const OptionSetters<MeshingOptions> table = {
       {"order", [](MeshingOptions& o, double v) { o.order = static_cast<int>(v); }},
       {"size",
        [](MeshingOptions& o, double v) {
@@ -72,41 +71,16 @@ const std::map<std::string, Setter>& setters() {
   return table;
 }
 
-std::string joined(const std::vector<std::string>& words) {
-  std::string out;
-  for (const std::string& w : words) {
-    if (!out.empty()) out += ", ";
-    out += w;
-  }
-  return out;
-}
-
 }  // namespace
 
 std::vector<std::string> MeshingOptions::keys(const std::vector<std::string>& allowed) {
-  std::vector<std::string> out;
-  for (const ParameterDefinition& p : parameterDefinitions()) {
-    const bool listed = allowed.empty()
-                            ? setters().count(p.key) != 0
-                            : std::find(allowed.begin(), allowed.end(), p.key) != allowed.end();
-    if (listed) out.emplace_back(p.key);
-  }
-  return out;
+  return optionKeys(setters(), allowed);
 }
 
 void MeshingOptions::apply(const OptionMap& values, const std::vector<std::string>& allowed) {
   const bool sizes =
       values.count("min_delta") + values.count("max_delta") + values.count("eps") > 0;
-  for (const auto& [key, value] : values) {
-    const double number = checkedOption(key, value);  // unknown keys and bad values named here
-    const auto setter = setters().find(key);
-    const bool wanted =
-        allowed.empty() || std::find(allowed.begin(), allowed.end(), key) != allowed.end();
-    if (setter == setters().end() || !wanted)
-      throw ParameterError("option '" + key +
-                           "' does not apply here (options: " + joined(keys(allowed)) + ")");
-    setter->second(*this, number);
-  }
+  applyOptions(*this, values, setters(), allowed, "here");
   if (size && !sizes) sizing.reset();  // asked for together, validate() names both
   validate();
 }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "cad/cad_model.hpp"
+#include "pipeline/mesh_pipeline.hpp"  // kContinuationOrder
 
 namespace homesh {
 namespace {
@@ -98,8 +99,8 @@ std::string predictReportJson(const SizingResult& sizing, const std::string& inp
   return json.str();
 }
 
-void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
-  const BoundaryLayerRecord& r = *result.boundaryLayer;
+void appendBoundaryLayer(JsonWriter& json, const StageRecords& records) {
+  const BoundaryLayerRecord& r = *records.boundaryLayer;
   json.beginObject("boundary_layer");
   json.numbers("faces",
                std::vector<std::size_t>(r.parameters.faces.begin(), r.parameters.faces.end()));
@@ -110,8 +111,8 @@ void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
   json.value("min", r.thicknessMin);
   json.value("max", r.thicknessMax);
   json.endObject();
-  if (result.layerSplit) {  // measured on the split layer (layer_split.hpp)
-    const LayerSplitStats& s = *result.layerSplit;
+  if (records.layerSplit) {  // measured on the split layer (layer_split.hpp)
+    const LayerSplitStats& s = *records.layerSplit;
     json.beginObject("first_height");
     json.value("min", s.firstHeightMin);
     json.value("max", s.firstHeightMax);
@@ -140,57 +141,58 @@ void appendBoundaryLayer(JsonWriter& json, const MeshResult& result) {
   json.value("shrink_passes", static_cast<std::size_t>(r.shrinkPasses));
   json.value("released_around_invalid", r.release != LayerRelease::None);
   json.value("release", std::string(layerReleaseName(r.release)));
-  if (result.macroQuality) {
-    json.value("macro_worst_scaled_jacobian", result.macroQuality->scaled.min);
-    json.value("macro_invalid", result.macroQuality->invalid);
-    json.value("macro_undecided", result.macroQuality->undecided);
+  if (records.macroQuality) {
+    json.value("macro_worst_scaled_jacobian", records.macroQuality->scaled.min);
+    json.value("macro_invalid", records.macroQuality->invalid);
+    json.value("macro_undecided", records.macroQuality->undecided);
   }
-  if (result.layerSplit) {
-    json.value("split_projected_nodes", result.layerSplit->projected);
-    json.value("split_max_projection", result.layerSplit->maxProjection);
-    json.value("split_plain_columns", result.layerSplit->plainColumns);
+  if (records.layerSplit) {
+    json.value("split_projected_nodes", records.layerSplit->projected);
+    json.value("split_max_projection", records.layerSplit->maxProjection);
+    json.value("split_plain_columns", records.layerSplit->plainColumns);
   }
   json.value("seconds", r.seconds);
   json.endObject();
 }
 
-std::string meshReportJson(const MeshResult& result, const std::string& input) {
+std::string meshReportJson(const CurvedMesh& curved, const StageRecords& records,
+                           const std::string& input) {
   JsonWriter json;
   json.beginObject();
   json.value("input", input);
-  if (result.cad) {
+  if (curved.cad) {
     json.beginObject("cad");
-    json.value("solids", result.cad->numSolids());
-    json.value("faces", result.cad->numFaces());
-    json.value("edges", result.cad->numEdges());
-    json.value("vertices", result.cad->numVertices());
-    json.value("diagonal", result.cad->boundingDiagonal());
+    json.value("solids", curved.cad->numSolids());
+    json.value("faces", curved.cad->numFaces());
+    json.value("edges", curved.cad->numEdges());
+    json.value("vertices", curved.cad->numVertices());
+    json.value("diagonal", curved.cad->boundingDiagonal());
     json.endObject();
-    appendHealing(json, result.healing);
+    appendHealing(json, records.healing);
   }
-  json.value("dimension", result.mesh.dim);
-  json.value("order", result.mesh.order);
-  json.value("size", result.options.size.value_or(0.0));
-  json.value("nodes", result.mesh.numNodes());
-  appendCounts(json, result.mesh);
-  json.value("tangent_ears_split", result.tangentEars);
-  if (result.sizing) {
+  json.value("dimension", curved.mesh.dim);
+  json.value("order", curved.mesh.order);
+  json.value("size", records.options.size.value_or(0.0));
+  json.value("nodes", curved.mesh.numNodes());
+  appendCounts(json, curved.mesh);
+  json.value("tangent_ears_split", records.tangentEars);
+  if (records.sizing) {
     json.value("predicted_elements",
-               static_cast<std::size_t>(std::llround(result.sizing->prediction.elements)));
-    appendSizing(json, *result.sizing);
+               static_cast<std::size_t>(std::llround(records.sizing->prediction.elements)));
+    appendSizing(json, *records.sizing);
   }
-  appendQuality(json, result.mesh, result.quality);
-  if (result.geometry) appendGeometry(json, *result.geometry);
-  if (result.optimiser) appendOptimiser(json, *result.optimiser);
-  if (result.lowOrderOptimiser)
-    appendOptimiser(json, *result.lowOrderOptimiser,
+  appendQuality(json, curved.mesh, curved.quality);
+  if (records.geometry) appendGeometry(json, *records.geometry);
+  if (records.optimiser) appendOptimiser(json, *records.optimiser);
+  if (records.lowOrderOptimiser)
+    appendOptimiser(json, *records.lowOrderOptimiser,
                     "optimiser_order_" + std::to_string(kContinuationOrder));
-  appendRepairRounds(json, result.rounds);
-  if (result.boundaryLayer) appendBoundaryLayer(json, result);
-  appendStrings(json, "notes", result.notes);
-  appendJob(json, result.job);
+  appendRepairRounds(json, records.rounds);
+  if (records.boundaryLayer) appendBoundaryLayer(json, records);
+  appendStrings(json, "notes", records.notes);
+  appendJob(json, records.job);
   json.beginObject("timings_s");
-  for (const auto& [stage, s] : result.timings.seconds) json.value(stage, s);
+  for (const auto& [stage, s] : records.timings.seconds) json.value(stage, s);
   json.endObject();
   json.endObject();
   return json.str();

@@ -218,30 +218,36 @@ OptionMap optionMapFrom(const bp::dict& d) {
   return values;
 }
 
-// The Python-visible mesh: a pipeline result (or a mesh rebuilt from saved arrays).
+// The Python-visible mesh: the curved mesh a job made (or a mesh read from a file or rebuilt from
+// saved arrays) and, apart, its job's records, from which report() and summary() are written.
 class PyMesh {
  public:
-  explicit PyMesh(MeshResult result) : result_(std::make_shared<MeshResult>(std::move(result))) {}
+  PyMesh(CurvedMesh curved, StageRecords records)
+      : curved_(std::make_shared<const CurvedMesh>(std::move(curved))),
+        records_(std::make_shared<const StageRecords>(std::move(records))) {}
+  explicit PyMesh(MeshResult result)
+      : PyMesh(std::move(static_cast<CurvedMesh&>(result)),
+               std::move(static_cast<StageRecords&>(result))) {}
 
-  int order() const { return result_->mesh.order; }
-  int dim() const { return result_->mesh.dim; }
-  std::size_t numNodes() const { return result_->mesh.numNodes(); }
-  std::size_t numElements() const { return result_->mesh.numElements(); }
-  bool hasCad() const { return static_cast<bool>(result_->cad); }
+  int order() const { return curved_->mesh.order; }
+  int dim() const { return curved_->mesh.dim; }
+  std::size_t numNodes() const { return curved_->mesh.numNodes(); }
+  std::size_t numElements() const { return curved_->mesh.numElements(); }
+  bool hasCad() const { return static_cast<bool>(curved_->cad); }
 
-  np::ndarray nodes() const { return toArray(result_->mesh.xyz, numNodes(), 3); }
-  np::ndarray nodeCadDim() const { return toArray(result_->mesh.nodeCadDim, numNodes(), 0); }
-  np::ndarray nodeCadIndex() const { return toArray(result_->mesh.nodeCadIndex, numNodes(), 0); }
-  np::ndarray nodeCadParams() const { return toArray(result_->mesh.nodeCadParam, numNodes(), 2); }
+  np::ndarray nodes() const { return toArray(curved_->mesh.xyz, numNodes(), 3); }
+  np::ndarray nodeCadDim() const { return toArray(curved_->mesh.nodeCadDim, numNodes(), 0); }
+  np::ndarray nodeCadIndex() const { return toArray(curved_->mesh.nodeCadIndex, numNodes(), 0); }
+  np::ndarray nodeCadParams() const { return toArray(curved_->mesh.nodeCadParam, numNodes(), 2); }
   bp::tuple planeNormal() const {
-    const auto& n = result_->mesh.planeNormal;
+    const auto& n = curved_->mesh.planeNormal;
     return bp::make_tuple(n[0], n[1], n[2]);
   }
 
   // [(type name, order, connectivity (E, npe) int64, entity (E,) int32), ...]
   bp::list blocks() const {
     bp::list out;
-    for (const ElementBlock& b : result_->mesh.blocks)
+    for (const ElementBlock& b : curved_->mesh.blocks)
       out.append(bp::make_tuple(cellShortName(b.type), b.order,
                                 toArray(b.nodes, b.count(), b.nodesPerElement()),
                                 toArray(b.entity, b.count(), 0)));
@@ -249,11 +255,11 @@ class PyMesh {
   }
 
   np::ndarray scaledJacobian() const {
-    return toArray(result_->quality.scaledJacobian, result_->quality.scaledJacobian.size(), 0);
+    return toArray(curved_->quality.scaledJacobian, curved_->quality.scaledJacobian.size(), 0);
   }
 
   bp::dict qualitySummary() const {
-    const QualitySummary& q = result_->quality;
+    const QualitySummary& q = curved_->quality;
     bp::dict d;
     d["min"] = q.scaled.min;
     d["mean"] = q.scaled.mean;
@@ -276,26 +282,26 @@ class PyMesh {
   }
 
   np::ndarray distortion() const {
-    return toArray(result_->quality.distortion, result_->quality.distortion.size(), 0);
+    return toArray(curved_->quality.distortion, curved_->quality.distortion.size(), 0);
   }
 
   // Upper ends of the intervals that hold each element's min J / max J.
   np::ndarray scaledJacobianUpper() const {
-    const auto& v = result_->quality.scaledJacobianUpper;
+    const auto& v = curved_->quality.scaledJacobianUpper;
     return toArray(v, v.size(), 0);
   }
 
   // Per element: 1 proven valid, -1 invalid, 0 undecided.
   np::ndarray validity() const {
     std::vector<std::int8_t> v;
-    for (const Validity x : result_->quality.validity)
+    for (const Validity x : curved_->quality.validity)
       v.push_back(x == Validity::Valid ? 1 : x == Validity::Invalid ? -1 : 0);
     return toArray(v, v.size(), 0);
   }
 
   bp::dict timings() const {
     bp::dict d;
-    for (const auto& [stage, s] : result_->timings.seconds) d[stage] = s;
+    for (const auto& [stage, s] : records_->timings.seconds) d[stage] = s;
     return d;
   }
 
@@ -317,26 +323,28 @@ class PyMesh {
       options.groups.push_back(std::move(group));
     }
     const ReleaseGil nogil;
-    writeMeshFiles(*result_, {path}, options);
+    writeMeshFiles(*curved_, {path}, options);
     if (std::filesystem::path(path).extension() != ".xml") return "";
-    const NektarReadBack check = checkNektarReadBack(path, result_->options.threads);
+    const NektarReadBack check = checkNektarReadBack(path, records_->options.threads);
     return check.proven() ? "" : check.line();
   }
 
   np::ndarray elementVolumes() const {
-    const std::vector<double> v = elementMeasures(result_->mesh);
+    const std::vector<double> v = elementMeasures(curved_->mesh);
     return toArray(v, v.size(), 0);
   }
 
-  std::string reportJson(const std::string& input) const { return meshReportJson(*result_, input); }
+  std::string reportJson(const std::string& input) const {
+    return meshReportJson(*curved_, *records_, input);
+  }
 
   // pipeline/mesh_summary.hpp's lines and headline, as the CLI prints them.
   bp::list summaryLines() const {
     bp::list out;
-    for (const std::string& line : meshSummaryLines(*result_)) out.append(line);
+    for (const std::string& line : meshSummaryLines(*curved_, *records_)) out.append(line);
     return out;
   }
-  std::string headline() const { return qualityHeadline(result_->mesh, result_->quality); }
+  std::string headline() const { return qualityHeadline(curved_->mesh, curved_->quality); }
 
   // A copy of this mesh optimised (optimise/optimiser.hpp) with the options of a dict keyed as
   // the parameter table (OptimiserOptions::apply checks them), and the optimiser's JSON record.
@@ -344,23 +352,26 @@ class PyMesh {
     OptimiserOptions options;
     options.apply(optionMapFrom(given));
     const int threads = options.threads;
-    MeshResult copy = *result_;
+    CurvedMesh copy = *curved_;
+    StageRecords records = *records_;
     OptimiserResult record;
     {
       const ReleaseGil nogil;
       // A mesh made from CAD keeps it: boundary nodes slide on their curves and faces.
       record = optimiseMesh(copy.mesh, options, nullptr, copy.cad.get());
       copy.quality = evaluateQuality(copy.mesh, threads);
-      if (copy.cad) copy.geometry = measureGeometryAccuracy(copy.mesh, *copy.cad, threads);
+      if (copy.cad) records.geometry = measureGeometryAccuracy(copy.mesh, *copy.cad, threads);
     }
     JsonWriter json;
     json.beginObject();
     appendOptimiser(json, record);
     json.endObject();
-    return bp::make_tuple(PyMesh(std::move(copy)), json.str());
+    return bp::make_tuple(PyMesh(std::move(copy), std::move(records)), json.str());
   }
 
-  std::shared_ptr<const MeshResult> result_;  // immutable: safe to read without the GIL
+  // Immutable, so safe to read without the GIL.
+  std::shared_ptr<const CurvedMesh> curved_;
+  std::shared_ptr<const StageRecords> records_;
 };
 
 Eigen::Vector3d pointFrom(const bp::object& p, const std::string& what) {
@@ -454,7 +465,7 @@ const std::vector<std::string> kReadKeys = {"threads"};
 // The table keys the front-end function `function` ("mesh", "curve", "sizing": predict and
 // size_field, "read", "optimise": HighOrderMesh.optimise) takes, in the table's order, for
 // homesh/api.py's keywords and docstrings.
-bp::list optionKeys(const std::string& function) {
+bp::list frontEndKeys(const std::string& function) {
   const std::vector<std::string>* keys = function == "mesh"     ? &kMeshKeys
                                          : function == "curve"  ? &kCurveKeys
                                          : function == "sizing" ? &kSizingKeys
@@ -670,8 +681,8 @@ PyMesh curveFile(const std::string& path, const bp::object& nodes, const bp::obj
 PyMesh meshFromArrays(int dim, int order, const bp::object& nodes, const bp::object& cadDim,
                       const bp::object& cadIndex, const bp::object& cadParams,
                       const bp::list& blocks, const bp::tuple& normal) {
-  MeshResult result;
-  Mesh& mesh = result.mesh;
+  CurvedMesh curved;
+  Mesh& mesh = curved.mesh;
   mesh.dim = dim;
   mesh.order = order;
   if (dim != 2 && dim != 3) throw ParameterError("dim must be 2 or 3");
@@ -691,22 +702,24 @@ PyMesh meshFromArrays(int dim, int order, const bp::object& nodes, const bp::obj
     mesh.blocks.push_back(std::move(block));
   }
   mesh.checkConsistency();
-  result.quality = evaluateQuality(mesh);
-  result.options.order = order;
-  return PyMesh(std::move(result));
+  curved.quality = evaluateQuality(mesh);
+  StageRecords records;
+  records.options.order = order;
+  return {std::move(curved), std::move(records)};
 }
 
 // Reads a mesh file (.msh, .xml) and evaluates its quality.
 PyMesh readMeshFile(const std::string& path, const bp::dict& given) {
   const int threads = MeshingOptions::fromMap(optionMapFrom(given), kReadKeys).threads;
-  std::unique_ptr<MeshResult> result = std::make_unique<MeshResult>();
+  CurvedMesh curved;
+  StageRecords records;
   {
     const ReleaseGil nogil;
-    result->mesh = readMesh(path, &result->notes);
-    result->quality = evaluateQuality(result->mesh, threads);
+    curved.mesh = readMesh(path, &records.notes);
+    curved.quality = evaluateQuality(curved.mesh, threads);
   }
-  result->options.order = result->mesh.order;
-  return PyMesh(std::move(*result));
+  records.options.order = curved.mesh.order;
+  return {std::move(curved), std::move(records)};
 }
 
 // Reference coordinates (equispaced, Gmsh order) of the nodes of (type, order): (nodes x dim).
@@ -819,7 +832,7 @@ BOOST_PYTHON_MODULE(_core) {
   bp::def("predict_brep", &predictBrep,
           (bp::arg("text"), bp::arg("name"), bp::arg("options"), bp::arg("octree_path") = ""));
   bp::def("parameters", &parameters);
-  bp::def("option_keys", &optionKeys, (bp::arg("function")));
+  bp::def("option_keys", &frontEndKeys, (bp::arg("function")));
   bp::def("parameter_in_range", &parameterInRange, (bp::arg("key"), bp::arg("value")));
   bp::def(
       "curve_brep", &curveBrep,

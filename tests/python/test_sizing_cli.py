@@ -318,3 +318,15 @@ def test_case_and_octree_output_are_checked_first(homesh_bin, tmp_path):
     assert result.returncode == 1  # as for any bad output path
     assert "octree.txt" in result.stderr and "unknown mesh format" in result.stderr
     assert stages_run(result.stderr) == []  # refused before any stage ran
+
+
+def test_uniform_size_and_octree_sizing_are_refused_together(homesh_bin, tmp_path):
+    # The rule is the core's (MeshingOptions::validate), reached the same way from every front end.
+    case = write_box_hole_case(tmp_path)
+    for extra, says in ((["--max-delta", "1"], "not both"),
+                        (["--refine-sphere", "0,0,0,1,0.1"], "not both"),
+                        (["--write-octree", tmp_path / "octree.vtu"], "needs octree sizing")):
+        result = run([homesh_bin, "mesh", case, "--size", "1", *extra])
+        assert result.returncode == 2, (extra, result.stderr)
+        assert says in result.stderr, (extra, result.stderr)
+        assert stages_run(result.stderr) == []  # refused before any stage ran
