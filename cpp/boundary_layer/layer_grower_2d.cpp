@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -43,6 +44,7 @@ class LayerGrower2D {
 
   Mesh run(const LinearMeshOptions& fill) {
     directions();
+    fitToClearance();
     shrink();
     return assemble(fill);
   }
@@ -65,6 +67,10 @@ class LayerGrower2D {
     // bisector (the neighbours' relaxation uses the fan's end on their side).
     std::vector<Vec> fan, fanTops;
     std::array<std::size_t, 2> fanSegs{};
+    // Along its directions, the distance to the first other boundary segment, and its curve (0:
+    // none within kRayReach heights asked).
+    double clearance = std::numeric_limits<double>::infinity();
+    int clearanceCurve = 0;
   };
   using Seg = std::array<std::int64_t, 2>;
 
@@ -396,20 +402,52 @@ class LayerGrower2D {
   // ray p -> q crosses, but those around wall node w and the side curve it climbs.
   std::optional<int> crossedCurve(const WallNode& w, const Vec& p, const Vec& q,
                                   const std::vector<Seg>& all) const {
-    for (std::size_t s = 0; s < all.size(); ++s) {
-      if (all[s][0] == w.id || all[s][1] == w.id) continue;
-      if (s >= wallSegs_.size() && sideCurve_[s - wallSegs_.size()] == w.sideCurve) continue;
-      const Vec a = at(out_, all[s][0]), b = at(out_, all[s][1]);
-      // p + u (q - p) = a + v (b - a), in the plane.
-      const Vec r = q - p, e = b - a;
-      const double den = r.cross(e).dot(normal_);
-      if (std::fabs(den) <= 1e-14 * r.norm() * e.norm()) continue;
-      const double u = (a - p).cross(e).dot(normal_) / den;
-      const double v = (a - p).cross(r).dot(normal_) / den;
-      if (u > 1e-9 && u < 1.0 && v >= 0.0 && v <= 1.0)
-        return s < wallSegs_.size() ? wallCurve_[s] : sideCurve_[s - wallSegs_.size()];
-    }
+    for (std::size_t s = 0; s < all.size(); ++s)
+      if (!std::isnan(segmentHit(w, p, q, all, s))) return curveOf(s);
     return std::nullopt;
+  }
+
+  // The curve of segment s of wall segments then side segments.
+  int curveOf(std::size_t s) const {
+    return s < wallSegs_.size() ? wallCurve_[s] : sideCurve_[s - wallSegs_.size()];
+  }
+
+  // Where the ray p -> q crosses segment s of `all`, as the share of p -> q; NaN where it does not
+  // or where the segment is around wall node w or on the side curve it climbs.
+  double segmentHit(const WallNode& w, const Vec& p, const Vec& q, const std::vector<Seg>& all,
+                    std::size_t s) const {
+    if (all[s][0] == w.id || all[s][1] == w.id) return kNaN;
+    if (s >= wallSegs_.size() && sideCurve_[s - wallSegs_.size()] == w.sideCurve) return kNaN;
+    const Vec a = at(out_, all[s][0]), b = at(out_, all[s][1]);
+    // p + u (q - p) = a + v (b - a), in the plane.
+    const Vec r = q - p, e = b - a;
+    const double den = r.cross(e).dot(normal_);
+    if (std::fabs(den) <= 1e-14 * r.norm() * e.norm()) return kNaN;
+    const double u = (a - p).cross(e).dot(normal_) / den;
+    const double v = (a - p).cross(r).dot(normal_) / den;
+    return u > 1e-9 && u < 1.0 && v >= 0.0 && v <= 1.0 ? u : kNaN;
+  }
+
+  // Each node's clearance along its directions (the fan's, at a fan), and its height brought at
+  // once to what the shrink loop's ray rule would make of it (clearanceFactor).
+  void fitToClearance() {
+    std::vector<Seg> all = wallSegs_;
+    all.insert(all.end(), sideSegs_.begin(), sideSegs_.end());
+    for (WallNode& w : wall_) {
+      const Vec p = at(out_, w.id);
+      // No farther than the model's diagonal: a wall within it is met as well, and the hit's
+      // share of the ray stays clear of segmentHit's end-point margin.
+      const double reach = std::min(kRayReach * w.full, cad_.boundingDiagonal());
+      for (const Vec& d : w.fan.empty() ? std::vector<Vec>{w.d} : w.fan)
+        for (std::size_t s = 0; s < all.size(); ++s) {
+          const double hit = segmentHit(w, p, p + reach * d, all, s);
+          if (!std::isnan(hit) && hit * reach < w.clearance) {
+            w.clearance = hit * reach;
+            w.clearanceCurve = curveOf(s);
+          }
+        }
+      w.factor = clearanceFactor(w.clearance, w.full);
+    }
   }
 
   void shrink() {
@@ -419,7 +457,11 @@ class LayerGrower2D {
           for (WallNode& w : wall_) place(w);
         },
         [this](const WallNode& w) {
-          return "Edge" + std::to_string(w.curve) + " cannot be grown at " + where(w);
+          std::string text = "Edge" + std::to_string(w.curve) + " cannot be grown at " + where(w);
+          if (w.clearanceCurve != 0)
+            text += " (Edge" + std::to_string(w.clearanceCurve) + " is " +
+                    formatNumber(w.clearance) + " away along the layer's normal)";
+          return text;
         });
   }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -32,21 +33,26 @@ double triangleShape(const Vec& a, const Vec& b, const Vec& c) {
   return edges > 0.0 ? 2.0 * std::sqrt(3.0) * area2 / edges : 0.0;
 }
 
-// Whether segment p-q crosses triangle abc (Moller-Trumbore, the end points excluded).
-bool segmentCrosses(const Vec& p, const Vec& q, const Vec& a, const Vec& b, const Vec& c) {
+// Where segment p-q crosses triangle abc, as the share t of p-q (Moller-Trumbore, the end
+// points excluded); NaN where it does not.
+double segmentHit(const Vec& p, const Vec& q, const Vec& a, const Vec& b, const Vec& c) {
   const Vec d = q - p, e1 = b - a, e2 = c - a;
   const Vec h = d.cross(e2);
   const double det = e1.dot(h);
-  if (std::fabs(det) <= 1e-14 * e1.norm() * e2.norm() * d.norm()) return false;
+  if (std::fabs(det) <= 1e-14 * e1.norm() * e2.norm() * d.norm()) return kNaN;
   const double inv = 1.0 / det;
   const Vec s = p - a;
   const double u = inv * s.dot(h);
-  if (u < 0.0 || u > 1.0) return false;
+  if (u < 0.0 || u > 1.0) return kNaN;
   const Vec qv = s.cross(e1);
   const double v = inv * d.dot(qv);
-  if (v < 0.0 || u + v > 1.0) return false;
+  if (v < 0.0 || u + v > 1.0) return kNaN;
   const double t = inv * e2.dot(qv);
-  return t > 1e-9 && t < 1.0;
+  return t > 1e-9 && t < 1.0 ? t : kNaN;
+}
+
+bool segmentCrosses(const Vec& p, const Vec& q, const Vec& a, const Vec& b, const Vec& c) {
+  return !std::isnan(segmentHit(p, q, a, b, c));
 }
 
 // Scaled Jacobian at the six corners of the linear prism (wall a, b, c; tops A, B, C), smallest.
@@ -79,6 +85,7 @@ class LayerGrower {
   Mesh run(const LinearMeshOptions& fill) {
     directions();
     heights();
+    fitToClearance();
     shrink();
     return assemble(fill);
   }
@@ -87,13 +94,17 @@ class LayerGrower {
   // How a wall node may move: freely, on one face without a layer, or on the curve where two
   // such faces meet.
   struct WallNode {
-    std::int64_t id = 0;                  // node of out_
-    std::vector<int> sideFaces;           // faces without a layer through the node
-    int curve = 0;                        // with two side faces: their common curve
-    int face = 0;                         // a layer face the node lies on (for the report)
-    Vec d = Vec::Zero();                  // unit growth direction (into the solid)
-    double full = 0.0, factor = 1.0;      // asked thickness, share of it grown
-    Vec top = Vec::Zero();                // the top node's position
+    std::int64_t id = 0;              // node of out_
+    std::vector<int> sideFaces;       // faces without a layer through the node
+    int curve = 0;                    // with two side faces: their common curve
+    int face = 0;                     // a layer face the node lies on (for the report)
+    Vec d = Vec::Zero();              // unit growth direction (into the solid)
+    double full = 0.0, factor = 1.0;  // asked thickness, share of it grown
+    Vec top = Vec::Zero();            // the top node's position
+    // Along d, the distance to the first other wall, and its face (0: none within kRayReach
+    // heights asked).
+    double clearance = std::numeric_limits<double>::infinity();
+    int clearanceFace = 0;
     double u = kNaN, v = kNaN;            // its CAD parameters (side face or curve)
     std::vector<std::size_t> facets;      // layer triangles around it
     std::vector<std::size_t> neighbours;  // wall nodes sharing a layer edge
@@ -396,6 +407,39 @@ class LayerGrower {
     }
   }
 
+  // Each node's clearance along its direction, and its height brought at once to what the
+  // shrink loop's ray rule would make of it (clearanceFactor).
+  void fitToClearance() {
+    for (WallNode& w : wall_) {
+      const Vec p = at(out_, w.id);
+      // No farther than the model's diagonal: a wall within it is met as well, and the hit's
+      // share of the ray stays clear of segmentHit's end-point margin.
+      const Vec q = p + std::min(kRayReach * w.full, cad_.boundingDiagonal()) * w.d;
+      const Vec lo = p.cwiseMin(q), hi = p.cwiseMax(q);
+      for (std::size_t t = 0; t < walls_.triangles.size(); ++t) {
+        if (aroundNode(w, t, lo, hi)) continue;
+        const Tri& f = walls_.triangles[t];
+        const double hit = segmentHit(p, q, at(out_, f[0]), at(out_, f[1]), at(out_, f[2]));
+        if (!std::isnan(hit) && hit * (q - p).norm() < w.clearance) {
+          w.clearance = hit * (q - p).norm();
+          w.clearanceFace = walls_.faces[t];
+        }
+      }
+      w.factor = clearanceFactor(w.clearance, w.full);
+    }
+  }
+
+  // Whether wall triangle t is left out of w's ray test: outside the ray's box [lo, hi], around
+  // the node, or on a face the node climbs.
+  bool aroundNode(const WallNode& w, std::size_t t, const Vec& lo, const Vec& hi) const {
+    const std::pair<Vec, Vec>& box = walls_.boxes[t];
+    if ((box.first.array() > hi.array()).any() || (box.second.array() < lo.array()).any())
+      return true;
+    const Tri& f = walls_.triangles[t];
+    if (std::find(f.begin(), f.end(), w.id) != f.end()) return true;
+    return std::find(w.sideFaces.begin(), w.sideFaces.end(), walls_.faces[t]) != w.sideFaces.end();
+  }
+
   void heights() {
     for (WallNode& w : wall_) {
       const Vec x = at(out_, w.id);
@@ -481,24 +525,16 @@ class LayerGrower {
       }
     }
     // The normal, extended, must not cross a wall that is not around the node.
-    const std::vector<Tri>& all = walls_.triangles;
-    const std::vector<int>& allFace = walls_.faces;
-    const std::vector<std::pair<Vec, Vec>>& boxes = walls_.boxes;
     for (std::size_t i = 0; i < wall_.size(); ++i) {
       const WallNode& w = wall_[i];
       const Vec p = at(out_, w.id);
       const Vec q = p + kRayReach * (w.top - p);
       const Vec lo = p.cwiseMin(q), hi = p.cwiseMax(q);
-      for (std::size_t t = 0; t < all.size(); ++t) {
-        if ((boxes[t].first.array() > hi.array()).any() ||
-            (boxes[t].second.array() < lo.array()).any())
-          continue;
-        const Tri& f = all[t];
-        if (std::find(f.begin(), f.end(), w.id) != f.end()) continue;
-        if (std::find(w.sideFaces.begin(), w.sideFaces.end(), allFace[t]) != w.sideFaces.end())
-          continue;
+      for (std::size_t t = 0; t < walls_.triangles.size(); ++t) {
+        if (aroundNode(w, t, lo, hi)) continue;
+        const Tri& f = walls_.triangles[t];
         if (segmentCrosses(p, q, at(out_, f[0]), at(out_, f[1]), at(out_, f[2]))) {
-          bad.emplace(i, "the layer would reach Face" + std::to_string(allFace[t]));
+          bad.emplace(i, "the layer would reach Face" + std::to_string(walls_.faces[t]));
           break;
         }
       }
@@ -514,7 +550,11 @@ class LayerGrower {
           relaxSide();
         },
         [this](const WallNode& w) {
-          return "Face" + std::to_string(w.face) + " cannot be grown at " + where(w);
+          std::string text = "Face" + std::to_string(w.face) + " cannot be grown at " + where(w);
+          if (w.clearanceFace != 0)
+            text += " (Face" + std::to_string(w.clearanceFace) + " is " +
+                    formatNumber(w.clearance) + " away along the layer's normal)";
+          return text;
         });
   }
 

@@ -31,4 +31,10 @@ Vec curveTangent(const CadModel& cad, int curve, double t, double towards) {
   return d.norm() > 0.0 ? Vec(d.normalized()) : Vec(Vec::Zero());
 }
 
+double clearanceFactor(double clearance, double full) {
+  const double reach = kRayReach * full;
+  if (!(clearance > 0.0) || !(clearance < reach)) return 1.0;
+  return std::pow(kShrinkStep, std::ceil(std::log(clearance / reach) / std::log(kShrinkStep)));
+}
+
 }  // namespace homesh::layer_growth

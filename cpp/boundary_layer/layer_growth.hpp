@@ -56,13 +56,40 @@ double parameterOnCurve(const Mesh& mesh, const CadModel& cad, int curve, std::i
 // does: the NACA splines' cosine spacing at their ends; shorter chords there drown in rounding).
 Vec curveTangent(const CadModel& cad, int curve, double t, double towards);
 
+// The power of kShrinkStep that the shrink loop's clearance rule (the normal, extended to
+// kRayReach heights, must cross no other wall) would bring a height to, given `clearance`, the
+// distance along the normal to the first wall it crosses, and `full`, the height asked: 1 when the
+// height fits. Reached in one step, so that a layer far thicker than the space around it
+// (a thickness of 1e9 in a unit box) leaves the loop's passes to the other rules.
+double clearanceFactor(double clearance, double full);
+
+// Grades the heights (Node: factor, full, neighbours): none more than kGrading times a
+// neighbour's.
+template <class Node>
+void gradeHeights(std::vector<Node>& nodes) {
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (Node& w : nodes)
+      for (const std::size_t n : w.neighbours) {
+        const double cap = kGrading * nodes[n].factor * nodes[n].full;
+        if (w.factor * w.full > cap * (1.0 + 1e-12)) {
+          w.factor = cap / w.full;
+          changed = true;
+        }
+      }
+  }
+}
+
 // Shrinks the flagged wall nodes (Node: factor, full, neighbours) by kShrinkStep and grades the
-// rest (no height more than kGrading times a neighbour's), re-placing every node with
-// `placeAll`, until `offenders` (node index -> why) flags none. Returns the passes taken; throws
-// MeshingError with `describe(node)` (where the layer is) after kMaxShrinkPasses.
+// rest (gradeHeights; first of all too, when a node starts below its full height), re-placing
+// every node with `placeAll`, until `offenders` (node index -> why) flags none. Returns the
+// passes taken; throws MeshingError with `describe(node)` (where the layer is) and the height
+// asked there after kMaxShrinkPasses.
 template <class Node, class Offenders, class PlaceAll, class Describe>
 int shrinkUntilClear(std::vector<Node>& nodes, Offenders offenders, PlaceAll placeAll,
                      Describe describe) {
+  if (std::any_of(nodes.begin(), nodes.end(), [](const Node& w) { return w.factor < 1.0; }))
+    gradeHeights(nodes);
   placeAll();
   for (int pass = 0;; ++pass) {
     const std::map<std::size_t, std::string> bad = offenders();
@@ -70,26 +97,17 @@ int shrinkUntilClear(std::vector<Node>& nodes, Offenders offenders, PlaceAll pla
     if (pass == kMaxShrinkPasses) {
       const Node& w = nodes[bad.begin()->first];
       throw MeshingError("the boundary layer on " + describe(w) + ": " + bad.begin()->second +
-                         " even at " + formatNumber(w.factor) + " of the thickness");
+                         " even at " + formatNumber(w.factor) + " of the " + formatNumber(w.full) +
+                         " asked there");
     }
     for (const auto& [i, why] : bad) nodes[i].factor *= kShrinkStep;
-    for (bool changed = true; changed;) {
-      changed = false;
-      for (Node& w : nodes)
-        for (const std::size_t n : w.neighbours) {
-          const double cap = kGrading * nodes[n].factor * nodes[n].full;
-          if (w.factor * w.full > cap * (1.0 + 1e-12)) {
-            w.factor = cap / w.full;
-            changed = true;
-          }
-        }
-    }
+    gradeHeights(nodes);
     placeAll();
   }
 }
 
-// The record's macro heights, first-layer heights and shrink entries (per layer face or curve,
-// `entity(node)`: the smallest factor, where, how many nodes) from the grown wall nodes.
+// The record's macro heights and per layer face or curve (`entity(node)`) its columns, how many
+// were shrunk, the smallest factor and where, from the grown wall nodes.
 template <class Node, class Entity>
 void recordHeights(BoundaryLayerRecord& record, const BoundaryLayerParameters& p, const Mesh& mesh,
                    const std::vector<Node>& nodes, Entity entity) {
@@ -97,14 +115,15 @@ void recordHeights(BoundaryLayerRecord& record, const BoundaryLayerParameters& p
   record.wallNodes = nodes.size();
   record.thicknessMin = std::numeric_limits<double>::infinity();
   record.thicknessMax = 0.0;
-  std::map<int, LayerShrink> shrunk;
+  std::map<int, LayerShrink> faces;
   for (const Node& w : nodes) {
     const double h = (w.top - at(mesh, w.id)).norm();
     record.thicknessMin = std::min(record.thicknessMin, h);
     record.thicknessMax = std::max(record.thicknessMax, h);
-    if (w.factor >= 0.999) continue;
-    LayerShrink& s = shrunk[entity(w)];
+    LayerShrink& s = faces[entity(w)];
     s.face = entity(w);
+    ++s.columns;
+    if (w.factor >= 0.999) continue;
     ++s.nodes;
     if (s.nodes == 1 || w.factor < s.factor) {
       s.factor = w.factor;
@@ -112,7 +131,8 @@ void recordHeights(BoundaryLayerRecord& record, const BoundaryLayerParameters& p
       s.where = {x.x(), x.y(), x.z()};
     }
   }
-  for (auto& [face, s] : shrunk) record.shrunk.push_back(s);
+  record.faces.clear();
+  for (auto& [face, s] : faces) record.faces.push_back(s);
 }
 
 }  // namespace homesh::layer_growth

@@ -16,4 +16,11 @@ const char* layerReleaseName(LayerRelease release) {
   return "none";
 }
 
+std::vector<LayerShrink> BoundaryLayerRecord::shrunk() const {
+  std::vector<LayerShrink> out;
+  for (const LayerShrink& f : faces)
+    if (f.nodes > 0) out.push_back(f);
+  return out;
+}
+
 }  // namespace homesh

@@ -11,12 +11,18 @@
 
 namespace homesh {
 
-// Where the layer was grown thinner than asked: per face, the smallest factor and where.
+// How much of one layer face (2D: curve) got the height asked: its columns (one per wall node),
+// how many were grown thinner, the smallest share grown and where.
 struct LayerShrink {
   int face = 0;
-  std::array<double, 3> where{};  // the wall node with the smallest factor
+  std::array<double, 3> where{};  // the wall node with the smallest factor (when nodes > 0)
   double factor = 1.0;            // grown height / asked thickness there
   std::size_t nodes = 0;          // wall nodes of the face whose height was reduced
+  std::size_t columns = 0;        // wall nodes of the face
+  // Share of the face's columns grown to the height asked.
+  double fullHeight() const {
+    return columns == 0 ? 1.0 : 1.0 - static_cast<double>(nodes) / static_cast<double>(columns);
+  }
 };
 
 // How far the optimiser let a macro layer's top move (BoundaryLayerRecord::release).
@@ -28,7 +34,9 @@ struct BoundaryLayerRecord {
   BoundaryLayerParameters parameters;
   double thicknessMin = 0, thicknessMax = 0;  // macro heights grown at the wall nodes
   // (The first split layer's height, as measured, is the split's: LayerSplitStats.)
-  std::vector<LayerShrink> shrunk;
+  std::vector<LayerShrink> faces;  // every layer face (2D: curve), in order
+  // The faces where the layer was grown thinner than asked somewhere.
+  std::vector<LayerShrink> shrunk() const;
   std::size_t cells = 0;  // macro cells: prisms (3D), quadrilaterals (2D)
   // 2D: triangles of the fans at sharp convex corners of the wall (a column per wall curve's
   // normal there and between them, instead of one along the bisector): part of the layer, split

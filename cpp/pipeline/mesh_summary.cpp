@@ -21,12 +21,19 @@ std::string boundaryLayerLine(const StageRecords& records, int dim) {
   const BoundaryLayerRecord& b = *records.boundaryLayer;
   const LayerSplitStats& s = *records.layerSplit;
   const bool solid = dim == 3;
+  std::size_t columns = 0, shrunk = 0;
+  for (const LayerShrink& f : b.faces) {
+    columns += f.columns;
+    shrunk += f.nodes;
+  }
   return formatted(
       "boundary layer: %zu macro %s split into %d layers, height %g to %g, first layer %g to %g "
-      "(worst %.2f %% off); shrunk on %zu %s; macro mesh worst %.4f",
+      "(worst %.2f %% off); %.1f %% of the columns at full height (shrunk on %zu %s); macro "
+      "mesh worst %.4f",
       b.cells, solid ? "prisms" : "quadrilaterals", b.parameters.layers, b.thicknessMin,
       b.thicknessMax, s.firstHeightMin, s.firstHeightMax, 100.0 * s.firstHeightDeviation,
-      b.shrunk.size(), solid ? "faces" : "curves",
+      columns == 0 ? 100.0 : 100.0 * static_cast<double>(columns - shrunk) / columns,
+      b.shrunk().size(), solid ? "faces" : "curves",
       records.macroQuality ? records.macroQuality->scaled.min : 0.0);
 }
 

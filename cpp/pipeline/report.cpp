@@ -124,12 +124,23 @@ void appendBoundaryLayer(JsonWriter& json, const StageRecords& records) {
     json.endObject();
   }
   json.beginArray("shrunk");
-  for (const LayerShrink& s : r.shrunk) {
+  for (const LayerShrink& s : r.shrunk()) {
     json.beginObject();
     json.value("face", static_cast<std::size_t>(s.face));
     json.numbers("where", std::vector<double>(s.where.begin(), s.where.end()));
     json.value("factor", s.factor);
     json.value("nodes", s.nodes);
+    json.endObject();
+  }
+  json.endArray();
+  json.beginArray("columns");  // every layer face: how much of it got the height asked
+  for (const LayerShrink& s : r.faces) {
+    json.beginObject();
+    json.value("face", static_cast<std::size_t>(s.face));
+    json.value("columns", s.columns);
+    json.value("full_height", s.fullHeight());
+    json.value("smallest_factor", s.factor);
+    if (s.nodes > 0) json.numbers("where", std::vector<double>(s.where.begin(), s.where.end()));
     json.endObject();
   }
   json.endArray();

@@ -68,7 +68,7 @@ void expectValidWithLayersInEveryWallColumn(const MeshResult& r, const std::set<
                                             int layers) {
   ASSERT_TRUE(r.boundaryLayer.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
-  EXPECT_TRUE(r.boundaryLayer->shrunk.empty());
+  EXPECT_TRUE(r.boundaryLayer->shrunk().empty());
   const Mesh& m = r.mesh;
   std::map<std::array<std::int64_t, 3>, const std::int64_t*> byBottom;
   std::size_t prisms = 0;

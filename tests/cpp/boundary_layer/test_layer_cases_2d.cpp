@@ -27,7 +27,7 @@ TEST(BoundaryLayer2D, AerofoilIsValidWithSixQuadrilateralsOnEveryWallLineAndItsF
   ASSERT_TRUE(r.boundaryLayer.has_value());
   EXPECT_EQ(r.mesh.dim, 2);
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
-  EXPECT_TRUE(r.boundaryLayer->shrunk.empty());
+  EXPECT_TRUE(r.boundaryLayer->shrunk().empty());
   ASSERT_EQ(r.boundaryLayer->release, LayerRelease::None);  // the layer as grown: heights hold
   double worst = 0.0;
   expectQuadrilateralColumnsOnEveryWallLine(r, {2, 4}, 6, 0.1 * (1 - 1.5) / (1 - std::pow(1.5, 6)),
@@ -153,7 +153,7 @@ TEST(BoundaryLayer2D, OwnNacaCaseHasItsLayersItsFirstHeightAndATrailingEdgeFan) 
   EXPECT_EQ(r.mesh.dim, 2);
   EXPECT_EQ(r.mesh.order, 4);
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
-  EXPECT_TRUE(r.boundaryLayer->shrunk.empty());
+  EXPECT_TRUE(r.boundaryLayer->shrunk().empty());
   const double first = kThickness * (1 - kProgression) / (1 - std::pow(kProgression, kLayers));
   // The top fixed or at most sliding parallel to the wall: the heights as grown, so the first
   // layer's (the top's component along the wall normal; the split's, along the normal line)

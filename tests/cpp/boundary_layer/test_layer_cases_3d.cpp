@@ -224,7 +224,8 @@ TEST(BoundaryLayerOnAHole, FirstLayerHeightAlongTheWallNormalIsWithinFivePercent
   ASSERT_TRUE(r.boundaryLayer.has_value());
   ASSERT_TRUE(r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
-  EXPECT_TRUE(r.boundaryLayer->shrunk.empty());
+  EXPECT_TRUE(r.boundaryLayer->shrunk().empty());
+  for (const LayerShrink& face : r.boundaryLayer->faces) EXPECT_EQ(face.fullHeight(), 1.0);
   const double expected =
       kHoleThickness * (1 - kHoleProgression) / (1 - std::pow(kHoleProgression, kHoleLayers));
   double worst = 0.0;

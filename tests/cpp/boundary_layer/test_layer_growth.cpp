@@ -2,6 +2,10 @@
 // where, and the faces, thicknesses and tangent neighbours it refuses, named.
 #include <gtest/gtest.h>
 
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <gp.hxx>
+#include <gp_Pln.hxx>
+
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -30,14 +34,18 @@ TEST(BoundaryLayer, AThinGapShrinksTheLayerAndTheRecordSaysWhere) {
   p.thickness = "0.06";
   BoundaryLayerRecord record;
   const Mesh mesh = growBoundaryLayer(volume, cad, p, fill, record);
-  ASSERT_EQ(record.shrunk.size(), 2U);
-  for (const LayerShrink& s : record.shrunk) {
+  ASSERT_EQ(record.shrunk().size(), 2U);
+  for (const LayerShrink& s : record.shrunk()) {
     EXPECT_TRUE(s.face == 5 || s.face == 6);
     EXPECT_LT(s.factor, 0.7);  // 2.5 heights must fit in the 0.1 gap: at most 0.04 of 0.06
     EXPECT_GT(s.factor, 0.0);
     EXPECT_GT(s.nodes, 0U);
     EXPECT_NEAR(s.where[2], s.face == 5 ? 0.0 : 0.1, 1e-12);
+    // Every column of both faces faces the other across the gap: none at full height.
+    EXPECT_EQ(s.nodes, s.columns);
+    EXPECT_EQ(s.fullHeight(), 0.0);
   }
+  EXPECT_EQ(record.faces.size(), 2U);
   EXPECT_LE(record.thicknessMax, 0.04);
   EXPECT_GT(record.thicknessMin, 0.0);
   // Every prism positive at its corners, the tops of both layers apart, the whole linear mesh
@@ -62,6 +70,56 @@ TEST(BoundaryLayer, AThinGapShrinksTheLayerAndTheRecordSaysWhere) {
   EXPECT_EQ(quads, record.sideQuadrilaterals);
   const QualitySummary q = evaluateQuality(mesh);
   EXPECT_EQ(q.invalid + q.undecided, 0U);
+}
+
+// A layer a billion times thicker than the unit cube it is asked in: every column is brought to
+// what the space along its normal allows (2.5 heights within the cube's side, the ray rule), the
+// layer is grown and valid, and the record says that no column got the height asked.
+TEST(BoundaryLayer, ALayerThickerThanTheSolidShrinksToFitAndTheRecordSaysSo) {
+  const CadModel cad = test::toModel(test::box(1.0, 1.0, 1.0));
+  const LinearMeshOptions fill = LinearMeshOptions::uniform(0.25);
+  const Mesh volume = generateLinearMesh(cad, fill);
+  BoundaryLayerParameters p;
+  p.faces = {1};  // x = 0
+  p.thickness = "1e9";
+  BoundaryLayerRecord record;
+  const Mesh mesh = growBoundaryLayer(volume, cad, p, fill, record);
+  ASSERT_EQ(record.faces.size(), 1U);
+  const LayerShrink& face = record.faces[0];
+  EXPECT_EQ(face.face, 1);
+  EXPECT_GT(face.columns, 4U);
+  EXPECT_EQ(face.nodes, face.columns);
+  EXPECT_EQ(face.fullHeight(), 0.0);
+  EXPECT_LE(face.factor * 1e9, 1.0 / 2.5);  // the ray rule: 2.5 heights within the side
+  EXPECT_NEAR(face.where[0], 0.0, 1e-12);
+  EXPECT_LE(record.thicknessMax, 1.0 / 2.5);
+  EXPECT_GT(record.thicknessMin, 0.0);
+  EXPECT_EQ(record.shrunk().size(), 1U);
+  EXPECT_GT(record.cells, 0U);
+  const QualitySummary q = evaluateQuality(mesh);
+  EXPECT_EQ(q.invalid + q.undecided, 0U);
+}
+
+// The same in 2D, through the whole pipeline: a unit square with a layer of 1e9 on one side.
+TEST(BoundaryLayer, APlanarLayerThickerThanTheFaceShrinksToFitAndIsCertified) {
+  const TopoDS_Shape square = BRepBuilderAPI_MakeFace(gp_Pln(gp::XOY()), 0.0, 1.0, 0.0, 1.0).Face();
+  MeshingOptions options;
+  options.order = 2;
+  options.size = 0.2;
+  BoundaryLayerParameters p;
+  p.faces = {1};
+  p.thickness = "1e9";
+  options.boundaryLayer = p;
+  const MeshResult r = runMeshPipeline(CadSource::brepText(test::brepText(square)), options);
+  ASSERT_TRUE(r.boundaryLayer.has_value());
+  ASSERT_EQ(r.boundaryLayer->faces.size(), 1U);
+  const LayerShrink& curve = r.boundaryLayer->faces[0];
+  EXPECT_EQ(curve.face, 1);
+  EXPECT_GT(curve.columns, 2U);
+  EXPECT_EQ(curve.fullHeight(), 0.0);
+  EXPECT_LE(r.boundaryLayer->thicknessMax, 1.0 / 2.5);
+  EXPECT_GT(r.boundaryLayer->thicknessMin, 0.0);
+  EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
 }
 
 TEST(BoundaryLayer, MissingFacesAndBadThicknessesAreNamed) {
