@@ -11,12 +11,23 @@
 
 namespace homesh::layer_splitting {
 
+double LayerSplitter::lengthening(const std::int64_t* v, int walls, const double* l) const {
+  double s = 0.0;
+  for (int k = 0; k < walls; ++k) {
+    const auto it = lengthened_.find(v[k]);
+    s += l[k] * (it == lengthened_.end() ? 1.0 : it->second);
+  }
+  return s;
+}
+
 double LayerSplitter::grownHeight(const std::int64_t* v, int walls, const double* l) const {
   if (grown_ == nullptr) return std::nan("");
   double h = 0.0;
   for (int k = 0; k < walls; ++k) {
     const auto id = static_cast<std::size_t>(v[k]);
-    h += l[k] * (id < grown_->size() ? (*grown_)[id] : std::nan(""));
+    const auto it = lengthened_.find(v[k]);
+    h += l[k] * (id < grown_->size() ? (*grown_)[id] : std::nan("")) /
+         (it == lengthened_.end() ? 1.0 : it->second);
   }
   return h;
 }
@@ -43,6 +54,13 @@ const Column& LayerSplitter::column(const ElementBlock& b, const std::map<Lattic
     const Eigen::Vector3d rise =
         Eigen::Vector3d(&macro_.xyz[3 * static_cast<std::size_t>(topNode)]) - x0;
     const Eigen::Vector3d n = normal->second.sum.normalized();
+    // A lengthened column at a sharp edge or corner leans between its walls by design and ends
+    // at the height from each: measured along each wall's normal, unshifted.
+    if (normal->second.sharp() && lengthening(v, wallVertices(b), l) > 1.0) {
+      const double height = normal->second.minAlong(rise);
+      if (height > 0.0) setFirstLevel(col, z_[1] * target / height);
+      return columns_.emplace(topNode, std::move(col)).first->second;
+    }
     const double height = rise.dot(n);
     if (height > 0.0) {
       const double first = setFirstLevel(col, z_[1] * target / height);

@@ -36,6 +36,13 @@ constexpr double kShrinkStep = 0.7;      // height factor of a node flagged in a
 constexpr double kGrading = 1.25;        // neighbouring heights differ at most by this ratio
 constexpr double kMinPrismCorner = 0.1;  // scaled Jacobian at every prism corner
 constexpr double kRayReach = 2.5;        // thicknesses along the normal that must stay clear
+// A column leaning from a layer face's normal is lengthened by 1 / cos of the lean, at most this
+// much (a lean of 60 degrees): beyond, at sharper edges, it stays short of the thickness there.
+constexpr double kMaxStretch = 2.0;
+// Away from sharp edges, only a lean of more than 10 degrees (cos below this) is made up for: a
+// smaller one is the discrete normal of a curved wall (the facets' angle, 8 degrees on NekMesh's
+// 3d_bl_cyl), whose lengthening would overshoot the height measured along the CAD normal.
+constexpr double kStretchLean = 0.985;
 
 // Node i's position.
 inline Vec at(const Mesh& m, std::int64_t i) {

@@ -5,8 +5,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <vector>
 
@@ -63,9 +65,17 @@ void forEachColumn(const Mesh& mesh, Visit&& visit) {
 struct NormalSum {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int count = 0;
+  std::vector<Eigen::Vector3d> normals;  // each added
   void add(const Eigen::Vector3d& n) {
     sum += n;
     ++count;
+    normals.push_back(n);
+  }
+  // The smallest component of `v` along the normals added (+infinity when none).
+  double minAlong(const Eigen::Vector3d& v) const {
+    double least = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3d& n : normals) least = std::min(least, v.dot(n));
+    return least;
   }
   // A sharp corner: the normals spread by more than about 30 degrees (their mean is shorter
   // than cos 15 degrees).

@@ -5,6 +5,8 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
+#include <map>
 #include <vector>
 
 #include "boundary_layer/layer_parameters.hpp"
@@ -46,6 +48,11 @@ struct BoundaryLayerRecord {
   // along one.
   std::size_t wallSplits = 0;
   std::size_t sideQuadrilaterals = 0, wallNodes = 0;
+  // 3D: wall node (of the grown linear mesh) -> how many times the thickness its column was
+  // grown along its direction, where more than 1: at a sharp edge or corner the column leans
+  // between the layer faces and is lengthened so that its top lies at the thickness from each
+  // (the split then measures its first level the same way: LayerHeights::lengthened).
+  std::map<std::int64_t, double> lengthened;
   int shrinkPasses = 0;
   // The optimiser keeps the macro layer as grown unless elements stay invalid; then it lets the
   // layer's top move around them, first parallel to the wall (the heights stay; its nodes on

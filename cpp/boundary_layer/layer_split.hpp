@@ -20,6 +20,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <set>
 #include <vector>
 
@@ -55,6 +56,10 @@ struct LayerSplitStats {
 struct LayerHeights {
   std::vector<double> grown;
   std::set<std::int64_t> plain;
+  // Wall vertex -> how much longer than the thickness its column was grown
+  // (BoundaryLayerRecord::lengthened): its first level is then set and measured by the height
+  // along each wall normal at the vertex, not along their mean.
+  std::map<std::int64_t, double> lengthened;
 };
 
 // `z`: the split coordinates (BoundaryLayerParameters::splitCoordinates). `cad` may be null

@@ -107,6 +107,7 @@ class LayerSplitter {
         cad_(cad),
         grown_(heights != nullptr ? &heights->grown : nullptr),
         plain_(heights != nullptr ? heights->plain : std::set<std::int64_t>()),
+        lengthened_(heights != nullptr ? heights->lengthened : std::map<std::int64_t, double>()),
         stats_(stats),
         p_(macro.order),
         n_(static_cast<int>(z.size()) - 1) {
@@ -124,6 +125,7 @@ class LayerSplitter {
   const CadModel* cad_;
   const std::vector<double>* grown_;  // wall vertex -> height as grown (NaN elsewhere), or null
   std::set<std::int64_t> plain_;      // wall nodes whose columns are split at z as they are
+  std::map<std::int64_t, double> lengthened_;  // LayerHeights::lengthened
   LayerSplitStats& stats_;
   int p_, n_;
   Mesh out_;
@@ -175,8 +177,12 @@ class LayerSplitter {
     return z_[kk] + (z_[kk + 1] - z_[kk]) * a / p_;
   }
 
-  // The height a wall point's layer was grown to: the wall vertices' heights interpolated
-  // linearly (barycentric `l`), as blendLayerInteriors places the tops; NaN without them.
+  // How much the column at a wall point was lengthened: the wall vertices' lengthening
+  // (LayerHeights::lengthened, 1 where none) interpolated with the weights `l`.
+  double lengthening(const std::int64_t* v, int walls, const double* l) const;
+  // The height a wall point's layer was grown to: the wall vertices' heights (their columns'
+  // lengths, over their lengthening) interpolated linearly (barycentric `l`), as
+  // blendLayerInteriors places the tops; NaN without them.
   double grownHeight(const std::int64_t* v, int walls, const double* l) const;
 
   // The column above lattice point `c` of cell `v` (Column): made by the first cell reaching it.

@@ -231,7 +231,8 @@ void splitLayers(MeshResult& result, const Mesh& linear, const MeshingOptions& o
   result.macroQuality = std::move(result.quality);
   const double poor = 0.5 * std::max(result.macroQuality->scaled.min, 0.0);
   const int layers = options.boundaryLayer->layers;
-  LayerHeights heights{grownLayerHeights(linear), {}};
+  LayerHeights heights{grownLayerHeights(linear), {}, {}};
+  if (result.boundaryLayer) heights.lengthened = result.boundaryLayer->lengthened;
   LayerSplitStats stats;
   for (int attempt = 0;; ++attempt) {
     stats = LayerSplitStats();

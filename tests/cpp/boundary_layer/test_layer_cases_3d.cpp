@@ -3,6 +3,10 @@
 // the split's nodes on the CAD, the files read back, and the raise to order 6.
 #include <gtest/gtest.h>
 
+#include <BRepAlgoAPI_Cut.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <gp_Pnt.hxx>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -252,6 +256,47 @@ TEST(BoundaryLayerOnAHole, FirstLayerHeightAlongTheWallNormalIsWithinFivePercent
 TEST(BoundaryLayerOnAHole, AtOrderSixTheFirstLayerFollowsTheRaisedWall) {
   const MeshResult& r = holeInABox(6).result;
   expectRaisedToOrderSixKeepingTheFirstHeight(r);
+}
+
+// A unit cube in a box of side 4 with the layer on the cube's six faces (0.1, 3 layers,
+// progression 1.5, order 4, optimised): at its sharp convex edges and corners the columns lean
+// between the faces and are lengthened (by sqrt 2 on an edge, sqrt 3 at a corner) so that their
+// tops lie at the thickness from each face. Every column at full height, the first layer's
+// height on the flat walls exact to rounding (the tops are the faces' planes offset by it), the
+// split certified valid.
+TEST(BoundaryLayerOnACube, EdgesAndCornersKeepTheFirstLayerHeightOnEveryFace) {
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(gp_Pnt(-1.5, -1.5, -1.5), 4.0, 4.0, 4.0).Shape();
+  const TopoDS_Shape domain = BRepAlgoAPI_Cut(box, BRepPrimAPI_MakeBox(1.0, 1.0, 1.0).Shape());
+  const CadModel cad = test::toModel(domain);
+  BoundaryLayerParameters p;
+  for (int f = 1; f <= cad.numFaces(); ++f) {
+    const SurfaceBounds b = cad.faceBounds(f);  // the middle of a planar face's rectangle
+    const Eigen::Vector3d c =
+        cad.evaluateSurface(f, 0.5 * (b.uMin + b.uMax), 0.5 * (b.vMin + b.vMax)).point;
+    if (c.minCoeff() > -0.5 && c.maxCoeff() < 1.5) p.faces.push_back(f);  // the cube's
+  }
+  ASSERT_EQ(p.faces.size(), 6U);
+  p.thickness = "0.1";
+  p.layers = 3;
+  p.progression = 1.5;
+  MeshingOptions options;
+  options.order = 4;
+  options.optimiseIterations = 20;
+  options.boundaryLayer = p;
+  const MeshResult r = runMeshPipeline(CadSource::brepText(test::brepText(domain)), options);
+  ASSERT_TRUE(r.boundaryLayer.has_value());
+  ASSERT_TRUE(r.layerSplit.has_value());
+  EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
+  for (const LayerShrink& face : r.boundaryLayer->faces) EXPECT_EQ(face.fullHeight(), 1.0);
+  // Lengthened where they lean (none shorter than the thickness), the longest on the cube's
+  // corner diagonals.
+  EXPECT_FALSE(r.boundaryLayer->lengthened.empty());
+  EXPECT_NEAR(r.boundaryLayer->thicknessMax, 0.1 * std::sqrt(3.0), 1e-9);
+  EXPECT_GT(r.boundaryLayer->thicknessMin, 0.1 - 1e-9);
+  const double first = 0.1 * (1.5 - 1.0) / (std::pow(1.5, 3) - 1.0);
+  EXPECT_LT(r.layerSplit->firstHeightDeviation, 1e-9);  // rounding in the Newton measure
+  EXPECT_GT(r.layerSplit->cornerCells, 0U);
+  EXPECT_GT(r.layerSplit->firstHeightMin, 0.95 * first);  // 29 % short before the lengthening
 }
 
 }  // namespace
