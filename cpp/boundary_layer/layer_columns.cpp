@@ -56,7 +56,7 @@ const Column& LayerSplitter::column(const ElementBlock& b, const std::map<Lattic
     const Eigen::Vector3d n = normal->second.sum.normalized();
     // A lengthened column at a sharp edge or corner leans between its walls by design and ends
     // at the height from each: measured along each wall's normal, unshifted.
-    if (normal->second.sharp() && lengthening(v, wallVertices(b), l) > 1.0) {
+    if (normal->second.sharp() && lengthening(v, wallVertices(b), l) > 1.0 + 1e-9) {
       const double height = normal->second.minAlong(rise);
       if (height > 0.0) setFirstLevel(col, z_[1] * target / height);
       return columns_.emplace(topNode, std::move(col)).first->second;

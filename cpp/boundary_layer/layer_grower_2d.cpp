@@ -457,7 +457,8 @@ class LayerGrower2D {
           for (WallNode& w : wall_) place(w);
         },
         [this](const WallNode& w) {
-          std::string text = "Edge" + std::to_string(w.curve) + " cannot be grown at " + where(w);
+          std::string text = "Edge" + std::to_string(w.curve) + " (thickness " +
+                             formatNumber(w.full) + ") cannot be grown at " + where(w);
           if (w.clearanceCurve != 0)
             text += " (Edge" + std::to_string(w.clearanceCurve) + " is " +
                     formatNumber(w.clearance) + " away along the layer's normal)";

@@ -423,16 +423,19 @@ class LayerGrower {
       for (const std::size_t t : w.facets) faces.insert(layerFace_[t]);
       if (faces.size() < 2) continue;
       const Vec x = at(out_, w.id);
-      Eigen::MatrixXd normals(static_cast<Eigen::Index>(faces.size()), 3);
-      Eigen::Index row = 0;
-      Vec mean = Vec::Zero();
+      std::vector<Vec> inward;  // the faces' unit normals, into the solid (none at a pole)
       for (const int f : faces) {
         const Vec n = faceNormal(f, x);
-        const Vec inward = n.dot(w.d) >= 0.0 ? n : Vec(-n);
-        normals.row(row++) = inward.transpose();
-        mean += inward;
+        if (!n.isZero()) inward.push_back(n.dot(w.d) >= 0.0 ? n : Vec(-n));
       }
-      if (mean.norm() >= kCornerMeanNormal * static_cast<double>(faces.size())) continue;
+      Vec mean = Vec::Zero();
+      for (const Vec& n : inward) mean += n;
+      if (inward.size() < 2 ||
+          mean.norm() >= kCornerMeanNormal * static_cast<double>(inward.size()))
+        continue;
+      Eigen::MatrixXd normals(static_cast<Eigen::Index>(inward.size()), 3);
+      for (std::size_t k = 0; k < inward.size(); ++k)
+        normals.row(static_cast<Eigen::Index>(k)) = inward[k].transpose();
       const Eigen::VectorXd ones = Eigen::VectorXd::Ones(normals.rows());
       const Vec d = normals.completeOrthogonalDecomposition().solve(ones);
       if (!(d.norm() > 0.0) || !d.allFinite()) continue;
@@ -500,7 +503,10 @@ class LayerGrower {
     for (const std::size_t t : w.facets) faces.insert(layerFace_[t]);
     const Vec x = at(out_, w.id);
     double lean = 1.0;
-    for (const int f : faces) lean = std::min(lean, std::fabs(faceNormal(f, x).dot(w.d)));
+    for (const int f : faces) {
+      const Vec n = faceNormal(f, x);
+      if (!n.isZero()) lean = std::min(lean, std::fabs(n.dot(w.d)));  // (none at a pole)
+    }
     if (!w.sharp && lean > kStretchLean) return 1.0;
     return 1.0 / std::max(lean, 1.0 / kMaxStretch);
   }
@@ -604,7 +610,8 @@ class LayerGrower {
           relaxSide();
         },
         [this](const WallNode& w) {
-          std::string text = "Face" + std::to_string(w.face) + " cannot be grown at " + where(w);
+          std::string text = "Face" + std::to_string(w.face) + " (thickness " +
+                             formatNumber(w.full / w.stretch) + ") cannot be grown at " + where(w);
           if (w.clearanceFace != 0)
             text += " (Face" + std::to_string(w.clearanceFace) + " is " +
                     formatNumber(w.clearance) + " away along the layer's normal)";

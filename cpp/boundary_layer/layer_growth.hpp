@@ -90,8 +90,8 @@ void gradeHeights(std::vector<Node>& nodes) {
 // Shrinks the flagged wall nodes (Node: factor, full, neighbours) by kShrinkStep and grades the
 // rest (gradeHeights; first of all too, when a node starts below its full height), re-placing
 // every node with `placeAll`, until `offenders` (node index -> why) flags none. Returns the
-// passes taken; throws MeshingError with `describe(node)` (where the layer is) and the height
-// asked there after kMaxShrinkPasses.
+// passes taken; throws MeshingError with `describe(node)` (where the layer is and the thickness
+// asked there) after kMaxShrinkPasses.
 template <class Node, class Offenders, class PlaceAll, class Describe>
 int shrinkUntilClear(std::vector<Node>& nodes, Offenders offenders, PlaceAll placeAll,
                      Describe describe) {
@@ -104,8 +104,7 @@ int shrinkUntilClear(std::vector<Node>& nodes, Offenders offenders, PlaceAll pla
     if (pass == kMaxShrinkPasses) {
       const Node& w = nodes[bad.begin()->first];
       throw MeshingError("the boundary layer on " + describe(w) + ": " + bad.begin()->second +
-                         " even at " + formatNumber(w.factor) + " of the " + formatNumber(w.full) +
-                         " asked there");
+                         " even at " + formatNumber(w.factor) + " of its height");
     }
     for (const auto& [i, why] : bad) nodes[i].factor *= kShrinkStep;
     gradeHeights(nodes);

@@ -1,9 +1,11 @@
 #include "pipeline/closing_note.hpp"
 
+#include <cstdio>
 #include <vector>
 
 #include "cad/face_cusps.hpp"
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "io/quality_report.hpp"
 #include "pipeline/job_messages.hpp"
 #include "pipeline/repair.hpp"
@@ -94,6 +96,21 @@ std::string notValidNote(const MeshResult& result, bool linearGiven) {
   if (static_cast<int>(result.rounds.size()) == result.options.repairRounds)
     text += ", all that " + parameterText("repair_rounds") + " allows";
   return text;
+}
+
+std::vector<std::string> layerShortNotes(const BoundaryLayerRecord& layer, int dim) {
+  std::vector<std::string> notes;
+  for (const LayerShrink& f : layer.faces) {
+    if (f.fullHeight() >= kFullLayerShare && f.factor >= 0.5) continue;
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "the boundary layer on %s%d reaches its thickness on %.0f %% of its %zu columns; "
+                  "the thinnest is %s of it, at (%g, %g, %g)",
+                  dim == 3 ? "Face" : "Edge", f.face, 100.0 * f.fullHeight(), f.columns,
+                  formatNumber(f.factor).c_str(), f.where[0], f.where[1], f.where[2]);
+    notes.emplace_back(text);
+  }
+  return notes;
 }
 
 }  // namespace homesh

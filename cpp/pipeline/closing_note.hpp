@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "pipeline/mesh_pipeline.hpp"
 
@@ -12,5 +13,13 @@ namespace homesh {
 
 // `linearGiven`: the caller gave the linear mesh (no repair rounds can remesh it).
 std::string notValidNote(const MeshResult& result, bool linearGiven);
+
+// One note per layer face (2D: curve) where the layer is well short of the thickness asked:
+// fewer than kFullLayerShare of its columns at full height, or one below half of it. "the
+// boundary layer on Face5 reaches its thickness on 0 % of its 194 columns; the thinnest is
+// 4.2e-11 of it, at (0, 0, 0)". A layer the space around it could not hold is grown to fit, and
+// says so here as well as in the report.
+inline constexpr double kFullLayerShare = 0.95;
+std::vector<std::string> layerShortNotes(const BoundaryLayerRecord& layer, int dim);
 
 }  // namespace homesh

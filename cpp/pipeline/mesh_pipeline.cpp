@@ -256,6 +256,9 @@ void finishJob(MeshResult& result, JobBudget& budget, PipelineObserver* observer
                bool linearGiven) {
   if (result.quality.invalid + result.quality.undecided > 0)
     result.notes.push_back(notValidNote(result, linearGiven));
+  if (result.boundaryLayer)
+    for (std::string& note : layerShortNotes(*result.boundaryLayer, result.mesh.dim))
+      result.notes.push_back(std::move(note));
   if (budget.spent()) {
     budget.skip("geometry");
     result.notes.push_back("the boundary's distance to the CAD was not measured: " +

@@ -80,7 +80,7 @@ struct StageRecords {
 };
 
 // A job's result: the curved mesh it hands on and what its stages recorded. Python keeps the two
-// apart (the mesh is copied for a new optimisation, the records are not).
+// apart (HighOrderMesh.optimise copies both, the records with the new geometry measure).
 struct MeshResult : CurvedMesh, StageRecords {};
 
 }  // namespace homesh

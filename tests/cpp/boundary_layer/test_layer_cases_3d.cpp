@@ -229,6 +229,7 @@ TEST(BoundaryLayerOnAHole, FirstLayerHeightAlongTheWallNormalIsWithinFivePercent
   ASSERT_TRUE(r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
   EXPECT_TRUE(r.boundaryLayer->shrunk().empty());
+  EXPECT_FALSE(r.boundaryLayer->faces.empty());
   for (const LayerShrink& face : r.boundaryLayer->faces) EXPECT_EQ(face.fullHeight(), 1.0);
   const double expected =
       kHoleThickness * (1 - kHoleProgression) / (1 - std::pow(kHoleProgression, kHoleLayers));
@@ -287,6 +288,7 @@ TEST(BoundaryLayerOnACube, EdgesAndCornersKeepTheFirstLayerHeightOnEveryFace) {
   ASSERT_TRUE(r.boundaryLayer.has_value());
   ASSERT_TRUE(r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
+  ASSERT_EQ(r.boundaryLayer->faces.size(), 6U);
   for (const LayerShrink& face : r.boundaryLayer->faces) EXPECT_EQ(face.fullHeight(), 1.0);
   // Lengthened where they lean (none shorter than the thickness), the longest on the cube's
   // corner diagonals.

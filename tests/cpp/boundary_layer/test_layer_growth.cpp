@@ -120,6 +120,11 @@ TEST(BoundaryLayer, APlanarLayerThickerThanTheFaceShrinksToFitAndIsCertified) {
   EXPECT_LE(r.boundaryLayer->thicknessMax, 1.0 / 2.5);
   EXPECT_GT(r.boundaryLayer->thicknessMin, 0.0);
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
+  // Grown to fit, and the job's notes say so.
+  const std::string said = "the boundary layer on Edge1 reaches its thickness on 0 % of its";
+  EXPECT_TRUE(std::any_of(r.notes.begin(), r.notes.end(), [&](const std::string& n) {
+    return n.find(said) != std::string::npos;
+  })) << (r.notes.empty() ? "no notes" : r.notes.front());
 }
 
 TEST(BoundaryLayer, MissingFacesAndBadThicknessesAreNamed) {
