@@ -11,12 +11,14 @@
 
 namespace homesh::layer_splitting {
 
+double LayerSplitter::lengthenedAt(std::int64_t vertex) const {
+  const auto it = lengthened_.find(vertex);
+  return it == lengthened_.end() ? 1.0 : it->second;
+}
+
 double LayerSplitter::lengthening(const std::int64_t* v, int walls, const double* l) const {
   double s = 0.0;
-  for (int k = 0; k < walls; ++k) {
-    const auto it = lengthened_.find(v[k]);
-    s += l[k] * (it == lengthened_.end() ? 1.0 : it->second);
-  }
+  for (int k = 0; k < walls; ++k) s += l[k] * lengthenedAt(v[k]);
   return s;
 }
 
@@ -25,9 +27,7 @@ double LayerSplitter::grownHeight(const std::int64_t* v, int walls, const double
   double h = 0.0;
   for (int k = 0; k < walls; ++k) {
     const auto id = static_cast<std::size_t>(v[k]);
-    const auto it = lengthened_.find(v[k]);
-    h += l[k] * (id < grown_->size() ? (*grown_)[id] : std::nan("")) /
-         (it == lengthened_.end() ? 1.0 : it->second);
+    h += l[k] * (id < grown_->size() ? (*grown_)[id] : std::nan("")) / lengthenedAt(v[k]);
   }
   return h;
 }

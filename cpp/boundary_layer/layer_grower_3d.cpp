@@ -103,6 +103,7 @@ class LayerGrower {
     double full = 0.0, factor = 1.0;  // asked height along d, share of it grown
     double stretch = 1.0;             // full / the thickness asked (stretch())
     bool sharp = false;               // layer faces meet at a sharp edge or corner here
+    std::vector<Vec> faceNormals;     // layerFaceNormals, set by offsetAtEdges
     Vec top = Vec::Zero();            // the top node's position
     // Along d, the distance to the first other wall, and its face (0: none within kRayReach
     // heights asked).
@@ -411,23 +412,19 @@ class LayerGrower {
     offsetAtEdges();
   }
 
-  // At a free node where layer faces meet at a sharp edge or corner (their CAD normals spread
-  // as the split's NormalSum::sharp says), the direction whose component along each face's
-  // inward normal is the same (the least-norm solution of N d = 1): its column, lengthened by
-  // stretch(), ends at the thickness from every face, where each face's plane offset by the
-  // thickness passes. Kept where every facet around still sees it.
+  // Every node's layer face normals (WallNode::faceNormals); then, at a free node where layer
+  // faces meet at a sharp edge or corner (their CAD normals spread as the split's
+  // NormalSum::sharp says), the direction whose component along each face's inward normal is the
+  // same (the least-norm solution of N d = 1): its column, lengthened by stretch(), ends at the
+  // thickness from every face, where each face's plane offset by the thickness passes. Kept
+  // where every facet around still sees it.
   void offsetAtEdges() {
     for (WallNode& w : wall_) {
+      w.faceNormals = layerFaceNormals(w);
       if (!w.sideFaces.empty()) continue;
-      std::set<int> faces;
-      for (const std::size_t t : w.facets) faces.insert(layerFace_[t]);
-      if (faces.size() < 2) continue;
-      const Vec x = at(out_, w.id);
-      std::vector<Vec> inward;  // the faces' unit normals, into the solid (none at a pole)
-      for (const int f : faces) {
-        const Vec n = faceNormal(f, x);
-        if (!n.isZero()) inward.push_back(n.dot(w.d) >= 0.0 ? n : Vec(-n));
-      }
+      std::vector<Vec> inward = w.faceNormals;
+      for (Vec& n : inward)
+        if (n.dot(w.d) < 0.0) n = -n;  // into the solid
       Vec mean = Vec::Zero();
       for (const Vec& n : inward) mean += n;
       if (inward.size() < 2 ||
@@ -444,6 +441,19 @@ class LayerGrower {
       w.d = unit;
       w.sharp = true;
     }
+  }
+
+  // The CAD unit normals (either way round) at w of the layer faces through it, but where a
+  // face has none (a pole).
+  std::vector<Vec> layerFaceNormals(const WallNode& w) const {
+    std::set<int> faces;
+    for (const std::size_t t : w.facets) faces.insert(layerFace_[t]);
+    std::vector<Vec> normals;
+    for (const int f : faces) {
+      const Vec n = faceNormal(f, at(out_, w.id));
+      if (!n.isZero()) normals.push_back(n);
+    }
+    return normals;
   }
 
   // Each node's clearance along its direction, and its height brought at once to what the
@@ -499,14 +509,8 @@ class LayerGrower {
   // smoothing tilts it near such edges); 1 elsewhere. A column of the bare thickness would leave
   // the first layer short by that cosine (29 % at a cube's edge, 42 % at its corner).
   double stretch(const WallNode& w) const {
-    std::set<int> faces;
-    for (const std::size_t t : w.facets) faces.insert(layerFace_[t]);
-    const Vec x = at(out_, w.id);
     double lean = 1.0;
-    for (const int f : faces) {
-      const Vec n = faceNormal(f, x);
-      if (!n.isZero()) lean = std::min(lean, std::fabs(n.dot(w.d)));  // (none at a pole)
-    }
+    for (const Vec& n : w.faceNormals) lean = std::min(lean, std::fabs(n.dot(w.d)));
     if (!w.sharp && lean > kStretchLean) return 1.0;
     return 1.0 / std::max(lean, 1.0 / kMaxStretch);
   }

@@ -61,14 +61,12 @@ void forEachColumn(const Mesh& mesh, Visit&& visit) {
   }
 }
 
-// The unit normals of the cells meeting at a node, summed.
+// The unit normals of the cells meeting at a node, each and summed.
 struct NormalSum {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  int count = 0;
-  std::vector<Eigen::Vector3d> normals;  // each added
+  std::vector<Eigen::Vector3d> normals;
   void add(const Eigen::Vector3d& n) {
     sum += n;
-    ++count;
     normals.push_back(n);
   }
   // The smallest component of `v` along the normals added (+infinity when none).
@@ -79,7 +77,9 @@ struct NormalSum {
   }
   // A sharp corner: the normals spread by more than about 30 degrees (their mean is shorter
   // than cos 15 degrees).
-  bool sharp() const { return sum.norm() < kCornerMeanNormal * count; }
+  bool sharp() const {
+    return sum.norm() < kCornerMeanNormal * static_cast<double>(normals.size());
+  }
 };
 
 // Per node (3 values): for the nodes of a macro layer's top (prisms' and, in 2D,

@@ -177,8 +177,9 @@ class LayerSplitter {
     return z_[kk] + (z_[kk + 1] - z_[kk]) * a / p_;
   }
 
-  // How much the column at a wall point was lengthened: the wall vertices' lengthening
-  // (LayerHeights::lengthened, 1 where none) interpolated with the weights `l`.
+  // How much the column on a wall vertex was lengthened (LayerHeights::lengthened, 1 where none),
+  // and at a wall point: the wall vertices' interpolated with the weights `l`.
+  double lengthenedAt(std::int64_t vertex) const;
   double lengthening(const std::int64_t* v, int walls, const double* l) const;
   // The height a wall point's layer was grown to: the wall vertices' heights (their columns'
   // lengths, over their lengthening) interpolated linearly (barycentric `l`), as
