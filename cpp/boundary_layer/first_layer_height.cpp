@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "boundary_layer/layer_splitter.hpp"
+#include "element/element_map.hpp"
 #include "element/quadrature.hpp"
 
 namespace homesh::layer_splitting {
@@ -21,35 +22,28 @@ namespace {
 // (a, b) lies well to the side of the normal line, and its component along n understates the
 // height. Returns nullopt when the search does not converge inside the cell's own top (the
 // normal line leaves it through a neighbour's).
-std::optional<double> heightAlongNormal(const Mesh& mesh, const ReferenceElement& ref,
-                                        const std::int64_t* v, double a, double b,
-                                        const Eigen::Vector3d& bottom, const Eigen::Vector3d& n) {
-  const bool prism = ref.type() == CellType::Prism;
+std::optional<double> heightAlongNormal(const ElementMap& map, const Eigen::Vector3d& plane,
+                                        double a, double b, const Eigen::Vector3d& bottom,
+                                        const Eigen::Vector3d& n) {
+  const bool prism = map.reference().type() == CellType::Prism;
   Eigen::Vector3d t1, t2 = Eigen::Vector3d::Zero();
   if (prism) {
     t1 = n.unitOrthogonal();
     t2 = n.cross(t1);
   } else {
-    t1 = Eigen::Vector3d(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]).cross(n);
+    t1 = plane.cross(n);
     if (!(t1.norm() > 0.0)) return std::nullopt;
     t1.normalize();
   }
-  Eigen::VectorXd values;
-  Eigen::MatrixXd gradients;
+  Eigen::Matrix3d d;
   // Newton converges quadratically from a start within the cell; steps of 1e-12 in reference
   // coordinates (of order 1) are far below what the height needs and above rounding.
   constexpr int kIterations = 30;
   constexpr double kStep = 1e-12, kInside = 1e-9;
   for (int it = 0; it < kIterations; ++it) {
     const double xi[3] = {a, prism ? b : 1.0, 1.0};
-    ref.evaluate(xi, values, gradients);
-    Eigen::Vector3d x = Eigen::Vector3d::Zero(), da = x, db = x;
-    for (int i = 0; i < ref.numNodes(); ++i) {
-      const Eigen::Vector3d y(&mesh.xyz[3 * static_cast<std::size_t>(v[i])]);
-      x += values(i) * y;
-      da += gradients(i, 0) * y;
-      if (prism) db += gradients(i, 1) * y;
-    }
+    const Eigen::Vector3d x = map.position(xi, d);
+    const Eigen::Vector3d da = d.col(0), db = d.col(1);
     const Eigen::Vector3d offset = x - bottom;
     Eigen::Vector2d step(0.0, 0.0);
     if (prism) {
@@ -78,26 +72,20 @@ void LayerSplitter::measureFirstLayer() {
     const bool prism = b.type == CellType::Prism;
     const ReferenceElement& ref = ReferenceElement::get(b.type, p_);
     const QuadratureRule rule = quadratureRule(prism ? CellType::Triangle : CellType::Line, 2 * p_);
-    Eigen::VectorXd values;
-    Eigen::MatrixXd gradients;
+    const Eigen::Vector3d plane(out_.planeNormal[0], out_.planeNormal[1], out_.planeNormal[2]);
     for (std::size_t e = 0; e < b.count(); e += static_cast<std::size_t>(n_)) {
       const std::int64_t* v = b.element(e);  // the column's first layer
       const bool corner = cellCorner_.at(cell++) != 0;
       if (corner) ++stats_.cornerCells;
+      const ElementMap map(ref, out_.xyz.data(), v);
       for (int q = 0; q < rule.size(); ++q) {
         const auto qq = static_cast<std::size_t>(q);
         const double a = rule.points[qq * static_cast<std::size_t>(rule.dim)];
         const double bb = prism ? rule.points[qq * 2 + 1] : 0.0;
-        Eigen::Vector3d bottom = Eigen::Vector3d::Zero(), top = Eigen::Vector3d::Zero();
-        for (const double zeta : {0.0, 1.0}) {
-          const double xi[3] = {a, prism ? bb : zeta, zeta};
-          ref.evaluate(xi, values, gradients);
-          for (int i = 0; i < ref.numNodes(); ++i)
-            (zeta == 0.0 ? bottom : top) +=
-                values(i) * Eigen::Vector3d(&out_.xyz[3 * static_cast<std::size_t>(v[i])]);
-        }
-        const Eigen::Vector3d n = wallNormal(out_, ref, v, a, bb, top - bottom);
-        const std::optional<double> along = heightAlongNormal(out_, ref, v, a, bb, bottom, n);
+        const double atWall[3] = {a, prism ? bb : 0.0, 0.0}, atTop[3] = {a, prism ? bb : 1.0, 1.0};
+        const Eigen::Vector3d bottom = map.position(atWall), top = map.position(atTop);
+        const Eigen::Vector3d n = wallNormal(map, a, bb, plane, top - bottom);
+        const std::optional<double> along = heightAlongNormal(map, plane, a, bb, bottom, n);
         if (!along) ++stats_.firstHeightOffNormal;
         const double h = along ? *along : (top - bottom).dot(n);
         const double l[3] = {prism ? 1.0 - a - bb : 1.0 - a, a, bb};

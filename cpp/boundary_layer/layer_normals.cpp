@@ -11,19 +11,18 @@ namespace homesh {
 
 Eigen::Vector3d wallNormal(const Mesh& mesh, const ReferenceElement& ref, const std::int64_t* v,
                            double a, double b, const Eigen::Vector3d& towards) {
-  const bool prism = ref.type() == CellType::Prism;
+  return wallNormal(ElementMap(ref, mesh.xyz.data(), v), a, b,
+                    Eigen::Vector3d(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]),
+                    towards);
+}
+
+Eigen::Vector3d wallNormal(const ElementMap& map, double a, double b, const Eigen::Vector3d& plane,
+                           const Eigen::Vector3d& towards) {
+  const bool prism = map.reference().type() == CellType::Prism;
   const double xi[3] = {a, prism ? b : 0.0, 0.0};
-  Eigen::VectorXd values;
-  Eigen::MatrixXd gradients;
-  ref.evaluate(xi, values, gradients);
-  Eigen::Vector3d du = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
-  for (int i = 0; i < ref.numNodes(); ++i) {
-    const Eigen::Vector3d x(&mesh.xyz[3 * static_cast<std::size_t>(v[i])]);
-    du += gradients(i, 0) * x;
-    if (prism) dv += gradients(i, 1) * x;
-  }
-  const Eigen::Vector3d plane(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
-  Eigen::Vector3d n = prism ? du.cross(dv) : plane.cross(du);
+  Eigen::Matrix3d d;
+  map.position(xi, d);
+  Eigen::Vector3d n = prism ? Eigen::Vector3d(d.col(0).cross(d.col(1))) : plane.cross(d.col(0));
   if (!(n.norm() > 0.0)) return Eigen::Vector3d::Zero();
   n.normalize();
   return n.dot(towards) < 0.0 ? Eigen::Vector3d(-n) : n;

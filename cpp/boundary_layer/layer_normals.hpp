@@ -15,6 +15,7 @@
 #include "boundary_layer/layer_cells.hpp"
 #include "cad/cad_model.hpp"
 #include "core/mesh.hpp"
+#include "element/element_map.hpp"
 #include "element/reference_element.hpp"
 
 namespace homesh {
@@ -27,6 +28,9 @@ constexpr double kCornerMeanNormal = 0.966;
 // quadrilateral's edge, in the plane) at wall coordinates (a, b), on the side of `towards`.
 Eigen::Vector3d wallNormal(const Mesh& mesh, const ReferenceElement& ref, const std::int64_t* v,
                            double a, double b, const Eigen::Vector3d& towards);
+// The same on the cell's map (element/element_map.hpp), `plane` the mesh's plane normal in 2D.
+Eigen::Vector3d wallNormal(const ElementMap& map, double a, double b, const Eigen::Vector3d& plane,
+                           const Eigen::Vector3d& towards);
 
 // The unit normal of CAD curve `curve` in the mesh's plane at mesh node `node` (on the curve,
 // or one of its vertices: the end nearer parameter `near`), on the side of `towards`; zero

@@ -11,6 +11,7 @@
 
 #include "boundary_layer/layer_cells.hpp"
 #include "boundary_layer/layer_splitter.hpp"
+#include "element/element_map.hpp"
 #include "element/reference_element.hpp"
 
 namespace homesh {
@@ -82,8 +83,9 @@ ElementBlock LayerSplitter::splitCells(const ElementBlock& b) {
   out.order = p_;
   out.nodes.resize(b.count() * static_cast<std::size_t>(n_) * static_cast<std::size_t>(nn));
   out.entity.resize(b.count() * static_cast<std::size_t>(n_));
-  Eigen::MatrixXd x(nn, 3);
   Eigen::MatrixXd points(nn, dim);
+  // Each macro cell's map, made when its first new node is (a new node then costs O(nodes)).
+  std::vector<std::optional<ElementMap>> maps(b.count());
   for (std::size_t e = 0; e < b.count(); ++e) {
     bool corner = false;
     for (int k = 0; k < wallVertices(b); ++k)
@@ -95,7 +97,7 @@ ElementBlock LayerSplitter::splitCells(const ElementBlock& b) {
       const std::int64_t* v = b.element(e);
       const std::int64_t t[3] = {topVertex(b, v, 0), topVertex(b, v, 1),
                                  prism ? topVertex(b, v, 2) : kNone};
-      // The macro cell's basis at the k-th thin cell's nodes, on its columns' levels.
+      // The k-th thin cell's nodes in the macro cell's reference element, on its columns' levels.
       for (int r = 0; r < nn; ++r) {
         const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
         const std::vector<double>& z = column(b, index, v, c).levels;
@@ -104,8 +106,6 @@ ElementBlock LayerSplitter::splitCells(const ElementBlock& b) {
           points(r, static_cast<Eigen::Index>(a)) = double(c[a]) / p_;
         points(r, static_cast<Eigen::Index>(across)) = z[kk] + (z[kk + 1] - z[kk]) * c[across] / p_;
       }
-      const Eigen::MatrixXd values = ref.valuesAt(points);
-      bool gathered = false;
       const std::size_t sub = e * static_cast<std::size_t>(n_) + static_cast<std::size_t>(k);
       out.entity[sub] = b.entity[e];
       for (int r = 0; r < nn; ++r) {
@@ -125,15 +125,12 @@ ElementBlock LayerSplitter::splitCells(const ElementBlock& b) {
           if (it != nodes_.end()) {
             id = it->second;
           } else {
-            if (!gathered) {
-              for (int i = 0; i < nn; ++i)
-                for (int d = 0; d < 3; ++d) x(i, d) = macro_.xyz[3 * v[i] + d];
-              gathered = true;
-            }
+            if (!maps[e]) maps[e].emplace(ref, macro_.xyz.data(), v);
             const Column& col = column(b, index, v, c);
-            const Eigen::RowVector3d p =
-                values.row(r) * x +
-                col.shift.transpose() * col.shiftAt(points(r, static_cast<Eigen::Index>(across)));
+            const Eigen::VectorXd xi = points.row(r).transpose();
+            const Eigen::Vector3d p =
+                maps[e]->position(xi.data()) +
+                col.shift * col.shiftAt(points(r, static_cast<Eigen::Index>(across)));
             const double xyz[3] = {p(0), p(1), p(2)};
             id = out_.addNode(xyz, macro_.dim, b.entity[e], std::nan(""), std::nan(""));
             nodes_.emplace(key, id);

@@ -55,6 +55,22 @@ void ReferenceElement::evaluate(const double* xi, Eigen::VectorXd& values,
   gradients.noalias() = inverseVandermonde_.transpose() * dpsi;
 }
 
+Eigen::MatrixXd ReferenceElement::modalCoefficients(const Eigen::MatrixXd& nodal) const {
+  if (nodal.rows() != numNodes())
+    throw Error("reference element: " + std::to_string(nodal.rows()) + " nodal rows for " +
+                std::to_string(numNodes()) + " nodes");
+  return inverseVandermonde_ * nodal;
+}
+
+Eigen::RowVectorXd ReferenceElement::interpolate(const Eigen::MatrixXd& modal, const double* xi,
+                                                 Eigen::MatrixXd* derivatives) const {
+  Eigen::VectorXd psi;
+  Eigen::MatrixXd dpsi;
+  orthogonalBasis(type_, order_, xi, psi, dpsi);
+  if (derivatives != nullptr) derivatives->noalias() = dpsi.transpose() * modal;
+  return psi.transpose() * modal;
+}
+
 Eigen::MatrixXd ReferenceElement::valuesAt(const Eigen::MatrixXd& points) const {
   Eigen::MatrixXd out(points.rows(), numNodes());
   Eigen::VectorXd values;

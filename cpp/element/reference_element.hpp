@@ -47,6 +47,15 @@ class ReferenceElement {
   // optimiser, its facet term and the quality samplers lay out in their own orders.
   std::vector<Eigen::MatrixXd> derivativesAt(const Eigen::MatrixXd& points) const;
 
+  // A field given at the nodes (numNodes() x k, a row per node) as its coefficients in the
+  // orthogonal basis, V^{-1} nodal: interpolate then evaluates it at a point in O(numNodes() k),
+  // where the nodal basis costs O(numNodes()^2) a point (a dense product with V^{-1}).
+  Eigen::MatrixXd modalCoefficients(const Eigen::MatrixXd& nodal) const;
+  // The field with coefficients `modal` (modalCoefficients) at reference point xi: k values,
+  // and, where `derivatives` is given, their derivatives there (dim() x k, d/dxi_j in row j).
+  Eigen::RowVectorXd interpolate(const Eigen::MatrixXd& modal, const double* xi,
+                                 Eigen::MatrixXd* derivatives = nullptr) const;
+
   // Lebesgue constant max_xi sum_n |l_n(xi)|, estimated on a lattice of `samples` points per
   // edge (a measure of how well the node set interpolates; 1 is ideal).
   double lebesgueConstant(int samples) const;
