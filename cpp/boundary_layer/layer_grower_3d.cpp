@@ -56,17 +56,22 @@ bool segmentCrosses(const Vec& p, const Vec& q, const Vec& a, const Vec& b, cons
   return !std::isnan(segmentHit(p, q, a, b, c));
 }
 
-// Scaled Jacobian at the six corners of the linear prism (wall a, b, c; tops A, B, C), smallest.
+// The Jacobian at the six corners of the linear prism (wall a, b, c; tops A, B, C), smallest,
+// scaled by the wall triangle's area vector and the column's length: at the wall, the cosine of
+// the column's lean from the wall's normal; at the top, that times the top triangle's area as
+// projected, over the wall's. The wall triangle's own shape is the linear mesh's and no height
+// changes it: a sliver (a sharp trailing edge's cap) must not read as a fold.
 double prismCornerQuality(const std::array<Vec, 6>& v) {
+  const double wall = (v[1] - v[0]).cross(v[2] - v[0]).norm();
+  if (!(wall > 0.0)) return -1.0;
   double worst = 1.0;
   for (std::size_t top = 0; top < 2; ++top) {
     const Vec& o = v[3 * top];
-    const Vec dx = v[3 * top + 1] - o;
-    const Vec dy = v[3 * top + 2] - o;
+    const Vec area = (v[3 * top + 1] - o).cross(v[3 * top + 2] - o);
     for (std::size_t k = 0; k < 3; ++k) {
       const Vec dz = v[3 + k] - v[k];
-      const double scale = dx.norm() * dy.norm() * dz.norm();
-      worst = std::min(worst, scale > 0.0 ? dx.cross(dy).dot(dz) / scale : -1.0);
+      const double scale = wall * dz.norm();
+      worst = std::min(worst, scale > 0.0 ? area.dot(dz) / scale : -1.0);
     }
   }
   return worst;

@@ -4,7 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepOffsetAPI_ThruSections.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
+#include <GeomAPI_Interpolate.hxx>
+#include <Geom_BSplineCurve.hxx>
+#include <TColgp_HArray1OfPnt.hxx>
+#include <TopoDS_Wire.hxx>
 #include <gp_Pnt.hxx>
 
 #include <algorithm>
@@ -299,6 +306,82 @@ TEST(BoundaryLayerOnACube, EdgesAndCornersKeepTheFirstLayerHeightOnEveryFace) {
   EXPECT_LT(r.layerSplit->firstHeightDeviation, 1e-9);  // rounding in the Newton measure
   EXPECT_GT(r.layerSplit->cornerCells, 0U);
   EXPECT_GT(r.layerSplit->firstHeightMin, 0.95 * first);  // 29 % short before the lengthening
+}
+
+// A NACA 0012 section with its trailing edge open (0.25 % of the chord: the x^4 coefficient
+// -0.1015), chord `c`, leading edge at (x0, 0, z): one B-spline from the upper trailing edge round
+// the nose to the lower one (41 cosine-spaced stations a side) and the segment closing it.
+TopoDS_Wire bluntNaca0012(double c, double x0, double z) {
+  const auto yt = [](double x) {
+    return 0.6 * (0.2969 * std::sqrt(x) - 0.1260 * x - 0.3516 * x * x + 0.2843 * x * x * x -
+                  0.1015 * x * x * x * x);
+  };
+  constexpr int kStations = 40;
+  std::vector<gp_Pnt> points;
+  for (int i = kStations; i >= 0; --i) {
+    const double x = 0.5 * (1.0 - std::cos(M_PI * i / kStations));
+    points.emplace_back(x0 + c * x, c * yt(x), z);
+  }
+  for (int i = 1; i <= kStations; ++i) {
+    const double x = 0.5 * (1.0 - std::cos(M_PI * i / kStations));
+    points.emplace_back(x0 + c * x, -c * yt(x), z);
+  }
+  Handle(TColgp_HArray1OfPnt) array = new TColgp_HArray1OfPnt(1, static_cast<int>(points.size()));
+  for (std::size_t i = 0; i < points.size(); ++i)
+    array->SetValue(static_cast<int>(i) + 1, points[i]);
+  GeomAPI_Interpolate spline(array, false, 1e-9);
+  spline.Perform();
+  BRepBuilderAPI_MakeWire wire(BRepBuilderAPI_MakeEdge(spline.Curve()).Edge(),
+                               BRepBuilderAPI_MakeEdge(points.back(), points.front()).Edge());
+  return wire.Wire();
+}
+
+// The wing: NACA 0012 sections lofted from the root (chord 1, on the box's symmetry face
+// z = 0) to a flat tip (chord 0.5, z = 4), leading edge swept 30 degrees, the trailing edge blunt
+// (a face 0.25 % of the chord tall); the layer (0.02, 6 layers, 1.5) on every wing face: the
+// suction and pressure sides, the trailing-edge face and the tip. The columns along the thin
+// trailing-edge face and at the tip's corners lean far from the faces' normals, and the wall
+// triangles there are slivers; before the growth scaled a prism's corners by the wall triangle's
+// own area (not its corner angle), every height there read as a fold and no layer grew.
+// Order 2, optimised; the box smaller than the (7 x 5 x 6 chords) to keep the test short.
+TEST(BoundaryLayerOnAWing, BluntTrailingEdgeGrowsAndIsCertifiedValid) {
+  BRepOffsetAPI_ThruSections loft(true, false);
+  loft.AddWire(bluntNaca0012(1.0, 0.0, 0.0));
+  loft.AddWire(bluntNaca0012(0.5, 4.0 * std::tan(M_PI / 6.0), 4.0));
+  loft.Build();
+  ASSERT_TRUE(loft.IsDone());
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(gp_Pnt(-2.0, -2.5, 0.0), 7.0, 5.0, 6.0).Shape();
+  const TopoDS_Shape domain = BRepAlgoAPI_Cut(box, loft.Shape());
+  const CadModel cad = test::toModel(domain);
+  BoundaryLayerParameters p;
+  for (int f = 1; f <= cad.numFaces(); ++f) {
+    const SurfaceBounds b = cad.faceBounds(f);
+    const Eigen::Vector3d c =
+        cad.evaluateSurface(f, 0.5 * (b.uMin + b.uMax), 0.5 * (b.vMin + b.vMax)).point;
+    const bool onWing = c.x() > -0.01 && c.x() < 2.9 && std::fabs(c.y()) < 0.1;
+    if (onWing && c.z() > 1e-6 && c.z() < 4.0 + 1e-6) p.faces.push_back(f);
+  }
+  ASSERT_EQ(p.faces.size(), 3U);  // the sides (one spline face), the trailing-edge face, the tip
+  p.thickness = "0.02";
+  p.layers = 6;
+  p.progression = 1.5;
+  MeshingOptions options;
+  options.order = 2;
+  options.optimiseIterations = 20;
+  options.threads = 2;
+  options.boundaryLayer = p;
+  const MeshResult r = runMeshPipeline(CadSource::brepText(test::brepText(domain)), options);
+  ASSERT_TRUE(r.boundaryLayer.has_value());
+  ASSERT_TRUE(r.layerSplit.has_value());
+  EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
+  std::size_t columns = 0, full = 0;
+  for (const LayerShrink& face : r.boundaryLayer->faces) {
+    columns += face.columns;
+    full += face.columns - face.nodes;
+  }
+  EXPECT_GT(columns, 500U);
+  EXPECT_GE(static_cast<double>(full), 0.95 * static_cast<double>(columns));
+  EXPECT_GT(r.layerSplit->prisms, 500U);  // macro prisms, each split into 6
 }
 
 }  // namespace
