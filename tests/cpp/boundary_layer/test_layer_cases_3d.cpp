@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <memory>
 #include <set>
@@ -266,6 +267,38 @@ TEST(BoundaryLayerOnAHole, AtOrderSixTheFirstLayerFollowsTheRaisedWall) {
   expectRaisedToOrderSixKeepingTheFirstHeight(r);
 }
 
+// The faces of `domain` whose middle (the point at the middle of their parameter box: a planar
+// face's rectangle, a spline face's mid-span) satisfies `inside`.
+std::vector<int> facesWithMiddle(const TopoDS_Shape& domain,
+                                 const std::function<bool(const Eigen::Vector3d&)>& inside) {
+  const CadModel cad = test::toModel(domain);
+  std::vector<int> faces;
+  for (int f = 1; f <= cad.numFaces(); ++f) {
+    const SurfaceBounds b = cad.faceBounds(f);
+    if (inside(cad.evaluateSurface(f, 0.5 * (b.uMin + b.uMax), 0.5 * (b.vMin + b.vMax)).point))
+      faces.push_back(f);
+  }
+  return faces;
+}
+
+// `domain` meshed at `order` with the layer (`thickness`, `layers`, `progression`) on `faces` and
+// the optimiser (20 sweeps, `threads`).
+MeshResult meshWithLayer(const TopoDS_Shape& domain, const std::vector<int>& faces,
+                         const std::string& thickness, int layers, double progression, int order,
+                         int threads) {
+  BoundaryLayerParameters p;
+  p.faces = faces;
+  p.thickness = thickness;
+  p.layers = layers;
+  p.progression = progression;
+  MeshingOptions options;
+  options.order = order;
+  options.optimiseIterations = 20;
+  options.threads = threads;
+  options.boundaryLayer = p;
+  return runMeshPipeline(CadSource::brepText(test::brepText(domain)), options);
+}
+
 // A unit cube in a box of side 4 with the layer on the cube's six faces (0.1, 3 layers,
 // progression 1.5, order 4, optimised): at its sharp convex edges and corners the columns lean
 // between the faces and are lengthened (by sqrt 2 on an edge, sqrt 3 at a corner) so that their
@@ -275,25 +308,12 @@ TEST(BoundaryLayerOnAHole, AtOrderSixTheFirstLayerFollowsTheRaisedWall) {
 TEST(BoundaryLayerOnACube, EdgesAndCornersKeepTheFirstLayerHeightOnEveryFace) {
   const TopoDS_Shape box = BRepPrimAPI_MakeBox(gp_Pnt(-1.5, -1.5, -1.5), 4.0, 4.0, 4.0).Shape();
   const TopoDS_Shape domain = BRepAlgoAPI_Cut(box, BRepPrimAPI_MakeBox(1.0, 1.0, 1.0).Shape());
-  const CadModel cad = test::toModel(domain);
-  BoundaryLayerParameters p;
-  for (int f = 1; f <= cad.numFaces(); ++f) {
-    const SurfaceBounds b = cad.faceBounds(f);  // the middle of a planar face's rectangle
-    const Eigen::Vector3d c =
-        cad.evaluateSurface(f, 0.5 * (b.uMin + b.uMax), 0.5 * (b.vMin + b.vMax)).point;
-    if (c.minCoeff() > -0.5 && c.maxCoeff() < 1.5) p.faces.push_back(f);  // the cube's
-  }
-  ASSERT_EQ(p.faces.size(), 6U);
-  p.thickness = "0.1";
-  p.layers = 3;
-  p.progression = 1.5;
-  MeshingOptions options;
-  options.order = 4;
-  options.optimiseIterations = 20;
-  options.boundaryLayer = p;
-  const MeshResult r = runMeshPipeline(CadSource::brepText(test::brepText(domain)), options);
-  ASSERT_TRUE(r.boundaryLayer.has_value());
-  ASSERT_TRUE(r.layerSplit.has_value());
+  const std::vector<int> faces = facesWithMiddle(domain, [](const Eigen::Vector3d& c) {
+    return c.minCoeff() > -0.5 && c.maxCoeff() < 1.5;  // the cube's
+  });
+  ASSERT_EQ(faces.size(), 6U);
+  const MeshResult r = meshWithLayer(domain, faces, "0.1", 3, 1.5, 4, 1);
+  ASSERT_TRUE(r.boundaryLayer.has_value() && r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
   ASSERT_EQ(r.boundaryLayer->faces.size(), 6U);
   for (const LayerShrink& face : r.boundaryLayer->faces) EXPECT_EQ(face.fullHeight(), 1.0);
@@ -352,27 +372,13 @@ TEST(BoundaryLayerOnAWing, BluntTrailingEdgeGrowsAndIsCertifiedValid) {
   ASSERT_TRUE(loft.IsDone());
   const TopoDS_Shape box = BRepPrimAPI_MakeBox(gp_Pnt(-2.0, -2.5, 0.0), 7.0, 5.0, 6.0).Shape();
   const TopoDS_Shape domain = BRepAlgoAPI_Cut(box, loft.Shape());
-  const CadModel cad = test::toModel(domain);
-  BoundaryLayerParameters p;
-  for (int f = 1; f <= cad.numFaces(); ++f) {
-    const SurfaceBounds b = cad.faceBounds(f);
-    const Eigen::Vector3d c =
-        cad.evaluateSurface(f, 0.5 * (b.uMin + b.uMax), 0.5 * (b.vMin + b.vMax)).point;
+  const std::vector<int> faces = facesWithMiddle(domain, [](const Eigen::Vector3d& c) {
     const bool onWing = c.x() > -0.01 && c.x() < 2.9 && std::fabs(c.y()) < 0.1;
-    if (onWing && c.z() > 1e-6 && c.z() < 4.0 + 1e-6) p.faces.push_back(f);
-  }
-  ASSERT_EQ(p.faces.size(), 3U);  // the sides (one spline face), the trailing-edge face, the tip
-  p.thickness = "0.02";
-  p.layers = 6;
-  p.progression = 1.5;
-  MeshingOptions options;
-  options.order = 2;
-  options.optimiseIterations = 20;
-  options.threads = 2;
-  options.boundaryLayer = p;
-  const MeshResult r = runMeshPipeline(CadSource::brepText(test::brepText(domain)), options);
-  ASSERT_TRUE(r.boundaryLayer.has_value());
-  ASSERT_TRUE(r.layerSplit.has_value());
+    return onWing && c.z() > 1e-6 && c.z() < 4.0 + 1e-6;
+  });
+  ASSERT_EQ(faces.size(), 3U);  // the sides (one spline face), the trailing-edge face, the tip
+  const MeshResult r = meshWithLayer(domain, faces, "0.02", 6, 1.5, 2, 2);
+  ASSERT_TRUE(r.boundaryLayer.has_value() && r.layerSplit.has_value());
   EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
   std::size_t columns = 0, full = 0;
   for (const LayerShrink& face : r.boundaryLayer->faces) {
