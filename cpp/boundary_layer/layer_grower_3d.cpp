@@ -57,10 +57,13 @@ bool segmentCrosses(const Vec& p, const Vec& q, const Vec& a, const Vec& b, cons
 }
 
 // The Jacobian at the six corners of the linear prism (wall a, b, c; tops A, B, C), smallest,
-// scaled by the wall triangle's area vector and the column's length: at the wall, the cosine of
-// the column's lean from the wall's normal; at the top, that times the top triangle's area as
-// projected, over the wall's. The wall triangle's own shape is the linear mesh's and no height
-// changes it: a sliver (a sharp trailing edge's cap) must not read as a fold.
+// as (e1 x e2) . dz / (|A_wall| |dz|): e1, e2 the edges of the corner's triangle (wall or top)
+// from its first vertex, dz the corner's column, A_wall the wall triangle's area vector. At the
+// wall that is the cosine of the column's lean from the wall's normal; at the top, the top
+// triangle's area projected across the column over the wall's area. The wall triangle's own
+// angles are the linear mesh's and no height changes them: a sliver (a thin trailing-edge
+// face, a wing tip's corner) must not read as a fold. An inverted or collapsed top or wall gives
+// 0 or less.
 double prismCornerQuality(const std::array<Vec, 6>& v) {
   const double wall = (v[1] - v[0]).cross(v[2] - v[0]).norm();
   if (!(wall > 0.0)) return -1.0;

@@ -31,11 +31,13 @@ constexpr double kVisibility = 0.2;   // a direction must see every facet around
 // A layer face and a face without a layer whose CAD normals at a common node are within 6
 // degrees (|cos| above this) meet tangentially: the layer cannot climb the other face there.
 constexpr double kTangentFaces = 0.9945;
-constexpr int kMaxShrinkPasses = 40;     // 0.7^40 ~ 6e-7: a layer that thin is no layer
-constexpr double kShrinkStep = 0.7;      // height factor of a node flagged in a pass
-constexpr double kGrading = 1.25;        // neighbouring heights differ at most by this ratio
-constexpr double kMinPrismCorner = 0.1;  // scaled Jacobian at every prism corner
-constexpr double kRayReach = 2.5;        // thicknesses along the normal that must stay clear
+constexpr int kMaxShrinkPasses = 40;  // 0.7^40 ~ 6e-7: a layer that thin is no layer
+constexpr double kShrinkStep = 0.7;   // height factor of a node flagged in a pass
+constexpr double kGrading = 1.25;     // neighbouring heights differ at most by this ratio
+// Every corner of a 3D macro prism: its Jacobian over the wall's area times the column's length
+// (prismCornerQuality); a 2D quadrilateral's: its scaled Jacobian.
+constexpr double kMinPrismCorner = 0.1;
+constexpr double kRayReach = 2.5;  // thicknesses along the normal that must stay clear
 // A column leaning from a layer face's normal is lengthened by 1 / cos of the lean, at most this
 // much (a lean of 60 degrees): beyond, at sharper edges, it stays short of the thickness there.
 constexpr double kMaxStretch = 2.0;

@@ -84,8 +84,6 @@ ElementBlock LayerSplitter::splitCells(const ElementBlock& b) {
   out.nodes.resize(b.count() * static_cast<std::size_t>(n_) * static_cast<std::size_t>(nn));
   out.entity.resize(b.count() * static_cast<std::size_t>(n_));
   Eigen::MatrixXd points(nn, dim);
-  // Each macro cell's map, made when its first new node is (a new node then costs O(nodes)).
-  std::vector<std::optional<ElementMap>> maps(b.count());
   for (std::size_t e = 0; e < b.count(); ++e) {
     bool corner = false;
     for (int k = 0; k < wallVertices(b); ++k)
@@ -106,6 +104,10 @@ ElementBlock LayerSplitter::splitCells(const ElementBlock& b) {
           points(r, static_cast<Eigen::Index>(a)) = double(c[a]) / p_;
         points(r, static_cast<Eigen::Index>(across)) = z[kk] + (z[kk + 1] - z[kk]) * c[across] / p_;
       }
+      // The macro cell's map, made for the thin cell's first new node: a node then costs
+      // O(nodes) (made once per thin cell, not kept for the block: O(nodes^2) each, far below the
+      // nodes' own cost at order 6, and no block-sized store).
+      std::optional<ElementMap> map;
       const std::size_t sub = e * static_cast<std::size_t>(n_) + static_cast<std::size_t>(k);
       out.entity[sub] = b.entity[e];
       for (int r = 0; r < nn; ++r) {
@@ -125,11 +127,11 @@ ElementBlock LayerSplitter::splitCells(const ElementBlock& b) {
           if (it != nodes_.end()) {
             id = it->second;
           } else {
-            if (!maps[e]) maps[e].emplace(ref, macro_.xyz.data(), v);
+            if (!map) map.emplace(ref, macro_.xyz.data(), v);
             const Column& col = column(b, index, v, c);
             const Eigen::VectorXd xi = points.row(r).transpose();
             const Eigen::Vector3d p =
-                maps[e]->position(xi.data()) +
+                map->position(xi.data()) +
                 col.shift * col.shiftAt(points(r, static_cast<Eigen::Index>(across)));
             const double xyz[3] = {p(0), p(1), p(2)};
             id = out_.addNode(xyz, macro_.dim, b.entity[e], std::nan(""), std::nan(""));

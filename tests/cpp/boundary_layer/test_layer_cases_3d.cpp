@@ -386,6 +386,7 @@ TEST(BoundaryLayerOnAWing, BluntTrailingEdgeGrowsAndIsCertifiedValid) {
     full += face.columns - face.nodes;
   }
   EXPECT_GT(columns, 500U);
+  // The share (the larger box grows every column to full height).
   EXPECT_GE(static_cast<double>(full), 0.95 * static_cast<double>(columns));
   EXPECT_GT(r.layerSplit->prisms, 500U);  // macro prisms, each split into 6
 }
