@@ -430,17 +430,12 @@ class LayerGrower {
     for (WallNode& w : wall_) {
       w.faceNormals = layerFaceNormals(w);
       if (!w.sideFaces.empty()) continue;
-      std::vector<Vec> inward = w.faceNormals;
-      for (Vec& n : inward)
-        if (n.dot(w.d) < 0.0) n = -n;  // into the solid
-      Vec mean = Vec::Zero();
-      for (const Vec& n : inward) mean += n;
-      if (inward.size() < 2 ||
-          mean.norm() >= kCornerMeanNormal * static_cast<double>(inward.size()))
-        continue;
-      Eigen::MatrixXd normals(static_cast<Eigen::Index>(inward.size()), 3);
-      for (std::size_t k = 0; k < inward.size(); ++k)
-        normals.row(static_cast<Eigen::Index>(k)) = inward[k].transpose();
+      NormalSum inward;  // into the solid
+      for (const Vec& n : w.faceNormals) inward.add(n.dot(w.d) < 0.0 ? Vec(-n) : n);
+      if (inward.normals.size() < 2 || !inward.sharp()) continue;
+      Eigen::MatrixXd normals(static_cast<Eigen::Index>(inward.normals.size()), 3);
+      for (std::size_t k = 0; k < inward.normals.size(); ++k)
+        normals.row(static_cast<Eigen::Index>(k)) = inward.normals[k].transpose();
       const Eigen::VectorXd ones = Eigen::VectorXd::Ones(normals.rows());
       const Vec d = normals.completeOrthogonalDecomposition().solve(ones);
       if (!(d.norm() > 0.0) || !d.allFinite()) continue;

@@ -51,6 +51,8 @@ void forEachColumn(const Mesh& mesh, Visit&& visit) {
     const std::map<LatticePoint, int> index = latticeIndex(ref);
     for (std::size_t e = 0; e < b.count(); ++e) {
       const std::int64_t* v = b.element(e);
+      const ElementMap map(ref, mesh.xyz.data(), v);  // one per cell: nothing moves here
+      const Eigen::Vector3d plane(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
       for (int r = 0; r < ref.numNodes(); ++r) {
         LatticePoint c = ref.lattice()[static_cast<std::size_t>(r)];
         if (c[across] != 0) continue;
@@ -59,7 +61,7 @@ void forEachColumn(const Mesh& mesh, Visit&& visit) {
         const Eigen::Vector3d rise = Eigen::Vector3d(&mesh.xyz[3 * static_cast<std::size_t>(top)]) -
                                      Eigen::Vector3d(&mesh.xyz[3 * static_cast<std::size_t>(v[r])]);
         visit(v[r], top,
-              wallNormal(mesh, ref, v, double(c[0]) / p, prism ? double(c[1]) / p : 0.0, rise));
+              wallNormal(map, double(c[0]) / p, prism ? double(c[1]) / p : 0.0, plane, rise));
       }
     }
   }
