@@ -176,6 +176,28 @@ void gmshPrism(Nodes& out, const std::vector<P3>& v, int n) {
   }
 }
 
+// Gmsh's pyramid: base corners 0-3, apex 4; the eight edges, the four triangles' interiors, the
+// base's interior (as the quadrilateral 0, 3, 2, 1), then the interior: a pyramid of order n - 3
+// one lattice step inside every face.
+void gmshPyramid(Nodes& out, const std::vector<P3>& v, int n) {
+  if (n == 0) {
+    out.push_back(v[0]);
+    return;
+  }
+  corners(out, v);
+  edges(out, v, {{0, 1}, {0, 3}, {0, 4}, {1, 2}, {1, 4}, {2, 3}, {2, 4}, {3, 4}}, n);
+  for (const auto& f : Faces{{0, 1, 4}, {3, 0, 4}, {1, 2, 4}, {2, 3, 4}})
+    triangleInterior(out, v[f[0]], v[f[1]], v[f[2]], n);
+  quadrilateralInterior(out, v[0], v[3], v[2], v[1], n);
+  if (n >= 3)
+    gmshPyramid(out,
+                {inward(v[0], {v[1], v[3], v[4]}, n), inward(v[1], {v[0], v[2], v[4]}, n),
+                 inward(v[2], {v[1], v[3], v[4]}, n), inward(v[3], {v[0], v[2], v[4]}, n),
+                 // the apex steps down the axis: one step towards the base's diagonal ends
+                 inward(v[4], {v[0], v[2]}, n)},
+                n - 3);
+}
+
 void vtkQuadrilateral(Nodes& out, int n) {
   // (push_back rather than insert of a list: GCC 12 warns falsely about the latter here)
   for (const P3& corner : {P3{0, 0, 0}, P3{n, 0, 0}, P3{n, n, 0}, P3{0, n, 0}})
@@ -280,6 +302,10 @@ std::vector<LatticePoint> latticeOrder(CellType type, int order, NodeConvention 
         vtkHexahedron(out, v, n);
       break;
     }
+    case CellType::Pyramid:
+      if (!gmsh) throw ParameterError("no VTK node ordering for a pyramid");
+      gmshPyramid(out, {{0, 0, 0}, {n, 0, 0}, {n, n, 0}, {0, n, 0}, {0, 0, n}}, n);
+      break;
     default:
       throw ParameterError("no node ordering for " + cellShortName(type));
   }

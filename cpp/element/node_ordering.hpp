@@ -1,12 +1,15 @@
 // Node orderings of complete Lagrange elements (line, triangle, quadrilateral, tetrahedron,
-// prism, hexahedron) in Gmsh's and VTK's conventions.
+// prism, hexahedron in Gmsh's and VTK's conventions; pyramid in Gmsh's).
 //
 // A node of an order-P element is named by its integer lattice point c = (i, j, k): its
 // equispaced reference position is c / P (unused coordinates are 0). Vertices are at the
 // corners: triangle (0,0) (P,0) (0,P); quadrilateral (0,0) (P,0) (P,P) (0,P); tetrahedron the
 // origin and P times the unit vectors; prism the triangle at k = 0 then at k = P; hexahedron the
-// quadrilateral at k = 0 then at k = P. Any node set (equispaced, GLL, warp & blend) names its
-// nodes by the same lattice points, so connectivity does not depend on the node set.
+// quadrilateral at k = 0 then at k = P; pyramid the square (0,0) (P,0) (P,P) (0,P) at k = 0 and
+// the apex (0,0,P) above its first corner, its level k holding 0 <= i, j <= P - k (an affine
+// image of Gmsh's pyramid, whose apex is above the square's centre). Any node set (equispaced, GLL,
+// warp & blend) names its nodes by the same lattice points, so connectivity does not depend on the
+// node set.
 //
 // Gmsh orders nodes as vertices, edge interiors (edge by edge, from its first vertex to its
 // second), face interiors (each a recursively ordered triangle or quadrilateral on the face's

@@ -1,5 +1,6 @@
 #include "element/orthogonal_basis.hpp"
 
+#include <algorithm>
 #include <array>
 #include <string>
 #include <vector>
@@ -51,6 +52,13 @@ Dual<D> operator*(double s, Dual<D> a) {
   a.v *= s;
   for (int k = 0; k < D; ++k) a.g[k] *= s;
   return a;
+}
+template <int D>
+Dual<D> operator/(const Dual<D>& a, const Dual<D>& b) {
+  Dual<D> r;
+  r.v = a.v / b.v;
+  for (int k = 0; k < D; ++k) r.g[k] = (a.g[k] - r.v * b.g[k]) / b.v;
+  return r;
 }
 template <int D>
 Dual<D> operator*(const Dual<D>& a, const Dual<D>& b) {
@@ -186,6 +194,48 @@ void prismBasis(int p, const double* xi, Eigen::VectorXd& values, Eigen::MatrixX
   store<3>(funcs, values, grads);
 }
 
+// Bergot, Cohen and Durufle's basis ("Higher-order finite elements for hybrid meshes using new
+// nodal pyramidal elements", J. Sci. Comput. 2010), which Gmsh's pyramids use:
+// P_i(xi) P_j(eta) s^max(i,j) P_k^(2 max(i,j) + 2, 0)(2z - 1) for 0 <= i, j <= p and
+// 0 <= k <= p - max(i,j), with s = 1 - z and xi, eta the base's coordinates scaled to [-1, 1] at
+// every level: X / s and Y / s, X = 2x - s and Y = 2y - s. P_i(xi) s^i is the scaled Legendre
+// polynomial q_i(X, s), so a function is q_i q_j / s^min(i,j) times a polynomial in z: a
+// polynomial where i or j is 0, rational otherwise (x y / (1 - z) at order 1). The space holds
+// every polynomial of degree p, is Q_p on the base and P_p on the triangles, so pyramids conform
+// to hexahedra, prisms and tetrahedra. At the apex (s = 0) a rational function, homogeneous of
+// degree max(i,j) >= 1 in (X, Y, s), is 0, and so are its derivatives for max(i,j) >= 2; for
+// i = j = 1 they depend on the direction the apex is approached from, and the value given is
+// their limit along the axis (0), where the base's centre rises to the apex.
+void pyramidBasis(int p, const double* xi, Eigen::VectorXd& values, Eigen::MatrixXd& grads) {
+  using D3 = Dual<3>;
+  D3 s = D3::affine(1.0, {0.0, 0.0, -1.0});  // s = 1 - z
+  D3 x = D3::affine(-1.0, {2.0, 0.0, 1.0});  // X = 2x - s
+  D3 y = D3::affine(-1.0, {0.0, 2.0, 1.0});  // Y = 2y - s
+  D3 c = D3::affine(-1.0, {0.0, 0.0, 2.0});  // 2z - 1
+  for (D3* d : {&s, &x, &y, &c}) d->at(xi);
+  const bool apex = !(s.v > 0.0) && !(s.v < 0.0);
+  const auto qx = scaledJacobi<3>(p, 0.0, x, s);
+  const auto qy = scaledJacobi<3>(p, 0.0, y, s);
+  std::vector<D3> funcs;
+  for (int i = 0; i <= p; ++i)
+    for (int j = 0; j <= p; ++j) {
+      const int high = std::max(i, j), low = std::min(i, j);
+      D3 base = qx[static_cast<std::size_t>(i)] * qy[static_cast<std::size_t>(j)];
+      if (low > 0) {
+        if (apex) {
+          base = D3::constant(0.0);
+        } else {
+          D3 power = s;
+          for (int e = 1; e < low; ++e) power = power * s;
+          base = base / power;
+        }
+      }
+      const auto rk = scaledJacobi<3>(p - high, 2.0 * high + 2.0, c, D3::constant(1.0));
+      for (const D3& r : rk) funcs.push_back(base * r);
+    }
+  store<3>(funcs, values, grads);
+}
+
 }  // namespace
 
 void orthogonalBasis(CellType type, int order, const double* xi, Eigen::VectorXd& values,
@@ -204,6 +254,8 @@ void orthogonalBasis(CellType type, int order, const double* xi, Eigen::VectorXd
       return hexahedronBasis(order, xi, values, gradients);
     case CellType::Prism:
       return prismBasis(order, xi, values, gradients);
+    case CellType::Pyramid:
+      return pyramidBasis(order, xi, values, gradients);
     default:
       throw ParameterError("no polynomial basis for " + cellShortName(type));
   }

@@ -6,8 +6,10 @@
 // coordinates and is evaluated without the 0/0 of collapsed coordinates at the top vertices.
 // Quadrilateral and hexahedron: tensor Legendre polynomials spanning Q_order. Prism: the
 // triangle's basis times Legendre polynomials in z, spanning P_order(x, y) x P_order(z).
+// Pyramid: Bergot, Cohen and Durufle's basis (as Gmsh's pyramids), rational where it must be for
+// the base to be Q_order and the triangles P_order (x y / (1 - z) at order 1).
 // The reference shapes are unit: simplices with vertices at the origin and the unit vectors,
-// [0, 1]^d boxes, the unit triangle times [0, 1].
+// [0, 1]^d boxes, the unit triangle times [0, 1], the pyramid 0 <= x, y <= 1 - z.
 #pragma once
 
 #include <Eigen/Core>

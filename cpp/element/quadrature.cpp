@@ -119,6 +119,19 @@ QuadratureRule quadratureRule(CellType type, int degree) {
         }
       return rule;
     }
+    case CellType::Pyramid:
+      // x = p (1 - r), y = q (1 - r), z = r; Jacobian (1 - r)^2, the Jacobi weight in r.
+      rule.dim = 3;
+      unitGaussJacobi(n, 2.0, r, wr);
+      for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+          for (int i = 0; i < n; ++i) {
+            rule.points.push_back(p[i] * (1.0 - r[k]));
+            rule.points.push_back(p[j] * (1.0 - r[k]));
+            rule.points.push_back(r[k]);
+            rule.weights.push_back(wp[i] * wp[j] * wr[k]);
+          }
+      return rule;
     default:
       throw ParameterError("no quadrature rule for " + cellShortName(type));
   }

@@ -1,9 +1,10 @@
 // Quadrature rules on the reference shapes (unit simplices, [0, 1]^d boxes, unit triangle x
-// [0, 1] prism).
+// [0, 1] prism, pyramid 0 <= x, y <= 1 - z).
 //
-// Simplex rules are collapsed (Stroud conical) products of Gauss-Jacobi rules and box rules
-// tensor products of Gauss-Legendre rules, so a rule of any degree exists; the points lie
-// strictly inside the element.
+// Simplex and pyramid rules are collapsed (Stroud conical) products of Gauss-Jacobi rules and
+// box rules tensor products of Gauss-Legendre rules, so a rule of any degree exists; the points
+// lie strictly inside the element. The pyramid's rule of degree d also integrates exactly the
+// rational functions of its basis (orthogonal_basis.hpp) of degree d.
 #pragma once
 
 #include <Eigen/Core>
@@ -18,7 +19,7 @@ struct QuadratureRule {
   int degree = 0;  // integrates every polynomial of this total degree exactly (boxes and
                    // prisms: of this degree in each variable)
   std::vector<double> points;   // dim * size(), point-major
-  std::vector<double> weights;  // sum = reference volume (1, 1/2, 1/6)
+  std::vector<double> weights;  // sum = reference volume (1, 1/2, 1/6, 1/3)
   int size() const { return static_cast<int>(weights.size()); }
 };
 

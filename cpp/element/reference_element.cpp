@@ -1,6 +1,7 @@
 #include "element/reference_element.hpp"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -109,9 +110,10 @@ std::vector<LatticePoint> samplingLattice(CellType type, int n) {
   for (int k = 0; k <= (dim > 2 ? n : 0); ++k)
     for (int j = 0; j <= (dim > 1 ? n : 0); ++j)
       for (int i = 0; i <= n; ++i) {
-        const bool inside = (type == CellType::Triangle || type == CellType::Prism)
-                                ? i + j <= n
-                                : (type == CellType::Tetrahedron ? i + j + k <= n : true);
+        bool inside = true;
+        if (type == CellType::Triangle || type == CellType::Prism) inside = i + j <= n;
+        if (type == CellType::Tetrahedron) inside = i + j + k <= n;
+        if (type == CellType::Pyramid) inside = std::max(i, j) + k <= n;
         if (inside) points.push_back({i, j, k});
       }
   return points;
