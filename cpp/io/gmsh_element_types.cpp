@@ -18,6 +18,7 @@ const std::map<CellType, std::array<int, 10>>& codeTable() {
       {CellType::Tetrahedron, {4, 11, 29, 30, 31, 71, 72, 73, 74, 75}},
       {CellType::Prism, {6, 13, 90, 91, 106, 107, 108, 109, 110, 0}},
       {CellType::Hexahedron, {5, 12, 92, 93, 94, 95, 96, 97, 98, 0}},
+      {CellType::Pyramid, {7, 14, 118, 119, 120, 121, 122, 123, 124, 0}},
   };
   return table;
 }

@@ -43,14 +43,14 @@ const TypeInfo kTypes[] = {
     {11, "VTK_VOXEL", CellType::Point, 0, "a voxel (write it as VTK_HEXAHEDRON)"},
     {12, "VTK_HEXAHEDRON", CellType::Hexahedron, 1, nullptr},
     {13, "VTK_WEDGE", CellType::Prism, 1, nullptr},
-    {14, "VTK_PYRAMID", CellType::Point, 0, "a pyramid"},
+    {14, "VTK_PYRAMID", CellType::Pyramid, 1, nullptr},
     {21, "VTK_QUADRATIC_EDGE", CellType::Line, 2, nullptr},
     {22, "VTK_QUADRATIC_TRIANGLE", CellType::Triangle, 2, nullptr},
     {23, "VTK_QUADRATIC_QUAD", CellType::Point, 0, kSerendipity},
     {24, "VTK_QUADRATIC_TETRA", CellType::Tetrahedron, 2, nullptr},
     {25, "VTK_QUADRATIC_HEXAHEDRON", CellType::Point, 0, kSerendipity},
     {26, "VTK_QUADRATIC_WEDGE", CellType::Point, 0, kSerendipity},
-    {27, "VTK_QUADRATIC_PYRAMID", CellType::Point, 0, "a pyramid"},
+    {27, "VTK_QUADRATIC_PYRAMID", CellType::Point, 0, kSerendipity},
     {28, "VTK_BIQUADRATIC_QUAD", CellType::Quadrilateral, 2, nullptr},
     {29, "VTK_TRIQUADRATIC_HEXAHEDRON", CellType::Hexahedron, 2, nullptr},
     {30, "VTK_QUADRATIC_LINEAR_QUAD", CellType::Point, 0, kSerendipity},
@@ -67,7 +67,8 @@ const TypeInfo kTypes[] = {
     {71, "VTK_LAGRANGE_TETRAHEDRON", CellType::Tetrahedron, 0, nullptr},
     {72, "VTK_LAGRANGE_HEXAHEDRON", CellType::Hexahedron, 0, nullptr},
     {73, "VTK_LAGRANGE_WEDGE", CellType::Prism, 0, nullptr},
-    {74, "VTK_LAGRANGE_PYRAMID", CellType::Point, 0, "a pyramid"},
+    {74, "VTK_LAGRANGE_PYRAMID", CellType::Point, 0,
+     "a curved pyramid (VTK 9.1 has no Lagrange pyramid to agree a node order with)"},
 };
 
 const TypeInfo* typeInfo(std::int64_t code) {
@@ -115,6 +116,10 @@ CellReading reading(std::int64_t code, std::size_t nodes, bool hexVersion1,
     r.fromFile = {0, 2, 1, 3, 5, 4};
     return r;
   }
+  if (code == 14) {  // VTK_PYRAMID: Gmsh's order
+    r.fromFile = {0, 1, 2, 3, 4};
+    return r;
+  }
   const std::vector<int> perm = vtkPermutationFromGmsh(r.type, r.order, hexVersion1);
   r.fromFile.assign(perm.size(), 0);
   for (std::size_t i = 0; i < perm.size(); ++i)
@@ -138,8 +143,6 @@ std::uint8_t vtkLagrangeType(CellType type) {
       return 72;
     case CellType::Prism:
       return 73;
-    case CellType::Pyramid:
-      return 74;
     default:
       throw ParameterError("no VTK Lagrange cell for " + cellShortName(type));
   }

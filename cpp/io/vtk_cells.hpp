@@ -11,7 +11,8 @@
 
 namespace homesh {
 
-// VTK's Lagrange cell code of a shape (VTK_LAGRANGE_CURVE 68 ... VTK_LAGRANGE_WEDGE 73).
+// VTK's Lagrange cell code of a shape (VTK_LAGRANGE_CURVE 68 ... VTK_LAGRANGE_WEDGE 73; none for
+// a pyramid: VTK 9.1 has no Lagrange pyramid, and a linear one is a VTK_PYRAMID, 14).
 std::uint8_t vtkLagrangeType(CellType type);
 
 // perm[i] = index, in Gmsh order, of the i-th node of VTK's Lagrange cell. `hexVersion1`: VTK

@@ -75,12 +75,21 @@ void writeVtu(const Mesh& mesh, const std::string& path, const std::vector<CellF
     if (cellDimension(block.type) != mesh.dim) continue;
     // File version 1.0, which every reader (meshio included) accepts: hexahedra carry VTK's
     // version-1 numbering, which VTK 9 renumbers on reading.
-    const std::vector<int> perm = vtkPermutationFromGmsh(block.type, block.order, true);
+    // VTK 9.1 (Debian 12's) has no Lagrange pyramid: a linear pyramid is a VTK_PYRAMID, in
+    // Gmsh's order, and a curved one cannot be written.
+    const bool pyramid = block.type == CellType::Pyramid;
+    if (pyramid && block.order > 1)
+      throw ParameterError("VTU output has no curved pyramid (these are of order " +
+                           std::to_string(block.order) +
+                           "): VTK 9.1 has no Lagrange pyramid; write .msh instead");
+    const std::vector<int> perm = pyramid ? std::vector<int>{0, 1, 2, 3, 4}
+                                          : vtkPermutationFromGmsh(block.type, block.order, true);
+    const std::uint8_t cellType = pyramid ? 14 : vtkLagrangeType(block.type);
     for (std::size_t e = 0; e < block.count(); ++e) {
       const std::int64_t* nodes = block.element(e);
       for (const int k : perm) connectivity.push_back(nodes[k]);
       offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
-      types.push_back(vtkLagrangeType(block.type));
+      types.push_back(cellType);
       entity.push_back(block.entity[e]);
     }
   }

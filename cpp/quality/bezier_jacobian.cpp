@@ -127,25 +127,96 @@ Eigen::MatrixXd lagrangeToBezier(const ReferenceElement& ref, const BernsteinSpa
   return out;
 }
 
+// The columns of J's matrix in Bezier form: per reference direction k, the matrix from the
+// nodes' coordinates to the control points of the column, and the column's space.
+struct Columns {
+  std::vector<Eigen::MatrixXd> matrix;
+  std::vector<const BernsteinSpace*> space;
+};
+
+// A polynomial shape: the columns are dx/dxi_k, the derivatives of the geometry's control points
+// composed with Lagrange-to-Bezier.
+Columns polynomialColumns(const ReferenceElement& ref) {
+  const BernsteinSpace& geometry = BernsteinSpace::get(geometryFactors(ref.type(), ref.order()));
+  const Eigen::MatrixXd toBezier = lagrangeToBezier(ref, geometry);
+  Columns c;
+  for (int k = 0; k < ref.dim(); ++k) {
+    c.space.push_back(&BernsteinSpace::get(geometry.derivativeFactors(k)));
+    Eigen::MatrixXd d(c.space.back()->size(), ref.numNodes());
+    for (int j = 0; j < ref.numNodes(); ++j) d.col(j) = geometry.derivative(k, toBezier.col(j));
+    c.matrix.push_back(std::move(d));
+  }
+  return c;
+}
+
+// Control points of f / (1 - z), rows of `coeffs` in `space` (three intervals, z the last, of
+// degree m), for f that vanishes at z = 1: B_k^m(z) / (1 - z) = m / (m - k) B_k^(m-1)(z); the
+// coefficients at k = m, zero but for rounding, are dropped.
+Eigen::MatrixXd divideByOneMinusZ(const BernsteinSpace& space, const Eigen::MatrixXd& coeffs,
+                                  const BernsteinSpace& quotient) {
+  const int m = space.factors()[2].second;
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(quotient.size(), coeffs.cols());
+  for (int j = 0; j < space.size(); ++j) {
+    const std::vector<int>& index = space.multiIndex(j);
+    if (index[2] == m) continue;
+    out.row(quotient.indexOf(index)) = coeffs.row(j) * (static_cast<double>(m) / (m - index[2]));
+  }
+  return out;
+}
+
+// A pyramid's map is rational in its own coordinates, but in collapsed ones (u, v, z) on the unit
+// cube, x = u (1 - z) and y = v (1 - z), every function of its basis (xi^a eta^b s^max(a,b) z^c,
+// orthogonal_basis.hpp, with xi = u and eta = v) is a polynomial of degree p in each of u, v, z:
+// the geometry has control points in the hexahedron's space, interpolated at its equispaced
+// points (the top face's all at the apex). There dx/du and dx/dv vanish with s = 1 - z and,
+// divided by it, are the pyramid's dx/dx and dx/dy; dx/dz at fixed (u, v) is dx/dz - u dx/dx -
+// v dx/dy; so the determinant of the three is the pyramid's own J, a polynomial on the cube (of
+// degree 3p - 1 in u and v, 3p - 3 in z) whose Bezier coefficients bound J over the pyramid and,
+// on the top face, its limits at the apex from every direction (where J itself depends on the
+// direction once the geometry holds the rational functions, x y / (1 - z) at order 1).
+Columns pyramidColumns(const ReferenceElement& ref) {
+  const int p = ref.order();
+  const ReferenceElement& cube = ReferenceElement::get(CellType::Hexahedron, p);
+  const BernsteinSpace& geometry = BernsteinSpace::get(geometryFactors(CellType::Hexahedron, p));
+  Eigen::MatrixXd points(cube.numNodes(), 3);
+  for (int h = 0; h < cube.numNodes(); ++h) {
+    const Eigen::Vector3d uvz = cube.nodes().row(h).transpose();
+    points.row(h) << uvz.x() * (1.0 - uvz.z()), uvz.y() * (1.0 - uvz.z()), uvz.z();
+  }
+  const Eigen::MatrixXd toBezier = lagrangeToBezier(cube, geometry) * ref.valuesAt(points);
+  Columns c;
+  for (int k = 0; k < 3; ++k) {
+    const BernsteinSpace& derivative = BernsteinSpace::get(geometry.derivativeFactors(k));
+    Eigen::MatrixXd d(derivative.size(), ref.numNodes());
+    for (int j = 0; j < ref.numNodes(); ++j) d.col(j) = geometry.derivative(k, toBezier.col(j));
+    if (k == 2) {
+      c.space.push_back(&derivative);
+      c.matrix.push_back(std::move(d));
+      continue;
+    }
+    BernsteinFactors reduced = derivative.factors();
+    reduced[2].second -= 1;
+    c.space.push_back(&BernsteinSpace::get(reduced));
+    c.matrix.push_back(divideByOneMinusZ(derivative, d, *c.space.back()));
+  }
+  return c;
+}
+
 std::unique_ptr<BezierTables> buildTables(CellType type, int order) {
   auto t = std::make_unique<BezierTables>();
   const ReferenceElement& ref = ReferenceElement::get(type, order);
-  const int n = ref.numNodes(), dim = ref.dim();
+  const int dim = ref.dim();
   t->dim = dim;
-  const BernsteinSpace& geometry = BernsteinSpace::get(geometryFactors(type, order));
-  const Eigen::MatrixXd toBezier = lagrangeToBezier(ref, geometry);
-  std::vector<const BernsteinSpace*> spaces;
+  const Columns columns = type == CellType::Pyramid ? pyramidColumns(ref) : polynomialColumns(ref);
+  const std::vector<const BernsteinSpace*>& spaces = columns.space;
   for (int k = 0; k < dim; ++k) {
-    // The derivative as a matrix on control points, composed with Lagrange-to-Bezier.
-    Eigen::MatrixXd d(BernsteinSpace::get(geometry.derivativeFactors(k)).size(), n);
-    for (int j = 0; j < n; ++j) d.col(j) = geometry.derivative(k, toBezier.col(j));
+    const Eigen::MatrixXd& d = columns.matrix[static_cast<std::size_t>(k)];
     t->derivative.push_back(d);
     t->derivativeNorm.push_back(d.cwiseAbs().rowwise().sum().maxCoeff());
     // Exact rows sum to zero (a constant has no derivative): what they sum to measures the
     // tables' own rounding, relative to the row norms; four times it is allowed for.
     t->derivativeError.push_back(4.0 * d.rowwise().sum().cwiseAbs().maxCoeff() /
                                  t->derivativeNorm.back());
-    spaces.push_back(&BernsteinSpace::get(geometry.derivativeFactors(k)));
   }
   const BernsteinSpace& innerA = dim == 3 ? *spaces[1] : *spaces[0];
   const BernsteinSpace& innerB = dim == 3 ? *spaces[2] : *spaces[1];

@@ -3,6 +3,9 @@
 // The Jacobian determinant J of a polynomial element is itself a polynomial: of total degree
 // 2(P-1) on a triangle and 3(P-1) on a tetrahedron, of degree 2P-1 per variable on a
 // quadrilateral and 3P-1 on a hexahedron, and of degree 3P-2 in (x, y) by 3P-1 in z on a prism.
+// A pyramid's J, rational in its own coordinates, is a polynomial in collapsed ones (u, v, z) on
+// the unit cube, x = u (1 - z) and y = v (1 - z): of degree 3P-1 in u and v by 3P-3 in z, whose
+// top face holds J's limits at the apex from every direction (bezier_jacobian.cpp says why).
 // Its coefficients in the Bernstein (Bezier) basis of that space bound it from below and above,
 // and the coefficients at the domain's corners are values of J. Where the bounds do not decide,
 // the domain is subdivided, best first, until the minimum and maximum of J are known to a
@@ -12,7 +15,8 @@
 //
 // The coefficients on the whole element are computed exactly from the geometry's own Bezier
 // control points (differentiation and products of Bernstein polynomials, quality/bernstein.hpp),
-// so they stay accurate at high order, where interpolating J at points would be ill conditioned.
+// so they stay accurate at high order, where interpolating J at points would be ill conditioned
+// (a pyramid's control points are its geometry interpolated at the cube's equispaced points).
 // A subdivision is a longest-edge bisection of the part, done on J's coefficients alone by
 // de Casteljau's algorithm (averages only, so the child bounds stay exact up to rounding): it
 // costs a few hundred additions where re-evaluating the geometry on 2^d children would cost tens

@@ -283,15 +283,37 @@ def test_cells_homesh_does_not_read(homesh_bin, tmp_path):
                      [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4),
                       (1, 5), (2, 6), (3, 7)]])
     hex20 = meshio.Mesh(np.vstack([points, mids]), [("hexahedron20", [list(range(20))])])
-    pyramid = meshio.Mesh(points[:5], [("pyramid", [[0, 1, 2, 3, 4]])])
+    # A 13-node pyramid, in legacy VTK written here (this meshio has no name for it).
+    pyramid13 = np.vstack([points[:5], [(points[a] + points[b]) / 2 for a, b in
+                                        [(0, 1), (1, 2), (2, 3), (3, 0), (0, 4), (1, 4), (2, 4),
+                                         (3, 4)]]])
+    (tmp_path / "pyramid13.vtk").write_text(
+        "# vtk DataFile Version 4.2\npyramid13\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+        "POINTS 13 double\n" + "".join(f"{x} {y} {z}\n" for x, y, z in pyramid13)
+        + "CELLS 1 14\n13 " + " ".join(str(i) for i in range(13)) + "\nCELL_TYPES 1\n27\n")
     for name, mesh, phrase in [
             ("hex20.vtu", hex20, "cell 0 is a VTK_QUADRATIC_HEXAHEDRON (type 25), a serendipity"),
             ("hex20.vtk", hex20, "cell 0 is a VTK_QUADRATIC_HEXAHEDRON (type 25)"),
-            ("pyramid.vtu", pyramid, "cell 0 is a VTK_PYRAMID (type 14), a pyramid")]:
-        meshio.write(tmp_path / name, mesh)
+            ("pyramid13.vtk", None,
+             "cell 0 is a VTK_QUADRATIC_PYRAMID (type 27), a serendipity")]:
+        if mesh is not None:
+            meshio.write(tmp_path / name, mesh)
         assert_one_line_error(run([homesh_bin, "quality", tmp_path / name]), name, phrase)
         with pytest.raises(homesh.FileError, match=re.escape(phrase)):
             homesh.read(tmp_path / name)
+
+
+def test_linear_pyramids_are_read_and_judged(homesh_bin, tmp_path):
+    # The reference pyramid (apex above its base's first corner), a VTK_PYRAMID: read, and
+    # certified valid with min J / max J = 1 (its J is constant), from the CLI and from Python.
+    points = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
+    path = tmp_path / "pyramid.vtu"
+    meshio.write(path, meshio.Mesh(points, [("pyramid", [[0, 1, 2, 3, 4]])]))
+    r = run([homesh_bin, "quality", path])
+    assert r.returncode == 0, r.stderr
+    assert "pyramid" in r.stdout and "invalid elements 0" in r.stdout, r.stdout
+    mesh = homesh.read(path)
+    assert mesh.num_elements == 1
 
 
 UNV_QUAD8 = """    -1
