@@ -30,6 +30,8 @@ std::vector<FacetPlane> facetPlanes(CellType type) {
     case CellType::Hexahedron:
       return {{{1, 0, 0}, 0}, {{1, 0, 0}, 1}, {{0, 1, 0}, 0},
               {{0, 1, 0}, 1}, {{0, 0, 1}, 0}, {{0, 0, 1}, 1}};
+    case CellType::Pyramid:  // the base, then the triangles (apex above the base's corner 0)
+      return {{{0, 0, 1}, 0}, {{0, 1, 0}, 0}, {{1, 0, 0}, 0}, {{1, 0, 1}, 1}, {{0, 1, 1}, 1}};
     default:
       throw ParameterError("no facet topology for " + cellShortName(type) + " cells");
   }

@@ -107,12 +107,13 @@ class WorkingMesh {
   using Mat = Eigen::Matrix<double, D, D>;
   using Vec = Eigen::Matrix<double, D, 1>;
 
-  // `converting`: move the working node set's nodes (kWorkingSet) rather than the mesh's own.
+  // `converting`: move the working node set's nodes (kWorkingSet) rather than the mesh's own
+  // (never where the mesh holds pyramids, which have no such set).
   // `order`: the renumbering `mesh` has been given (applied); null: the mesh's own numbers.
   WorkingMesh(Mesh& mesh, bool converting, const SpatialOrder* order = nullptr);
 
   // The frame, the blocks, the working positions and the incidence, in that order. Throws
-  // ParameterError for pyramids, a straight-sided element of zero volume (named by the caller's
+  // ParameterError for a straight-sided element of zero volume (named by the caller's
   // number) or a mesh without elements of dimension D.
   void build();
 

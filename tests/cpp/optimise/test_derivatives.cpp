@@ -363,7 +363,7 @@ TEST(Optimiser, NodeDerivativesMatchFiniteDifferencesOnEveryElementType) {
   std::mt19937 rng(11);
   ProbeStats stats;
   for (const CellType type : {CellType::Triangle, CellType::Quadrilateral, CellType::Tetrahedron,
-                              CellType::Prism, CellType::Hexahedron})
+                              CellType::Prism, CellType::Pyramid, CellType::Hexahedron})
     for (const int order : {1, 2, 4, 6})
       for (const Functional f : kAll) {
         const Mesh mesh = oneElement(type, order, 0.1 / order, rng);
@@ -525,7 +525,7 @@ TEST(Optimiser, RotatedOrTranslatedIdealElementHasZeroGradient) {
       Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
   const Eigen::Matrix3d R2 = Eigen::AngleAxisd(1.1, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   for (const CellType type : {CellType::Triangle, CellType::Quadrilateral, CellType::Tetrahedron,
-                              CellType::Prism, CellType::Hexahedron})
+                              CellType::Prism, CellType::Pyramid, CellType::Hexahedron})
     for (const int order : {1, 3, 5}) {
       const Mesh mesh = rotatedIdeal(type, order, cellDimension(type) == 2 ? R2 : R);
       // dW/dF = 0 at a rotation for these three functionals.
