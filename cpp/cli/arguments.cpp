@@ -235,6 +235,20 @@ constexpr std::initializer_list<const char*> kOptimiseKeys = {
 // The CAD modes, which mesh and predict share.
 constexpr std::initializer_list<const char*> kCadModes = {"heal", "solids_only", "surface", "auto"};
 
+// --optimise (mesh and curve): run the optimiser with the table's sweeps.
+void addOptimiseSwitch(OptionTable& table, bool& optimise) {
+  table.flag({"--optimise", "--optimize"}, [&optimise] { optimise = true; });
+}
+
+// The optimiser's options do nothing without --optimise: refused by name (in the table's order).
+void checkOptimiseSwitch(bool optimise, OptionMap& values) {
+  if (!optimise)
+    for (const char* key : {"optimise", "optimise_seconds", "facet_weight"})
+      if (values.count(key) != 0)
+        throw UsageError{std::string(parameterDefinition(key).option) + " needs --optimise"};
+  if (optimise && values.count("optimise") == 0) values["optimise"] = true;  // the table's
+}
+
 MeshCommand parseMesh(const std::vector<std::string>& args) {
   MeshCommand cmd;
   OptionTable table;
@@ -246,7 +260,7 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
                    "linear_seconds", "job_seconds"});
   addTableOptions(table, values, kCadModes);
   bool optimise = false;
-  table.flag({"--optimise", "--optimize"}, [&optimise] { optimise = true; });
+  addOptimiseSwitch(table, optimise);
   table.value({"--bl-faces"},
               [&cmd](const std::string&, const std::string& v) { cmd.blFaces = v; });
   table.value({"--bl-thickness"},
@@ -264,12 +278,7 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   if (verbosity > 0)
     values["verbosity"] = static_cast<double>(
         std::min(verbosity, static_cast<int>(parameterDefinition("verbosity").max)));
-  // The optimiser's options do nothing without it: refused by name (in the table's order).
-  if (!optimise)
-    for (const char* key : {"optimise", "optimise_seconds", "facet_weight"})
-      if (values.count(key) != 0)
-        throw UsageError{std::string(parameterDefinition(key).option) + " needs --optimise"};
-  if (optimise && values.count("optimise") == 0) values["optimise"] = true;  // the table's
+  checkOptimiseSwitch(optimise, values);
   return cmd;
 }
 
@@ -313,6 +322,22 @@ OptimiseCommand parseOptimise(const std::vector<std::string>& args) {
   return cmd;
 }
 
+CurveCommand parseCurve(const std::vector<std::string>& args) {
+  CurveCommand cmd;
+  OptionTable table;
+  addCommon(table, cmd.common, true, true);
+  addTableOptions(table, cmd.options,
+                  {"order", "optimise", "optimise_seconds", "facet_weight", "job_seconds"});
+  bool optimise = false;
+  addOptimiseSwitch(table, optimise);
+  table.value({"--cad"}, [&cmd](const std::string&, const std::string& v) { cmd.cad = v; });
+  cmd.input = onlyInput(table.parse(args, 1, "curve"), "curve", "an INPUT mesh file");
+  if (cmd.cad.empty())
+    throw UsageError{"'homesh curve' needs --cad CAD, the CAD file the mesh was made from"};
+  checkOptimiseSwitch(optimise, cmd.options);
+  return cmd;
+}
+
 }  // namespace
 
 ParsedCommand parseCommandLine(const std::vector<std::string>& args) {
@@ -335,7 +360,7 @@ ParsedCommand parseCommandLine(const std::vector<std::string>& args) {
   }
   const bool optimise = first == "optimise" || first == "optimize";
   if (first != "mesh" && first != "predict" && first != "quality" && first != "convert" &&
-      !optimise)
+      first != "curve" && !optimise)
     throw UsageError{"unknown command '" + first + "'"};
   for (std::size_t i = 1; i < args.size(); ++i)
     if (args[i] == "-h" || args[i] == "--help") {
@@ -354,6 +379,9 @@ ParsedCommand parseCommandLine(const std::vector<std::string>& args) {
   } else if (optimise) {
     parsed.kind = ParsedCommand::Kind::Optimise;
     parsed.optimise = parseOptimise(args);
+  } else if (first == "curve") {
+    parsed.kind = ParsedCommand::Kind::Curve;
+    parsed.curve = parseCurve(args);
   } else {
     parsed.kind = ParsedCommand::Kind::Convert;
     parsed.convert = parseConvert(args);
@@ -540,6 +568,28 @@ options (the parameter table's, which Python's HighOrderMesh.optimise reads too)
 )" + commonHelp();
 }
 
+std::string curveHelp() {
+  return R"(usage: homesh curve INPUT --cad CAD [-o OUTPUT] [options]
+
+Curves a linear tetrahedral mesh made by another tool (Gmsh, Netgen, FreeCAD FEM; .msh, .unv,
+.vtk, .vtu, .xml) on the CAD it was made from (.step .stp .iges .igs .brep .brp, one solid):
+each boundary node is put on the CAD vertex, edge or face it lies on (within 1e-5 of the CAD's
+bounding diagonal; a node that lies on none is an error naming it, its position and its
+distance to the nearest face, and nothing is written), the mesh is raised to order P with its
+new boundary nodes on the CAD and, with --optimise, optimised with them sliding on it. A
+quadratic mesh is curved from its corners (its mid-edge nodes are dropped, with a note).
+Prisms, pyramids and hexahedra are not taken yet.
+
+options (the parameter table's, which Python's homesh.curve reads too):
+)" + tableHelp({"order"}) +
+         R"(      --optimise      run the variational optimiser after curving (hyperelastic),
+                      boundary nodes sliding on the CAD curves and faces
+)" + tableHelp({"optimise", "optimise_seconds", "facet_weight", "job_seconds"}) +
+         outputHelp() +
+         R"(      --report FILE   write the JSON report ("-" for standard output)
+)" + commonHelp();
+}
+
 std::string commandsHelp() {
   return R"(usage: homesh COMMAND [options]
 
@@ -549,6 +599,7 @@ commands:
   quality INPUT   certified quality of a mesh file (homesh quality --help)
   convert INPUT   mesh file to another format (homesh convert --help)
   optimise INPUT  curve the interior of a mesh file (homesh optimise --help)
+  curve INPUT     curve another tool's linear mesh on its CAD (homesh curve --help)
   --version       print the version
   --help          this text
 )";
@@ -562,6 +613,7 @@ std::string usageText(const std::string& topic) {
   if (topic == "quality") return qualityHelp();
   if (topic == "convert") return convertHelp();
   if (topic == "optimise" || topic == "optimize") return optimiseHelp();
+  if (topic == "curve") return curveHelp();
   return commandsHelp();
 }
 
@@ -591,7 +643,7 @@ std::string manPage() {
       "CFD\n.SH SYNOPSIS\n.nf\n";
   out += roffText(usageText(""));
   out += ".fi\n";
-  for (const char* topic : {"mesh", "predict", "quality", "convert", "optimise"}) {
+  for (const char* topic : {"mesh", "predict", "quality", "convert", "optimise", "curve"}) {
     out +=
         std::string(".SH \"HOMESH ") + topic + "\"\n.nf\n" + roffText(usageText(topic)) + ".fi\n";
   }

@@ -74,14 +74,33 @@ struct OptimiseCommand {
   CommonOptions common;
 };
 
+struct CurveCommand {
+  std::string input;  // the linear mesh
+  std::string cad;    // --cad: the CAD file it was made from
+  // The parameter table's options given, by key ("order", "optimise", ...): MeshingOptions::apply
+  // takes them.
+  OptionMap options;
+  CommonOptions common;
+};
+
 struct ParsedCommand {
-  enum class Kind { Help, Version, Mesh, Predict, Quality, Convert, Optimise } kind = Kind::Help;
+  enum class Kind {
+    Help,
+    Version,
+    Mesh,
+    Predict,
+    Quality,
+    Convert,
+    Optimise,
+    Curve
+  } kind = Kind::Help;
   std::string helpTopic;  // "" or a command name
   MeshCommand mesh;
   PredictCommand predict;
   QualityCommand quality;
   ConvertCommand convert;
   OptimiseCommand optimise;
+  CurveCommand curve;
 };
 
 // argv without the program name. Throws UsageError.

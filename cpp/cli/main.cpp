@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -122,6 +123,38 @@ void printPrediction(const homesh::SizingResult& s, int dim) {
     std::fprintf(stderr, "homesh: %s\n", line.c_str());
 }
 
+// The end of `mesh` and `curve`: the mesh written, its summary printed (with `octree`, written
+// before), the report, Nektar++'s reading of any .xml checked; the exit status.
+int finishMeshJob(homesh::MeshResult& result, const homesh::CommonOptions& c,
+                  const std::string& input, homesh::PipelineObserver* observer,
+                  const std::optional<std::string>& octree) {
+  if (!c.outputs.empty()) homesh::writeMeshOutputs(result, c.outputs, writeOptions(c), observer);
+  if (!c.quiet) {
+    for (const std::string& line : homesh::meshSummaryLines(result))
+      std::fprintf(stderr, "homesh: %s\n", line.c_str());
+    if (octree) std::fprintf(stderr, "homesh: wrote %s\n", octree->c_str());
+    for (const std::string& path : c.outputs)
+      std::fprintf(stderr, "homesh: wrote %s\n", path.c_str());
+  }
+  if (c.report) writeReport(*c.report, homesh::meshReportJson(result, input));
+  const std::size_t nektarNotValid = checkNektarOutputs(c.outputs, c.threads, c.quiet);
+  // The mesh is written either way; status 4 tells scripts it is not proven valid.
+  if (result.quality.invalid + result.quality.undecided > 0) {
+    if (!c.quiet)
+      std::fprintf(stderr, "homesh: %zu %s invalid, %zu undecided (exit status 4)\n",
+                   result.quality.invalid, result.quality.invalid == 1 ? "element" : "elements",
+                   result.quality.undecided);
+    return kNotProvenValid;
+  }
+  if (nektarNotValid > 0) {
+    std::fprintf(stderr,
+                 "homesh: the mesh is valid, but not the geometry Nektar++ builds from the .xml "
+                 "(exit status 4)\n");
+    return kNotProvenValid;
+  }
+  return 0;
+}
+
 int runMesh(const homesh::MeshCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
   checkOutputs(c, cmd.input);
@@ -139,32 +172,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
   StderrProgress progress;
   homesh::PipelineObserver* observer = c.quiet ? nullptr : &progress;
   homesh::MeshResult result = homesh::runMeshPipeline(setup.source, options, observer);
-  if (!c.outputs.empty()) homesh::writeMeshOutputs(result, c.outputs, writeOptions(c), observer);
-  if (!c.quiet) {
-    for (const std::string& line : homesh::meshSummaryLines(result))
-      std::fprintf(stderr, "homesh: %s\n", line.c_str());
-    if (cmd.sizing.writeOctree)
-      std::fprintf(stderr, "homesh: wrote %s\n", cmd.sizing.writeOctree->c_str());
-    for (const std::string& path : c.outputs)
-      std::fprintf(stderr, "homesh: wrote %s\n", path.c_str());
-  }
-  if (c.report) writeReport(*c.report, homesh::meshReportJson(result, cmd.input));
-  const std::size_t nektarNotValid = checkNektarOutputs(c.outputs, c.threads, c.quiet);
-  // The mesh is written either way; status 4 tells scripts it is not proven valid.
-  if (result.quality.invalid + result.quality.undecided > 0) {
-    if (!c.quiet)
-      std::fprintf(stderr, "homesh: %zu %s invalid, %zu undecided (exit status 4)\n",
-                   result.quality.invalid, result.quality.invalid == 1 ? "element" : "elements",
-                   result.quality.undecided);
-    return kNotProvenValid;
-  }
-  if (nektarNotValid > 0) {
-    std::fprintf(stderr,
-                 "homesh: the mesh is valid, but not the geometry Nektar++ builds from the .xml "
-                 "(exit status 4)\n");
-    return kNotProvenValid;
-  }
-  return 0;
+  return finishMeshJob(result, c, cmd.input, observer, cmd.sizing.writeOctree);
 }
 
 int runPredict(const homesh::PredictCommand& cmd) {
@@ -305,6 +313,36 @@ int runOptimise(const homesh::OptimiseCommand& cmd) {
   return 0;
 }
 
+// Curves another tool's linear tetrahedral mesh on its CAD (pipeline's curveMeshOnCad).
+int runCurve(const homesh::CurveCommand& cmd) {
+  const homesh::CommonOptions& c = cmd.common;
+  checkOutputs(c, cmd.input);
+  homesh::MeshingOptions options;
+  options.threads = c.threads;
+  options.apply(cmd.options);
+  std::vector<std::string> notes;
+  homesh::Mesh linear = readMeshFile(cmd.input, c.quiet, notes);
+  for (const homesh::ElementBlock& b : linear.blocks)
+    if (homesh::cellDimension(b.type) == 3 && b.type != homesh::CellType::Tetrahedron &&
+        b.count() > 0)
+      throw homesh::ParameterError(cmd.input + " holds " + std::to_string(b.count()) + " " +
+                                   homesh::cellShortName(b.type) +
+                                   " cells: 'homesh curve' takes tetrahedra only, as yet");
+  if (linear.order > 1) {
+    if (!c.quiet)
+      std::fprintf(stderr,
+                   "homesh: note: %s is of order %d: it is curved from its corners, the other "
+                   "nodes dropped\n",
+                   cmd.input.c_str(), linear.order);
+    linear = homesh::changeOrder(linear, 1, nullptr);
+  }
+  StderrProgress progress;
+  homesh::PipelineObserver* observer = c.quiet ? nullptr : &progress;
+  homesh::MeshResult result =
+      homesh::curveMeshOnCad(homesh::CadSource::file(cmd.cad), linear, options, observer);
+  return finishMeshJob(result, c, cmd.input, observer, std::nullopt);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -330,6 +368,8 @@ int main(int argc, char** argv) {
         return runConvert(parsed.convert);
       case homesh::ParsedCommand::Kind::Optimise:
         return runOptimise(parsed.optimise);
+      case homesh::ParsedCommand::Kind::Curve:
+        return runCurve(parsed.curve);
     }
   } catch (const homesh::UsageError& e) {
     std::fprintf(stderr, "homesh: error: %s (see 'homesh --help')\n", e.message.c_str());

@@ -1,0 +1,96 @@
+"""`homesh curve`: another tool's linear tetrahedral mesh (Gmsh's, made here from the STEP) curved
+on its CAD from the command line, every boundary node on the CAD, certified valid; a mesh whose
+boundary node lies off the CAD is refused naming it, and nothing is written."""
+
+import json
+import shutil
+
+import meshio
+import numpy as np
+import pytest
+
+from conftest import run
+
+# tests/data/box_hole.step: the box [0, 4] x [0, 4] x [0, 2] with a hole of radius 1 through it
+# around the axis x = y = 2 (test_support.hpp's boxWithHole). Its bounding diagonal is 6.
+DIAGONAL = 6.0
+
+
+def distance_to_cad(points):
+    """Each point's distance to the nearest of the CAD's surfaces (planes and the cylinder)."""
+    x, y, z = points.T
+    planes = np.abs(np.stack([x, x - 4.0, y, y - 4.0, z, z - 2.0]))
+    cylinder = np.abs(np.hypot(x - 2.0, y - 2.0) - 1.0)
+    return np.minimum(planes.min(axis=0), cylinder)
+
+
+@pytest.fixture(scope="module")
+def gmsh_linear(tmp_path_factory, data):
+    gmsh = shutil.which("gmsh")
+    assert gmsh, "Debian's gmsh package is needed"
+    out = tmp_path_factory.mktemp("curve")
+    linear = out / "linear.msh"
+    r = run([gmsh, data / "box_hole.step", "-3", "-clmax", "0.6", "-format", "msh41", "-o",
+             linear])
+    assert r.returncode == 0 and linear.is_file(), r.stdout + r.stderr
+    return out, linear
+
+
+def test_gmsh_mesh_is_curved_on_its_cad_and_certified_valid(homesh_bin, data, gmsh_linear):
+    out, linear = gmsh_linear
+    curved, report = out / "curved.msh", out / "report.json"
+    r = run([homesh_bin, "curve", linear, "--cad", data / "box_hole.step", "--order", "3",
+             "--optimise", "-o", curved, "--report", report])
+    assert r.returncode == 0, r.stderr
+    rep = json.loads(report.read_text())
+    assert rep["quality"]["invalid_elements"] == 0
+    assert rep["quality"]["undecided_elements"] == 0
+    assert rep["quality"]["scaled_jacobian"]["min"] > 0.0
+    mesh = meshio.read(curved)
+    before = meshio.read(linear)
+    assert len(mesh.cells_dict["tetra20"]) == len(before.cells_dict["tetra"])
+    boundary = np.unique(mesh.cells_dict["triangle10"].ravel())
+    assert len(boundary) > len(np.unique(before.cells_dict["triangle"].ravel()))
+    # Every boundary node, the new ones included, is a point of the CAD: its distance is the
+    # CAD's own projection and evaluation rounding (about 1e-15 of these coordinates), far
+    # below 1e-9 of the diagonal; a node left on a straight chord of the hole is up to 5e-3 off.
+    assert distance_to_cad(mesh.points[boundary]).max() < 1e-9 * DIAGONAL
+
+
+def test_a_node_off_the_cad_is_refused_by_name_and_nothing_is_written(homesh_bin, data,
+                                                                       gmsh_linear, tmp_path):
+    _, linear = gmsh_linear
+    mesh = meshio.read(linear)
+    boundary = np.unique(mesh.cells_dict["triangle"].ravel())
+    # A node on the hole, moved outwards by 1 % of the 0.6 size: 6e-3, far beyond the 6e-5
+    # (1e-5 of the diagonal) within which a node counts as on the CAD.
+    on_hole = boundary[np.abs(np.hypot(mesh.points[boundary, 0] - 2.0,
+                                       mesh.points[boundary, 1] - 2.0) - 1.0) < 1e-9]
+    node = on_hole[len(on_hole) // 2]
+    radial = mesh.points[node, :2] - 2.0
+    mesh.points[node, :2] += 0.006 * radial / np.linalg.norm(radial)
+    moved = tmp_path / "moved.msh"
+    meshio.write(moved, meshio.Mesh(mesh.points, [("tetra", mesh.cells_dict["tetra"])]),
+                 file_format="gmsh22", binary=False)
+    out = tmp_path / "out.msh"
+    r = run([homesh_bin, "curve", moved, "--cad", data / "box_hole.step", "-o", out])
+    assert r.returncode == 1, (r.returncode, r.stderr)
+    error = r.stderr.splitlines()[-1]
+    assert error.startswith("homesh: error: "), r.stderr
+    # The node by its number in the file (1-based, as Gmsh numbers it), where it is, the face
+    # nearest to it and how far.
+    assert "node %d at (%g, %g, %g)" % ((node + 1,) + tuple(mesh.points[node])) in error, error
+    assert "Face" in error and "distance 0.006" in error, error
+    assert not out.exists()
+
+
+def test_curve_needs_its_cad_and_refuses_other_cells(homesh_bin, data, tmp_path):
+    r = run([homesh_bin, "curve", data / "box_hole.step"])
+    assert r.returncode == 2 and "--cad" in r.stderr, r.stderr
+    points = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
+    pyramid = tmp_path / "pyramid.vtu"
+    meshio.write(pyramid, meshio.Mesh(points, [("pyramid", [[0, 1, 2, 3, 4]])]))
+    r = run([homesh_bin, "curve", pyramid, "--cad", data / "box_hole.step", "-o",
+             tmp_path / "out.msh"])
+    assert r.returncode == 2 and "pyramid" in r.stderr and "tetrahedra" in r.stderr, r.stderr
+    assert not (tmp_path / "out.msh").exists()
