@@ -82,6 +82,7 @@ _VOLUME_FACES = {
     "tet": ((0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)),
     "prism": ((0, 1, 2), (3, 4, 5), (0, 1, 4, 3), (1, 2, 5, 4), (2, 0, 3, 5)),
     "hex": ((0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)),
+    "pyramid": ((0, 1, 2, 3), (0, 1, 4), (1, 2, 4), (2, 3, 4), (3, 0, 4)),
 }
 
 
@@ -166,9 +167,12 @@ def element_surfaces(mesh, selected, level=None, measure="Scaled Jacobian"):
             points.append(p.reshape(-1, 3))
             count += p.shape[0] * p.shape[1]
             colors.append(np.repeat(quality_colors(block_values), len(sub), axis=0))
-            # The face's boundary, as polylines through the lattice's border points.
+            # The face's boundary, one polyline of level + 1 lattice points per side (so that
+            # triangle and quadrilateral faces, as a prism's or a pyramid's, stack alike).
             corners = 3 if len(ref) == (level + 1) * (level + 2) // 2 else 4
-            polylines.append(p[:, _lattice_border(level, corners), :])
+            border = _lattice_border(level, corners)
+            for side in range(corners):
+                polylines.append(p[:, border[side * level:(side + 1) * level + 1], :])
     points = np.concatenate(points) if points else np.zeros((0, 3))
     triangles = np.concatenate(triangles) if triangles else np.zeros((0, 3), dtype=np.int64)
     colors = np.concatenate(colors) if colors else np.zeros((0, 3))

@@ -9,6 +9,7 @@
 #include "core/format.hpp"
 #include "core/parameters.hpp"
 #include "core/version.hpp"
+#include "linear/cad_classification.hpp"
 #include "optimise/functional.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 
@@ -157,8 +158,8 @@ std::string onlyInput(const std::vector<std::string>& positional, const std::str
 // The table's options `keys` by their command-line spellings (core/parameters.hpp), into
 // `values`: a Boolean's flag turns its default around, the others take a value checked against
 // the table's range.
-void addTableOptions(OptionTable& table, OptionMap& values,
-                     std::initializer_list<const char*> keys) {
+template <class Keys>
+void addTableOptions(OptionTable& table, OptionMap& values, const Keys& keys) {
   for (const char* key : keys) {
     const ParameterDefinition& p = parameterDefinition(key);
     const std::string name = p.option;
@@ -188,6 +189,11 @@ void addTableOptions(OptionTable& table, OptionMap& values,
       }
     }
   }
+}
+
+void addTableOptions(OptionTable& table, OptionMap& values,
+                     std::initializer_list<const char*> keys) {
+  addTableOptions<std::initializer_list<const char*>>(table, values, keys);
 }
 
 // The octree's sizes (rows of the table, into `values`) and its refinement sources and octree
@@ -326,8 +332,7 @@ CurveCommand parseCurve(const std::vector<std::string>& args) {
   CurveCommand cmd;
   OptionTable table;
   addCommon(table, cmd.common, true, true);
-  addTableOptions(table, cmd.options,
-                  {"order", "optimise", "optimise_seconds", "facet_weight", "job_seconds"});
+  addTableOptions(table, cmd.options, kCurveOptionKeys);
   bool optimise = false;
   addOptimiseSwitch(table, optimise);
   table.value({"--cad"}, [&cmd](const std::string&, const std::string& v) { cmd.cad = v; });
@@ -415,7 +420,8 @@ std::string wrapped(const std::string& text, std::size_t first, std::size_t inde
 
 // The help lines of the table's options `keys` (core/parameters.hpp): spellings, meaning, range
 // and default, as the table states them.
-std::string tableHelp(std::initializer_list<const char*> keys) {
+template <class Keys>
+std::string tableHelp(const Keys& keys) {
   constexpr std::size_t kColumn = 22;
   std::string out;
   for (const char* key : keys) {
@@ -445,6 +451,10 @@ std::string tableHelp(std::initializer_list<const char*> keys) {
     out += head + wrapped(text, head.size(), kColumn, 92);
   }
   return out;
+}
+
+std::string tableHelp(std::initializer_list<const char*> keys) {
+  return tableHelp<std::initializer_list<const char*>>(keys);
 }
 
 // The output options of the commands that write meshes.
@@ -573,7 +583,8 @@ std::string curveHelp() {
 
 Curves a linear tetrahedral mesh made by another tool (Gmsh, Netgen, FreeCAD FEM; .msh, .unv,
 .vtk, .vtu, .xml) on the CAD it was made from (.step .stp .iges .igs .brep .brp, one solid):
-each boundary node is put on the CAD vertex, edge or face it lies on (within 1e-5 of the CAD's
+each boundary node is put on the CAD vertex, edge or face it lies on (within )" +
+         formatNumber(kClassificationTolerance) + R"( of the CAD's
 bounding diagonal; a node that lies on none is an error naming it, its position and its
 distance to the nearest face, and nothing is written), the mesh is raised to order P with its
 new boundary nodes on the CAD and, with --optimise, optimised with them sliding on it. A

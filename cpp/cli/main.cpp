@@ -68,19 +68,26 @@ std::size_t checkNektarOutputs(const std::vector<std::string>& outputs, int thre
 // Refuses bad output and report paths before any time is spent.
 // Refuses, before any work, outputs that cannot be written and any output (mesh or report)
 // that is the input itself: the input would be replaced by what was made from it.
-void checkOutputs(const homesh::CommonOptions& c, const std::string& input) {
-  const auto isInput = [&input](const std::string& path) {
-    std::error_code error;
-    return std::filesystem::equivalent(path, input, error) && !error;
+// `inputs`: the files the command reads (the mesh or CAD, and curve's CAD), which no output may
+// replace.
+void checkOutputs(const homesh::CommonOptions& c, const std::vector<std::string>& inputs) {
+  const auto readFile = [&inputs](const std::string& path) -> const std::string* {
+    for (const std::string& input : inputs) {
+      std::error_code error;
+      if (std::filesystem::equivalent(path, input, error) && !error) return &input;
+    }
+    return nullptr;
   };
   for (const std::string& path : c.outputs) {
-    if (isInput(path))
-      throw homesh::IoError("output '" + path + "' is the input file; write to another file");
+    if (const std::string* input = readFile(path))
+      throw homesh::IoError("output '" + path + "' is the input file '" + *input +
+                            "'; write to another file");
     homesh::checkMeshOutputPath(path);
   }
   if (c.report && *c.report != "-") {
-    if (isInput(*c.report))
-      throw homesh::IoError("report '" + *c.report + "' is the input file; write to another file");
+    if (const std::string* input = readFile(*c.report))
+      throw homesh::IoError("report '" + *c.report + "' is the input file '" + *input +
+                            "'; write to another file");
     homesh::checkParentFolder(*c.report);
   }
 }
@@ -157,7 +164,7 @@ int finishMeshJob(homesh::MeshResult& result, const homesh::CommonOptions& c,
 
 int runMesh(const homesh::MeshCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
-  checkOutputs(c, cmd.input);
+  checkOutputs(c, {cmd.input});
   homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.options, cmd.sizing, c);
   homesh::MeshingOptions& options = setup.options;
   if (cmd.blFaces || cmd.blThickness || cmd.blLayers || cmd.blProgression) {
@@ -177,7 +184,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
 
 int runPredict(const homesh::PredictCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
-  checkOutputs(c, cmd.input);
+  checkOutputs(c, {cmd.input});
   homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.options, cmd.sizing, c);
   const homesh::SizingResult s = homesh::runSizingStage(setup.source, setup.options);
   const bool toStdout = c.report && *c.report == "-";
@@ -236,7 +243,7 @@ homesh::Mesh readMeshFile(const std::string& path, bool quiet, std::vector<std::
 }
 
 int runQuality(const homesh::QualityCommand& cmd) {
-  checkOutputs(cmd.common, cmd.input);
+  checkOutputs(cmd.common, {cmd.input});
   std::vector<std::string> notes;
   const homesh::Mesh mesh = readMeshFile(cmd.input, cmd.common.quiet, notes);
   const homesh::QualitySummary q = homesh::evaluateQuality(mesh, cmd.common.threads);
@@ -249,7 +256,7 @@ int runQuality(const homesh::QualityCommand& cmd) {
 }
 
 int runConvert(const homesh::ConvertCommand& cmd) {
-  checkOutputs(cmd.common, cmd.input);
+  checkOutputs(cmd.common, {cmd.input});
   std::vector<std::string> notes;
   const homesh::Mesh mesh = readMeshFile(cmd.input, cmd.common.quiet, notes);
   const homesh::QualitySummary q = homesh::evaluateQuality(mesh, cmd.common.threads);
@@ -275,7 +282,7 @@ class SweepLog : public homesh::OptimiserObserver {
 
 int runOptimise(const homesh::OptimiseCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
-  checkOutputs(c, cmd.input);
+  checkOutputs(c, {cmd.input});
   homesh::OptionMap values = cmd.options;
   values["threads"] = static_cast<double>(c.threads);
   homesh::OptimiserOptions options;
@@ -316,7 +323,7 @@ int runOptimise(const homesh::OptimiseCommand& cmd) {
 // Curves another tool's linear tetrahedral mesh on its CAD (pipeline's curveMeshOnCad).
 int runCurve(const homesh::CurveCommand& cmd) {
   const homesh::CommonOptions& c = cmd.common;
-  checkOutputs(c, cmd.input);
+  checkOutputs(c, {cmd.input, cmd.cad});
   homesh::MeshingOptions options;
   options.threads = c.threads;
   options.apply(cmd.options);

@@ -156,7 +156,7 @@ class NodeIndex {
 
 // The vertex weights x P^3 of lattice point c of an order-P cell (node_ordering.hpp's lattice:
 // quadrilateral corners (0,0) (P,0) (P,P) (0,P); prism triangle at k = 0 then k = P;
-// hexahedron quadrilateral at k = 0 then k = P).
+// hexahedron quadrilateral at k = 0 then k = P; pyramid square at k = 0, apex (0,0,P)).
 std::array<int, kMaxSupport> vertexWeights(CellType type, const LatticePoint& c, int p) {
   std::array<int, kMaxSupport> w{};
   const int i = c[0], j = c[1], k = c[2];
@@ -188,6 +188,24 @@ std::array<int, kMaxSupport> vertexWeights(CellType type, const LatticePoint& c,
         w[v] = q[v] * (p - k);
         w[v + 4] = q[v] * k;
       }
+      break;
+    }
+    case CellType::Pyramid: {
+      // Level k is a square of side s = p - k (lattice: apex above corner 0). On the faces the
+      // straight-sided (order-1) pyramid's weights are integers over p^3 (a triangle face's its
+      // barycentric weights, the base's the quadrilateral's), so neighbours key those nodes
+      // alike. Inside, they are rational (x y / (1 - z)): the key is then only a code, one to one
+      // with (i, j, k) (k, then i from a1 + a2, then j), and the node's position comes from the
+      // element's own map (elevateBlock).
+      const int s = p - k;
+      if (s == 0) {
+        w[4] = p * p * p;
+        break;
+      }
+      const int base[4] = {(s - i) * (s - j), i * (s - j), i * j, (s - i) * j};
+      const bool inside = k > 0 && i > 0 && j > 0 && i < s && j < s;
+      for (int v = 0; v < 4; ++v) w[v] = inside ? base[v] * p : base[v] * p * p / s;
+      w[4] = k * p * p;
       break;
     }
     default:
@@ -299,8 +317,6 @@ struct Elevator {
   }
 
   void elevateBlock(const ElementBlock& block) {
-    if (block.type == CellType::Pyramid)
-      throw ParameterError("changing the order does not support pyramids");
     const ReferenceElement& ref = ReferenceElement::get(block.type, order);
     const int nv = cellNumVertices(block.type);
     ElementBlock high;
@@ -308,8 +324,9 @@ struct Elevator {
     high.order = order;
     high.entity = block.entity;
     high.nodes.reserve(block.count() * ref.numNodes());
-    // A curved source: its basis at the new nodes (new nodes x source nodes).
-    const bool curvedSource = block.order > 1;
+    // A curved source, or a pyramid (whose straight-sided map is rational inside: vertexWeights):
+    // its basis at the new nodes (new nodes x source nodes).
+    const bool curvedSource = block.order > 1 || block.type == CellType::Pyramid;
     Eigen::MatrixXd interpolation;
     if (curvedSource)
       interpolation = ReferenceElement::get(block.type, block.order).valuesAt(ref.nodes());

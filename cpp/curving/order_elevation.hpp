@@ -1,6 +1,6 @@
 // Raises a linear mesh to order P and puts the new boundary nodes on the CAD.
 //
-// Every shape but the pyramid: lines, triangles, quadrilaterals, tetrahedra, prisms and
+// Every shape: lines, triangles, quadrilaterals, tetrahedra, prisms, pyramids and
 // hexahedra, mixed in one mesh. New nodes are shared between the elements that contain them: a
 // node is identified by the global vertices of the edge, face or cell it belongs to and the
 // integer weights (times P^3) its straight-sided position gives them, which every neighbour

@@ -25,7 +25,7 @@ int jacobianDegree(CellType type, int p) {
       return 2 * p;
     case CellType::Tetrahedron:
       return 3 * (p - 1);
-    default:  // prisms and hexahedra
+    default:  // prisms, hexahedra, and pyramids (J: degree 3p - 1 in collapsed coordinates)
       return 3 * p;
   }
 }

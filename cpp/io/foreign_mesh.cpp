@@ -18,7 +18,8 @@ std::string countedName(CellType type, std::size_t count) {
   static const std::pair<CellType, std::pair<const char*, const char*>> kNames[] = {
       {CellType::Tetrahedron, {"tetrahedron", "tetrahedra"}},
       {CellType::Prism, {"prism", "prisms"}},
-      {CellType::Hexahedron, {"hexahedron", "hexahedra"}}};
+      {CellType::Hexahedron, {"hexahedron", "hexahedra"}},
+      {CellType::Pyramid, {"pyramid", "pyramids"}}};
   for (const auto& [t, names] : kNames)
     if (t == type)
       return count == 1 ? std::string("the 1 ") + names.first

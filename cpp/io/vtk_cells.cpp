@@ -68,7 +68,8 @@ const TypeInfo kTypes[] = {
     {72, "VTK_LAGRANGE_HEXAHEDRON", CellType::Hexahedron, 0, nullptr},
     {73, "VTK_LAGRANGE_WEDGE", CellType::Prism, 0, nullptr},
     {74, "VTK_LAGRANGE_PYRAMID", CellType::Point, 0,
-     "a curved pyramid (VTK 9.1 has no Lagrange pyramid to agree a node order with)"},
+     "a Lagrange pyramid (VTK 9.1 has none to agree a node order with; a linear pyramid is read as "
+     "a VTK_PYRAMID)"},
 };
 
 const TypeInfo* typeInfo(std::int64_t code) {

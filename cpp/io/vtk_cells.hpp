@@ -24,11 +24,11 @@ std::vector<int> vtkPermutationFromGmsh(CellType type, int order, bool hexVersio
 // `firstPoint` on in `mesh`): cell c has the points connectivity[start .. offsets[c]) (start:
 // the previous offset, 0 for the first), numbered from 0 in the piece, and VTK type types[c].
 // Each is added to `mesh`
-// in Gmsh's order: linear cells (VTK_LINE, _TRIANGLE, _QUAD, _TETRA, _HEXAHEDRON, _WEDGE, whose
-// handedness is the opposite of Gmsh's prism), quadratic ones that are complete Lagrange cells
-// (VTK_QUADRATIC_EDGE, _QUADRATIC_TRIANGLE, _QUADRATIC_TETRA, _BIQUADRATIC_QUAD,
+// in Gmsh's order: linear cells (VTK_LINE, _TRIANGLE, _QUAD, _TETRA, _HEXAHEDRON, _PYRAMID,
+// _WEDGE, whose handedness is the opposite of Gmsh's prism), quadratic ones that are complete
+// Lagrange cells (VTK_QUADRATIC_EDGE, _QUADRATIC_TRIANGLE, _QUADRATIC_TETRA, _BIQUADRATIC_QUAD,
 // _TRIQUADRATIC_HEXAHEDRON) and Lagrange cells of orders 1 to 10; vertices are skipped. Throws
-// IoError "<where>: cell N ..." for other types (serendipity, pyramids, polygons, ...), node
+// IoError "<where>: cell N ..." for other types (serendipity, curved pyramids, polygons, ...), node
 // counts that do not fit the type, offsets out of order or point ids outside the piece.
 void addVtkCells(ForeignMesh& mesh, const std::vector<std::int64_t>& connectivity,
                  const std::vector<std::int64_t>& offsets, const std::vector<std::int64_t>& types,

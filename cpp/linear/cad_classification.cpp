@@ -326,7 +326,7 @@ std::pair<ElementBlock, ElementBlock> boundaryCells(const Mesh& mesh,
 Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
                    CadClassificationStats* stats) {
   const ElementBlock& tets = checkedTetrahedra(linear, cad);
-  if (!(tolerance > 0.0)) tolerance = 1e-5 * cad.boundingDiagonal();
+  if (!(tolerance > 0.0)) tolerance = kClassificationTolerance * cad.boundingDiagonal();
   Mesh mesh = nodesInSolid(linear);
   ElementBlock cells;
   cells.type = CellType::Tetrahedron;

@@ -16,6 +16,10 @@
 
 namespace homesh {
 
+// The default tolerance, relative to the CAD's bounding diagonal: above the CAD's own
+// tolerances, below any element.
+constexpr double kClassificationTolerance = 1e-5;
+
 struct CadClassificationStats {
   std::size_t boundaryNodes = 0, onVertices = 0, onEdges = 0, onFaces = 0;
   std::size_t boundaryTriangles = 0, boundarySegments = 0;

@@ -154,7 +154,8 @@ class WorkingMesh {
   }
 
   Mesh& mesh;
-  // Without CAD the optimiser moves the nodes of the well-conditioned set (kWorkingSet). With
+  // Without CAD the optimiser moves the nodes of the well-conditioned set (kWorkingSet), but
+  // for a mesh with pyramids (which have none). With
   // CAD it moves the mesh's own (equispaced) nodes, the ones that lie on the CAD, and so it does
   // with a region, where a fixed node of an element at the region's edge would otherwise change
   // its equispaced position with its free neighbours' working nodes.

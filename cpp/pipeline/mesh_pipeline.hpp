@@ -8,6 +8,7 @@
 // point, so they validate parameters and report identically.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -151,6 +152,11 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
 // repair rounds and no boundary layer (ParameterError when one is asked for).
 MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOptions options,
                           PipelineObserver* observer = nullptr);
+
+// The parameter table's keys curveMeshOnCad's front ends take (`homesh curve`, homesh.curve),
+// beside threads and verbosity, which each front end sets its own way.
+inline constexpr std::array<const char*, 5> kCurveOptionKeys = {
+    "order", "optimise", "optimise_seconds", "facet_weight", "job_seconds"};
 
 // writeMeshFiles as the pipeline's last stage: records its "output" timing in the result.
 void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,

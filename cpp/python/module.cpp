@@ -456,8 +456,11 @@ MeshingOptions optionsFrom(const bp::dict& d, const std::vector<std::string>& al
 
 // The table keys each front-end function uses (MeshingOptions::fromMap refuses the others).
 const std::vector<std::string> kMeshKeys = {};
-const std::vector<std::string> kCurveKeys = {
-    "order", "threads", "verbosity", "optimise", "optimise_seconds", "job_seconds", "facet_weight"};
+const std::vector<std::string> kCurveKeys = [] {
+  std::vector<std::string> keys{"threads", "verbosity"};
+  keys.insert(keys.end(), kCurveOptionKeys.begin(), kCurveOptionKeys.end());
+  return keys;
+}();
 const std::vector<std::string> kSizingKeys = {"threads", "heal",      "solids_only", "surface",
                                               "auto",    "min_delta", "max_delta",   "eps"};
 const std::vector<std::string> kReadKeys = {"threads"};

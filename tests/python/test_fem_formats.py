@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 
 import homesh
+from homesh import tessellation
 from conftest import DATA, ROOT, run
 
 FEM = DATA / "fem"
@@ -314,6 +315,15 @@ def test_linear_pyramids_are_read_and_judged(homesh_bin, tmp_path):
     assert "pyramid" in r.stdout and "invalid elements 0" in r.stdout, r.stdout
     mesh = homesh.read(path)
     assert mesh.num_elements == 1
+    # Certified to within the Bezier bounds' rounding margin (1e-9 here) of 1.
+    assert mesh.quality()["scaled_jacobian"][0] == pytest.approx(1.0, abs=1e-9)
+    # Drawn as FreeCAD draws chosen elements: its 5 faces, every point on one of them, and one
+    # polyline per side of each face (4 + 4 x 3).
+    drawn = tessellation.element_surfaces(mesh, [0], level=4)
+    x, y, z = drawn["points"].T
+    on_face = np.min(np.abs(np.stack([z, y, x, x + z - 1.0, y + z - 1.0])), axis=0)
+    assert on_face.max() < 1e-12
+    assert len(drawn["edge_polylines"]) == 16
 
 
 UNV_QUAD8 = """    -1

@@ -4,11 +4,16 @@
 #include <array>
 #include <cmath>
 #include <set>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "boundary_layer/layer_blend.hpp"
 #include "core/error.hpp"
 #include "curving/order_elevation.hpp"
 #include "element/reference_element.hpp"
+#include "gmsh_hybrid_box.hpp"
+#include "io/mesh_readers.hpp"
 #include "linear/linear_mesher.hpp"
 #include "quality/mesh_quality.hpp"
 #include "test_support.hpp"
@@ -418,6 +423,47 @@ TEST(OrderElevation, RaisingALayerKeepsItsTopEdgesOnTheSideFacesParallelToTheWal
   }
   const QualitySummary q = evaluateQuality(raised);
   EXPECT_EQ(q.invalid + q.undecided, 0u);
+}
+
+// Pyramids raised with the tetrahedra beside them: a Gmsh hybrid mesh of the unit box at order
+// 1 raised to 2, 3, 4 and 6 makes Gmsh's own order-P mesh, element by element and node by node
+// in Gmsh's order (its triangle faces shared with the tetrahedra, its base quadrilaterals on the
+// box, its inside from its own rational map), with as many nodes, and every element valid.
+TEST(OrderElevation, PyramidsShareTheirNodesAsGmshsOwnHighOrderMesh) {
+  const auto dir = test::tempDir();
+  std::vector<std::pair<int, std::string>> files;
+  for (const int p : {1, 2, 3, 4, 6})
+    files.emplace_back(p, (dir / ("hybrid" + std::to_string(p) + ".msh")).string());
+  test::writeGmshHybridBox(files);
+  const Mesh linear = readMesh(files[0].second);
+  for (const auto& [p, path] : std::vector(files.begin() + 1, files.end())) {
+    const Mesh gmshMesh = readMesh(path);
+    const Mesh raised = changeOrder(linear, p, nullptr);
+    ASSERT_EQ(raised.numNodes(), gmshMesh.numNodes()) << "order " << p;
+    int pyramids = 0;
+    for (const ElementBlock& ours : raised.blocks) {
+      if (cellDimension(ours.type) != 3) continue;
+      pyramids += ours.type == CellType::Pyramid ? 1 : 0;
+      const ElementBlock* theirs = nullptr;
+      for (const ElementBlock& b : gmshMesh.blocks)
+        if (b.type == ours.type) theirs = &b;
+      ASSERT_NE(theirs, nullptr);
+      ASSERT_EQ(ours.count(), theirs->count());
+      // The same straight elements (the box's faces are flat), nodes at multiples of 1 / p
+      // along straight segments: equal to rounding (1e-15); 1e-12 is slack, a wrong node is
+      // 1e-2 away.
+      for (std::size_t e = 0; e < ours.count(); ++e)
+        for (int n = 0; n < ours.nodesPerElement(); ++n)
+          for (int c = 0; c < 3; ++c)
+            ASSERT_NEAR(raised.xyz[3 * static_cast<std::size_t>(ours.element(e)[n]) + c],
+                        gmshMesh.xyz[3 * static_cast<std::size_t>(theirs->element(e)[n]) + c],
+                        1e-12)
+                << cellShortName(ours.type) << " " << e << " node " << n << " order " << p;
+    }
+    EXPECT_EQ(pyramids, 1);
+    const QualitySummary q = evaluateQuality(raised);
+    EXPECT_EQ(q.invalid + q.undecided, 0U) << "order " << p;
+  }
 }
 
 TEST(OrderElevation, RejectsBadOrders) {

@@ -1,8 +1,8 @@
-// The pyramid in the element library, orders 1 to 10: Gmsh's node order and reference nodes (to
-// order 9, the highest Gmsh 4.8 has), a nodal basis that reproduces Bergot, Cohen and Durufle's
-// space (its rational functions included) with their derivatives, interpolates at its nodes (the
-// apex included), conforms to triangles and quadrilaterals on its faces, and a quadrature exact
-// for that space to its degree.
+// The pyramid in the element library, orders 1 to 10: Gmsh's node order, reference nodes and MSH
+// type codes (to order 9, the highest Gmsh 4.8 has), a nodal basis that reproduces Bergot, Cohen
+// and Durufle's space (its rational functions included) with their derivatives, interpolates at its
+// nodes (the apex included), conforms to triangles and quadrilaterals on its faces, and a
+// quadrature exact for that space to its degree.
 #include <gmsh.h>
 #include <gtest/gtest.h>
 
@@ -16,6 +16,7 @@
 
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
+#include "io/gmsh_element_types.hpp"
 
 namespace homesh {
 namespace {
@@ -79,6 +80,8 @@ TEST(Pyramid, NodesAreGmshsInGmshsOrder) {
     gmsh::model::mesh::getElementProperties(gmsh::model::mesh::getElementType("Pyramid", p), name,
                                             dim, order, numNodes, coord, numPrimary);
     ASSERT_EQ(order, p);
+    EXPECT_EQ(gmshElementType(CellType::Pyramid, p),
+              gmsh::model::mesh::getElementType("Pyramid", p));  // MSH's type codes
     const ReferenceElement& ref = ReferenceElement::get(CellType::Pyramid, p);
     ASSERT_EQ(numNodes, ref.numNodes()) << name;
     ASSERT_EQ(ref.numNodes(), cellNumNodes(CellType::Pyramid, p));

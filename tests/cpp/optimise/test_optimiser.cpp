@@ -3,7 +3,6 @@
 // data (../shared, peer_data.hpp) and may be absent: its regression cases then skip, each with a
 // sibling on a mesh made here, and the generic tests run on meshes made here, and on NekMesh's
 // too when they are there.
-#include <gmsh.h>
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -25,6 +24,7 @@
 #include "core/spatial_order.hpp"
 #include "curving/order_elevation.hpp"
 #include "element/reference_element.hpp"
+#include "gmsh_hybrid_box.hpp"
 #include "io/mesh_readers.hpp"
 #include "optimise/mesh_topology.hpp"
 #include "optimise/optimiser.hpp"
@@ -361,8 +361,8 @@ TEST(Optimiser, CubeSphereOrder4ConvergesAndKeepsTheBoundaryOfTheMadeMesh) {
   EXPECT_LT(fixed, input.numNodes());
 }
 
-// A hybrid mesh as Gmsh makes it: a unit box with quadrilaterals on its faces, pyramids on
-// them and tetrahedra inside (633 and 36 from Gmsh 4.8), at order 4. The nodes inside each pyramid
+// A hybrid mesh as Gmsh makes it (gmsh_hybrid_box.hpp: pyramids on the unit box's faces,
+// tetrahedra inside) at order 4. The nodes inside each pyramid
 // moved at random tangle most of them (23 of 36); the optimiser, on the mesh's own equispaced nodes
 // (pyramids have no optimal set), makes every element certified valid again (worst 0.28) and
 // leaves the boundary where it was. (Moved by up to 30 % of the spacing, 4 of 32 tangled
@@ -370,19 +370,7 @@ TEST(Optimiser, CubeSphereOrder4ConvergesAndKeepsTheBoundaryOfTheMadeMesh) {
 TEST(Optimiser, UntanglesThePyramidsOfAHybridMesh) {
   const auto dir = test::tempDir();
   const std::string path = (dir / "hybrid.msh").string();
-  gmsh::initialize(0, nullptr, false);
-  gmsh::option::setNumber("General.Terminal", 0);
-  gmsh::model::add("hybrid");
-  gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
-  gmsh::model::occ::synchronize();
-  gmsh::vectorpair corners;
-  gmsh::model::getEntities(corners, 0);
-  gmsh::model::mesh::setSize(corners, 0.5);
-  gmsh::option::setNumber("Mesh.RecombineAll", 1);
-  gmsh::model::mesh::generate(3);
-  gmsh::model::mesh::setOrder(4);
-  gmsh::write(path);
-  gmsh::finalize();
+  test::writeGmshHybridBox({{4, path}});
   const Mesh input = readMesh(path);
   std::vector<const ElementBlock*> cells;
   const ElementBlock* pyramids = nullptr;
