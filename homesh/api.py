@@ -438,8 +438,8 @@ def curve(shape, nodes, tetrahedra, progress=None, cancel=None, name=None, **opt
     mesher) on the CAD it was made from.
 
     shape       as for :func:`mesh` (one solid).
-    nodes       (N, 3) coordinates; the boundary nodes must lie on the CAD (within 1e-5 of its
-                bounding diagonal).
+    nodes       (N, 3) coordinates; the boundary nodes must lie on the CAD (within
+                ``classify_tolerance``, by default 1e-5, of its bounding diagonal).
     tetrahedra  (E, 4) 0-based node indices (either orientation; corner nodes only).
 
     Each boundary node is put on the CAD vertex, edge or face it lies on, the mesh is raised to

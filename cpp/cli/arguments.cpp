@@ -9,7 +9,6 @@
 #include "core/format.hpp"
 #include "core/parameters.hpp"
 #include "core/version.hpp"
-#include "linear/cad_classification.hpp"
 #include "optimise/functional.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 
@@ -583,10 +582,9 @@ std::string curveHelp() {
 
 Curves a linear tetrahedral mesh made by another tool (Gmsh, Netgen, FreeCAD FEM; .msh, .unv,
 .vtk, .vtu, .xml) on the CAD it was made from (.step .stp .iges .igs .brep .brp, one solid):
-each boundary node is put on the CAD vertex, edge or face it lies on (within )" +
-         formatNumber(kClassificationTolerance) + R"( of the CAD's
-bounding diagonal; a node that lies on none is an error naming it, its position and its
-distance to the nearest face, and nothing is written), the mesh is raised to order P with its
+each boundary node is put on the CAD vertex, edge or face it lies on (within --classify-tolerance
+of the CAD's bounding diagonal; a node that lies on none is an error naming it, its position and
+its distance to the nearest face, and nothing is written), the mesh is raised to order P with its
 new boundary nodes on the CAD and, with --optimise, optimised with them sliding on it. A
 quadratic mesh is curved from its corners (its mid-edge nodes are dropped, with a note).
 Prisms, pyramids and hexahedra are not taken yet.
@@ -595,7 +593,9 @@ options (the parameter table's, which Python's homesh.curve reads too):
 )" + tableHelp({"order"}) +
          R"(      --optimise      run the variational optimiser after curving (hyperelastic),
                       boundary nodes sliding on the CAD curves and faces
-)" + tableHelp({"optimise", "optimise_seconds", "facet_weight", "job_seconds"}) +
+)" +
+         tableHelp({"optimise", "optimise_seconds", "facet_weight", "job_seconds",
+                    "classify_tolerance"}) +
          outputHelp() +
          R"(      --report FILE   write the JSON report ("-" for standard output)
 )" + commonHelp();

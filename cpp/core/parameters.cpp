@@ -49,6 +49,11 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        ParameterKind::Integer, 0, 20, false, 8, false, false, "mesh",
        "Most repair rounds while elements are not proven valid (split, flip, remesh or refine "
        "around them, curve, optimise and check again)"},
+      {"classify_tolerance", "", "--classify-tolerance", "", "classification tolerance",
+       ParameterKind::Real, 0, 0.01, true, 1e-5, false, false, "mesh",
+       "How far a boundary node of a mesh made elsewhere (homesh curve) may lie from the CAD "
+       "vertex, edge or face it is put on, relative to the CAD's bounding diagonal; the node is "
+       "then moved onto it"},
       {"threads", "Threads", "--threads", "-j", "threads", ParameterKind::Integer, 1, 1024, false,
        1, false, false, "mesh", "Threads the sizing octree and the optimiser use"},
       {"verbosity", "", "--verbose", "-v", "verbosity", ParameterKind::Integer, 0, 2, false, 0,

@@ -12,6 +12,7 @@
 
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "core/parameters.hpp"
 #include "linear/edge_split.hpp"
 
 namespace homesh {
@@ -326,7 +327,8 @@ std::pair<ElementBlock, ElementBlock> boundaryCells(const Mesh& mesh,
 Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
                    CadClassificationStats* stats) {
   const ElementBlock& tets = checkedTetrahedra(linear, cad);
-  if (!(tolerance > 0.0)) tolerance = kClassificationTolerance * cad.boundingDiagonal();
+  if (!(tolerance > 0.0))
+    tolerance = parameterDefault("classify_tolerance") * cad.boundingDiagonal();
   Mesh mesh = nodesInSolid(linear);
   ElementBlock cells;
   cells.type = CellType::Tetrahedron;

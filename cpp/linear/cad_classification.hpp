@@ -16,10 +16,6 @@
 
 namespace homesh {
 
-// The default tolerance, relative to the CAD's bounding diagonal: above the CAD's own
-// tolerances, below any element.
-constexpr double kClassificationTolerance = 1e-5;
-
 struct CadClassificationStats {
   std::size_t boundaryNodes = 0, onVertices = 0, onEdges = 0, onFaces = 0;
   std::size_t boundaryTriangles = 0, boundarySegments = 0;
@@ -27,7 +23,8 @@ struct CadClassificationStats {
 };
 
 // `linear`: dim 3, order 1, one tetrahedron block (other blocks are ignored; node records need
-// not be set). The CAD must have exactly one solid. `tolerance` <= 0: 1e-5 of the CAD's bounding
+// not be set). The CAD must have exactly one solid. `tolerance` <= 0: the parameter table's
+// classify_tolerance (1e-5) of the CAD's bounding
 // diagonal (above the CAD's own tolerances, below any element). Throws ParameterError for a mesh
 // that is not such, and MeshingError naming the node, its position and the nearest CAD face when
 // a boundary node lies on no CAD face.

@@ -321,7 +321,8 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
   cad.done();
   result.options = options;
   StageClock classify("classify", result.timings, observer);
-  Mesh onCad = classifyOnCad(linear, *result.cad);
+  Mesh onCad = classifyOnCad(linear, *result.cad,
+                             options.classifyTolerance * result.cad->boundingDiagonal());
   classify.done();
   CurvedState state =
       curve(std::move(onCad), options, *result.cad, result.timings, observer, true, budget, "");

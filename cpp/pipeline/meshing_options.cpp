@@ -16,6 +16,7 @@ void MeshingOptions::validate() const {
   checkParameter("linear_seconds", linearSeconds);
   checkParameter("job_seconds", jobSeconds);
   checkParameter("repair_rounds", repairRounds);
+  checkParameter("classify_tolerance", classifyTolerance);
   if (boundaryLayer) boundaryLayer->validate();
   if (surface && boundaryLayer)
     throw ParameterError(
@@ -57,6 +58,7 @@ const OptionSetters<MeshingOptions>& setters() {
       {"linear_seconds", [](MeshingOptions& o, double v) { o.linearSeconds = v; }},
       {"job_seconds", [](MeshingOptions& o, double v) { o.jobSeconds = v; }},
       {"repair_rounds", [](MeshingOptions& o, double v) { o.repairRounds = static_cast<int>(v); }},
+      {"classify_tolerance", [](MeshingOptions& o, double v) { o.classifyTolerance = v; }},
       {"threads", [](MeshingOptions& o, double v) { o.threads = static_cast<int>(v); }},
       {"verbosity", [](MeshingOptions& o, double v) { o.verbosity = static_cast<int>(v); }},
       {"heal", [](MeshingOptions& o, double v) { o.heal = v != 0.0; }},

@@ -40,6 +40,9 @@ struct MeshingOptions {
   // (core/job_budget.hpp): Gmsh and every optimiser run get at most what is left, repair rounds
   // stop when the last one would no longer fit, the geometry check is skipped once it is spent.
   double jobSeconds = defaultOf<double>("job_seconds");
+  // How far a boundary node of a given linear mesh (curveMeshOnCad) may lie from the CAD,
+  // relative to its bounding diagonal (linear/cad_classification.hpp).
+  double classifyTolerance = defaultOf<double>("classify_tolerance");
   // Repair rounds (pipeline/repair.hpp) while elements are not proven valid, range in
   // core/parameters.hpp: each splits the offending linear cells' edges on curved faces (or refines
   // around them), then curves, optimises and checks again. 0: none.

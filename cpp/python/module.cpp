@@ -455,7 +455,12 @@ MeshingOptions optionsFrom(const bp::dict& d, const std::vector<std::string>& al
 }
 
 // The table keys each front-end function uses (MeshingOptions::fromMap refuses the others).
-const std::vector<std::string> kMeshKeys = {};
+// homesh.mesh: every MeshingOptions key but those of a mesh made elsewhere.
+const std::vector<std::string> kMeshKeys = [] {
+  std::vector<std::string> keys = MeshingOptions::keys({});
+  keys.erase(std::remove(keys.begin(), keys.end(), "classify_tolerance"), keys.end());
+  return keys;
+}();
 const std::vector<std::string> kCurveKeys = [] {
   std::vector<std::string> keys{"threads", "verbosity"};
   keys.insert(keys.end(), kCurveOptionKeys.begin(), kCurveOptionKeys.end());

@@ -84,6 +84,18 @@ def test_a_node_off_the_cad_is_refused_by_name_and_nothing_is_written(homesh_bin
     assert "node %d at (%g, %g, %g)" % ((node + 1,) + tuple(mesh.points[node])) in error, error
     assert "Face" in error and "distance 0.006" in error, error
     assert not out.exists()
+    # Within a tolerance of 2e-3 of the diagonal (0.012) the node counts as on the hole: it is
+    # put back onto it and the mesh is curved and certified valid.
+    r = run([homesh_bin, "curve", moved, "--cad", data / "box_hole.step", "-o", out,
+             "--classify-tolerance", "2e-3", "--order", "2"])
+    assert r.returncode == 0, r.stderr
+    curved = meshio.read(out)
+    boundary = np.unique(curved.cells_dict["triangle6"].ravel())
+    assert distance_to_cad(curved.points[boundary]).max() < 1e-9 * DIAGONAL
+    r = run([homesh_bin, "curve", moved, "--cad", data / "box_hole.step",
+             "--classify-tolerance", "0.5"])
+    assert r.returncode == 2 and "--classify-tolerance must be a number in (0, 0.01]" in r.stderr, \
+        r.stderr
 
 
 def test_curve_needs_its_cad_and_refuses_other_cells(homesh_bin, data, tmp_path):
