@@ -94,9 +94,9 @@ TEST(Arguments, OptimiserOptionsNeedTheOptimiser) {
 
 TEST(Arguments, HelpListsTheTablesOptionsWithTheirRangesAndDefaults) {
   // The help's words in one line: a range may be wrapped over two. The optimiser's own options
-  // are `homesh optimise`'s.
+  // are `homesh optimise`'s, the classification tolerance `homesh curve`'s.
   std::string help;
-  for (const char c : usageText("mesh") + usageText("optimise"))
+  for (const char c : usageText("mesh") + usageText("optimise") + usageText("curve"))
     if (c != '\n' && !(c == ' ' && !help.empty() && help.back() == ' ')) help += c;
   for (const ParameterDefinition& p : parameterDefinitions()) {
     if (*p.option == '\0' || std::string(p.key) == "verbosity") continue;
