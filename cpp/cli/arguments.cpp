@@ -590,13 +590,10 @@ quadratic mesh is curved from its corners (its mid-edge nodes are dropped, with 
 Prisms, pyramids and hexahedra are not taken yet.
 
 options (the parameter table's, which Python's homesh.curve reads too):
-)" + tableHelp({"order"}) +
+)" + tableHelp(kCurveOptionKeys) +
          R"(      --optimise      run the variational optimiser after curving (hyperelastic),
                       boundary nodes sliding on the CAD curves and faces
-)" +
-         tableHelp({"optimise", "optimise_seconds", "facet_weight", "job_seconds",
-                    "classify_tolerance"}) +
-         outputHelp() +
+)" + outputHelp() +
          R"(      --report FILE   write the JSON report ("-" for standard output)
 )" + commonHelp();
 }

@@ -134,19 +134,25 @@ struct Columns {
   std::vector<const BernsteinSpace*> space;
 };
 
-// A polynomial shape: the columns are dx/dxi_k, the derivatives of the geometry's control points
-// composed with Lagrange-to-Bezier.
-Columns polynomialColumns(const ReferenceElement& ref) {
-  const BernsteinSpace& geometry = BernsteinSpace::get(geometryFactors(ref.type(), ref.order()));
-  const Eigen::MatrixXd toBezier = lagrangeToBezier(ref, geometry);
+// The columns dx/dxi_k (k < dim) of a geometry in `geometry`'s space whose control points are
+// toBezier times the nodes: the derivatives of the control points.
+Columns derivativeColumns(const BernsteinSpace& geometry, const Eigen::MatrixXd& toBezier,
+                          int dim) {
   Columns c;
-  for (int k = 0; k < ref.dim(); ++k) {
+  for (int k = 0; k < dim; ++k) {
     c.space.push_back(&BernsteinSpace::get(geometry.derivativeFactors(k)));
-    Eigen::MatrixXd d(c.space.back()->size(), ref.numNodes());
-    for (int j = 0; j < ref.numNodes(); ++j) d.col(j) = geometry.derivative(k, toBezier.col(j));
+    Eigen::MatrixXd d(c.space.back()->size(), toBezier.cols());
+    for (Eigen::Index j = 0; j < toBezier.cols(); ++j)
+      d.col(j) = geometry.derivative(k, toBezier.col(j));
     c.matrix.push_back(std::move(d));
   }
   return c;
+}
+
+// A polynomial shape: its own geometry space, Lagrange-to-Bezier on its nodes.
+Columns polynomialColumns(const ReferenceElement& ref) {
+  const BernsteinSpace& geometry = BernsteinSpace::get(geometryFactors(ref.type(), ref.order()));
+  return derivativeColumns(geometry, lagrangeToBezier(ref, geometry), ref.dim());
 }
 
 // Control points of f / (1 - z), rows of `coeffs` in `space` (three intervals, z the last, of
@@ -183,21 +189,14 @@ Columns pyramidColumns(const ReferenceElement& ref) {
     const Eigen::Vector3d uvz = cube.nodes().row(h).transpose();
     points.row(h) << uvz.x() * (1.0 - uvz.z()), uvz.y() * (1.0 - uvz.z()), uvz.z();
   }
-  const Eigen::MatrixXd toBezier = lagrangeToBezier(cube, geometry) * ref.valuesAt(points);
-  Columns c;
-  for (int k = 0; k < 3; ++k) {
-    const BernsteinSpace& derivative = BernsteinSpace::get(geometry.derivativeFactors(k));
-    Eigen::MatrixXd d(derivative.size(), ref.numNodes());
-    for (int j = 0; j < ref.numNodes(); ++j) d.col(j) = geometry.derivative(k, toBezier.col(j));
-    if (k == 2) {
-      c.space.push_back(&derivative);
-      c.matrix.push_back(std::move(d));
-      continue;
-    }
+  Columns c =
+      derivativeColumns(geometry, lagrangeToBezier(cube, geometry) * ref.valuesAt(points), 3);
+  for (std::size_t k = 0; k < 2; ++k) {  // dx/du and dx/dv over 1 - z
+    const BernsteinSpace& derivative = *c.space[k];
     BernsteinFactors reduced = derivative.factors();
     reduced[2].second -= 1;
-    c.space.push_back(&BernsteinSpace::get(reduced));
-    c.matrix.push_back(divideByOneMinusZ(derivative, d, *c.space.back()));
+    c.space[k] = &BernsteinSpace::get(reduced);
+    c.matrix[k] = divideByOneMinusZ(derivative, c.matrix[k], *c.space[k]);
   }
   return c;
 }
