@@ -433,34 +433,51 @@ def _four_argument_progress(progress):
     return stages_only
 
 
-def curve(shape, nodes, tetrahedra, progress=None, cancel=None, name=None, **options):
-    """Curves a linear tetrahedral mesh made by another tool (FreeCAD FEM's Gmsh or Netgen
-    mesher) on the CAD it was made from.
+_CURVE_CELLS = {"tet": 4, "prism": 6, "pyramid": 5, "hex": 8}
 
-    shape       as for :func:`mesh` (one solid).
-    nodes       (N, 3) coordinates; the boundary nodes must lie on the CAD (within
-                ``classify_tolerance``, by default 1e-5, of its bounding diagonal).
-    tetrahedra  (E, 4) 0-based node indices (either orientation; corner nodes only).
 
-    Each boundary node is put on the CAD vertex, edge or face it lies on, the mesh is raised to
+def curve(shape, nodes, cells, progress=None, cancel=None, name=None, **options):
+    """Curves a linear volume mesh made by another tool (FreeCAD FEM's Gmsh or Netgen mesher,
+    Gmsh, an industrial mesher's hybrid mesh) on the CAD it was made from.
+
+    shape   as for :func:`mesh` (one solid).
+    nodes   (N, 3) coordinates; the boundary nodes must lie on the CAD (within
+            ``classify_tolerance``, by default 1e-5, of its bounding diagonal).
+    cells   an (E, 4) array of tetrahedra, or a dict of corner arrays by cell type: ``"tet"``
+            (E, 4), ``"prism"`` (E, 6), ``"pyramid"`` (E, 5), ``"hex"`` (E, 8); 0-based node
+            indices, corners only, in Gmsh's order (either orientation).
+
+    Each boundary node is put on the CAD vertex, edge or face it lies on; prisms stacked on the
+    wall (a boundary layer) are joined into one macro prism per column; the mesh is raised to
     ``order`` with its boundary nodes on the CAD and, with ``optimise``, optimised with them
-    sliding on it (stages "classify", "high_order", "optimise", ...). progress, cancel and name
-    as for :func:`mesh`; the options are listed below. Raises ParameterError, CadError or
-    MeshingError (naming the boundary node that lies on no CAD face).
+    sliding on it; the macro layer is split back into the given layers (stages "classify",
+    "high_order", "optimise", "split_layers", ...). progress, cancel and name as for
+    :func:`mesh`; the options are listed below. Raises ParameterError, CadError or MeshingError
+    (naming the boundary node that lies on no CAD face, or the cell that cannot be curved).
     """
     progress = _progress(progress, cancel)
     nodes = np.ascontiguousarray(nodes, dtype=np.float64)
-    tetrahedra = np.ascontiguousarray(tetrahedra, dtype=np.int64)
     if nodes.ndim != 2 or nodes.shape[1] != 3:
         raise ParameterError("nodes must be an (N, 3) array, got shape %s" % (nodes.shape,))
-    if tetrahedra.ndim != 2 or tetrahedra.shape[1] != 4:
-        raise ParameterError("tetrahedra must be an (E, 4) array of corner nodes, got shape %s"
-                             % (tetrahedra.shape,))
+    if not isinstance(cells, dict):
+        cells = {"tet": cells}
+    unknown = sorted(set(cells) - set(_CURVE_CELLS))
+    if unknown:
+        raise ParameterError("cells: unknown cell type %r (types: %s)"
+                             % (unknown[0], ", ".join(_CURVE_CELLS)))
+    arrays = {}
+    for kind, array in cells.items():
+        array = np.ascontiguousarray(array, dtype=np.int64)
+        corners = _CURVE_CELLS[kind]
+        if array.ndim != 2 or array.shape[1] != corners:
+            raise ParameterError("%s cells must be an (E, %d) array of corner nodes, got shape %s"
+                                 % (kind, corners, array.shape))
+        arrays[kind] = array
     kind, value, label = _cad_source(shape, name)
     if kind == "brep":
-        core = _core.curve_brep(value, label, nodes, tetrahedra, options, progress, cancel)
+        core = _core.curve_brep(value, label, nodes, arrays, options, progress, cancel)
     else:
-        core = _core.curve_file(value, nodes, tetrahedra, options, progress, cancel)
+        core = _core.curve_file(value, nodes, arrays, options, progress, cancel)
     return HighOrderMesh(core)
 
 

@@ -28,6 +28,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <mutex>
 #include <sstream>
 #include <vector>
@@ -394,7 +395,29 @@ CurveProjection CadModel::projectOnCurve(int edge, const Eigen::Vector3d& p,
     double t = 0.0;
     const double precision = 1e-9 * impl_->diagonal;
     const ShapeAnalysis_Curve analysis;
-    const double d = analysis.Project(c, toGp(p), precision, proj, t);
+    double d = analysis.Project(c, toGp(p), precision, proj, t);
+    const double first = c.FirstParameter(), last = c.LastParameter();
+    const double slack = 1e-9 * std::max(1.0, last - first);
+    if (c.IsPeriodic()) {  // the same point in the edge's own period
+      const double period = c.Period();
+      t = first + std::fmod(std::fmod(t - first, period) + period, period);
+      if (t > last + slack && t - period >= first - slack) t -= period;
+    }
+    if (t < first - slack || t > last + slack) {
+      // OCCT projected onto the curve beyond the edge (a seam's circle on its other half): the
+      // nearest point of the edge is then an end or a local minimum found from its middle.
+      d = std::numeric_limits<double>::infinity();
+      const auto keep = [&](double s, const gp_Pnt& q) {
+        const double ds = q.Distance(toGp(p));
+        if (s >= first - slack && s <= last + slack && ds < d) d = ds, t = s, proj = q;
+      };
+      keep(first, c.Value(first));
+      keep(last, c.Value(last));
+      gp_Pnt q;
+      double s = 0.5 * (first + last);
+      analysis.NextProject(s, c, toGp(p), precision, q, s);
+      keep(s, q);
+    }
     CurveProjection best{t, toEigen(proj), d};
     // The local search from the guess settles ties (a point as near to both ends of a closed
     // curve) on the guess's side. Alone it is not enough: it stops at once where the curve's

@@ -136,7 +136,12 @@ class Classifier {
   std::vector<std::vector<int>> vertexEdges_, edgeFaces_;
 };
 
-using Face = std::array<std::int64_t, 3>;
+// A boundary face: 3 corners (a triangle, last entry -1) or 4 (a quadrilateral), pointing out.
+using Face = std::array<std::int64_t, 4>;
+
+int faceSize(const Face& f) {
+  return f[3] < 0 ? 3 : 4;
+}
 
 std::string describe(const Eigen::Vector3d& p) {
   std::ostringstream s;
@@ -145,19 +150,61 @@ std::string describe(const Eigen::Vector3d& p) {
   return s.str();
 }
 
-// The tetrahedra of `linear`, refusing a mesh or CAD that cannot be put together.
-const ElementBlock& checkedTetrahedra(const Mesh& linear, const CadModel& cad) {
+std::string nodeList(const std::int64_t* nodes, int count) {
+  std::string out;
+  for (int k = 0; k < count; ++k) out += (k == 0 ? "" : ", ") + std::to_string(nodes[k] + 1);
+  return out;
+}
+
+std::string nodeList(const Face& f) {
+  return nodeList(f.data(), faceSize(f));
+}
+
+// The faces of a positive linear cell as local corners in Gmsh's order, pointing out, and the
+// corner swaps that turn a negative cell positive (a mirror of its reference shape).
+struct CellFaces {
+  std::vector<std::vector<int>> faces;
+  std::vector<std::pair<int, int>> mirror;
+};
+
+const CellFaces& cellFaces(CellType type) {
+  static const CellFaces tet{{{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}, {{1, 2}}};
+  static const CellFaces prism{{{0, 2, 1}, {3, 4, 5}, {0, 1, 4, 3}, {1, 2, 5, 4}, {0, 3, 5, 2}},
+                               {{1, 2}, {4, 5}}};
+  static const CellFaces pyramid{{{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}},
+                                 {{1, 3}}};
+  static const CellFaces hex{
+      {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {0, 4, 7, 3}},
+      {{1, 3}, {5, 7}}};
+  switch (type) {
+    case CellType::Tetrahedron:
+      return tet;
+    case CellType::Prism:
+      return prism;
+    case CellType::Pyramid:
+      return pyramid;
+    case CellType::Hexahedron:
+      return hex;
+    default:
+      throw ParameterError(cellShortName(type) + " cells cannot be put on the CAD");
+  }
+}
+
+// The volume cells of `linear`, refusing a mesh or CAD that cannot be put together.
+std::vector<const ElementBlock*> checkedCells(const Mesh& linear, const CadModel& cad) {
   if (linear.dim != 3 || linear.order != 1)
-    throw ParameterError("only a linear (order 1) tetrahedral mesh can be put on the CAD");
-  const ElementBlock* tets = nullptr;
+    throw ParameterError("only a linear (order 1) volume mesh can be put on the CAD");
+  std::vector<const ElementBlock*> cells;
   for (const ElementBlock& b : linear.blocks)
-    if (b.type == CellType::Tetrahedron) tets = &b;
-  if (tets == nullptr || tets->count() == 0)
-    throw ParameterError("the mesh has no tetrahedra to put on the CAD");
+    if (cellDimension(b.type) == 3 && b.count() > 0) {
+      cellFaces(b.type);  // (refuses a type it has no faces for)
+      cells.push_back(&b);
+    }
+  if (cells.empty()) throw ParameterError("the mesh has no volume cells to put on the CAD");
   if (cad.numSolids() != 1)
     throw ParameterError("the CAD must be one solid to put a mesh on it, " + cad.sourceName() +
                          " has " + std::to_string(cad.numSolids()));
-  return *tets;
+  return cells;
 }
 
 // The nodes of `linear`, all inside solid 1 until the boundary is classified.
@@ -173,39 +220,91 @@ Mesh nodesInSolid(const Mesh& linear) {
   return mesh;
 }
 
-// Makes the tetrahedra of `cells` positive and returns their faces that no other tetrahedron
-// shares, pointing out.
-std::vector<Face> orientAndFindBoundary(const Mesh& mesh, ElementBlock& cells) {
+// Six times the volume a cell's faces enclose (each quadrilateral as two triangles), and the
+// cube of its bounding box's diagonal (measured from corner 0, which keeps the rounding to the
+// cell's size).
+std::pair<double, double> enclosedVolume(const Mesh& mesh, const std::int64_t* c,
+                                         const CellFaces& faces, int corners) {
+  const Eigen::Vector3d origin = nodePoint(mesh, c[0]);
+  Box box;
+  for (int k = 0; k < corners; ++k) box.add(nodePoint(mesh, c[k]) - origin);
+  double v = 0.0;
+  for (const std::vector<int>& f : faces.faces)
+    for (std::size_t k = 1; k + 1 < f.size(); ++k)
+      v +=
+          (nodePoint(mesh, c[f[0]]) - origin)
+              .dot(
+                  (nodePoint(mesh, c[f[k]]) - origin).cross(nodePoint(mesh, c[f[k + 1]]) - origin));
+  return {v, std::pow((box.hi - box.lo).norm(), 3)};
+}
+
+// Face use: sorted corners -> how many cells have it, pointing out of the first, which is that.
+struct FaceUse {
+  int count = 0;
+  Face out{};
+  std::string cell;
+};
+using FaceUses = std::map<Face, FaceUse>;
+
+// Whether `b` runs round the same corners as `a` in the same direction.
+bool sameTurn(const Face& a, const Face& b) {
+  const int n = faceSize(a);
+  const auto at = std::find(b.begin(), b.begin() + n, a[0]) - b.begin();
+  for (int k = 0; k < n; ++k)
+    if (b[static_cast<std::size_t>((at + k) % n)] != a[static_cast<std::size_t>(k)]) return false;
+  return true;
+}
+
+// Makes the cells of `cells` positive and counts their faces in `uses`.
+void orientAndCountFaces(const Mesh& mesh, ElementBlock& cells, FaceUses& uses) {
   const std::size_t n = mesh.numNodes();
-  std::map<Face, std::pair<int, Face>> faces;  // sorted face -> (count, outward face)
+  const CellFaces& faces = cellFaces(cells.type);
+  const int nv = cellNumVertices(cells.type);
+  const std::string name = cellShortName(cells.type);
   for (std::size_t e = 0; e < cells.count(); ++e) {
-    std::int64_t* t = cells.nodes.data() + 4 * e;
-    for (int k = 0; k < 4; ++k)
-      if (t[k] < 0 || static_cast<std::size_t>(t[k]) >= n)
-        throw ParameterError("tetrahedron " + std::to_string(e + 1) + " refers to node " +
-                             std::to_string(t[k] + 1) + " of " + std::to_string(n));
-    const Eigen::Vector3d a = nodePoint(mesh, t[0]);
-    const double volume =
-        (nodePoint(mesh, t[1]) - a).cross(nodePoint(mesh, t[2]) - a).dot(nodePoint(mesh, t[3]) - a);
-    if (volume == 0.0)
-      throw ParameterError("tetrahedron " + std::to_string(e + 1) + " is flat (zero volume)");
-    if (volume < 0.0) std::swap(t[1], t[2]);
-    // Outward faces of a positive tetrahedron (Gmsh's corner order).
-    const std::array<Face, 4> out = {Face{t[0], t[2], t[1]}, Face{t[0], t[1], t[3]},
-                                     Face{t[0], t[3], t[2]}, Face{t[1], t[2], t[3]}};
-    for (const Face& f : out) {
-      Face key = f;
-      std::sort(key.begin(), key.end());
-      auto [it, fresh] = faces.try_emplace(key, 0, f);
-      ++it->second.first;
+    std::int64_t* c = cells.nodes.data() + static_cast<std::size_t>(nv) * e;
+    for (int k = 0; k < nv; ++k)
+      if (c[k] < 0 || static_cast<std::size_t>(c[k]) >= n)
+        throw ParameterError(name + " " + std::to_string(e + 1) + " refers to node " +
+                             std::to_string(c[k] + 1) + " of " + std::to_string(n));
+    const auto [volume, size] = enclosedVolume(mesh, c, faces, nv);
+    // (1e-10: far above the rounding of the sum, eps times the size cubed; far below any cell
+    // a mesher means, whose volume is a fair fraction of its size cubed.)
+    if (!(std::abs(volume) > 1e-10 * size))
+      throw ParameterError(name + " " + std::to_string(e + 1) + " of the given mesh (nodes " +
+                           nodeList(c, nv) + ") is flat (volume " + formatNumber(volume / 6.0) +
+                           ", " + formatNumber(std::abs(volume) / size) +
+                           " of its size cubed): no curved cell made from it can be valid");
+    if (volume < 0.0)
+      for (const auto& [a, b] : faces.mirror) std::swap(c[a], c[b]);
+    for (const std::vector<int>& f : faces.faces) {
+      Face out{-1, -1, -1, -1};
+      for (std::size_t k = 0; k < f.size(); ++k) out[k] = c[f[k]];
+      Face key = out;
+      std::sort(key.begin(), key.begin() + static_cast<std::ptrdiff_t>(f.size()));
+      const std::string cell = name + " " + std::to_string(e + 1);
+      auto [it, fresh] = uses.try_emplace(key, FaceUse{0, out, cell});
+      // Two positive cells on either side of a face see it turn opposite ways; the same way,
+      // they lie on one side of it: the mesh folds there (a cell turned inside out by a moved
+      // node, which making it positive hid).
+      if (++it->second.count == 2 && sameTurn(it->second.out, out))
+        throw MeshingError(it->second.cell + " and " + cell +
+                           " of the given mesh overlap: both lie on one side of their face of "
+                           "nodes " +
+                           nodeList(out) + " (a tangled mesh cannot be curved valid)");
     }
   }
+}
+
+// The faces no other cell shares, pointing out.
+std::vector<Face> boundaryFaces(const FaceUses& uses) {
   std::vector<Face> boundary;
-  for (const auto& [key, entry] : faces) {
-    if (entry.first > 2)
-      throw ParameterError("a triangle is a face of " + std::to_string(entry.first) +
-                           " tetrahedra: the mesh is not a manifold volume");
-    if (entry.first == 1) boundary.push_back(entry.second);
+  for (const auto& [key, entry] : uses) {
+    if (entry.count > 2)
+      throw ParameterError("the face of nodes " + nodeList(entry.out) + " is a face of " +
+                           std::to_string(entry.count) +
+                           " cells: the mesh is not a manifold volume");
+    if (entry.count == 1) boundary.push_back(entry.out);
   }
   return boundary;
 }
@@ -216,7 +315,7 @@ CadClassificationStats placeBoundaryNodes(Mesh& mesh, const std::vector<Face>& b
   const std::size_t n = mesh.numNodes();
   std::vector<char> onBoundary(n, 0);
   for (const Face& f : boundary)
-    for (const std::int64_t v : f) onBoundary[static_cast<std::size_t>(v)] = 1;
+    for (int k = 0; k < faceSize(f); ++k) onBoundary[static_cast<std::size_t>(f[k])] = 1;
   CadClassificationStats s;
   for (std::size_t i = 0; i < n; ++i) {
     if (onBoundary[i] == 0) continue;
@@ -243,24 +342,26 @@ CadClassificationStats placeBoundaryNodes(Mesh& mesh, const std::vector<Face>& b
   return s;
 }
 
-// The CAD face a boundary triangle lies on: the one its nodes share (nearest its centroid when
+// The CAD face a boundary face lies on: the one its nodes share (nearest its centroid when
 // several do).
-int faceOfTriangle(const Face& f, const Mesh& mesh, const Classifier& classifier,
-                   const CadModel& cad) {
+int faceOfBoundaryFace(const Face& f, const Mesh& mesh, const Classifier& classifier,
+                       const CadModel& cad) {
+  const int nf = faceSize(f);
   std::set<int> common = classifier.facesOf(mesh.nodeCadDim[f[0]], mesh.nodeCadIndex[f[0]]);
-  for (int k = 1; k < 3; ++k) {
+  Eigen::Vector3d centroid = nodePoint(mesh, f[0]);
+  for (int k = 1; k < nf; ++k) {
     const std::set<int> other = classifier.facesOf(mesh.nodeCadDim[f[k]], mesh.nodeCadIndex[f[k]]);
     std::set<int> both;
     std::set_intersection(common.begin(), common.end(), other.begin(), other.end(),
                           std::inserter(both, both.begin()));
     common = std::move(both);
+    centroid += nodePoint(mesh, f[k]);
   }
-  const Eigen::Vector3d centroid =
-      (nodePoint(mesh, f[0]) + nodePoint(mesh, f[1]) + nodePoint(mesh, f[2])) / 3.0;
+  centroid /= nf;
   if (common.empty())
-    throw MeshingError("the boundary triangle of nodes " + std::to_string(f[0] + 1) + ", " +
-                       std::to_string(f[1] + 1) + ", " + std::to_string(f[2] + 1) + " near " +
-                       describe(centroid) + " spans more than one face of " + cad.sourceName() +
+    throw MeshingError("the boundary " + std::string(nf == 3 ? "triangle" : "quadrilateral") +
+                       " of nodes " + nodeList(f) + " near " + describe(centroid) +
+                       " spans more than one face of " + cad.sourceName() +
                        ": the mesh does not follow the CAD's faces");
   int face = *common.begin();
   if (common.size() > 1) {
@@ -297,51 +398,63 @@ int edgeOfSegment(std::int64_t a, std::int64_t b, const Mesh& mesh, const Classi
   return edge;
 }
 
-// Boundary triangles on the face their nodes share; segments on the edge theirs share.
-std::pair<ElementBlock, ElementBlock> boundaryCells(const Mesh& mesh,
-                                                    const std::vector<Face>& boundary,
-                                                    const Classifier& classifier,
-                                                    const CadModel& cad, double tolerance) {
-  ElementBlock tris, lines;
-  tris.type = CellType::Triangle;
-  lines.type = CellType::Line;
+// The boundary's cells: triangles and quadrilaterals on the CAD face their nodes share, segments
+// on the CAD edge theirs share.
+struct BoundaryCells {
+  ElementBlock tris, quads, lines;
+};
+
+BoundaryCells boundaryCells(const Mesh& mesh, const std::vector<Face>& boundary,
+                            const Classifier& classifier, const CadModel& cad, double tolerance) {
+  BoundaryCells out;
+  out.tris.type = CellType::Triangle;
+  out.quads.type = CellType::Quadrilateral;
+  out.lines.type = CellType::Line;
   std::set<std::pair<std::int64_t, std::int64_t>> seen;
   for (const Face& f : boundary) {
-    const int face = faceOfTriangle(f, mesh, classifier, cad);
-    tris.nodes.insert(tris.nodes.end(), f.begin(), f.end());
-    tris.entity.push_back(face);
-    for (int k = 0; k < 3; ++k) {
-      std::int64_t a = f[k], b = f[(k + 1) % 3];
+    const int nf = faceSize(f);
+    ElementBlock& cells = nf == 3 ? out.tris : out.quads;
+    cells.nodes.insert(cells.nodes.end(), f.begin(), f.begin() + nf);
+    cells.entity.push_back(faceOfBoundaryFace(f, mesh, classifier, cad));
+    for (int k = 0; k < nf; ++k) {
+      const std::int64_t a = f[k], b = f[(k + 1) % nf];
       if (!seen.insert({std::min(a, b), std::max(a, b)}).second) continue;
       const int edge = edgeOfSegment(a, b, mesh, classifier, cad, tolerance);
       if (edge == 0) continue;
-      lines.nodes.insert(lines.nodes.end(), {a, b});
-      lines.entity.push_back(edge);
+      out.lines.nodes.insert(out.lines.nodes.end(), {a, b});
+      out.lines.entity.push_back(edge);
     }
   }
-  return {std::move(tris), std::move(lines)};
+  return out;
 }
 
 }  // namespace
 
 Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
                    CadClassificationStats* stats) {
-  const ElementBlock& tets = checkedTetrahedra(linear, cad);
+  const std::vector<const ElementBlock*> given = checkedCells(linear, cad);
   if (!(tolerance > 0.0))
     tolerance = parameterDefault("classify_tolerance") * cad.boundingDiagonal();
   Mesh mesh = nodesInSolid(linear);
-  ElementBlock cells;
-  cells.type = CellType::Tetrahedron;
-  cells.nodes = tets.nodes;
-  cells.entity.assign(tets.count(), 1);
-  const std::vector<Face> boundary = orientAndFindBoundary(mesh, cells);
+  FaceUses uses;
+  for (const ElementBlock* b : given) {
+    ElementBlock cells;
+    cells.type = b->type;
+    cells.nodes = b->nodes;
+    cells.entity.assign(b->count(), 1);
+    orientAndCountFaces(mesh, cells, uses);
+    mesh.blocks.push_back(std::move(cells));
+  }
+  const std::vector<Face> boundary = boundaryFaces(uses);
   const Classifier classifier(cad, tolerance);
   CadClassificationStats s = placeBoundaryNodes(mesh, boundary, classifier, cad);
-  auto [tris, lines] = boundaryCells(mesh, boundary, classifier, cad, tolerance);
-  s.boundaryTriangles = tris.count();
-  s.boundarySegments = lines.count();
-  mesh.blocks = {std::move(cells), std::move(tris), std::move(lines)};
-  compactNodes(mesh);  // nodes no tetrahedron uses (a quadratic mesh's mid-edge nodes)
+  BoundaryCells cells = boundaryCells(mesh, boundary, classifier, cad, tolerance);
+  s.boundaryTriangles = cells.tris.count();
+  s.boundaryQuadrilaterals = cells.quads.count();
+  s.boundarySegments = cells.lines.count();
+  for (ElementBlock* b : {&cells.tris, &cells.quads, &cells.lines})
+    if (b->count() > 0) mesh.blocks.push_back(std::move(*b));
+  compactNodes(mesh);  // nodes no cell uses (a quadratic mesh's mid-edge nodes)
   mesh.checkConsistency();
   if (stats != nullptr) *stats = s;
   return mesh;

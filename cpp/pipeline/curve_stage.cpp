@@ -147,7 +147,7 @@ struct CurveRun {
   const std::string& round;
   const CurvedState* previous;
   // Quadrilaterals (2D) and prisms are a macro boundary layer only when one was grown here;
-  // otherwise (a mesh given to curveMeshOnCad, tetrahedra only today) the layer's fixing,
+  // otherwise (a mesh given to curveMeshOnCad without recognised stacks) the layer's fixing,
   // blending and wall spacing stay out of it.
   bool layered;
   CurvedState state;
@@ -336,10 +336,11 @@ void evaluateCurved(CurveRun& run) {
 
 CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& cad,
                   StageTimings& timings, PipelineObserver* observer, bool clocked,
-                  JobBudget& budget, const std::string& round, const CurvedState* previous) {
+                  JobBudget& budget, const std::string& round, const CurvedState* previous,
+                  bool givenLayer) {
   CurveRun run{options,  cad,      timings,
                observer, clocked,  budget,
-               round,    previous, options.boundaryLayer.has_value(),
+               round,    previous, options.boundaryLayer.has_value() || givenLayer,
                {},       {},       {},
                {}};
   run.state.linear = std::move(linear);

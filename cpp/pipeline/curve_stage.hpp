@@ -53,10 +53,12 @@ struct CurvedState {
 // `budget` and is left out once it is spent (named with `round`, "repair 2", in the budget's
 // record; "" before the rounds); the elevation keeps back (JobBudget::reserve) four times its
 // measured time for the stages that always run. Throws ParameterError (memory), MeshingError,
-// CadError or CancelledError.
+// CadError or CancelledError. The prisms of `linear` are a macro boundary layer (wall 0-1-2,
+// top 3-4-5: blended after elevation, kept while the rest is optimised) when options ask for a
+// layer or `givenLayer` says a given mesh's stacks were agglomerated into them (layer_stacks.hpp).
 CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& cad,
                   StageTimings& timings, PipelineObserver* observer, bool clocked,
                   JobBudget& budget, const std::string& round,
-                  const CurvedState* previous = nullptr);
+                  const CurvedState* previous = nullptr, bool givenLayer = false);
 
 }  // namespace homesh

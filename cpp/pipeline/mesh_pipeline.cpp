@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "boundary_layer/layer_stacks.hpp"
 #include "cad/model_dimension.hpp"
 #include "core/error.hpp"
 #include "core/job_budget.hpp"
@@ -17,6 +18,7 @@
 #include "pipeline/linear_stage.hpp"
 #include "pipeline/repair_rounds.hpp"
 #include "pipeline/stage_clock.hpp"
+#include "quality/bezier_jacobian.hpp"
 
 namespace homesh {
 
@@ -219,26 +221,23 @@ void takeCurved(MeshResult& result, CurvedState& state) {
 // thin cells the one before left invalid or poor).
 constexpr int kPlainSplitAttempts = 3;
 
-// The "split_layers" stage: the macro layer of result.mesh (grown on `linear`) split into the
-// layers asked for; result.quality becomes the split mesh's, the macro mesh's kept as
-// result.macroQuality. Split with the columns adjusted to the grown heights; where that makes
-// thin cells invalid, or worse than half the macro mesh's worst (the plain split, a sub-map of
-// each macro cell, keeps that), their columns are split plain and the split made again.
-void splitLayers(MeshResult& result, const Mesh& linear, const MeshingOptions& options,
-                 PipelineObserver* observer) {
+// The "split_layers" stage: the macro layer of result.mesh split at the levels `z` (0 < ... <
+// 1, one layer between each two); result.quality becomes the split mesh's, the macro mesh's kept
+// as result.macroQuality. Split with the columns adjusted to `heights`; where that makes thin
+// cells invalid, or worse than half the macro mesh's worst (the plain split, a sub-map of each
+// macro cell, keeps that), their columns are split plain and the split made again.
+void splitLayers(MeshResult& result, const std::vector<double>& z, LayerHeights heights,
+                 int threads, PipelineObserver* observer) {
   StageClock split("split_layers", result.timings, observer);
   const Mesh macro = std::move(result.mesh);
   result.macroQuality = std::move(result.quality);
   const double poor = 0.5 * std::max(result.macroQuality->scaled.min, 0.0);
-  const int layers = options.boundaryLayer->layers;
-  LayerHeights heights{grownLayerHeights(linear), {}, {}};
-  if (result.boundaryLayer) heights.lengthened = result.boundaryLayer->lengthened;
+  const int layers = static_cast<int>(z.size()) - 1;
   LayerSplitStats stats;
   for (int attempt = 0;; ++attempt) {
     stats = LayerSplitStats();
-    result.mesh = splitBoundaryLayer(macro, options.boundaryLayer->splitCoordinates(),
-                                     result.cad.get(), &stats, &heights);
-    result.quality = evaluateQuality(result.mesh, options.threads);
+    result.mesh = splitBoundaryLayer(macro, z, result.cad.get(), &stats, &heights);
+    result.quality = evaluateQuality(result.mesh, threads);
     if (attempt == kPlainSplitAttempts) break;
     const std::size_t before = heights.plain.size();
     for (std::size_t e = 0; e < result.quality.validity.size(); ++e)
@@ -275,6 +274,33 @@ void finishJob(MeshResult& result, JobBudget& budget, PipelineObserver* observer
   result.job.skipped = budget.skippedStages();
 }
 
+// Refuses a given mesh with a straight-sided cell that is not valid as it stands (a flat
+// pyramid whose apex lies in the plane of its base, a twisted hexahedron): its Jacobian vanishes
+// or changes sign, so no curving of it can be valid and the optimiser cannot measure it. The
+// cells are oriented (classifyOnCad), so a valid one has J > 0; counts are 1-based per type.
+void checkGivenCells(const Mesh& mesh) {
+  for (const ElementBlock& block : mesh.blocks) {
+    if (cellDimension(block.type) != 3 || block.type == CellType::Tetrahedron) continue;
+    const int n = block.nodesPerElement();
+    for (std::size_t e = 0; e < block.count(); ++e) {
+      NodeCoordinates x(n, 3);
+      for (int i = 0; i < n; ++i)
+        x.row(i) = nodePoint(mesh, block.element(e)[i]).transpose() -
+                   nodePoint(mesh, block.element(e)[0]).transpose();
+      const JacobianBounds b = boundJacobian(block.type, block.order, x, nullptr);
+      if (b.validity == Validity::Valid) continue;
+      const Eigen::Vector3d centre =
+          nodePoint(mesh, block.element(e)[0]) + x.colwise().mean().transpose();
+      std::ostringstream msg;
+      msg << cellShortName(block.type) << " " << e + 1 << " of the given mesh (centre ("
+          << centre.x() << ", " << centre.y() << ", " << centre.z()
+          << ")) is not valid as given: its Jacobian ranges over [" << b.minLower << ", "
+          << b.maxUpper << "], so no curved cell made from it can be valid";
+      throw MeshingError(msg.str());
+    }
+  }
+}
+
 }  // namespace
 
 MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
@@ -301,7 +327,12 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
                                      result, options, budget, observer);
   takeCurved(result, best);
 
-  if (options.boundaryLayer) splitLayers(result, best.linear, options, observer);
+  if (options.boundaryLayer) {
+    LayerHeights heights{grownLayerHeights(best.linear), {}, {}};
+    if (result.boundaryLayer) heights.lengthened = result.boundaryLayer->lengthened;
+    splitLayers(result, options.boundaryLayer->splitCoordinates(), std::move(heights),
+                options.threads, observer);
+  }
   finishJob(result, budget, observer, false);
   return result;
 }
@@ -323,13 +354,30 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
   StageClock classify("classify", result.timings, observer);
   Mesh onCad = classifyOnCad(linear, *result.cad,
                              options.classifyTolerance * result.cad->boundingDiagonal());
+  checkGivenCells(onCad);
+  std::string why;
+  std::optional<LayerStacks> stacks = recogniseLayerStacks(onCad, why);
+  if (stacks) {
+    onCad = std::move(stacks->macro);
+    result.givenLayers = stacks->record;
+  } else if (!why.empty()) {
+    result.notes.push_back("the prisms were curved as given, not as a boundary layer: " + why);
+  }
   classify.done();
-  CurvedState state =
-      curve(std::move(onCad), options, *result.cad, result.timings, observer, true, budget, "");
+  CurvedState state = curve(std::move(onCad), options, *result.cad, result.timings, observer, true,
+                            budget, "", nullptr, stacks.has_value());
   result.mesh = std::move(state.mesh);
   result.quality = std::move(state.quality);
   result.optimiser = std::move(state.optimiser);
   result.lowOrderOptimiser = std::move(state.lowOrderOptimiser);
+  if (stacks && stacks->record.layers > 1) {
+    // Each column's first level where its given first layer was: the splitter keeps the
+    // height z_1 H* of a column grown to H*, so H* = h_1 / z_1.
+    std::vector<double> grown = std::move(stacks->firstHeights);
+    for (double& h : grown) h /= stacks->record.levels[1];
+    splitLayers(result, stacks->record.levels, LayerHeights{std::move(grown), {}, {}},
+                options.threads, observer);
+  }
   finishJob(result, budget, observer, true);
   return result;
 }

@@ -37,6 +37,23 @@ std::string boundaryLayerLine(const StageRecords& records, int dim) {
       records.macroQuality ? records.macroQuality->scaled.min : 0.0);
 }
 
+std::string givenLayersLine(const StageRecords& records) {
+  const LayerStacksRecord& r = *records.givenLayers;
+  std::string walls;
+  for (const int f : r.walls) walls += (walls.empty() ? "Face" : ", Face") + std::to_string(f);
+  std::string line = formatted(
+      "given boundary layer: %zu stacks of %d prism layers (%zu columns) on %s, curved as macro "
+      "prisms (worst %.4f)",
+      r.stacks, r.layers, r.columns, walls.c_str(),
+      records.macroQuality ? records.macroQuality->scaled.min : 0.0);
+  if (records.layerSplit)
+    line += formatted("; split back: first layer %g to %g (given %g to %g, worst %.2f %% off)",
+                      records.layerSplit->firstHeightMin, records.layerSplit->firstHeightMax,
+                      r.firstHeightMin, r.firstHeightMax,
+                      100.0 * records.layerSplit->firstHeightDeviation);
+  return line;
+}
+
 std::string repairLine(std::size_t k, const RepairRound& r) {
   if (!r.failure.empty())
     return formatted("repair %zu: %s %zu elements failed: %s", k + 1, r.action.c_str(), r.elements,
@@ -92,6 +109,7 @@ std::vector<std::string> meshSummaryLines(const CurvedMesh& curved, const StageR
   lines.push_back(qualityHeadline(curved.mesh, curved.quality));
   if (records.boundaryLayer && records.layerSplit)
     lines.push_back(boundaryLayerLine(records, curved.mesh.dim));
+  if (records.givenLayers) lines.push_back(givenLayersLine(records));
   for (std::size_t k = 0; k < records.rounds.size(); ++k)
     lines.push_back(repairLine(k, records.rounds[k]));
   if (records.job.stopped())

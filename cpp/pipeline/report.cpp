@@ -99,6 +99,18 @@ std::string predictReportJson(const SizingResult& sizing, const std::string& inp
   return json.str();
 }
 
+namespace {
+
+// The certified quality of a macro layer's mesh before its split.
+void appendMacroQuality(JsonWriter& json, const StageRecords& records) {
+  if (!records.macroQuality) return;
+  json.value("macro_worst_scaled_jacobian", records.macroQuality->scaled.min);
+  json.value("macro_invalid", records.macroQuality->invalid);
+  json.value("macro_undecided", records.macroQuality->undecided);
+}
+
+}  // namespace
+
 void appendBoundaryLayer(JsonWriter& json, const StageRecords& records) {
   const BoundaryLayerRecord& r = *records.boundaryLayer;
   json.beginObject("boundary_layer");
@@ -152,17 +164,42 @@ void appendBoundaryLayer(JsonWriter& json, const StageRecords& records) {
   json.value("shrink_passes", static_cast<std::size_t>(r.shrinkPasses));
   json.value("released_around_invalid", r.release != LayerRelease::None);
   json.value("release", std::string(layerReleaseName(r.release)));
-  if (records.macroQuality) {
-    json.value("macro_worst_scaled_jacobian", records.macroQuality->scaled.min);
-    json.value("macro_invalid", records.macroQuality->invalid);
-    json.value("macro_undecided", records.macroQuality->undecided);
-  }
+  appendMacroQuality(json, records);
   if (records.layerSplit) {
     json.value("split_projected_nodes", records.layerSplit->projected);
     json.value("split_max_projection", records.layerSplit->maxProjection);
     json.value("split_plain_columns", records.layerSplit->plainColumns);
   }
   json.value("seconds", r.seconds);
+  json.endObject();
+}
+
+// A given mesh's boundary layer as recognised (layer_stacks.hpp) and as split.
+void appendGivenLayers(JsonWriter& json, const StageRecords& records) {
+  const LayerStacksRecord& r = *records.givenLayers;
+  json.beginObject("given_layers");
+  json.numbers("walls", std::vector<std::size_t>(r.walls.begin(), r.walls.end()));
+  json.value("stacks", r.stacks);
+  json.value("layers", static_cast<std::size_t>(r.layers));
+  json.value("columns", r.columns);
+  json.value("side_quadrilaterals", r.sidesMerged);
+  json.numbers("levels", r.levels);
+  json.value("level_spread", r.levelSpread);
+  json.beginObject("given_first_height");
+  json.value("min", r.firstHeightMin);
+  json.value("max", r.firstHeightMax);
+  json.endObject();
+  if (records.layerSplit) {
+    const LayerSplitStats& s = *records.layerSplit;
+    json.beginObject("first_height");
+    json.value("min", s.firstHeightMin);
+    json.value("max", s.firstHeightMax);
+    json.value("worst_deviation", s.firstHeightDeviation);
+    json.value("points", s.firstHeightMeasured);
+    json.endObject();
+    json.value("split_plain_columns", s.plainColumns);
+  }
+  appendMacroQuality(json, records);
   json.endObject();
 }
 
@@ -200,6 +237,7 @@ std::string meshReportJson(const CurvedMesh& curved, const StageRecords& records
                     "optimiser_order_" + std::to_string(kContinuationOrder));
   appendRepairRounds(json, records.rounds);
   if (records.boundaryLayer) appendBoundaryLayer(json, records);
+  if (records.givenLayers) appendGivenLayers(json, records);
   appendStrings(json, "notes", records.notes);
   appendJob(json, records.job);
   json.beginObject("timings_s");

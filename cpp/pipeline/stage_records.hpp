@@ -13,6 +13,7 @@
 
 #include "boundary_layer/layer_record.hpp"
 #include "boundary_layer/layer_split.hpp"
+#include "boundary_layer/layer_stacks.hpp"
 #include "cad/cad_healing.hpp"
 #include "optimise/optimiser.hpp"
 #include "pipeline/curved_mesh.hpp"
@@ -70,6 +71,9 @@ struct StageRecords {
   std::optional<BoundaryLayerRecord> boundaryLayer;
   std::optional<QualitySummary> macroQuality;
   std::optional<LayerSplitStats> layerSplit;
+  // A given mesh's prism stacks, recognised and agglomerated (curveMeshOnCad; the split then
+  // in layerSplit).
+  std::optional<LayerStacksRecord> givenLayers;
   StageTimings timings;
   MeshingOptions options;
   HealingRecord healing;  // what the CAD check found and healing did

@@ -647,9 +647,10 @@ PyMesh meshBrep(const std::string& text, const std::string& name, const bp::dict
                      std::move(progress), cancel);
 }
 
-// Curves a linear tetrahedral mesh made elsewhere (nodes (N, 3), tetrahedra (E, 4), 0-based) on
-// the CAD of `source` (BRep text or a CAD file): pipeline's curveMeshOnCad.
-PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::object& tets,
+// Curves a linear volume mesh made elsewhere on the CAD of `source` (BRep text or a CAD file):
+// pipeline's curveMeshOnCad. nodes (N, 3); cells: {"tet": (E, 4), "prism": (E, 6), "pyramid":
+// (E, 5), "hex": (E, 8)}, 0-based corner nodes in Gmsh's order (api.curve checks the keys).
+PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::dict& cells,
                   const bp::dict& given, bp::object progress, const bp::object& cancel) {
   const MeshingOptions options = optionsFrom(given, kCurveKeys, kNoExtras);
   Mesh linear;
@@ -657,12 +658,20 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::ob
   linear.order = 1;
   linear.xyz = finiteNodes(nodes);
   if (linear.xyz.size() % 3 != 0) throw ParameterError("nodes must be an (N, 3) array");
-  ElementBlock block;
-  block.type = CellType::Tetrahedron;
-  block.nodes = fromArray<std::int64_t>(tets, "tetrahedra");
-  if (block.nodes.size() % 4 != 0) throw ParameterError("tetrahedra must be an (E, 4) array");
-  block.entity.assign(block.nodes.size() / 4, 1);
-  linear.blocks.push_back(std::move(block));
+  for (const CellType type :
+       {CellType::Tetrahedron, CellType::Prism, CellType::Pyramid, CellType::Hexahedron}) {
+    const std::string name = cellShortName(type);
+    if (!cells.has_key(name)) continue;
+    ElementBlock block;
+    block.type = type;
+    const std::string what = name + " cells";
+    block.nodes = fromArray<std::int64_t>(cells[name], what.c_str());
+    const auto corners = static_cast<std::size_t>(cellNumVertices(type));
+    if (block.nodes.size() % corners != 0)
+      throw ParameterError(name + " cells must be an (E, " + std::to_string(corners) + ") array");
+    block.entity.assign(block.nodes.size() / corners, 1);
+    linear.blocks.push_back(std::move(block));
+  }
   const std::size_t n = linear.numNodes();
   linear.nodeCadDim.assign(n, 3);
   linear.nodeCadIndex.assign(n, 0);
@@ -673,15 +682,15 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::ob
 }
 
 PyMesh curveBrep(const std::string& text, const std::string& name, const bp::object& nodes,
-                 const bp::object& tets, const bp::dict& options, bp::object progress,
+                 const bp::dict& cells, const bp::dict& options, bp::object progress,
                  const bp::object& cancel) {
-  return curveOnCad(CadSource::brepText(text, name), nodes, tets, options, std::move(progress),
+  return curveOnCad(CadSource::brepText(text, name), nodes, cells, options, std::move(progress),
                     cancel);
 }
 
-PyMesh curveFile(const std::string& path, const bp::object& nodes, const bp::object& tets,
+PyMesh curveFile(const std::string& path, const bp::object& nodes, const bp::dict& cells,
                  const bp::dict& options, bp::object progress, const bp::object& cancel) {
-  return curveOnCad(CadSource::file(path), nodes, tets, options, std::move(progress), cancel);
+  return curveOnCad(CadSource::file(path), nodes, cells, options, std::move(progress), cancel);
 }
 
 // Rebuilds a mesh (without CAD) from the arrays PyMesh exposes, and evaluates its quality.
@@ -842,12 +851,11 @@ BOOST_PYTHON_MODULE(_core) {
   bp::def("parameters", &parameters);
   bp::def("option_keys", &frontEndKeys, (bp::arg("function")));
   bp::def("parameter_in_range", &parameterInRange, (bp::arg("key"), bp::arg("value")));
-  bp::def(
-      "curve_brep", &curveBrep,
-      (bp::arg("text"), bp::arg("name"), bp::arg("nodes"), bp::arg("tetrahedra"),
-       bp::arg("options"), bp::arg("progress") = bp::object(), bp::arg("cancel") = bp::object()));
+  bp::def("curve_brep", &curveBrep,
+          (bp::arg("text"), bp::arg("name"), bp::arg("nodes"), bp::arg("cells"), bp::arg("options"),
+           bp::arg("progress") = bp::object(), bp::arg("cancel") = bp::object()));
   bp::def("curve_file", &curveFile,
-          (bp::arg("path"), bp::arg("nodes"), bp::arg("tetrahedra"), bp::arg("options"),
+          (bp::arg("path"), bp::arg("nodes"), bp::arg("cells"), bp::arg("options"),
            bp::arg("progress") = bp::object(), bp::arg("cancel") = bp::object()));
   bp::def("size_field", &sizeField, (bp::arg("text"), bp::arg("name"), bp::arg("options")));
   bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("options") = bp::dict()));

@@ -39,7 +39,7 @@ def job_for(obj, values=None):
         except ValueError as e:
             raise ValueError("%s: %s: %s" % (obj.Label, fem_object.Label, e)) from None
         job = MeshJob(shape.exportBrepToString(), obj.Part.Label, function=homesh.curve,
-                      nodes=nodes, tetrahedra=tets, order=arguments["order"],
+                      nodes=nodes, cells=tets, order=arguments["order"],
                       optimise=arguments["optimise"], threads=arguments["threads"],
                       optimise_seconds=arguments["optimise_seconds"],
                       job_seconds=arguments["job_seconds"],

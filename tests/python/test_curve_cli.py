@@ -1,6 +1,7 @@
-"""`homesh curve`: another tool's linear tetrahedral mesh (Gmsh's, made here from the STEP) curved
-on its CAD from the command line, every boundary node on the CAD, certified valid; a mesh whose
-boundary node lies off the CAD is refused naming it, and nothing is written."""
+"""`homesh curve`: another tool's linear mesh (Gmsh's, made here from the STEP: tetrahedra, and a
+cylinder of prisms also through Python's homesh.curve) curved on its CAD from the command line,
+every boundary node on the CAD, certified valid; a mesh whose boundary node lies off the CAD is
+refused naming it, and nothing is written."""
 
 import json
 import shutil
@@ -8,6 +9,8 @@ import shutil
 import meshio
 import numpy as np
 import pytest
+
+import homesh
 
 from conftest import run
 
@@ -98,13 +101,62 @@ def test_a_node_off_the_cad_is_refused_by_name_and_nothing_is_written(homesh_bin
         r.stderr
 
 
-def test_curve_needs_its_cad_and_refuses_other_cells(homesh_bin, data, tmp_path):
+def test_curve_needs_its_cad_and_refuses_a_mesh_of_another_shape(homesh_bin, data, tmp_path):
     r = run([homesh_bin, "curve", data / "box_hole.step"])
     assert r.returncode == 2 and "--cad" in r.stderr, r.stderr
+    # A lone pyramid in the box's corner: its base and two faces lie on the box's faces, its
+    # two slanted faces on none.
     points = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
     pyramid = tmp_path / "pyramid.vtu"
     meshio.write(pyramid, meshio.Mesh(points, [("pyramid", [[0, 1, 2, 3, 4]])]))
     r = run([homesh_bin, "curve", pyramid, "--cad", data / "box_hole.step", "-o",
              tmp_path / "out.msh"])
-    assert r.returncode == 2 and "pyramid" in r.stderr and "tetrahedra" in r.stderr, r.stderr
+    assert r.returncode != 0 and "spans more than one face" in r.stderr, r.stderr
     assert not (tmp_path / "out.msh").exists()
+
+
+CYLINDER_GEO = """SetFactory("OpenCASCADE");
+Disk(1) = {0, 0, 0, 1};
+Extrude {0, 0, 1} { Surface{1}; Layers{4}; Recombine; }
+Mesh.MeshSizeMax = 0.4;
+"""
+
+
+def test_prisms_are_curved_from_the_command_line_and_python(homesh_bin, tmp_path):
+    """Gmsh's cylinder of 4 layers of prisms (a disk's triangles extruded): every prism's
+    column runs from the bottom to the top, so it is no boundary layer (the report says why)
+    and the prisms are curved as given, certified valid, with every boundary node on the CAD."""
+    gmsh = shutil.which("gmsh")
+    assert gmsh, "Debian's gmsh package is needed"
+    geo, linear, step = tmp_path / "cyl.geo", tmp_path / "cyl.msh", tmp_path / "cyl.step"
+    geo.write_text(CYLINDER_GEO)
+    for args in (["-3", "-format", "msh41", "-o", linear], ["-0", "-o", step]):
+        r = run([gmsh, geo] + args)
+        assert r.returncode == 0, r.stdout + r.stderr
+    curved, report = tmp_path / "curved.msh", tmp_path / "report.json"
+    r = run([homesh_bin, "curve", linear, "--cad", step, "--order", "4", "-o", curved,
+             "--report", report])
+    assert r.returncode == 0, r.stderr
+    rep = json.loads(report.read_text())
+    assert rep["quality"]["invalid_elements"] == 0 and rep["quality"]["undecided_elements"] == 0
+    assert any("spans the domain" in note for note in rep["notes"]), rep["notes"]
+    assert "given_layers" not in rep
+    before = meshio.read(linear)
+    mesh = meshio.read(curved)
+    wedges = before.cells_dict["wedge"]
+    assert len(mesh.cells_dict["wedge75"]) == len(wedges)
+    # Every boundary node (on the quadrilaterals of the side, the triangles of the ends) lies on
+    # the cylinder or its end planes to the CAD's projection rounding.
+    boundary = np.unique(np.concatenate([mesh.cells_dict["quad25"].ravel(),
+                                         mesh.cells_dict["triangle15"].ravel()]))
+    x, y, z = mesh.points[boundary].T
+    off = np.minimum(np.abs(np.hypot(x, y) - 1.0), np.minimum(np.abs(z), np.abs(z - 1.0)))
+    assert off.max() < 1e-9 * np.sqrt(4 + 4 + 1)
+
+    python = homesh.curve(str(step), before.points, {"prism": wedges}, order=4)
+    assert python.quality()["invalid_elements"] == 0
+    assert python.num_elements == len(wedges)
+    with pytest.raises(homesh.ParameterError, match="unknown cell type 'wedge'"):
+        homesh.curve(str(step), before.points, {"wedge": wedges}, order=4)
+    with pytest.raises(homesh.ParameterError, match=r"prism cells must be an \(E, 6\) array"):
+        homesh.curve(str(step), before.points, {"prism": wedges[:, :4]}, order=4)

@@ -122,6 +122,31 @@ TEST(CadModel, SphereEvaluationProjectionAndCurvature) {
   EXPECT_NEAR(k.kMax, -1.0 / r, 1e-9);
 }
 
+// A projection onto an edge stays on the edge: the sphere's seam is half of a circle (x >= 0 in
+// the plane y = 0), and a point on the circle's other half is not on it. OCCT projects onto the
+// whole circle there (distance 0, at a parameter beyond the edge); the nearest point of the edge
+// is then the nearer pole, and node classification must not put the point on the seam.
+TEST(CadModel, ProjectionOntoASeamStaysOnTheSeam) {
+  const double r = 0.5;
+  const CadModel cad = toModel(test::sphere(r));
+  int seam = 0;
+  for (int e = 1; e <= cad.numEdges(); ++e)
+    if (!cad.isDegenerated(e)) seam = e;
+  ASSERT_GT(seam, 0);
+  const ParameterRange range = cad.edgeRange(seam);
+  const double projection = 1e-9 * cad.boundingDiagonal();
+  const double a = 22.5 * M_PI / 180.0;  // from the north pole, on the far half
+  const Eigen::Vector3d q(-r * std::sin(a), 0.0, r * std::cos(a));
+  const CurveProjection proj = cad.projectOnCurve(seam, q);
+  EXPECT_GE(proj.t, range.first);
+  EXPECT_LE(proj.t, range.last);
+  EXPECT_NEAR((proj.point - Eigen::Vector3d(0, 0, r)).norm(), 0.0, projection);
+  EXPECT_NEAR(proj.distance, 2 * r * std::sin(a / 2), projection);
+  // On the seam's own half the projection is the point itself.
+  const Eigen::Vector3d onSeam(r * std::sin(a), 0.0, r * std::cos(a));
+  EXPECT_NEAR(cad.projectOnCurve(seam, onSeam).distance, 0.0, projection);
+}
+
 TEST(CadModel, CurvatureSignFollowsTheOutwardNormal) {
   // The wall of a hole bends towards the solid's outward normal (+1/r); a cylinder's side
   // bends away from it (-1/r). Both have a zero curvature along the axis.

@@ -1,0 +1,57 @@
+// The boundary layer of a linear mesh another tool made, recognised and agglomerated (issue 47,
+// DESIGN.md section 8 run backwards): the prism stacks that stand on the wall, each one macro
+// prism, so that curving and optimisation act on a well-shaped cell, and the levels to split
+// them back into exactly the given layers (layer_split.hpp) once they are curved.
+//
+// A stack is a column of prisms from a wall (a boundary triangle that is a triangular face of a
+// prism) outwards, each sharing its far triangle with the next, ending where the far triangle is
+// a face of a tetrahedron or pyramid. Its nodes form columns, one per wall vertex: the node at
+// each level above it. The macro prism is the wall triangle and the stack's last triangle; the
+// boundary quadrilaterals of the stacks' sides (on the CAD faces the layer meets) and the lines
+// climbing along CAD curves merge alike, so every node inside the layer goes. The levels
+// are each column's node distances, cumulative along the column and divided by its length; the
+// split uses their mean over the columns, with each column's first level set by its own
+// first-layer height.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "core/mesh.hpp"
+
+namespace homesh {
+
+// What was recognised (the report's "given_layers").
+struct LayerStacksRecord {
+  int layers = 0;               // prisms per stack, the same in every stack
+  std::size_t stacks = 0;       // macro prisms
+  std::size_t columns = 0;      // wall vertices
+  std::size_t sidesMerged = 0;  // macro side quadrilaterals
+  std::vector<double> levels;   // 0 = z_0 < ... < z_layers = 1: the mean of the columns'
+  double levelSpread = 0.0;     // largest |a column's level - the mean|
+  double firstHeightMin = 0.0, firstHeightMax = 0.0;  // the given first layer's heights
+  std::set<int> walls;                                // the CAD faces the stacks stand on
+};
+
+struct LayerStacks {
+  // The mesh with each stack one macro prism (in one prism block where the first prism block
+  // was; wall triangle 0, 1, 2 and top 3, 4, 5), the sides merged and the layer's inner nodes
+  // dropped; every other cell as given.
+  Mesh macro;
+  LayerStacksRecord record;
+  // Per node of `macro`: at a wall vertex, the height of its column's first layer (the distance
+  // to the next node up); NaN elsewhere.
+  std::vector<double> firstHeights;
+};
+
+// `mesh`: as classifyOnCad leaves it (cells positive, the boundary's triangles, quadrilaterals
+// and lines in blocks of their own with their CAD entities). Returns nothing, with the reason
+// in `why`, when it holds no prisms (why empty) or its prisms are not such stacks: a prism
+// with both triangles on the boundary, one in no stack or in two, stacks of different heights,
+// a node inside the layer that another cell uses.
+std::optional<LayerStacks> recogniseLayerStacks(const Mesh& mesh, std::string& why);
+
+}  // namespace homesh
