@@ -1,5 +1,5 @@
 // Recognising another tool's boundary layer (layer_stacks.hpp): Gmsh's prisms extruded from a
-// sphere's surface mesh (gmsh_layered_sphere.hpp) found as stacks and agglomerated into one macro
+// sphere's surface mesh (gmsh_layered.hpp) found as stacks and agglomerated into one macro
 // prism each; prisms that are no such layer left alone, with the reason.
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 
 #include "boundary_layer/layer_stacks.hpp"
 #include "cad/cad_model.hpp"
-#include "gmsh_layered_sphere.hpp"
+#include "gmsh_layered.hpp"
 #include "io/mesh_readers.hpp"
 #include "linear/cad_classification.hpp"
 #include "quality/mesh_quality.hpp"
@@ -23,7 +23,7 @@ using test::nodePoint;
 TEST(LayerStacks, GmshsExtrudedLayerBecomesOneMacroPrismPerColumnOfPrisms) {
   const auto dir = test::tempDir();
   const std::string msh = (dir / "sphere.msh").string(), step = (dir / "sphere.step").string();
-  const test::LayeredSphere layer;
+  const test::GmshLayer layer;
   test::writeGmshLayeredSphere(msh, step, layer);
   const CadModel cad = CadModel::fromFile(step);
   const Mesh onCad = classifyOnCad(readMesh(msh), cad);
