@@ -1,7 +1,8 @@
 #!/bin/sh
 # Installs the Debian 12 packages HOMesh needs to build, run and test (idempotent: does nothing
 # when all are present). Needs root, or sudo. occt-misc is OpenCASCADE's sample data: the CAD
-# corpus benchmark and a repair-round test mesh its files. man-db: `man homesh`.
+# corpus benchmark and a repair-round test mesh its files. man-db: `man homesh`. python3-netgen:
+# a test curves a mesh Netgen itself made (Debian's FreeCAD has no FEM Netgen mesher).
 set -eu
 
 PACKAGES="
@@ -10,7 +11,7 @@ PACKAGES="
   libocct-modeling-algorithms-dev libocct-data-exchange-dev libocct-foundation-dev libtbb-dev
   libeigen3-dev libgmsh-dev gmsh zlib1g-dev
   libboost-python-dev libboost-numpy-dev python3-dev python3-numpy
-  libgtest-dev python3-pytest python3-meshio python3-vtk9
+  libgtest-dev python3-pytest python3-meshio python3-vtk9 python3-netgen
   xvfb xauth ccache man-db
   occt-misc
 "

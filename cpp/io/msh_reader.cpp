@@ -323,8 +323,12 @@ Mesh readMsh(const std::string& path) {
   const long long fileType = c.integer();
   const long long dataSize = c.integer();
   const bool binary = fileType == 1;
-  if (version != "2.2" && version != "4.1")
-    c.fail("version " + version + " is not supported (use 2.2 or 4.1)");
+  // MSH 2.0 and 2.1 (Netgen writes "2.000000") have 2.2's ASCII sections.
+  const bool legacy =
+      version == "2.2" ||
+      (!binary && (version.rfind("2.0", 0) == 0 || version.rfind("2.1", 0) == 0 || version == "2"));
+  if (!legacy && version != "4.1")
+    c.fail("version " + version + " is not supported (use 2.2 or 4.1; ASCII 2.0 and 2.1 too)");
   if (dataSize != 8) c.fail("data size " + std::to_string(dataSize) + " is not supported");
   if (binary) {
     c.endOfLine();
@@ -338,10 +342,10 @@ Mesh readMsh(const std::string& path) {
   while (!c.atEnd()) {
     const std::string section = c.word();
     if (section == "$Nodes") {
-      version == "2.2" ? readNodes22(c, binary, raw) : readNodes41(c, binary, raw);
+      legacy ? readNodes22(c, binary, raw) : readNodes41(c, binary, raw);
       nodes = true;
     } else if (section == "$Elements") {
-      version == "2.2" ? readElements22(c, binary, raw) : readElements41(c, binary, raw);
+      legacy ? readElements22(c, binary, raw) : readElements41(c, binary, raw);
       elements = true;
     } else if (!section.empty() && section[0] == '$') {
       c.skipSection(section);

@@ -82,6 +82,38 @@ class FemBothWays(unittest.TestCase):
         self.assertEqual(len(corners), len(set(map(tuple, corners))))
         self.assertIn("classify", mesh.timings())
 
+    def test_curve_a_mesh_netgen_made_and_wrote(self):
+        """Netgen itself (Debian's python3-netgen; Debian's FreeCAD is built without FEM's
+        Netgen mesher) meshes the cylinder and writes the mesh (Abaqus .inp, 8 digits); FEM
+        reads the file, and the HighOrderMesh object curves it at order 4, certified valid."""
+        import Fem
+        import netgen.NgOCC
+        folder = tempfile.mkdtemp(prefix="homesh-netgen-test-")
+        step, inp = os.path.join(folder, "cyl.step"), os.path.join(folder, "cyl.inp")
+        self.cyl.Shape.exportStep(step)
+        netgen.NgOCC.LoadOCCGeometry(step).GenerateMesh(maxh=0.5).Export(inp, "Abaqus Format")
+        femmesh = self.doc.addObject("Fem::FemMeshObject", "NetgenMesh")
+        femmesh.FemMesh = Fem.read(inp)
+        tets = femmesh.FemMesh.VolumeCount
+        self.assertGreater(tets, 100)
+        obj = homesh.freecad.make_high_order_mesh(self.doc, self.cyl, order=4,
+                                                  fem_mesh=femmesh)
+        obj.OptimiserIterations = 20
+        self.doc.recompute()
+        self.assertTrue(obj.isValid(), obj.Status)
+        mesh = homesh.freecad.get_mesh(obj)
+        quality = mesh.quality()
+        self.assertEqual(mesh.num_elements, tets)
+        self.assertEqual(quality["invalid_elements"] + quality["undecided_elements"], 0)
+        # Every node on the lateral face at radius 1 (CAD evaluation rounding, as above).
+        lateral = [i + 1 for i, f in enumerate(self.cyl.Shape.Faces)
+                   if f.Surface.__class__.__name__ == "Cylinder"]
+        side = (mesh.node_cad_dim == 2) & np.isin(mesh.node_cad_index, lateral)
+        self.assertGreater(side.sum(), 100)
+        radius = np.hypot(mesh.nodes[side, 0], mesh.nodes[side, 1])
+        self.assertLess(np.abs(radius - 1.0).max(), 1e-12)
+        shutil.rmtree(folder)
+
     def test_to_fem_mesh_has_the_counts_of_the_order_two_mesh(self):
         own = gmsh_fem_mesh(self.doc, self.cyl).FemMesh
         signs = {corner_sign(own, element) for element in own.Volumes}

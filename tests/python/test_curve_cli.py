@@ -160,3 +160,25 @@ def test_prisms_are_curved_from_the_command_line_and_python(homesh_bin, tmp_path
         homesh.curve(str(step), before.points, {"wedge": wedges}, order=4)
     with pytest.raises(homesh.ParameterError, match=r"prism cells must be an \(E, 6\) array"):
         homesh.curve(str(step), before.points, {"prism": wedges[:, :4]}, order=4)
+
+
+def test_a_mesh_netgen_made_and_wrote_is_curved(homesh_bin, data, tmp_path):
+    """Netgen itself (Debian's python3-netgen) meshes box_hole.step and writes Gmsh's legacy
+    format (MSH 2.0, coordinates to 6 decimals, so its boundary nodes are up to 5e-7 off the
+    CAD); `homesh curve` reads the file and curves it at order 4, certified valid, every
+    boundary node put on the CAD."""
+    import netgen.NgOCC as ngocc  # Debian's python3-netgen (scripts/install-deps.sh)
+    linear = tmp_path / "netgen.msh"
+    ngocc.LoadOCCGeometry(str(data / "box_hole.step")).GenerateMesh(maxh=0.6).Export(
+        str(linear), "Gmsh2 Format")
+    assert linear.read_text().startswith("$MeshFormat\n2.0")
+    curved, report = tmp_path / "curved.msh", tmp_path / "report.json"
+    r = run([homesh_bin, "curve", linear, "--cad", data / "box_hole.step", "--order", "4",
+             "--optimise", "-o", curved, "--report", report])
+    assert r.returncode == 0, r.stderr
+    rep = json.loads(report.read_text())
+    assert rep["quality"]["invalid_elements"] == 0 and rep["quality"]["undecided_elements"] == 0
+    mesh = meshio.read(curved)
+    assert len(mesh.cells_dict["tetra35"]) == len(meshio.read(linear).cells_dict["tetra"])
+    boundary = np.unique(mesh.cells_dict["triangle15"].ravel())
+    assert distance_to_cad(mesh.points[boundary]).max() < 1e-9 * DIAGONAL
