@@ -338,8 +338,7 @@ int runCurve(const homesh::CurveCommand& cmd) {
                    cmd.input.c_str(), linear.order);
     linear = homesh::changeOrder(linear, 1, nullptr);
   }
-  // (Before the work, not after it: VTK 9.1 has no Lagrange pyramid, HOMesh's Nektar++ writer no
-  // pyramid yet.)
+  // (Before the work, not after it: VTK 9.1 has no Lagrange pyramid; io/nektar_writer.hpp.)
   const bool pyramids =
       std::any_of(linear.blocks.begin(), linear.blocks.end(), [](const homesh::ElementBlock& b) {
         return b.type == homesh::CellType::Pyramid && b.count() > 0;
@@ -348,11 +347,14 @@ int runCurve(const homesh::CurveCommand& cmd) {
     std::string ext = std::filesystem::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-    if (pyramids && ((ext == ".vtu" && options.order > 1) || ext == ".xml"))
-      throw homesh::ParameterError(
-          cmd.input + " holds pyramids, which " + path +
-          " cannot hold (VTU: VTK 9.1 has no curved pyramid; Nektar++ XML: not written yet): "
-          "write .msh");
+    if (pyramids && ext == ".vtu" && options.order > 1)
+      throw homesh::ParameterError(cmd.input + " holds pyramids, and VTU has no curved pyramid " +
+                                   "(VTK 9.1 has no Lagrange pyramid): write " + path +
+                                   " as .msh or .xml instead");
+    if (pyramids && ext == ".xml" && options.order > 2)
+      throw homesh::ParameterError(cmd.input + " holds pyramids, which Nektar++ XML takes up to " +
+                                   "order 2 (the interior Nektar++ rebuilds above it is not " +
+                                   "reproduced yet to certify it): write " + path + " as .msh");
   }
   StderrProgress progress;
   homesh::PipelineObserver* observer = c.quiet ? nullptr : &progress;

@@ -30,6 +30,8 @@ const std::vector<std::vector<int>>& localFaces(CellType type) {
       {0, 1, 2, 3}, {0, 1, 4}, {1, 2, 5, 4}, {3, 2, 5}, {0, 3, 5, 4}};
   static const std::vector<std::vector<int>> hex{{0, 1, 2, 3}, {0, 1, 5, 4}, {1, 2, 6, 5},
                                                  {3, 2, 6, 7}, {0, 3, 7, 4}, {4, 5, 6, 7}};
+  static const std::vector<std::vector<int>> pyramid{
+      {0, 1, 2, 3}, {0, 1, 4}, {1, 2, 4}, {3, 2, 4}, {0, 3, 4}};
   switch (type) {
     case CellType::Tetrahedron:
       return tet;
@@ -37,6 +39,8 @@ const std::vector<std::vector<int>>& localFaces(CellType type) {
       return prism;
     case CellType::Hexahedron:
       return hex;
+    case CellType::Pyramid:
+      return pyramid;
     default:
       throw ParameterError("no Nektar++ faces for a " + cellShortName(type));
   }

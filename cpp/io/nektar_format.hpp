@@ -42,11 +42,14 @@ inline constexpr const char* kGaussLobattoLegendre = "GaussLobattoLegendre";
 inline constexpr std::int64_t kTriElecId = 22;  // NodalTriElec, as NekMesh writes triangles
 inline constexpr std::int64_t kTriFeketeId = 23;
 
-// Element letters: 3D A (tetrahedron), R (prism), H (hexahedron); faces and 2D elements T, Q.
+// Element letters: 3D A (tetrahedron), R (prism), P (pyramid), H (hexahedron); faces and 2D
+// elements T, Q.
 char letter(CellType type);
 
 // Local faces of the 3D elements in Nektar++ order, as local vertex indices of Nektar++'s own
-// numbering (triangles have 3 entries).
+// numbering (triangles have 3 entries). A pyramid's local vertices are Gmsh's: its faces are the
+// base, then the triangles over base edges 01, 12, 32, 03 (PyrGeom derives its vertices from
+// that order).
 const std::vector<std::vector<int>>& localFaces(CellType type);
 
 // Packs records into a compressed blob (zlib, then base64 zero-padded) and back.

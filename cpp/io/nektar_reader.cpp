@@ -323,6 +323,20 @@ std::vector<int> Reader::elementVertices(const nektar::ElementRecord& e) const {
       // Nektar++ (v0..v5) to Gmsh: triangles (v4 v1 v0) and (v5 v2 v3).
       return {v4, v1, v0, v5, v2, v3};
     }
+    case CellType::Pyramid: {
+      // As PyrGeom: face 0 the base, faces 1..4 the triangles over its edges 0..3, in turn.
+      const int e0 = sharedEdge(f[0], f[1]), e1 = sharedEdge(f[0], f[2]);
+      const int e2 = sharedEdge(f[0], f[3]), e4 = sharedEdge(f[1], f[4]);
+      const int v1 = common(e0, e1), v0 = otherEnd(e0, v1), v2 = otherEnd(e1, v1);
+      const int v3 = otherEnd(e2, v2), v4 = otherEnd(e4, v0);
+      // Nektar++ refuses a triangle whose collapsed vertex (its third) is not the apex.
+      for (int k = 1; k <= 4; ++k)
+        if (face(f[static_cast<std::size_t>(k)]).vertices.at(2) != v4)
+          fail("pyramid " + std::to_string(e.id) + ": its apex (vertex " + std::to_string(v4) +
+               ") is not the third vertex of its triangular face " +
+               std::to_string(f[static_cast<std::size_t>(k)]) + ", which Nektar++ refuses");
+      return {v0, v1, v2, v3, v4};  // (Gmsh's order is PyrGeom's)
+    }
     case CellType::Hexahedron: {
       const int e0 = sharedEdge(f[0], f[1]), e1 = sharedEdge(f[0], f[2]);
       const int e2 = sharedEdge(f[0], f[3]);
@@ -506,6 +520,7 @@ std::vector<std::int64_t> Reader::volumeNodes(
   static const std::map<CellType, std::vector<std::vector<int>>> gmshFaces = {
       {CellType::Tetrahedron, {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}}},
       {CellType::Prism, {{0, 1, 2}, {3, 4, 5}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}}},
+      {CellType::Pyramid, {{0, 1, 2, 3}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}}},
       {CellType::Hexahedron,
        {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}}}};
   for (const std::vector<int>& local : gmshFaces.at(type)) {

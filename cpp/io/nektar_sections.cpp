@@ -252,6 +252,9 @@ void SectionReader::readElements(const XmlElement& section) {
     } else if (g_.dim == 3 && tag == "R") {
       type = CellType::Prism;
       n = 5;
+    } else if (g_.dim == 3 && tag == "P") {
+      type = CellType::Pyramid;
+      n = 5;
     } else if (g_.dim == 3 && tag == "H") {
       type = CellType::Hexahedron;
       n = 6;

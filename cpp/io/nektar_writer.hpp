@@ -20,9 +20,11 @@
 
 namespace homesh {
 
-// Throws ParameterError for element types Nektar++ has no counterpart for, IoError on write.
+// Throws ParameterError for element types Nektar++ has no counterpart for (and for pyramids
+// above order 2, checkNektarPyramids), IoError on write.
 // `groups` (checked by checkGroups): one boundary composite per group, named after it, holding
 // the faces (2D: edges) of all its entities, in place of their own "FaceN" composites.
+void checkNektarPyramids(const Mesh& mesh);
 void writeNektarXml(const Mesh& mesh, const std::string& path, bool compressed,
                     const std::vector<NamedGroup>& groups = {});
 
