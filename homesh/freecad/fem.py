@@ -3,9 +3,9 @@
 Quality: :func:`read_fem_mesh` gives a ``Fem::FemMesh`` as it is (linear or quadratic, every
 cell) with the certified validity of its curved elements, read from FEM's own UNV writer.
 
-In: the nodes and tetrahedra of a ``Fem::FemMesh`` (FEM's Gmsh or Netgen mesher, first or
-second order: only the corner nodes are used), for :func:`homesh.curve` to put on the CAD and
-curve. Out: a ``Fem::FemMesh`` of order 2 at most (what FEM's solvers and post-processing hold)
+In: the nodes and volume cells of a ``Fem::FemMesh`` (tetrahedra, pyramids, prisms, hexahedra
+from FEM's Gmsh or Netgen mesher, first or second order: only the corner nodes are used), for
+:func:`homesh.curve` to put on the CAD and curve. Out: a ``Fem::FemMesh`` of order 2 at most (what FEM's solvers and post-processing hold)
 from a HOMesh mesh: order 1 and 2 meshes as they are, higher orders through their own map at the
 order-2 nodes, so the FEM mesh's edges are the parabolas through the curved elements' midpoints.
 
@@ -29,27 +29,40 @@ _SMESH_FROM_GMSH = {"tet": [0, 2, 1, 3, 6, 5, 4, 7, 8, 9], "tri": [0, 1, 2, 3, 4
 _CORNERS = {"tet": 4, "tri": 3}
 
 
+# A FEM volume element's type by its node count (SMESH's linear, quadratic and bi/tri-quadratic
+# cells) and its corner count: the corners come first in each, and SMESH's corners are Gmsh's up
+# to a mirror (pyramids: the base, then the apex; prisms and hexahedra: one end, then the other,
+# corner k joined to corner k + 3 or k + 4), which homesh.curve undoes by making cells positive.
+_VOLUME_TYPES = {4: ("tet", 4), 10: ("tet", 4), 5: ("pyramid", 5), 13: ("pyramid", 5),
+                 6: ("prism", 6), 15: ("prism", 6), 18: ("prism", 6), 8: ("hex", 8),
+                 20: ("hex", 8), 27: ("hex", 8)}
+
+
 def fem_mesh_arrays(fem_mesh):
-    """(nodes (N, 3), tetrahedra (E, 4) 0-based) of a ``Fem::FemMesh``'s volume elements that
-    are tetrahedra (4 or 10 nodes; their corners), with the nodes no corner uses left out.
-    ValueError when it has no tetrahedra or has other volume elements."""
+    """(nodes (N, 3), cells {type: (E, corners) 0-based}) of a ``Fem::FemMesh``'s volume
+    elements (tetrahedra, pyramids, prisms, hexahedra, linear or quadratic: their corners, in
+    :func:`homesh.curve`'s dict), with the nodes no corner uses left out. ValueError when it has
+    no volume elements or one of another kind."""
     volumes = list(fem_mesh.Volumes)
     if not volumes:
         raise ValueError("the FEM mesh has no volume elements (a surface mesh cannot be "
                          "curved as a solid)")
-    corners = []
+    corners = {}
     for v in volumes:
         nodes = fem_mesh.getElementNodes(v)
-        if len(nodes) not in (4, 10):
+        if len(nodes) not in _VOLUME_TYPES:
             raise ValueError("the FEM mesh has a volume element of %d nodes (element %d): only "
-                             "tetrahedra (4 or 10 nodes) can be curved" % (len(nodes), v))
-        corners.append(nodes[:4])
-    used = sorted({n for c in corners for n in c})
+                             "tetrahedra, pyramids, prisms and hexahedra (linear or quadratic) "
+                             "can be curved" % (len(nodes), v))
+        kind, count = _VOLUME_TYPES[len(nodes)]
+        corners.setdefault(kind, []).append(nodes[:count])
+    used = sorted({n for cells in corners.values() for c in cells for n in c})
     index = {n: k for k, n in enumerate(used)}
     points = fem_mesh.Nodes
     nodes = np.array([[points[n].x, points[n].y, points[n].z] for n in used], dtype=float)
-    tets = np.array([[index[n] for n in c] for c in corners], dtype=np.int64)
-    return nodes, tets
+    cells = {kind: np.array([[index[n] for n in c] for c in cs], dtype=np.int64)
+             for kind, cs in corners.items()}
+    return nodes, cells
 
 
 def read_fem_mesh(fem_mesh):

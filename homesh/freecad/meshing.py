@@ -35,16 +35,16 @@ def job_for(obj, values=None):
             raise ValueError("%s: FemMesh must link to a FEM mesh object, not %s"
                              % (obj.Label, fem_object.Label))
         try:
-            nodes, tets = fem_mesh_arrays(fem_object.FemMesh)
+            nodes, cells = fem_mesh_arrays(fem_object.FemMesh)
         except ValueError as e:
             raise ValueError("%s: %s: %s" % (obj.Label, fem_object.Label, e)) from None
         job = MeshJob(shape.exportBrepToString(), obj.Part.Label, function=homesh.curve,
-                      nodes=nodes, cells=tets, order=arguments["order"],
+                      nodes=nodes, cells=cells, order=arguments["order"],
                       optimise=arguments["optimise"], threads=arguments["threads"],
                       optimise_seconds=arguments["optimise_seconds"],
                       job_seconds=arguments["job_seconds"],
                       facet_weight=arguments["facet_weight"])
-        job.fem_elements = len(tets)
+        job.fem_elements = sum(len(c) for c in cells.values())
     job.values = values or {}
     return job
 
@@ -55,7 +55,7 @@ def predicted_elements(obj, job):
     import homesh
     del obj
     if hasattr(job, "fem_elements"):
-        return job.fem_elements  # the FEM mesh's own tetrahedra
+        return job.fem_elements  # the FEM mesh's own cells
     arguments = job.arguments
     size = arguments.get("size")
     if size is None:

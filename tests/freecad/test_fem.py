@@ -114,6 +114,47 @@ class FemBothWays(unittest.TestCase):
         self.assertLess(np.abs(radius - 1.0).max(), 1e-12)
         shutil.rmtree(folder)
 
+    def test_curve_a_fem_mesh_of_prisms(self):
+        """A FEM mesh of prisms (Gmsh's cylinder made by extruding its disk in 4 layers, put
+        into a Fem::FemMesh as SMESH's 6-node volumes) curved by a HighOrderMesh object at
+        order 4, certified valid: Curve FEM mesh takes every volume type FEM holds."""
+        import Fem
+        folder = tempfile.mkdtemp(prefix="homesh-fem-prisms-")
+        geo, msh = os.path.join(folder, "cyl.geo"), os.path.join(folder, "cyl.msh")
+        with open(geo, "w") as f:
+            f.write('SetFactory("OpenCASCADE");\nDisk(1) = {0, 0, 0, 1};\n'
+                    "Extrude {0, 0, 2} { Surface{1}; Layers{4}; Recombine; }\n"
+                    "Mesh.MeshSizeMax = 0.5;\n")
+        import subprocess
+        subprocess.run([GMSH, geo, "-3", "-format", "msh41", "-o", msh], check=True,
+                       capture_output=True)
+        given = homesh.read(msh)
+        blocks = [b for b in given.element_blocks if b.element_type == "prism"]
+        self.assertEqual(len(blocks), 1)
+        fm = Fem.FemMesh()
+        for k, x in enumerate(given.nodes):
+            fm.addNode(float(x[0]), float(x[1]), float(x[2]), k + 1)
+        for cell in blocks[0].elements:
+            fm.addVolume([int(n) + 1 for n in cell])
+        femmesh = self.doc.addObject("Fem::FemMeshObject", "Prisms")
+        femmesh.FemMesh = fm
+        self.assertEqual(fm.PrismCount, len(blocks[0].elements))
+        obj = homesh.freecad.make_high_order_mesh(self.doc, self.cyl, order=4,
+                                                  fem_mesh=femmesh)
+        self.doc.recompute()
+        self.assertTrue(obj.isValid(), obj.Status)
+        mesh = homesh.freecad.get_mesh(obj)
+        quality = mesh.quality()
+        self.assertEqual(mesh.num_elements, len(blocks[0].elements))
+        self.assertEqual(quality["invalid_elements"] + quality["undecided_elements"], 0)
+        lateral = [i + 1 for i, f in enumerate(self.cyl.Shape.Faces)
+                   if f.Surface.__class__.__name__ == "Cylinder"]
+        side = (mesh.node_cad_dim == 2) & np.isin(mesh.node_cad_index, lateral)
+        self.assertGreater(side.sum(), 100)
+        radius = np.hypot(mesh.nodes[side, 0], mesh.nodes[side, 1])
+        self.assertLess(np.abs(radius - 1.0).max(), 1e-12)
+        shutil.rmtree(folder)
+
     def test_to_fem_mesh_has_the_counts_of_the_order_two_mesh(self):
         own = gmsh_fem_mesh(self.doc, self.cyl).FemMesh
         signs = {corner_sign(own, element) for element in own.Volumes}
