@@ -353,8 +353,9 @@ int runCurve(const homesh::CurveCommand& cmd) {
                                    " as .msh or .xml instead");
     if (pyramids && ext == ".xml" && options.order > 2)
       throw homesh::ParameterError(cmd.input + " holds pyramids, which Nektar++ XML takes up to " +
-                                   "order 2 (the interior Nektar++ rebuilds above it is not " +
-                                   "reproduced yet to certify it): write " + path + " as .msh");
+                                   "order 2 (above it Nektar++'s pyramid space is not ours, so " +
+                                   "its geometry could not be certified): write " + path +
+                                   " as .msh");
   }
   StderrProgress progress;
   homesh::PipelineObserver* observer = c.quiet ? nullptr : &progress;

@@ -64,6 +64,11 @@ std::vector<Mode> modesOf(CellType type, int order) {
   std::vector<Mode> modes;
   const int n = order + 1;
   for (int p = 0; p < n; ++p) {
+    if (type == CellType::Pyramid) {  // r up to order - max(p, q)
+      for (int q = 0; q < n; ++q)
+        for (int r = 0; r < n - std::max(p, q); ++r) modes.push_back({p, q, r});
+      continue;
+    }
     if (type == CellType::Triangle) {
       for (int q = 0; q < n - p; ++q) modes.push_back({p, q, 0});
       continue;
@@ -81,6 +86,8 @@ bool isInterior(CellType type, const Mode& m) {
       return m.p >= 2 && m.q >= 1;
     case CellType::Tetrahedron:
       return isInteriorTetMode(m.p, m.q, m.r);
+    case CellType::Pyramid:
+      return isInteriorPyramidMode(m.p, m.q, m.r);
     default:
       return isInteriorPrismMode(m.p, m.q, m.r);
   }
@@ -102,6 +109,9 @@ double modeAt(CellType type, const Mode& m, double x, double y, double z) {
   if (type == CellType::Triangle) return modifiedTriMode(m.p, m.q, {1.0 - x - y, x, y});
   if (type == CellType::Tetrahedron)
     return modifiedTetMode(m.p, m.q, m.r, {1.0 - x - y - z, x, y, z});
+  // Nektar++'s pyramid: its vertices are ours (the apex above vertex 0), xi = 2 x - 1.
+  if (type == CellType::Pyramid)
+    return modifiedPyramidMode(m.p, m.q, m.r, {2.0 * x - 1.0, 2.0 * y - 1.0, 2.0 * z - 1.0});
   // Nektar++'s prism: xi1 from its vertex 0 to 1 (our y = 0 .. x = 1), xi2 from 0 to 3 (our
   // z), xi3 from 0 to 4 (our x + y = 1 .. 0).
   const double xi1 = 2.0 * x - 1.0, xi2 = 2.0 * z - 1.0, xi3 = 1.0 - 2.0 * (x + y);
@@ -115,10 +125,13 @@ ExpansionInteriorMap buildMap(CellType type, int order) {
   for (int k = 0; k < n; ++k) {
     const LatticePoint& l = ref.lattice()[static_cast<std::size_t>(k)];
     const bool onTriangle = l[0] == 0 || l[1] == 0 || l[0] + l[1] == order;
-    const bool onFace = type == CellType::Triangle ? onTriangle
-                        : type == CellType::Tetrahedron
-                            ? l[0] == 0 || l[1] == 0 || l[2] == 0 || l[0] + l[1] + l[2] == order
-                            : onTriangle || l[2] == 0 || l[2] == order;
+    const bool onFace =
+        type == CellType::Triangle ? onTriangle
+        : type == CellType::Tetrahedron
+            ? l[0] == 0 || l[1] == 0 || l[2] == 0 || l[0] + l[1] + l[2] == order
+        : type == CellType::Pyramid
+            ? l[0] == 0 || l[1] == 0 || l[2] == 0 || l[0] + l[2] == order || l[1] + l[2] == order
+            : onTriangle || l[2] == 0 || l[2] == order;
     (onFace ? map.boundary : map.interior).push_back(k);
   }
   const std::vector<Mode> modes = modesOf(type, order);
@@ -134,11 +147,16 @@ ExpansionInteriorMap buildMap(CellType type, int order) {
   // coefficients from its values where collapsed coordinates are regular (well-spread nodes
   // shrunk towards the centroid; a well-conditioned Vandermonde matrix), then evaluated at the
   // nodes; exact up to rounding, as the modes lie in the element's space.
-  const Eigen::RowVector3d centroid = type == CellType::Tetrahedron
-                                          ? Eigen::RowVector3d(0.25, 0.25, 0.25)
-                                          : Eigen::RowVector3d(1.0 / 3, 1.0 / 3, 0.5);
+  const Eigen::RowVector3d centroid =
+      type == CellType::Tetrahedron ? Eigen::RowVector3d(0.25, 0.25, 0.25)
+      : type == CellType::Pyramid   ? Eigen::RowVector3d(0.3, 0.3, 0.25)
+                                    : Eigen::RowVector3d(1.0 / 3, 1.0 / 3, 0.5);
   const Eigen::Index dim = ref.dim();
-  Eigen::MatrixXd samples = ReferenceElement::get(type, order, NodeSet::Optimal).nodes();
+  // (Pyramids have no optimal node set: their equispaced nodes, shrunk the same way.)
+  Eigen::MatrixXd samples =
+      ReferenceElement::get(type, order,
+                            type == CellType::Pyramid ? NodeSet::Equispaced : NodeSet::Optimal)
+          .nodes();
   for (Eigen::Index k = 0; k < samples.rows(); ++k)
     samples.row(k) = centroid.head(dim) + 0.8 * (samples.row(k) - centroid.head(dim));
   const auto orthogonalAt = [&](const Eigen::MatrixXd& points) {
@@ -157,8 +175,30 @@ ExpansionInteriorMap buildMap(CellType type, int order) {
     for (std::size_t m = 0; m < modes.size(); ++m)
       modeValues(k, static_cast<Eigen::Index>(m)) =
           modeAt(type, modes[m], samples(k, 0), samples(k, 1), dim > 2 ? samples(k, 2) : 0.0);
-  const Eigen::MatrixXd atNodes =
-      orthogonalAt(ref.nodes()) * orthogonalAt(samples).partialPivLu().solve(modeValues);
+  const Eigen::MatrixXd coefficients = orthogonalAt(samples).partialPivLu().solve(modeValues);
+  const Eigen::MatrixXd atNodes = orthogonalAt(ref.nodes()) * coefficients;
+  // The modes lie in the element's space: checked at points between the samples, where a mode
+  // outside it would differ from its interpolant (1e-9: far above the rounding of these
+  // well-conditioned fits, far below any difference of functions).
+  Eigen::MatrixXd checks = samples;
+  for (Eigen::Index k = 0; k < checks.rows(); ++k)
+    checks.row(k) = centroid.head(dim) + 0.7 * (checks.row(k) - centroid.head(dim)) +
+                    0.01 * Eigen::RowVector3d(0.31, 0.17, 0.23).head(dim);
+  Eigen::MatrixXd exact(checks.rows(), static_cast<Eigen::Index>(modes.size()));
+  for (Eigen::Index k = 0; k < checks.rows(); ++k)
+    for (std::size_t m = 0; m < modes.size(); ++m)
+      exact(k, static_cast<Eigen::Index>(m)) =
+          modeAt(type, modes[m], checks(k, 0), checks(k, 1), dim > 2 ? checks(k, 2) : 0.0);
+  const Eigen::MatrixXd misfits = (orthogonalAt(checks) * coefficients - exact).cwiseAbs();
+  Eigen::Index worstRow = 0, worstMode = 0;
+  const double misfit = misfits.maxCoeff(&worstRow, &worstMode);
+  if (!(misfit < 1e-9)) {
+    const Mode& m = modes[static_cast<std::size_t>(worstMode)];
+    throw MeshingError("Nektar++'s " + cellShortName(type) + " mode (" + std::to_string(m.p) +
+                       ", " + std::to_string(m.q) + ", " + std::to_string(m.r) + ") of order " +
+                       std::to_string(order) + " is not in our element's space (misfit " +
+                       std::to_string(misfit) + ")");
+  }
 
   const auto nb = static_cast<Eigen::Index>(map.boundary.size());
   const auto ni = static_cast<Eigen::Index>(map.interior.size());
@@ -296,6 +336,26 @@ double modifiedPrismMode(int p, int q, int r, const std::array<double, 3>& xi) {
   return modA(p, eta1) * modA(q, xi[1]) * modB(p, r, xi[2]);
 }
 
+bool isInteriorPyramidMode(int p, int q, int r) {
+  return p >= 2 && q >= 2 && r >= 1;
+}
+
+double modifiedPyramidMode(int p, int q, int r, const std::array<double, 3>& xi) {
+  // The apex's function is (1 + xi3)/2 alone (Nektar++ adds it into all four base products).
+  if (p == 0 && q == 0 && r == 1) return 0.5 * (1.0 + xi[2]);
+  const double eta1 = 2.0 * (1.0 + xi[0]) / (1.0 - xi[2]) - 1.0;
+  const double eta2 = 2.0 * (1.0 + xi[1]) / (1.0 - xi[2]) - 1.0;
+  const double z = xi[2];
+  double c = 0.0;  // ModifiedPyr_C's factor for (p, q, r)
+  if (std::min(p, q) <= 1) {
+    c = modB(std::max(p, q), r, z);
+  } else {
+    c = std::pow(0.5 * (1.0 - z), p + q - 2);
+    if (r >= 1) c *= 0.5 * (1.0 + z) * jacobi(r - 1, 2.0 * (p + q) - 3.0, 1.0, z);
+  }
+  return modA(p, eta1) * modA(q, eta2) * c;
+}
+
 double modifiedTetMode(int p, int q, int r, const std::array<double, 4>& lambda) {
   const double s1 = lambda[0] + lambda[1], s2 = s1 + lambda[2];
   const double eta1 = (lambda[1] - lambda[0]) / s1;
@@ -310,7 +370,8 @@ double modifiedTetMode(int p, int q, int r, const std::array<double, 4>& lambda)
 }
 
 const ExpansionInteriorMap& interiorFromBoundary(CellType type, int order) {
-  if (type != CellType::Triangle && type != CellType::Tetrahedron && type != CellType::Prism)
+  if (type != CellType::Triangle && type != CellType::Tetrahedron && type != CellType::Prism &&
+      type != CellType::Pyramid)
     throw ParameterError("no modified-basis interior for " + cellShortName(type));
   if (order < 1 || order > kMaxOrder)
     throw ParameterError(cellShortName(type) + " order " + std::to_string(order) +

@@ -19,7 +19,9 @@
 
 namespace homesh::nektar {
 
-// Interior nodes of a triangle, tetrahedron or prism from its boundary nodes, on the equispaced
+// Interior nodes of a triangle, tetrahedron or prism (or a pyramid up to order 2, which has none:
+// from order 3 Nektar++'s ModifiedPyr_C modes are not in our pyramid's space, mode (3, 3, 0)
+// first, and MeshingError says so) from its boundary nodes, on the equispaced
 // Gmsh-ordered lattice of `order`: interior = weights * boundary (rows of the nodes'
 // coordinates). The element's local vertices are Nektar++'s as the reader orders them.
 struct ExpansionInteriorMap {
@@ -36,6 +38,11 @@ const ExpansionInteriorMap& interiorFromBoundary(CellType type, int order);
 // reference point `xi` in [-1, 1]^3 (xi3 < 1). Exposed for tests.
 double modifiedTetMode(int p, int q, int r, const std::array<double, 4>& lambda);
 double modifiedPrismMode(int p, int q, int r, const std::array<double, 3>& xi);
+// A pyramid's at reference point `xi` in [-1, 1]^3 (Nektar++'s vertices are Gmsh's, the apex
+// (-1, -1, 1) above vertex 0; xi3 < 1): modA(p, eta1) modA(q, eta2) ModifiedPyr_C(p, q, r; xi3),
+// the apex's function (1 + xi3)/2 (Nektar++ 5.2's Basis.cpp and StdPyrExp.cpp).
+double modifiedPyramidMode(int p, int q, int r, const std::array<double, 3>& xi);
+bool isInteriorPyramidMode(int p, int q, int r);
 bool isInteriorTetMode(int p, int q, int r);
 bool isInteriorPrismMode(int p, int q, int r);
 

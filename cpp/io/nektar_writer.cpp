@@ -558,15 +558,16 @@ void writeExpansions(std::ostream& os, int order, const std::vector<int>& domain
 }  // namespace
 
 // Pyramids are written up to order 2, which leaves none of their nodes inside: above it
-// Nektar++ rebuilds the interior from the faces in its own pyramid basis (ModifiedPyr_C), which
-// the reader does not reproduce yet, so the file could not be certified as Nektar++ sees it.
+// Nektar++ rebuilds the interior from the faces in its own pyramid basis (ModifiedPyr_C), whose
+// space is not our element's (Bergot's) from order 3 (nektar_expansion.hpp), so the file could
+// not be certified as Nektar++ sees it, nor hold our element.
 void checkNektarPyramids(const Mesh& mesh) {
   for (const ElementBlock& b : mesh.blocks)
     if (b.type == CellType::Pyramid && b.count() > 0 && b.order > 2)
       throw ParameterError("Nektar++ XML: pyramids are written up to order 2, these are of order " +
                            std::to_string(b.order) +
-                           " (the interior Nektar++ rebuilds from their faces is not reproduced "
-                           "yet to certify it): write .msh");
+                           " (above it Nektar++'s pyramid space is not ours, so its geometry "
+                           "could not be certified): write .msh");
 }
 
 void writeNektarXml(const Mesh& mesh, const std::string& path, bool compressed,
