@@ -114,7 +114,8 @@ class Recogniser {
   std::optional<Stack> climb(CellRef p, bool fromBottom, std::string& why) {
     Stack s;
     const std::int64_t* v = cell(p);
-    // Standing on the top, the corners 0, 2, 1 keep the macro prism positive.
+    // Standing on the top triangle, its corners 3, 5, 4 (0, 2, 1 of the triangle) keep the
+    // macro prism positive.
     const std::array<int, 3> order =
         fromBottom ? std::array<int, 3>{0, 1, 2} : std::array<int, 3>{3, 5, 4};
     for (int k = 0; k < 3; ++k) s.columns[k] = {v[order[k]]};

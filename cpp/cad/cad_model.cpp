@@ -425,7 +425,8 @@ CurveProjection CadModel::projectOnCurve(int edge, const Eigen::Vector3d& p,
     // point of a closed curve, so the global result stands unless the local one is as near.
     if (guess) {
       const double dLocal = analysis.NextProject(*guess, c, toGp(p), precision, proj, t);
-      if (dLocal <= d + precision) best = CurveProjection{t, toEigen(proj), dLocal};
+      if (dLocal <= d + precision && t >= first - slack && t <= last + slack)
+        best = CurveProjection{t, toEigen(proj), dLocal};
     }
     return best;
   });

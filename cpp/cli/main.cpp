@@ -348,9 +348,10 @@ int runCurve(const homesh::CurveCommand& cmd) {
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
     if (pyramids && ext == ".vtu" && options.order > 1)
-      throw homesh::ParameterError(cmd.input + " holds pyramids, and VTU has no curved pyramid " +
-                                   "(VTK 9.1 has no Lagrange pyramid): write " + path +
-                                   " as .msh or .xml instead");
+      throw homesh::ParameterError(
+          cmd.input + " holds pyramids, and VTU has no curved pyramid " +
+          "(VTK 9.1 has no Lagrange pyramid): write " + path +
+          (options.order > 2 ? " as .msh instead" : " as .msh or .xml instead"));
     if (pyramids && ext == ".xml" && options.order > 2)
       throw homesh::ParameterError(cmd.input + " holds pyramids, which Nektar++ XML takes up to " +
                                    "order 2 (above it Nektar++'s pyramid space is not ours, so " +

@@ -177,27 +177,32 @@ ExpansionInteriorMap buildMap(CellType type, int order) {
           modeAt(type, modes[m], samples(k, 0), samples(k, 1), dim > 2 ? samples(k, 2) : 0.0);
   const Eigen::MatrixXd coefficients = orthogonalAt(samples).partialPivLu().solve(modeValues);
   const Eigen::MatrixXd atNodes = orthogonalAt(ref.nodes()) * coefficients;
-  // The modes lie in the element's space: checked at points between the samples, where a mode
-  // outside it would differ from its interpolant (1e-9: far above the rounding of these
-  // well-conditioned fits, far below any difference of functions).
-  Eigen::MatrixXd checks = samples;
-  for (Eigen::Index k = 0; k < checks.rows(); ++k)
-    checks.row(k) = centroid.head(dim) + 0.7 * (checks.row(k) - centroid.head(dim)) +
-                    0.01 * Eigen::RowVector3d(0.31, 0.17, 0.23).head(dim);
-  Eigen::MatrixXd exact(checks.rows(), static_cast<Eigen::Index>(modes.size()));
-  for (Eigen::Index k = 0; k < checks.rows(); ++k)
-    for (std::size_t m = 0; m < modes.size(); ++m)
-      exact(k, static_cast<Eigen::Index>(m)) =
-          modeAt(type, modes[m], checks(k, 0), checks(k, 1), dim > 2 ? checks(k, 2) : 0.0);
-  const Eigen::MatrixXd misfits = (orthogonalAt(checks) * coefficients - exact).cwiseAbs();
-  Eigen::Index worstRow = 0, worstMode = 0;
-  const double misfit = misfits.maxCoeff(&worstRow, &worstMode);
-  if (!(misfit < 1e-9)) {
-    const Mode& m = modes[static_cast<std::size_t>(worstMode)];
-    throw MeshingError("Nektar++'s " + cellShortName(type) + " mode (" + std::to_string(m.p) +
-                       ", " + std::to_string(m.q) + ", " + std::to_string(m.r) + ") of order " +
-                       std::to_string(order) + " is not in our element's space (misfit " +
-                       std::to_string(misfit) + ")");
+  // A pyramid's modes lie in our element's space only up to order 2 (nektar_expansion.hpp):
+  // checked at points between the samples, where a mode outside it differs from its
+  // interpolant (1e-9 of the largest mode value: far above the rounding of these fits at the
+  // orders checked, far below the 1e-3 a mode outside the space misses by). Tetrahedra's,
+  // prisms' and triangles' spaces are ours by construction.
+  if (type == CellType::Pyramid) {
+    Eigen::MatrixXd checks = samples;
+    for (Eigen::Index k = 0; k < checks.rows(); ++k)
+      checks.row(k) = centroid.head(dim) + 0.7 * (checks.row(k) - centroid.head(dim)) +
+                      0.01 * Eigen::RowVector3d(0.31, 0.17, 0.23).head(dim);
+    Eigen::MatrixXd exact(checks.rows(), static_cast<Eigen::Index>(modes.size()));
+    for (Eigen::Index k = 0; k < checks.rows(); ++k)
+      for (std::size_t m = 0; m < modes.size(); ++m)
+        exact(k, static_cast<Eigen::Index>(m)) =
+            modeAt(type, modes[m], checks(k, 0), checks(k, 1), checks(k, 2));
+    const Eigen::MatrixXd misfits = (orthogonalAt(checks) * coefficients - exact).cwiseAbs();
+    Eigen::Index worstRow = 0, worstMode = 0;
+    const double misfit = misfits.maxCoeff(&worstRow, &worstMode);
+    if (!(misfit < 1e-9 * std::max(1.0, exact.cwiseAbs().maxCoeff()))) {
+      const Mode& m = modes[static_cast<std::size_t>(worstMode)];
+      throw MeshingError("Nektar++'s pyramid mode (" + std::to_string(m.p) + ", " +
+                         std::to_string(m.q) + ", " + std::to_string(m.r) + ") of order " +
+                         std::to_string(order) + " is not in our element's space (misfit " +
+                         std::to_string(misfit) +
+                         "): the geometry Nektar++ builds cannot be reproduced");
+    }
   }
 
   const auto nb = static_cast<Eigen::Index>(map.boundary.size());

@@ -493,7 +493,13 @@ void Reader::fillTransfinite(CellType type, const ReferenceElement& ref,
 // (io/nektar_expansion).
 void Reader::fillExpansion(CellType type, const std::vector<std::int64_t>& nodes,
                            const std::vector<int>& unknown) {
-  const nektar::ExpansionInteriorMap& map = nektar::interiorFromBoundary(type, order_);
+  const nektar::ExpansionInteriorMap& map = [&]() -> const nektar::ExpansionInteriorMap& {
+    try {
+      return nektar::interiorFromBoundary(type, order_);
+    } catch (const MeshingError& e) {  // (curved pyramids above order 2)
+      fail(cellShortName(type) + " of order " + std::to_string(order_) + ": " + e.what());
+    }
+  }();
   if (unknown != map.interior) fail("an element's faces are incomplete");
   Eigen::MatrixXd boundary(static_cast<Eigen::Index>(map.boundary.size()), 3);
   for (std::size_t k = 0; k < map.boundary.size(); ++k)

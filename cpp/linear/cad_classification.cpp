@@ -242,7 +242,8 @@ std::pair<double, double> enclosedVolume(const Mesh& mesh, const std::int64_t* c
 struct FaceUse {
   int count = 0;
   Face out{};
-  std::string cell;
+  CellType type = CellType::Tetrahedron;  // the first cell's, and its index in its block
+  std::size_t element = 0;
 };
 using FaceUses = std::map<Face, FaceUse>;
 
@@ -282,13 +283,14 @@ void orientAndCountFaces(const Mesh& mesh, ElementBlock& cells, FaceUses& uses) 
       for (std::size_t k = 0; k < f.size(); ++k) out[k] = c[f[k]];
       Face key = out;
       std::sort(key.begin(), key.begin() + static_cast<std::ptrdiff_t>(f.size()));
-      const std::string cell = name + " " + std::to_string(e + 1);
-      auto [it, fresh] = uses.try_emplace(key, FaceUse{0, out, cell});
+      auto [it, fresh] = uses.try_emplace(key, FaceUse{0, out, cells.type, e});
       // Two positive cells on either side of a face see it turn opposite ways; the same way,
       // they lie on one side of it: the mesh folds there (a cell turned inside out by a moved
       // node, which making it positive hid).
       if (++it->second.count == 2 && sameTurn(it->second.out, out))
-        throw MeshingError(it->second.cell + " and " + cell +
+        throw MeshingError(cellShortName(it->second.type) + " " +
+                           std::to_string(it->second.element + 1) + " and " + name + " " +
+                           std::to_string(e + 1) +
                            " of the given mesh overlap: both lie on one side of their face of "
                            "nodes " +
                            nodeList(out) + " (a tangled mesh cannot be curved valid)");

@@ -24,12 +24,13 @@ struct CadClassificationStats {
 
 // `linear`: dim 3, order 1, with blocks of tetrahedra, prisms, pyramids or hexahedra (blocks of
 // lower dimension are ignored; node records need not be set); the result has one block per
-// volume type given, in the given order, then its boundary's triangles, quadrilaterals and
-// segments. The CAD must have exactly one solid. `tolerance` <= 0: the parameter table's
-// classify_tolerance (1e-5) of the CAD's bounding
-// diagonal (above the CAD's own tolerances, below any element). Throws ParameterError for a mesh
-// that is not such, and MeshingError naming the node, its position and the nearest CAD face when
-// a boundary node lies on no CAD face.
+// non-empty volume block given, in the given order, then its boundary's triangles,
+// quadrilaterals and segments. The CAD must have exactly one solid. `tolerance` <= 0: the parameter
+// table's classify_tolerance (1e-5) of the CAD's bounding diagonal (above the CAD's own tolerances,
+// below any element). Throws ParameterError for a mesh that is not such (and naming a flat cell),
+// MeshingError naming two cells that overlap (both on one side of their shared face), and
+// MeshingError naming the node, its position and the nearest CAD face when a boundary node lies on
+// no CAD face.
 Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance = 0.0,
                    CadClassificationStats* stats = nullptr);
 

@@ -274,11 +274,13 @@ void finishJob(MeshResult& result, JobBudget& budget, PipelineObserver* observer
   result.job.skipped = budget.skippedStages();
 }
 
-// Refuses a given mesh with a straight-sided cell that is not valid as it stands (a flat
-// pyramid whose apex lies in the plane of its base, a twisted hexahedron): its Jacobian vanishes
-// or changes sign, so no curving of it can be valid and the optimiser cannot measure it. The
-// cells are oriented (classifyOnCad), so a valid one has J > 0; counts are 1-based per type.
-void checkGivenCells(const Mesh& mesh) {
+// The first straight-sided cell of `mesh` (tetrahedra aside: classifyOnCad made them positive
+// and not flat) proven invalid: its Jacobian vanishes or changes sign (a flat pyramid whose apex
+// lies in the mean plane of its twisted base, a hexahedron with a corner pushed inside it), so
+// no curving of it can be valid and the optimiser cannot measure it. Cells are oriented, so a
+// valid one has J > 0; an undecided one (J near zero somewhere, not proven negative) is left
+// to the certificate of the curved mesh. Empty when there is none; counts are 1-based per type.
+std::string firstInvalidCell(const Mesh& mesh, const char* what) {
   for (const ElementBlock& block : mesh.blocks) {
     if (cellDimension(block.type) != 3 || block.type == CellType::Tetrahedron) continue;
     const int n = block.nodesPerElement();
@@ -288,17 +290,33 @@ void checkGivenCells(const Mesh& mesh) {
         x.row(i) = nodePoint(mesh, block.element(e)[i]).transpose() -
                    nodePoint(mesh, block.element(e)[0]).transpose();
       const JacobianBounds b = boundJacobian(block.type, block.order, x, nullptr);
-      if (b.validity == Validity::Valid) continue;
+      if (b.validity != Validity::Invalid) continue;
       const Eigen::Vector3d centre =
           nodePoint(mesh, block.element(e)[0]) + x.colwise().mean().transpose();
       std::ostringstream msg;
-      msg << cellShortName(block.type) << " " << e + 1 << " of the given mesh (centre ("
+      msg << cellShortName(block.type) << " " << e + 1 << " of " << what << " (centre ("
           << centre.x() << ", " << centre.y() << ", " << centre.z()
-          << ")) is not valid as given: its Jacobian ranges over [" << b.minLower << ", "
-          << b.maxUpper << "], so no curved cell made from it can be valid";
-      throw MeshingError(msg.str());
+          << ")) is not valid straight-sided: its Jacobian ranges over [" << b.minLower << ", "
+          << b.maxUpper << "]";
+      return msg.str();
     }
   }
+  return {};
+}
+
+// The given mesh's prism stacks agglomerated (layer_stacks.hpp) when their macro prisms are
+// valid straight-sided (columns that bend or converge at a concave corner may make one that is
+// not: the prisms are then curved as given, with a note saying why).
+std::optional<LayerStacks> agglomerateLayer(const Mesh& onCad, MeshResult& result) {
+  std::string why;
+  std::optional<LayerStacks> stacks = recogniseLayerStacks(onCad, why);
+  if (stacks) {
+    why = firstInvalidCell(stacks->macro, "the macro layer");
+    if (why.empty()) return stacks;
+  }
+  if (!why.empty())
+    result.notes.push_back("the prisms were curved as given, not as a boundary layer: " + why);
+  return std::nullopt;
 }
 
 }  // namespace
@@ -354,14 +372,12 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
   StageClock classify("classify", result.timings, observer);
   Mesh onCad = classifyOnCad(linear, *result.cad,
                              options.classifyTolerance * result.cad->boundingDiagonal());
-  checkGivenCells(onCad);
-  std::string why;
-  std::optional<LayerStacks> stacks = recogniseLayerStacks(onCad, why);
+  if (const std::string invalid = firstInvalidCell(onCad, "the given mesh"); !invalid.empty())
+    throw MeshingError(invalid + ", so no curved cell made from it can be valid");
+  std::optional<LayerStacks> stacks = agglomerateLayer(onCad, result);
   if (stacks) {
     onCad = std::move(stacks->macro);
     result.givenLayers = stacks->record;
-  } else if (!why.empty()) {
-    result.notes.push_back("the prisms were curved as given, not as a boundary layer: " + why);
   }
   classify.done();
   CurvedState state = curve(std::move(onCad), options, *result.cad, result.timings, observer, true,

@@ -43,9 +43,9 @@ std::string givenLayersLine(const StageRecords& records) {
   for (const int f : r.walls) walls += (walls.empty() ? "Face" : ", Face") + std::to_string(f);
   std::string line = formatted(
       "given boundary layer: %zu stacks of %d prism layers (%zu columns) on %s, curved as macro "
-      "prisms (worst %.4f)",
-      r.stacks, r.layers, r.columns, walls.c_str(),
-      records.macroQuality ? records.macroQuality->scaled.min : 0.0);
+      "prisms",
+      r.stacks, r.layers, r.columns, walls.c_str());
+  if (records.macroQuality) line += formatted(" (worst %.4f)", records.macroQuality->scaled.min);
   if (records.layerSplit)
     line += formatted("; split back: first layer %g to %g (given %g to %g, worst %.2f %% off)",
                       records.layerSplit->firstHeightMin, records.layerSplit->firstHeightMax,

@@ -5,8 +5,8 @@ cell) with the certified validity of its curved elements, read from FEM's own UN
 
 In: the nodes and volume cells of a ``Fem::FemMesh`` (tetrahedra, pyramids, prisms, hexahedra
 from FEM's Gmsh or Netgen mesher, first or second order: only the corner nodes are used), for
-:func:`homesh.curve` to put on the CAD and curve. Out: a ``Fem::FemMesh`` of order 2 at most (what FEM's solvers and post-processing hold)
-from a HOMesh mesh: order 1 and 2 meshes as they are, higher orders through their own map at the
+:func:`homesh.curve` to put on the CAD and curve. Out: a ``Fem::FemMesh`` of order 2 at most
+(what FEM's solvers and post-processing hold) from a HOMesh mesh: order 1 and 2 meshes as they are, higher orders through their own map at the
 order-2 nodes, so the FEM mesh's edges are the parabolas through the curved elements' midpoints.
 
 Node orders: Gmsh's (ours) and SMESH's (FEM's) tetrahedra are oriented oppositely (SMESH's first

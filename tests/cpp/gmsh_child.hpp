@@ -19,6 +19,7 @@ void inGmshChild(const Session& session) {
   const pid_t child = fork();
   ASSERT_GE(child, 0) << "fork failed";
   if (child == 0) {
+    alarm(600);  // (a stuck session ends as a failure, not a hung test)
     int status = 0;
     try {
       session();
@@ -33,6 +34,7 @@ void inGmshChild(const Session& session) {
   }
   int status = 0;
   ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_FALSE(WIFSIGNALED(status)) << "the Gmsh session died of signal " << WTERMSIG(status);
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "the Gmsh session failed";
 }
 

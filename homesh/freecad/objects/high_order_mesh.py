@@ -102,7 +102,8 @@ class HighOrderMeshProxy(GuardedProxy):
         if "FemMesh" not in have:
             obj.addProperty("App::PropertyLink", "FemMesh", "Mesh",
                             "Optional FEM mesh of Part (FEM's Gmsh or Netgen mesher, first or "
-                            "second order): its tetrahedra are put on the CAD and curved "
+                            "second order; tetrahedra, pyramids, prisms, hexahedra): its cells "
+                            "are put on the CAD and curved "
                             "instead of meshing Part (Size, Sizing, RepairRounds and "
                             "BoundaryLayer do not apply)")
         if "MeshData" not in have:

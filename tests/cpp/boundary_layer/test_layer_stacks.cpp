@@ -102,5 +102,62 @@ TEST(LayerStacks, PrismsFromWallToWallAreNoLayer) {
   EXPECT_TRUE(why.empty()) << why;
 }
 
+// A stack may stand on a prism's top triangle (corners 3, 4, 5 on the wall, as a file may list
+// them): the macro prism then takes the top's corners 3, 5, 4 as its wall and stays positive.
+// One column of two prisms on the triangle (0,0,0) (1,0,0) (0,1,0), levels at 0.1 and 0.3, a
+// tetrahedron on top; the first prism listed upside down.
+TEST(LayerStacks, AStackOnAPrismsTopTriangleMakesAPositiveMacroPrism) {
+  Mesh mesh;
+  mesh.dim = 3;
+  for (const double z : {0.0, 0.1, 0.3})
+    for (const auto& [x, y] : std::vector<std::pair<double, double>>{{0, 0}, {1, 0}, {0, 1}})
+      mesh.xyz.insert(mesh.xyz.end(), {x, y, z});
+  mesh.xyz.insert(mesh.xyz.end(), {0.2, 0.2, 1.0});  // node 9: the tetrahedron's apex
+  const std::size_t n = mesh.xyz.size() / 3;
+  mesh.nodeCadDim.assign(n, 3);
+  mesh.nodeCadIndex.assign(n, 1);
+  mesh.nodeCadParam.assign(2 * n, std::nan(""));
+  // Positive both: (3, 5, 4, 0, 2, 1) has its top triangle (0, 2, 1) on the wall.
+  ElementBlock prisms{CellType::Prism, 1, {3, 5, 4, 0, 2, 1, 3, 4, 5, 6, 7, 8}, {1, 1}};
+  ElementBlock tets{CellType::Tetrahedron, 1, {6, 7, 8, 9}, {1}};
+  ElementBlock wall{CellType::Triangle, 1, {0, 2, 1}, {5}};
+  mesh.blocks = {prisms, tets, wall};
+  ASSERT_EQ(evaluateQuality(mesh, 1).invalid, 0U) << "the test's own cells must be positive";
+  std::string why;
+  const std::optional<LayerStacks> s = recogniseLayerStacks(mesh, why);
+  ASSERT_TRUE(s) << why;
+  EXPECT_EQ(s->record.stacks, 1U);
+  EXPECT_EQ(s->record.layers, 2);
+  EXPECT_EQ(s->record.walls, std::set<int>{5});
+  ASSERT_EQ(s->record.levels.size(), 3U);
+  EXPECT_NEAR(s->record.levels[1], 1.0 / 3.0, 1e-15);
+  EXPECT_EQ(s->macro.numNodes(), n - 3);  // the middle level's nodes go
+  const QualitySummary q = evaluateQuality(s->macro, 1);
+  EXPECT_EQ(q.invalid + q.undecided, 0U);
+  for (const ElementBlock& b : s->macro.blocks)
+    if (b.type == CellType::Prism)
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(nodePoint(s->macro, b.element(0)[k]).z(), 0.0, 0.0);
+        EXPECT_NEAR(nodePoint(s->macro, b.element(0)[k + 3]).z(), 0.3, 1e-15);
+      }
+
+  // Stacks of different heights are no layer the split can keep: a second column of one prism
+  // beside it is refused with the counts.
+  Mesh uneven = mesh;
+  for (const auto& [x, y] : std::vector<std::pair<double, double>>{{1, 1}})
+    for (const double z : {0.0, 0.1}) uneven.xyz.insert(uneven.xyz.end(), {x, y, z});
+  const std::size_t m = uneven.xyz.size() / 3;
+  uneven.nodeCadDim.assign(m, 3);
+  uneven.nodeCadIndex.assign(m, 1);
+  uneven.nodeCadParam.assign(2 * m, std::nan(""));
+  // Beside the first column: wall triangle (1,0,0) (1,1,0) (0,1,0), one prism up to 0.1.
+  uneven.blocks[0].nodes.insert(uneven.blocks[0].nodes.end(), {1, 10, 2, 4, 11, 5});
+  uneven.blocks[0].entity.push_back(1);
+  uneven.blocks[2].nodes.insert(uneven.blocks[2].nodes.end(), {1, 2, 10});
+  uneven.blocks[2].entity.push_back(5);
+  EXPECT_FALSE(recogniseLayerStacks(uneven, why));
+  EXPECT_NE(why.find("have 2 and 1 layers"), std::string::npos) << why;
+}
+
 }  // namespace
 }  // namespace homesh

@@ -216,7 +216,7 @@ TEST(GivenMesh, CellsThatCannotBeCurvedValidAreRefusedByName) {
   hexes.blocks.push_back(block);
   why = refusal<MeshingError>(hexes);
   EXPECT_NE(why.find("hex 14 of the given mesh"), std::string::npos) << why;
-  EXPECT_NE(why.find("is not valid as given"), std::string::npos) << why;
+  EXPECT_NE(why.find("is not valid straight-sided"), std::string::npos) << why;
 }
 
 }  // namespace
