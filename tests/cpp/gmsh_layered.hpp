@@ -91,6 +91,13 @@ void writeBoxLess(const std::string& step, double a, double z0, double z1,
   gmsh::write(step);
 }
 
+// A fresh Gmsh session, quiet, with an empty model.
+inline void startSession() {
+  gmsh::initialize(0, nullptr, false);
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::model::add("layered");
+}
+
 }  // namespace gmsh_layered
 
 inline void writeGmshLayeredSphere(const std::string& mesh, const std::string& step,
@@ -98,9 +105,7 @@ inline void writeGmshLayeredSphere(const std::string& mesh, const std::string& s
   inGmshChild([&] {
     namespace g = gmsh::model::geo;
     const double r = 0.5, a = 1.0;
-    gmsh::initialize(0, nullptr, false);
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::model::add("layered");
+    gmsh_layered::startSession();
     const gmsh_layered::Circle equator = gmsh_layered::circle(r, 0.0, s.size);
     const int c = equator.centre;
     const int north = g::addPoint(0, 0, r, s.size), south = g::addPoint(0, 0, -r, s.size);
@@ -139,9 +144,7 @@ inline void writeGmshLayeredCylinder(const std::string& mesh, const std::string&
   inGmshChild([&] {
     namespace g = gmsh::model::geo;
     const double r = 0.5, a = 1.0;
-    gmsh::initialize(0, nullptr, false);
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::model::add("layered");
+    gmsh_layered::startSession();
     const gmsh::vectorpair bottom = gmsh_layered::circle(r, 0.0, s.size).arcs;
     gmsh::vectorpair side, wall;
     g::extrude(bottom, 0, 0, 1, side);

@@ -96,22 +96,7 @@ class FemBothWays(unittest.TestCase):
         femmesh.FemMesh = Fem.read(inp)
         tets = femmesh.FemMesh.VolumeCount
         self.assertGreater(tets, 100)
-        obj = homesh.freecad.make_high_order_mesh(self.doc, self.cyl, order=4,
-                                                  fem_mesh=femmesh)
-        obj.OptimiserIterations = 20
-        self.doc.recompute()
-        self.assertTrue(obj.isValid(), obj.Status)
-        mesh = homesh.freecad.get_mesh(obj)
-        quality = mesh.quality()
-        self.assertEqual(mesh.num_elements, tets)
-        self.assertEqual(quality["invalid_elements"] + quality["undecided_elements"], 0)
-        # Every node on the lateral face at radius 1 (CAD evaluation rounding, as above).
-        lateral = [i + 1 for i, f in enumerate(self.cyl.Shape.Faces)
-                   if f.Surface.__class__.__name__ == "Cylinder"]
-        side = (mesh.node_cad_dim == 2) & np.isin(mesh.node_cad_index, lateral)
-        self.assertGreater(side.sum(), 100)
-        radius = np.hypot(mesh.nodes[side, 0], mesh.nodes[side, 1])
-        self.assertLess(np.abs(radius - 1.0).max(), 1e-12)
+        self.curve_at_order_four(femmesh, tets, optimise=20)
         shutil.rmtree(folder)
 
     def test_curve_a_fem_mesh_of_prisms(self):
@@ -139,13 +124,21 @@ class FemBothWays(unittest.TestCase):
         femmesh = self.doc.addObject("Fem::FemMeshObject", "Prisms")
         femmesh.FemMesh = fm
         self.assertEqual(fm.PrismCount, len(blocks[0].elements))
+        self.curve_at_order_four(femmesh, len(blocks[0].elements), optimise=0)
+        shutil.rmtree(folder)
+
+    def curve_at_order_four(self, femmesh, cells, optimise):
+        """A HighOrderMesh object curving `femmesh` on the cylinder at order 4: certified valid,
+        with the FEM mesh's `cells`, and every node on the lateral face at radius 1 (CAD
+        evaluation rounding, as above)."""
         obj = homesh.freecad.make_high_order_mesh(self.doc, self.cyl, order=4,
                                                   fem_mesh=femmesh)
+        obj.OptimiserIterations = optimise
         self.doc.recompute()
         self.assertTrue(obj.isValid(), obj.Status)
         mesh = homesh.freecad.get_mesh(obj)
         quality = mesh.quality()
-        self.assertEqual(mesh.num_elements, len(blocks[0].elements))
+        self.assertEqual(mesh.num_elements, cells)
         self.assertEqual(quality["invalid_elements"] + quality["undecided_elements"], 0)
         lateral = [i + 1 for i, f in enumerate(self.cyl.Shape.Faces)
                    if f.Surface.__class__.__name__ == "Cylinder"]
@@ -153,7 +146,6 @@ class FemBothWays(unittest.TestCase):
         self.assertGreater(side.sum(), 100)
         radius = np.hypot(mesh.nodes[side, 0], mesh.nodes[side, 1])
         self.assertLess(np.abs(radius - 1.0).max(), 1e-12)
-        shutil.rmtree(folder)
 
     def test_to_fem_mesh_has_the_counts_of_the_order_two_mesh(self):
         own = gmsh_fem_mesh(self.doc, self.cyl).FemMesh
