@@ -1,5 +1,6 @@
-"""`homesh curve`: another tool's linear mesh (Gmsh's, made here from the STEP: tetrahedra, and a
-cylinder of prisms also through Python's homesh.curve) curved on its CAD from the command line,
+"""`homesh curve`: another tool's linear mesh (Gmsh's, made here from the STEP: tetrahedra, a
+cylinder of prisms also through Python's homesh.curve, a cylinder of hexahedra; Netgen's
+tetrahedra) curved on its CAD from the command line,
 every boundary node on the CAD, certified valid; a mesh whose boundary node lies off the CAD is
 refused naming it, and nothing is written."""
 
@@ -182,3 +183,46 @@ def test_a_mesh_netgen_made_and_wrote_is_curved(homesh_bin, data, tmp_path):
     assert len(mesh.cells_dict["tetra35"]) == len(meshio.read(linear).cells_dict["tetra"])
     boundary = np.unique(mesh.cells_dict["triangle15"].ravel())
     assert distance_to_cad(mesh.points[boundary]).max() < 1e-9 * DIAGONAL
+
+
+HEX_CYLINDER_GEO = """Point(1) = {0, 0, 0, 0.4}; Point(2) = {1, 0, 0, 0.4}; Point(3) = {0, 1, 0, 0.4};
+Point(4) = {-1, 0, 0, 0.4}; Point(5) = {0, -1, 0, 0.4};
+Circle(1) = {2, 1, 3}; Circle(2) = {3, 1, 4}; Circle(3) = {4, 1, 5}; Circle(4) = {5, 1, 2};
+Curve Loop(1) = {1, 2, 3, 4};
+Plane Surface(1) = {1};
+Recombine Surface{1};
+Extrude {0, 0, 1} { Surface{1}; Layers{3}; Recombine; }
+"""
+CYLINDER_STEP_GEO = """SetFactory("OpenCASCADE");
+Cylinder(1) = {0, 0, 0, 0, 0, 1, 1};
+"""
+
+
+def test_hexahedra_on_a_cylinder_are_curved(homesh_bin, tmp_path):
+    """Gmsh's cylinder of hexahedra (its recombined disk extruded in 3 layers, in Gmsh's own
+    kernel; the CAD an OpenCASCADE cylinder of the same size): `homesh curve` makes it order 4,
+    certified valid, with every node of its boundary quadrilaterals on the cylinder or its end
+    planes (112 quadrilaterals: 32 on each end, 48 on the side)."""
+    gmsh = shutil.which("gmsh")
+    assert gmsh, "Debian's gmsh package is needed"
+    geo, step_geo = tmp_path / "hex.geo", tmp_path / "cyl.geo"
+    linear, step = tmp_path / "hex.msh", tmp_path / "cyl.step"
+    geo.write_text(HEX_CYLINDER_GEO)
+    step_geo.write_text(CYLINDER_STEP_GEO)
+    for args in ([geo, "-3", "-format", "msh41", "-o", linear], [step_geo, "-0", "-o", step]):
+        r = run([gmsh] + args)
+        assert r.returncode == 0, r.stdout + r.stderr
+    curved, report = tmp_path / "curved.msh", tmp_path / "report.json"
+    r = run([homesh_bin, "curve", linear, "--cad", step, "--order", "4", "--optimise", "-o",
+             curved, "--report", report])
+    assert r.returncode == 0, r.stderr
+    rep = json.loads(report.read_text())
+    assert rep["quality"]["invalid_elements"] == 0 and rep["quality"]["undecided_elements"] == 0
+    assert rep["elements"]["hex"] == len(meshio.read(linear).cells_dict["hexahedron"])
+    assert rep["boundary"]["quad"] == 112
+    mesh = meshio.read(curved)
+    quads = np.concatenate([c.data for c in mesh.cells if c.type == "quad25"])
+    boundary = np.unique(quads.ravel())
+    x, y, z = mesh.points[boundary].T
+    off = np.minimum(np.abs(np.hypot(x, y) - 1.0), np.minimum(np.abs(z), np.abs(z - 1.0)))
+    assert off.max() < 1e-9 * np.sqrt(4 + 4 + 1)
