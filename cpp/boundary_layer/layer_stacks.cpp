@@ -248,7 +248,7 @@ std::optional<LayerStacks> recogniseLayerStacks(const Mesh& mesh, std::string& w
   std::map<std::int64_t, std::vector<std::int64_t>> columns;
   for (const Stack& s : *stacks)
     for (const auto& c : s.columns)
-      if (!columns.emplace(c[0], c).first->second.empty() && columns.at(c[0]) != c) {
+      if (const auto [it, fresh] = columns.emplace(c[0], c); !fresh && it->second != c) {
         why = "wall node " + std::to_string(c[0] + 1) + " has two columns of prisms";
         return std::nullopt;
       }

@@ -199,13 +199,6 @@ gp_Pnt toGp(const Eigen::Vector3d& p) {
   return {p.x(), p.y(), p.z()};
 }
 
-std::string lowerExtension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
 // OCCT's STEP and IGES readers share process-wide state (the XSControl session, static
 // parameters): two threads reading at once corrupt each other. Reads are serialised.
 std::mutex& dataExchangeMutex() {

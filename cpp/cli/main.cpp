@@ -3,7 +3,6 @@
 #include <Message_Messenger.hxx>
 #include <Message_PrinterOStream.hxx>
 #include <algorithm>
-#include <cctype>
 #include <cstddef>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +13,7 @@
 
 #include "cli/arguments.hpp"
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 #include "core/version.hpp"
 #include "curving/order_elevation.hpp"
 #include "io/atomic_file.hpp"
@@ -344,9 +344,7 @@ int runCurve(const homesh::CurveCommand& cmd) {
         return b.type == homesh::CellType::Pyramid && b.count() > 0;
       });
   for (const std::string& path : c.outputs) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+    const std::string ext = homesh::lowerExtension(path);
     if (pyramids && ext == ".vtu" && options.order > 1)
       throw homesh::ParameterError(
           cmd.input + " holds pyramids, and VTU has no curved pyramid " +

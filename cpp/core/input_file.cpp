@@ -1,5 +1,7 @@
 #include "core/input_file.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -8,6 +10,13 @@
 #include "core/error.hpp"
 
 namespace homesh {
+
+std::string lowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
 
 void requireRegularFile(const std::string& path, const std::string& what) {
   namespace fs = std::filesystem;

@@ -14,9 +14,7 @@
 namespace homesh {
 
 Mesh readMesh(const std::string& path, std::vector<std::string>* notes) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lowerExtension(path);
   requireRegularFile(path, "mesh file");
   if (ext == ".msh") return readMsh(path);
   if (ext == ".xml") return readNektarXml(path);

@@ -8,22 +8,13 @@
 
 #include "cad/cad_model.hpp"
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 #include "io/atomic_file.hpp"
 #include "io/msh_writer.hpp"
 #include "io/nektar_writer.hpp"
 #include "io/vtu_writer.hpp"
 
 namespace homesh {
-namespace {
-
-std::string lowerExtension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
-}  // namespace
 
 void checkCellFields(const Mesh& mesh, const std::vector<CellField>& fields) {
   std::size_t cells = 0;

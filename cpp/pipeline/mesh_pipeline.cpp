@@ -18,7 +18,7 @@
 #include "pipeline/linear_stage.hpp"
 #include "pipeline/repair_rounds.hpp"
 #include "pipeline/stage_clock.hpp"
-#include "quality/bezier_jacobian.hpp"
+#include "quality/mesh_quality.hpp"
 
 namespace homesh {
 
@@ -274,32 +274,27 @@ void finishJob(MeshResult& result, JobBudget& budget, PipelineObserver* observer
   result.job.skipped = budget.skippedStages();
 }
 
-// The first straight-sided cell of `mesh` (tetrahedra aside: classifyOnCad made them positive
-// and not flat) proven invalid: its Jacobian vanishes or changes sign (a flat pyramid whose apex
-// lies in the mean plane of its twisted base, a hexahedron with a corner pushed inside it), so
-// no curving of it can be valid and the optimiser cannot measure it. Cells are oriented, so a
-// valid one has J > 0; an undecided one (J near zero somewhere, not proven negative) is left
-// to the certificate of the curved mesh. Empty when there is none; counts are 1-based per type.
-std::string firstInvalidCell(const Mesh& mesh, const char* what) {
-  for (const ElementBlock& block : mesh.blocks) {
-    if (cellDimension(block.type) != 3 || block.type == CellType::Tetrahedron) continue;
-    const int n = block.nodesPerElement();
-    for (std::size_t e = 0; e < block.count(); ++e) {
-      NodeCoordinates x(n, 3);
-      for (int i = 0; i < n; ++i)
-        x.row(i) = nodePoint(mesh, block.element(e)[i]).transpose() -
-                   nodePoint(mesh, block.element(e)[0]).transpose();
-      const JacobianBounds b = boundJacobian(block.type, block.order, x, nullptr);
-      if (b.validity != Validity::Invalid) continue;
-      const Eigen::Vector3d centre =
-          nodePoint(mesh, block.element(e)[0]) + x.colwise().mean().transpose();
-      std::ostringstream msg;
-      msg << cellShortName(block.type) << " " << e + 1 << " of " << what << " (centre ("
-          << centre.x() << ", " << centre.y() << ", " << centre.z()
-          << ")) is not valid straight-sided: its Jacobian ranges over [" << b.minLower << ", "
-          << b.maxUpper << "]";
-      return msg.str();
-    }
+// The first straight-sided cell of `mesh` proven invalid by its certified quality: its
+// Jacobian vanishes or changes sign (a flat pyramid whose apex lies in the mean plane of its
+// twisted base, a hexahedron with a corner pushed inside it), so no curving of it can be valid
+// and the optimiser cannot measure it. Cells are oriented (classifyOnCad), so a valid one has
+// J > 0; an undecided one (J near zero somewhere, not proven negative) is left to the
+// certificate of the curved mesh. Empty when there is none; counts are 1-based per block.
+std::string firstInvalidCell(const Mesh& mesh, const char* what, int threads) {
+  const QualitySummary quality = evaluateQuality(mesh, threads);
+  const auto elements = elementsOf(mesh);
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    if (quality.validity[e] != Validity::Invalid) continue;
+    const auto [block, i] = elements[e];
+    const int corners = cellNumVertices(block->type);
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (int k = 0; k < corners; ++k) centre += nodePoint(mesh, block->element(i)[k]);
+    centre /= corners;
+    std::ostringstream msg;
+    msg << cellShortName(block->type) << " " << i + 1 << " of " << what << " (centre ("
+        << centre.x() << ", " << centre.y() << ", " << centre.z()
+        << ")) is not valid straight-sided (scaled Jacobian " << quality.scaledJacobian[e] << ")";
+    return msg.str();
   }
   return {};
 }
@@ -307,11 +302,11 @@ std::string firstInvalidCell(const Mesh& mesh, const char* what) {
 // The given mesh's prism stacks agglomerated (layer_stacks.hpp) when their macro prisms are
 // valid straight-sided (columns that bend or converge at a concave corner may make one that is
 // not: the prisms are then curved as given, with a note saying why).
-std::optional<LayerStacks> agglomerateLayer(const Mesh& onCad, MeshResult& result) {
+std::optional<LayerStacks> agglomerateLayer(const Mesh& onCad, MeshResult& result, int threads) {
   std::string why;
   std::optional<LayerStacks> stacks = recogniseLayerStacks(onCad, why);
   if (stacks) {
-    why = firstInvalidCell(stacks->macro, "the macro layer");
+    why = firstInvalidCell(stacks->macro, "the macro layer", threads);
     if (why.empty()) return stacks;
   }
   if (!why.empty())
@@ -372,9 +367,10 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
   StageClock classify("classify", result.timings, observer);
   Mesh onCad = classifyOnCad(linear, *result.cad,
                              options.classifyTolerance * result.cad->boundingDiagonal());
-  if (const std::string invalid = firstInvalidCell(onCad, "the given mesh"); !invalid.empty())
+  if (const std::string invalid = firstInvalidCell(onCad, "the given mesh", options.threads);
+      !invalid.empty())
     throw MeshingError(invalid + ", so no curved cell made from it can be valid");
-  std::optional<LayerStacks> stacks = agglomerateLayer(onCad, result);
+  std::optional<LayerStacks> stacks = agglomerateLayer(onCad, result, options.threads);
   if (stacks) {
     onCad = std::move(stacks->macro);
     result.givenLayers = stacks->record;
