@@ -4,3 +4,4 @@ import FreeCAD
 
 FreeCAD.addExportType("HOMesh curved mesh (*.msh *.vtu)", "homesh.freecad.exporter")
 FreeCAD.addExportType("HOMesh curved mesh for Nektar++ (*.xml)", "homesh.freecad.exporter")
+FreeCAD.addExportType("HOMesh curved mesh, CGNS (*.cgns)", "homesh.freecad.exporter")

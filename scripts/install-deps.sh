@@ -3,13 +3,14 @@
 # when all are present). Needs root, or sudo. occt-misc is OpenCASCADE's sample data: the CAD
 # corpus benchmark and a repair-round test mesh its files. man-db: `man homesh`. python3-netgen:
 # a test curves a mesh Netgen itself made (Debian's FreeCAD has no FEM Netgen mesher).
+# cgns-convert: cgnscheck, the CGNS library's own checker, which tests run on written files.
 set -eu
 
 PACKAGES="
   g++ make cmake pkg-config
   freecad
   libocct-modeling-algorithms-dev libocct-data-exchange-dev libocct-foundation-dev libtbb-dev
-  libeigen3-dev libgmsh-dev gmsh zlib1g-dev
+  libeigen3-dev libgmsh-dev gmsh zlib1g-dev libcgns-dev cgns-convert
   libboost-python-dev libboost-numpy-dev python3-dev python3-numpy
   libgtest-dev python3-pytest python3-meshio python3-vtk9 python3-netgen
   xvfb xauth ccache man-db

@@ -458,11 +458,13 @@ std::string tableHelp(std::initializer_list<const char*> keys) {
 
 // The output options of the commands that write meshes.
 std::string outputHelp() {
-  return R"(  -o, --output FILE   write the mesh: .msh (Gmsh 4.1), .vtu (VTK), .xml (Nektar++); repeatable
+  return R"(  -o, --output FILE   write the mesh: .msh (Gmsh 4.1), .vtu (VTK), .xml (Nektar++),
+                      .cgns (CGNS, orders 1 to 4); repeatable
       --binary        binary MSH, raw appended VTU data
       --compressed    compressed Nektar++ XML (B64Z-LittleEndian)
       --group NAME=F1,F2  a named boundary group (faces; 2D: curves) written as one physical
-                      group (MSH) / composite (Nektar++ XML) called NAME; repeatable
+                      group (MSH) / composite (Nektar++ XML) / boundary condition (CGNS) called
+                      NAME; repeatable (convert and optimise keep a CGNS input's conditions)
 )";
 }
 
@@ -536,8 +538,8 @@ options:
 std::string qualityHelp() {
   return R"(usage: homesh quality INPUT [options]
 
-Prints the quality of a mesh (.msh 2.2 or 4.1, ASCII or binary; .xml Nektar++; FreeCAD FEM's
-.unv, .vtk and .vtu, linear or quadratic): per element type, the certified scaled Jacobian
+Prints the quality of a mesh (.msh 2.2 or 4.1, ASCII or binary; .xml Nektar++; .cgns; FreeCAD
+FEM's .unv, .vtk and .vtu, linear or quadratic): per element type, the certified scaled Jacobian
 (Bezier bounds, as Gmsh's AnalyseMeshQuality) and the distortion against the straight-sided
 elements, worst, mean and histogram, and the number of invalid elements.
 
@@ -550,8 +552,8 @@ options:
 std::string convertHelp() {
   return R"(usage: homesh convert INPUT -o OUTPUT [options]
 
-Converts a mesh between Gmsh MSH (2.2/4.1 in, 4.1 out), VTU, Nektar++ XML, and from UNV and
-legacy VTK, with the quality fields.
+Converts a mesh between Gmsh MSH (2.2/4.1 in, 4.1 out), VTU, Nektar++ XML, CGNS, and from UNV
+and legacy VTK, with the quality fields.
 
 options:
 )" + outputHelp() +
@@ -561,11 +563,11 @@ options:
 std::string optimiseHelp() {
   return R"(usage: homesh optimise INPUT [-o OUTPUT] [options]
 
-Curves the interior of a high-order mesh (.msh 2.2 or 4.1, .xml Nektar++, .unv, .vtk, .vtu) by
-minimising a variational energy node by node (Newton steps, parallel by node colours). Nodes on
-the boundary, on interfaces between volumes and on the file's boundary cells stay fixed. Prints
-the worst certified scaled Jacobian and the invalid count after every sweep; the mesh returned
-is never worse than the input in either.
+Curves the interior of a high-order mesh (.msh 2.2 or 4.1, .xml Nektar++, .cgns, .unv, .vtk,
+.vtu) by minimising a variational energy node by node (Newton steps, parallel by node colours).
+Nodes on the boundary, on interfaces between volumes and on the file's boundary cells stay
+fixed. Prints the worst certified scaled Jacobian and the invalid count after every sweep; the
+mesh returned is never worse than the input in either.
 
 options (the parameter table's, which Python's HighOrderMesh.optimise reads too):
 )" + tableHelp(kOptimiseKeys) +
@@ -581,8 +583,8 @@ std::string curveHelp() {
   return R"(usage: homesh curve INPUT --cad CAD [-o OUTPUT] [options]
 
 Curves a linear volume mesh made by another tool (tetrahedra, prisms, pyramids, hexahedra from
-Gmsh, Netgen, FreeCAD FEM, an industrial mesher; .msh, .unv, .vtk, .vtu, .xml) on the CAD it was
-made from (.step .stp .iges .igs .brep .brp, one solid): each boundary node is put on the CAD
+Gmsh, Netgen, FreeCAD FEM, an industrial mesher; .msh, .unv, .vtk, .vtu, .xml, .cgns) on the CAD
+it was made from (.step .stp .iges .igs .brep .brp, one solid): each boundary node is put on the CAD
 vertex, edge or face it lies on (within --classify-tolerance of the CAD's bounding diagonal; a
 node that lies on none is an error naming it, its position and its distance to the nearest face,
 and nothing is written; so is a cell that cannot be curved valid), prisms stacked on the wall (a

@@ -93,12 +93,32 @@ void checkOutputs(const homesh::CommonOptions& c, const std::vector<std::string>
   }
 }
 
-homesh::WriteOptions writeOptions(const homesh::CommonOptions& c) {
+// `read`: the groups the input mesh file named (CGNS boundary conditions), kept unless the
+// command line names its own.
+homesh::WriteOptions writeOptions(const homesh::CommonOptions& c,
+                                  const std::vector<homesh::NamedGroup>& read = {}) {
   homesh::WriteOptions w;
   w.binary = c.binary;
   w.compressed = c.compressed;
   for (const auto& [name, entities] : c.groups) w.groups.push_back({name, entities});
+  if (c.groups.empty()) w.groups = read;
   return w;
+}
+
+// CGNS names elements up to order 4 and names of at most 32 characters: refused before the
+// work, not after it.
+void checkCgnsOrder(const homesh::CommonOptions& c, int order) {
+  for (const std::string& path : c.outputs) {
+    if (homesh::lowerExtension(path) != ".cgns") continue;
+    if (order > 4)
+      throw homesh::ParameterError("cannot write " + path + ": CGNS names elements up to order " +
+                                   "4, not order " + std::to_string(order) +
+                                   " (write .msh, .vtu or .xml)");
+    for (const auto& group : c.groups)
+      if (group.first.size() > 32)
+        throw homesh::ParameterError("boundary group '" + group.first +
+                                     "': CGNS names are at most 32 characters");
+  }
 }
 
 // The case from INPUT (CAD file or .mcf) with the command line's options over it: the table's
@@ -177,6 +197,7 @@ int runMesh(const homesh::MeshCommand& cmd) {
     if (cmd.blProgression) bl.progression = *cmd.blProgression;
     options.boundaryLayer = bl;  // checked with the other options by the pipeline
   }
+  checkCgnsOrder(c, options.order);
   StderrProgress progress;
   homesh::PipelineObserver* observer = c.quiet ? nullptr : &progress;
   homesh::MeshResult result = homesh::runMeshPipeline(setup.source, options, observer);
@@ -236,8 +257,9 @@ void printQuality(std::FILE* out, const std::string& input, const homesh::Mesh& 
 }
 
 // Reads a mesh file, printing on stderr (unless quiet) what reading changed.
-homesh::Mesh readMeshFile(const std::string& path, bool quiet, std::vector<std::string>& notes) {
-  homesh::Mesh mesh = homesh::readMesh(path, &notes);
+homesh::Mesh readMeshFile(const std::string& path, bool quiet, std::vector<std::string>& notes,
+                          std::vector<homesh::NamedGroup>* groups = nullptr) {
+  homesh::Mesh mesh = homesh::readMesh(path, &notes, groups);
   if (!quiet)
     for (const std::string& note : notes) std::fprintf(stderr, "homesh: note: %s\n", note.c_str());
   return mesh;
@@ -259,10 +281,12 @@ int runQuality(const homesh::QualityCommand& cmd) {
 int runConvert(const homesh::ConvertCommand& cmd) {
   checkOutputs(cmd.common, {cmd.input});
   std::vector<std::string> notes;
-  const homesh::Mesh mesh = readMeshFile(cmd.input, cmd.common.quiet, notes);
+  std::vector<homesh::NamedGroup> groups;
+  const homesh::Mesh mesh = readMeshFile(cmd.input, cmd.common.quiet, notes, &groups);
+  checkCgnsOrder(cmd.common, mesh.order);
   const homesh::QualitySummary q = homesh::evaluateQuality(mesh, cmd.common.threads);
   for (const std::string& path : cmd.common.outputs) {
-    homesh::writeMesh(mesh, path, homesh::qualityFields(q), writeOptions(cmd.common));
+    homesh::writeMesh(mesh, path, homesh::qualityFields(q), writeOptions(cmd.common, groups));
     if (!cmd.common.quiet) std::fprintf(stderr, "homesh: wrote %s\n", path.c_str());
   }
   checkNektarOutputs(cmd.common.outputs, cmd.common.threads, cmd.common.quiet);
@@ -289,7 +313,9 @@ int runOptimise(const homesh::OptimiseCommand& cmd) {
   homesh::OptimiserOptions options;
   options.apply(values);
   std::vector<std::string> notes;
-  homesh::Mesh mesh = readMeshFile(cmd.input, c.quiet, notes);
+  std::vector<homesh::NamedGroup> groups;
+  homesh::Mesh mesh = readMeshFile(cmd.input, c.quiet, notes, &groups);
+  checkCgnsOrder(c, cmd.order.value_or(mesh.order));
   if (cmd.order && *cmd.order != mesh.order) mesh = homesh::changeOrder(mesh, *cmd.order, nullptr);
   SweepLog log;
   const homesh::OptimiserResult r = homesh::optimiseMesh(mesh, options, c.quiet ? nullptr : &log);
@@ -313,7 +339,7 @@ int runOptimise(const homesh::OptimiseCommand& cmd) {
                    r.keptIteration);
   }
   for (const std::string& path : c.outputs) {
-    homesh::writeMesh(mesh, path, homesh::qualityFields(q), writeOptions(c));
+    homesh::writeMesh(mesh, path, homesh::qualityFields(q), writeOptions(c, groups));
     if (!c.quiet) std::fprintf(stderr, "homesh: wrote %s\n", path.c_str());
   }
   if (c.report) writeReport(*c.report, homesh::optimiseReportJson(mesh, q, r, cmd.input, notes));
@@ -338,6 +364,7 @@ int runCurve(const homesh::CurveCommand& cmd) {
                    cmd.input.c_str(), linear.order);
     linear = homesh::changeOrder(linear, 1, nullptr);
   }
+  checkCgnsOrder(c, options.order);
   // (Before the work, not after it: VTK 9.1 has no Lagrange pyramid; io/nektar_writer.hpp.)
   const bool pyramids =
       std::any_of(linear.blocks.begin(), linear.blocks.end(), [](const homesh::ElementBlock& b) {

@@ -261,6 +261,97 @@ void vtkWedge(Nodes& out, const std::vector<P3>& v, int n) {
       for (int i = 1; i + j < n; ++i) out.push_back({i, j, k});
 }
 
+// CGNS's interior of a quadrilateral face (SIDS, "Unstructured Grid Element Numbering
+// Conventions", QUAD_16 / QUAD_25 and the faces of HEXA_64 / HEXA_125, PENTA_75, PYRA_55): the
+// (n-1) x (n-1) interior nodes walked ring by ring from the one next to corner a, towards b,
+// then c and d, each ring's corners and side nodes in turn, then the ring inside it.
+void cgnsRing(Nodes& out, const P3& a, const P3& b, const P3& c, const P3& d, int m) {
+  if (m == 0) {
+    out.push_back(a);
+    return;
+  }
+  const P3* ring[4] = {&a, &b, &c, &d};
+  for (int s = 0; s < 4; ++s) {
+    out.push_back(*ring[s]);
+    edge(out, *ring[s], *ring[(s + 1) % 4], m);
+  }
+  if (m >= 2)
+    cgnsRing(out, inward(a, {b, d}, m), inward(b, {a, c}, m), inward(c, {b, d}, m),
+             inward(d, {a, c}, m), m - 2);
+}
+
+void cgnsQuadrilateralInterior(Nodes& out, const P3& a, const P3& b, const P3& c, const P3& d,
+                               int n) {
+  if (n >= 2)
+    cgnsRing(out, inward(a, {b, d}, n), inward(b, {a, c}, n), inward(c, {b, d}, n),
+             inward(d, {a, c}, n), n - 2);
+}
+
+P3 lifted(P3 p, int k) {
+  p[2] += k;
+  return p;
+}
+
+// CGNS (orders 1 to 4; SIDS figures TRI_15, QUAD_25, TETRA_35, PYRA_55, PENTA_75, HEXA_125 and
+// their tables): vertices, edges, faces' interiors (triangles as Gmsh's recursion, which for the
+// one or three nodes of orders 3 and 4 is the SIDS's order from the face's first corner;
+// quadrilaterals by cgnsRing), then the cell's interior level by level from the base (prisms,
+// pyramids, hexahedra) or the tetrahedron's centroid.
+void cgnsCell(Nodes& out, CellType type, const std::vector<P3>& v, int n) {
+  corners(out, v);
+  switch (type) {
+    case CellType::Tetrahedron:
+      edges(out, v, {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}}, n);
+      for (const auto& f : Faces{{0, 1, 2}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}})
+        triangleInterior(out, v[f[0]], v[f[1]], v[f[2]], n);
+      if (n == 4) out.push_back({1, 1, 1});
+      break;
+    case CellType::Prism:
+      edges(out, v, {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 4}, {2, 5}, {3, 4}, {4, 5}, {5, 3}}, n);
+      triangleInterior(out, v[0], v[1], v[2], n);
+      for (const auto& f : Faces{{0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}})
+        cgnsQuadrilateralInterior(out, v[f[0]], v[f[1]], v[f[2]], v[f[3]], n);
+      triangleInterior(out, v[3], v[4], v[5], n);
+      for (int k = 1; k < n; ++k)
+        triangleInterior(out, lifted(v[0], k), lifted(v[1], k), lifted(v[2], k), n);
+      break;
+    case CellType::Pyramid:
+      edges(out, v, {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 4}, {1, 4}, {2, 4}, {3, 4}}, n);
+      cgnsQuadrilateralInterior(out, v[0], v[1], v[2], v[3], n);
+      for (const auto& f : Faces{{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}})
+        triangleInterior(out, v[f[0]], v[f[1]], v[f[2]], n);
+      for (int k = 1; k + 2 <= n; ++k) {  // level k: the square of side n - k
+        const int s = n - k;
+        cgnsQuadrilateralInterior(out, {0, 0, k}, {s, 0, k}, {s, s, k}, {0, s, k}, s);
+      }
+      break;
+    case CellType::Hexahedron:
+      edges(out, v,
+            {{0, 1},
+             {1, 2},
+             {2, 3},
+             {3, 0},
+             {0, 4},
+             {1, 5},
+             {2, 6},
+             {3, 7},
+             {4, 5},
+             {5, 6},
+             {6, 7},
+             {7, 4}},
+            n);
+      for (const auto& f : Faces{
+               {0, 1, 2, 3}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}, {4, 5, 6, 7}})
+        cgnsQuadrilateralInterior(out, v[f[0]], v[f[1]], v[f[2]], v[f[3]], n);
+      for (int k = 1; k < n; ++k)
+        cgnsQuadrilateralInterior(out, lifted(v[0], k), lifted(v[1], k), lifted(v[2], k),
+                                  lifted(v[3], k), n);
+      break;
+    default:
+      throw ParameterError("no CGNS node ordering for " + cellShortName(type));
+  }
+}
+
 }  // namespace
 
 std::vector<LatticePoint> latticeOrder(CellType type, int order, NodeConvention convention) {
@@ -268,6 +359,19 @@ std::vector<LatticePoint> latticeOrder(CellType type, int order, NodeConvention 
   const int n = order;
   const bool gmsh = convention == NodeConvention::Gmsh;
   Nodes out;
+  if (convention == NodeConvention::Cgns) {
+    if (order > 4)
+      throw ParameterError("CGNS names elements up to order 4, not order " + std::to_string(order));
+    if (type == CellType::Line || type == CellType::Triangle)
+      return latticeOrder(type, order, NodeConvention::Gmsh);  // the same numbering
+    if (type == CellType::Quadrilateral) {
+      const std::vector<P3> v{{0, 0, 0}, {n, 0, 0}, {n, n, 0}, {0, n, 0}};
+      corners(out, v);
+      edges(out, v, {{0, 1}, {1, 2}, {2, 3}, {3, 0}}, n);
+      cgnsQuadrilateralInterior(out, v[0], v[1], v[2], v[3], n);
+      return out;
+    }
+  }
   switch (type) {
     case CellType::Line:
       out = {{0, 0, 0}, {n, 0, 0}};
@@ -283,12 +387,17 @@ std::vector<LatticePoint> latticeOrder(CellType type, int order, NodeConvention 
         vtkQuadrilateral(out, n);
       break;
     case CellType::Tetrahedron:
-      tetrahedron(out, {{0, 0, 0}, {n, 0, 0}, {0, n, 0}, {0, 0, n}}, n, convention);
+      if (convention == NodeConvention::Cgns)
+        cgnsCell(out, type, {{0, 0, 0}, {n, 0, 0}, {0, n, 0}, {0, 0, n}}, n);
+      else
+        tetrahedron(out, {{0, 0, 0}, {n, 0, 0}, {0, n, 0}, {0, 0, n}}, n, convention);
       break;
     case CellType::Prism: {
       const std::vector<P3> v{{0, 0, 0}, {n, 0, 0}, {0, n, 0}, {0, 0, n}, {n, 0, n}, {0, n, n}};
       if (gmsh)
         gmshPrism(out, v, n);
+      else if (convention == NodeConvention::Cgns)
+        cgnsCell(out, type, v, n);
       else
         vtkWedge(out, v, n);
       break;
@@ -298,13 +407,19 @@ std::vector<LatticePoint> latticeOrder(CellType type, int order, NodeConvention 
                               {0, 0, n}, {n, 0, n}, {n, n, n}, {0, n, n}};
       if (gmsh)
         gmshHexahedron(out, v, n);
+      else if (convention == NodeConvention::Cgns)
+        cgnsCell(out, type, v, n);
       else
         vtkHexahedron(out, v, n);
       break;
     }
     case CellType::Pyramid:
-      if (!gmsh) throw ParameterError("no VTK node ordering for a pyramid");
-      gmshPyramid(out, {{0, 0, 0}, {n, 0, 0}, {n, n, 0}, {0, n, 0}, {0, 0, n}}, n);
+      if (convention == NodeConvention::Vtk)
+        throw ParameterError("no VTK node ordering for a pyramid");
+      if (gmsh)
+        gmshPyramid(out, {{0, 0, 0}, {n, 0, 0}, {n, n, 0}, {0, n, 0}, {0, 0, n}}, n);
+      else
+        cgnsCell(out, type, {{0, 0, 0}, {n, 0, 0}, {n, n, 0}, {0, n, 0}, {0, 0, n}}, n);
       break;
     default:
       throw ParameterError("no node ordering for " + cellShortName(type));

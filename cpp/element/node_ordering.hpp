@@ -1,5 +1,5 @@
 // Node orderings of complete Lagrange elements (line, triangle, quadrilateral, tetrahedron,
-// prism, hexahedron in Gmsh's and VTK's conventions; pyramid in Gmsh's).
+// prism, hexahedron in Gmsh's, VTK's and CGNS's conventions; pyramid in Gmsh's and CGNS's).
 //
 // A node of an order-P element is named by its integer lattice point c = (i, j, k): its
 // equispaced reference position is c / P (unused coordinates are 0). Vertices are at the
@@ -16,9 +16,13 @@
 // vertices in Gmsh's face order) and the cell interior (recursively; for prisms, triangle
 // interior by line interior). VTK uses the same recursion for triangles and tetrahedra with
 // other edge/face lists, and row-major (i fastest) interiors for quadrilaterals, hexahedra and
-// wedges. The C++ tests check the Gmsh order against Gmsh's getElementProperties; the Python
-// tests (tests/python/test_vtk_reading.py) check the VTK order by letting VTK interpolate our
-// VTU cells.
+// wedges. CGNS (orders 1 to 4) lists vertices, edges and face interiors in the SIDS's order, a
+// quadrilateral face's interior ring by ring from the node next to its first corner, and the
+// interiors of prisms, pyramids and hexahedra level by level from the base (io/cgns_elements.hpp).
+// The C++ tests check the Gmsh order against Gmsh's getElementProperties and the CGNS order
+// against the SIDS's figures; the Python tests (tests/python/test_vtk_reading.py,
+// test_cgns_files.py) check the VTK order by letting VTK interpolate our VTU cells, and the CGNS
+// order against VTK's CGNS reader.
 #pragma once
 
 #include <array>
@@ -28,7 +32,8 @@
 
 namespace homesh {
 
-enum class NodeConvention { Gmsh, Vtk };
+// Cgns: the SIDS's numbering (orders 1 to 4 only, the orders CGNS names).
+enum class NodeConvention { Gmsh, Vtk, Cgns };
 
 using LatticePoint = std::array<int, 3>;
 

@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/input_file.hpp"
 #include "io/atomic_file.hpp"
+#include "io/cgns_writer.hpp"
 #include "io/msh_writer.hpp"
 #include "io/nektar_writer.hpp"
 #include "io/vtu_writer.hpp"
@@ -27,9 +28,9 @@ void checkCellFields(const Mesh& mesh, const std::vector<CellField>& fields) {
 
 void checkMeshOutputPath(const std::string& path) {
   const std::string ext = lowerExtension(path);
-  if (ext != ".msh" && ext != ".vtu" && ext != ".xml")
+  if (ext != ".msh" && ext != ".vtu" && ext != ".xml" && ext != ".cgns")
     throw IoError("cannot write '" + path + "': unknown mesh format '" + ext +
-                  "' (use .msh, .vtu or .xml)");
+                  "' (use .msh, .vtu, .xml or .cgns)");
   checkParentFolder(path);
 }
 
@@ -67,6 +68,7 @@ void writeMesh(const Mesh& mesh, const std::string& path, const std::vector<Cell
   const std::string ext = lowerExtension(path);
   if (ext == ".msh") return writeMsh41(mesh, path, fields, options.binary, options.groups);
   if (ext == ".vtu") return writeVtu(mesh, path, fields, options.binary);
+  if (ext == ".cgns") return writeCgns(mesh, path, options.groups);
   return writeNektarXml(mesh, path, options.compressed, options.groups);
 }
 

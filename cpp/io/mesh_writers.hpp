@@ -4,6 +4,7 @@
 // - VTU, VTK's XML unstructured grid with Lagrange cells (vtu_writer.hpp), base64 inline or raw
 //   appended binary.
 // - Nektar++ XML (nektar_writer.hpp), plain or compressed (B64Z-LittleEndian).
+// - CGNS (cgns_writer.hpp), HDF5, orders 1 to 4.
 // Files are written to a temporary name and renamed, so a failed write never leaves a truncated
 // file behind.
 #pragma once
@@ -13,6 +14,7 @@
 
 #include "core/mesh.hpp"
 #include "io/gmsh_element_types.hpp"
+#include "io/named_group.hpp"
 
 namespace homesh {
 
@@ -22,14 +24,6 @@ namespace homesh {
 struct CellField {
   std::string name;
   std::vector<double> values;
-};
-
-// A named boundary group (wall, inlet, farfield ...): CAD entities of dimension mesh.dim - 1
-// (faces in 3D, curves in 2D) written as one physical group (MSH) or composite (Nektar++)
-// called `name`, instead of one per entity ("FaceN"). VTU holds the elements only: no groups.
-struct NamedGroup {
-  std::string name;
-  std::vector<int> entities;  // 1-based, FreeCAD's FaceN / EdgeN
 };
 
 struct WriteOptions {

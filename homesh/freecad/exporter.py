@@ -1,6 +1,6 @@
-"""File > Export of HighOrderMesh objects (registered in Init.py): .msh (Gmsh), .vtu (ParaView)
-and .xml (Nektar++), with the mesh's BoundaryGroup children as named physical groups /
-composites."""
+"""File > Export of HighOrderMesh objects (registered in Init.py): .msh (Gmsh), .vtu (ParaView),
+.xml (Nektar++) and .cgns (CGNS, orders 1 to 4), with the mesh's BoundaryGroup children as named
+physical groups / composites / boundary conditions."""
 
 import FreeCAD
 

@@ -4,6 +4,7 @@ of it survives save, close and reopen with nodes and connectivity bit-identical.
 
 import os
 import re
+import subprocess
 import tempfile
 import unittest
 
@@ -91,6 +92,15 @@ class RegionsAndGroups(unittest.TestCase):
             for name in ("wall", "farfield"):
                 self.assertRegex(text, r'"%s"' % name, ext)
             self.assertIsNone(re.search(r'"Face\d+"', text), ext)
+        # CGNS: one boundary condition per group, none per face (cgnslist: the CGNS library's
+        # own listing of the file's nodes).
+        path = os.path.join(self.folder, "out.cgns")
+        exporter.export([mesh], path)
+        listing = subprocess.run(["cgnslist", path], capture_output=True, text=True,
+                                 timeout=600).stdout
+        for name in ("wall", "farfield"):
+            self.assertRegex(listing, r"\+-%s\n" % name)
+        self.assertIsNone(re.search(r"\+-Face\d+\n", listing), listing)
         # Two groups of one name cannot be exported: nothing is written.
         homesh.freecad.make_boundary_group(self.doc, mesh, [(self.part, [faces[0]])], "wall")
         path = os.path.join(self.folder, "twice.msh")

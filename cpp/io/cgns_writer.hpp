@@ -1,0 +1,24 @@
+// CGNS writer (SIDS-conforming HDF5 file through Debian's CGNS library).
+//
+// One base ("HOMesh", cell dimension mesh.dim, physical dimension 3), one unstructured zone:
+// the nodes as CoordinateX/Y/Z (double), then the cells in block order, elements first, each
+// block's cells in sections of one CAD entity each ("Solid1_TETRA_35", "Face3_TRI_15"), so that
+// a reader rebuilds every cell's entity; then one boundary condition per named group and one per
+// other boundary entity ("Face7"), listing its cells (PointList at FaceCenter in 3D, EdgeCenter
+// in 2D; type BCTypeUserDefined: HOMesh knows the surfaces, not the physics). Node order:
+// io/cgns_elements.hpp. The file is written under a temporary name and renamed.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/mesh.hpp"
+#include "io/named_group.hpp"
+
+namespace homesh {
+
+// Throws ParameterError for order > 4 (CGNS has no such element) and IoError when the library
+// fails (naming the file and the library's message) or the mesh exceeds its 32-bit indices.
+void writeCgns(const Mesh& mesh, const std::string& path, const std::vector<NamedGroup>& groups);
+
+}  // namespace homesh
