@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -75,7 +76,13 @@ void writeCgns(const Mesh& mesh, const std::string& path, const std::vector<Name
   CgnsOutput out(path);
   const int fn = out.fn();
   int base = 0, zone = 0;
-  out.check(cg_base_write(fn, "HOMesh", mesh.dim, 3, &base), "base");
+  // A 2D mesh in the plane z = 0 is written in 2D physical space (X, Y), as CGNS's checker asks
+  // (a coordinate of range 0 is a warning); other 2D meshes, and surfaces, keep Z.
+  bool planeZ0 = mesh.dim == 2;
+  for (std::size_t i = 0; i < mesh.numNodes() && planeZ0; ++i)
+    planeZ0 = mesh.xyz[3 * i + 2] == 0.0 && !std::signbit(mesh.xyz[3 * i + 2]);
+  const int physical = planeZ0 ? 2 : 3;
+  out.check(cg_base_write(fn, "HOMesh", mesh.dim, physical, &base), "base");
   // The model's units are the CAD's, which the mesh does not record.
   out.check(cg_goto(fn, base, "end"), "base");
   out.check(cg_dataclass_write(CGNS_ENUMV(NormalizedByUnknownDimensional)), "data class");
@@ -83,7 +90,7 @@ void writeCgns(const Mesh& mesh, const std::string& path, const std::vector<Name
   out.check(cg_zone_write(fn, base, "Mesh", size, CGNS_ENUMV(Unstructured), &zone), "zone");
   const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
   std::vector<double> coordinate(mesh.numNodes());
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < physical; ++k) {
     for (std::size_t i = 0; i < mesh.numNodes(); ++i) coordinate[i] = mesh.xyz[3 * i + k];
     int c = 0;
     out.check(

@@ -1,6 +1,6 @@
 """`homesh curve`: another tool's linear mesh (Gmsh's, made here from the STEP: tetrahedra, a
 cylinder of prisms also through Python's homesh.curve, a cylinder of hexahedra; Netgen's
-tetrahedra) curved on its CAD from the command line,
+tetrahedra; CGNS files the CGNS library's converter wrote) curved on its CAD from the command line,
 every boundary node on the CAD, certified valid; a mesh whose boundary node lies off the CAD is
 refused naming it, and nothing is written."""
 
@@ -226,3 +226,79 @@ def test_hexahedra_on_a_cylinder_are_curved(homesh_bin, tmp_path):
     x, y, z = mesh.points[boundary].T
     off = np.minimum(np.abs(np.hypot(x, y) - 1.0), np.minimum(np.abs(z), np.abs(z - 1.0)))
     assert off.max() < 1e-9 * np.sqrt(4 + 4 + 1)
+
+
+def write_ugrid(path, mesh):
+    """A meshio mesh (Gmsh's linear cells) as an ASCII AFLR3 UGRID file: boundary triangles and
+    quadrilaterals with Gmsh's surface tags as surface IDs, then the volume cells. (UGRID lists a
+    pyramid's nodes as base 1, base 4, apex, base 2, base 3; the CGNS library's aflr3_to_cgns
+    turns them back.)"""
+    cells = {c.type: [] for c in mesh.cells}
+    tags = {c.type: [] for c in mesh.cells}
+    for block, tag in zip(mesh.cells, mesh.cell_data["gmsh:geometrical"]):
+        cells[block.type].append(block.data)
+        tags[block.type].append(tag)
+    get = {t: np.concatenate(cells[t]) for t in cells}
+    tri, quad = get.get("triangle", np.zeros((0, 3), int)), get.get("quad", np.zeros((0, 4), int))
+    tet, pyr = get.get("tetra", np.zeros((0, 4), int)), get.get("pyramid", np.zeros((0, 5), int))
+    prism = get.get("wedge", np.zeros((0, 6), int))
+    hexa = get.get("hexahedron", np.zeros((0, 8), int))
+    surface = np.concatenate([np.concatenate(tags[t]) for t in ("triangle", "quad") if t in tags])
+    lines = ["%d %d %d %d %d %d %d" % (len(mesh.points), len(tri), len(quad), len(tet), len(pyr),
+                                       len(prism), len(hexa))]
+    lines += ["%.17g %.17g %.17g" % tuple(p) for p in mesh.points]
+    for block in (tri, quad):
+        lines += [" ".join(str(i + 1) for i in c) for c in block]
+    lines += [str(s) for s in surface]
+    for block in (tet, pyr[:, [0, 3, 4, 1, 2]], prism, hexa):
+        lines += [" ".join(str(i + 1) for i in c) for c in block]
+    path.write_text("\n".join(lines) + "\n")
+
+
+@pytest.mark.parametrize("geo, kind", [(CYLINDER_GEO, "wedge"), (HEX_CYLINDER_GEO, "hexahedron")],
+                         ids=["prisms", "hexahedra"])
+def test_a_cgns_file_another_tool_wrote_is_curved(homesh_bin, tmp_path, geo, kind):
+    """Gmsh's cylinders of prisms and of hexahedra, turned into CGNS by the CGNS library's own
+    converter (aflr3_to_cgns, Debian's cgns-convert: a section and a boundary condition per
+    surface, named as it names them), read and curved by `homesh curve` at order 3: certified
+    valid, every boundary node on the cylinder or its end planes, the converter's conditions
+    carried over as named groups."""
+    gmsh = shutil.which("gmsh")
+    assert gmsh, "Debian's gmsh package is needed"
+    (tmp_path / "m.geo").write_text(geo)
+    (tmp_path / "step.geo").write_text(CYLINDER_STEP_GEO)
+    linear, step = tmp_path / "m.msh", tmp_path / "cyl.step"
+    for args in ([tmp_path / "m.geo", "-3", "-format", "msh41", "-o", linear],
+                 [tmp_path / "step.geo", "-0", "-o", step]):
+        r = run([gmsh] + args)
+        assert r.returncode == 0, r.stdout + r.stderr
+    before = meshio.read(linear)
+    ugrid, cgns = tmp_path / "m.ugrid", tmp_path / "m.cgns"
+    write_ugrid(ugrid, before)
+    r = run(["aflr3_to_cgns", "-f", ugrid, cgns])
+    assert r.returncode == 0 and cgns.is_file(), r.stdout + r.stderr
+    curved, report = tmp_path / "curved.msh", tmp_path / "report.json"
+    r = run([homesh_bin, "curve", cgns, "--cad", step, "--order", "3", "-o", curved, "--report",
+             report])
+    assert r.returncode == 0, r.stderr
+    rep = json.loads(report.read_text())
+    assert rep["quality"]["invalid_elements"] == 0 and rep["quality"]["undecided_elements"] == 0
+    mesh = meshio.read(curved)
+    order3 = {"wedge": "wedge40", "hexahedron": "hexahedron64"}[kind]
+    assert len(mesh.cells_dict[order3]) == len(before.cells_dict[kind])
+    boundary = np.unique(np.concatenate([c.data.ravel() for c in mesh.cells
+                                         if c.type in ("triangle10", "quad16")]))
+    x, y, z = mesh.points[boundary].T
+    off = np.minimum(np.abs(np.hypot(x, y) - 1.0), np.minimum(np.abs(z), np.abs(z - 1.0)))
+    assert off.max() < 1e-9 * np.sqrt(4 + 4 + 1)
+
+    # `convert` keeps the converter's conditions ("UserDefined 1", ...) as the groups of the MSH.
+    msh = tmp_path / "converted.msh"
+    r = run([homesh_bin, "convert", cgns, "-o", msh])
+    assert r.returncode == 0, r.stderr
+    names = set(meshio.read(msh).field_data)
+    surfaces = np.unique(np.concatenate([t for c, t in zip(
+        before.cells, before.cell_data["gmsh:geometrical"]) if c.type in ("triangle", "quad")]))
+    # (The converter numbers its conditions 1, 2, ... in the order of the surface IDs.)
+    assert {n for n in names if n.startswith("UserDefined ")} == \
+        {"UserDefined %d" % (k + 1) for k in range(len(surfaces))}, names

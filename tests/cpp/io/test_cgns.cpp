@@ -3,6 +3,8 @@
 // other tools write (several zones, MIXED sections, conditions on nodes) and refuses.
 #include <cgnslib.h>
 #include <gtest/gtest.h>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <gp_Pln.hxx>
 
 #include <cmath>
 #include <filesystem>
@@ -197,6 +199,26 @@ TEST(CgnsWriter, CurvedMeshRoundTripsBitForBitWithEntitiesAndGroups) {
     EXPECT_EQ(groups[1].name, "hole wall");
     EXPECT_EQ(groups[1].entities, std::vector<int>{all[1]});
   }
+}
+
+// A 2D mesh (the plane z = 0: written in 2D physical space) with its boundary lines and a named
+// group of two edges reads back bit for bit.
+TEST(CgnsWriter, TwoDimensionalMeshRoundTripsWithItsBoundaryLines) {
+  const auto dir = test::tempDir();
+  const TopoDS_Shape face = BRepBuilderAPI_MakeFace(gp_Pln(), 0.0, 2.0, 0.0, 1.0).Face();
+  const CadModel cad = test::toModel(face);
+  const Mesh mesh = elevateOrder(generateLinearMesh(cad, LinearMeshOptions::uniform(0.3)), 3, &cad);
+  ASSERT_EQ(mesh.dim, 2);
+  const std::string path = (dir / "square.cgns").string();
+  WriteOptions options;
+  options.groups = {{"inlet", {1, 3}}};
+  writeMesh(mesh, path, {}, options);
+  std::vector<NamedGroup> groups;
+  const Mesh back = readMesh(path, nullptr, &groups);
+  expectSameMesh(back, mesh, "2D");
+  ASSERT_EQ(groups.size(), 1u);
+  EXPECT_EQ(groups[0].name, "inlet");
+  EXPECT_EQ(groups[0].entities, (std::vector<int>{1, 3}));
 }
 
 // One curved element of every volume shape per order, side by side.
