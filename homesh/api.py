@@ -433,19 +433,21 @@ def _four_argument_progress(progress):
     return stages_only
 
 
-_CURVE_CELLS = {"tet": 4, "prism": 6, "pyramid": 5, "hex": 8}
+_CURVE_CELLS = {"tet": 4, "prism": 6, "pyramid": 5, "hex": 8, "tri": 3, "quad": 4}
 
 
 def curve(shape, nodes, cells, progress=None, cancel=None, name=None, **options):
     """Curves a linear volume mesh made by another tool (FreeCAD FEM's Gmsh or Netgen mesher,
-    Gmsh, an industrial mesher's hybrid mesh) on the CAD it was made from.
+    Gmsh, an industrial mesher's hybrid mesh) on the CAD it was made from, or a planar 2D mesh on
+    the faces it was made from.
 
-    shape   as for :func:`mesh` (one solid).
+    shape   as for :func:`mesh` (one solid; for a 2D mesh, faces without a solid).
     nodes   (N, 3) coordinates; the boundary nodes must lie on the CAD (within
             ``classify_tolerance``, by default 1e-5, of its bounding diagonal).
     cells   an (E, 4) array of tetrahedra, or a dict of corner arrays by cell type: ``"tet"``
-            (E, 4), ``"prism"`` (E, 6), ``"pyramid"`` (E, 5), ``"hex"`` (E, 8); 0-based node
-            indices, corners only, in Gmsh's order (either orientation).
+            (E, 4), ``"prism"`` (E, 6), ``"pyramid"`` (E, 5), ``"hex"`` (E, 8), or in 2D
+            ``"tri"`` (E, 3), ``"quad"`` (E, 4); 0-based node indices, corners only, in Gmsh's
+            order (either orientation).
 
     Each boundary node is put on the CAD vertex, edge or face it lies on; prisms stacked on the
     wall (a boundary layer) are joined into one macro prism per column; the mesh is raised to

@@ -430,10 +430,174 @@ BoundaryCells boundaryCells(const Mesh& mesh, const std::vector<Face>& boundary,
   return out;
 }
 
+// Twice the signed area of a linear 2D cell along `normal` (a quadrilateral's from its
+// diagonals), and the square of its bounding box's diagonal.
+std::pair<double, double> signedArea(const Mesh& mesh, const std::int64_t* c, int corners,
+                                     const Eigen::Vector3d& normal) {
+  const Eigen::Vector3d a = nodePoint(mesh, c[0]);
+  Box box;
+  for (int k = 0; k < corners; ++k) box.add(nodePoint(mesh, c[k]) - a);
+  const Eigen::Vector3d d1 = nodePoint(mesh, c[corners == 3 ? 1 : 2]) - a;
+  const Eigen::Vector3d d2 = corners == 3
+                                 ? Eigen::Vector3d(nodePoint(mesh, c[2]) - a)
+                                 : Eigen::Vector3d(nodePoint(mesh, c[3]) - nodePoint(mesh, c[1]));
+  return {d1.cross(d2).dot(normal), (box.hi - box.lo).squaredNorm()};
+}
+
+// The 2D cells of `linear` made counter-clockwise around its plane's normal, with their sides
+// counted (sorted pair -> uses, the first cell's direction).
+struct SideUse {
+  int count = 0;
+  std::int64_t from = 0, to = 0;
+};
+
+void orientPlanarCells(Mesh& mesh, ElementBlock& cells,
+                       std::map<std::pair<std::int64_t, std::int64_t>, SideUse>& sides) {
+  const Eigen::Vector3d normal(mesh.planeNormal[0], mesh.planeNormal[1], mesh.planeNormal[2]);
+  const int nv = cellNumVertices(cells.type);
+  const std::string name = cellShortName(cells.type);
+  for (std::size_t e = 0; e < cells.count(); ++e) {
+    std::int64_t* c = cells.nodes.data() + static_cast<std::size_t>(nv) * e;
+    for (int k = 0; k < nv; ++k)
+      if (c[k] < 0 || static_cast<std::size_t>(c[k]) >= mesh.numNodes())
+        throw ParameterError(name + " " + std::to_string(e + 1) + " refers to node " +
+                             std::to_string(c[k] + 1) + " of " + std::to_string(mesh.numNodes()));
+    const auto [area, size] = signedArea(mesh, c, nv, normal);
+    // (1e-10 of its size squared: far above rounding, far below any cell a mesher means.)
+    if (!(std::abs(area) > 1e-10 * size))
+      throw ParameterError(name + " " + std::to_string(e + 1) + " of the given mesh (nodes " +
+                           nodeList(c, nv) + ") is flat: no curved cell made from it can be valid");
+    if (area < 0.0) std::swap(c[1], c[nv - 1]);  // a mirror keeps corner 0
+    for (int k = 0; k < nv; ++k) {
+      const std::int64_t a = c[k], b = c[(k + 1) % nv];
+      SideUse& use = sides[{std::min(a, b), std::max(a, b)}];
+      if (++use.count == 1) {
+        use.from = a, use.to = b;
+      } else if (use.from == a) {  // two counter-clockwise cells run a side the same way: a fold
+        throw MeshingError(
+            "two cells of the given mesh overlap: both lie on one side of their "
+            "side of nodes " +
+            std::to_string(a + 1) + ", " + std::to_string(b + 1) +
+            " (a tangled mesh cannot be curved valid)");
+      }
+    }
+  }
+}
+
+// A planar linear 2D mesh (triangles, quadrilaterals) on a CAD of faces without solids: every
+// node classified (interior nodes on their face, with (u, v)), each cell on the face its nodes
+// share, each boundary side a line on the CAD edge its nodes share.
+Mesh classifyPlanarOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
+                         CadClassificationStats* stats) {
+  if (linear.order != 1) throw ParameterError("only a linear (order 1) mesh can be put on the CAD");
+  if (linear.isSurface())
+    throw ParameterError(
+        "a 2D mesh on curved faces (a surface mesh) cannot be put on the CAD: "
+        "homesh curve takes volume meshes and 2D meshes in a plane");
+  if (cad.numSolids() != 0 || cad.numFaces() < 1)
+    throw ParameterError("a 2D mesh is put on a CAD of faces without solids, " + cad.sourceName() +
+                         " has " + std::to_string(cad.numSolids()) + " solids and " +
+                         std::to_string(cad.numFaces()) + " faces");
+  if (!(tolerance > 0.0))
+    tolerance = parameterDefault("classify_tolerance") * cad.boundingDiagonal();
+  Mesh mesh;
+  mesh.dim = 2;
+  mesh.order = 1;
+  mesh.planeNormal = linear.planeNormal;
+  const std::size_t n = linear.numNodes();
+  mesh.xyz = linear.xyz;
+  mesh.nodeCadDim.assign(n, 2);
+  mesh.nodeCadIndex.assign(n, 0);
+  mesh.nodeCadParam.assign(2 * n, kNaN);
+  std::map<std::pair<std::int64_t, std::int64_t>, SideUse> sides;
+  std::vector<char> used(n, 0);
+  for (const ElementBlock& b : linear.blocks) {
+    if (cellDimension(b.type) != 2 || b.count() == 0) continue;
+    ElementBlock cells;
+    cells.type = b.type;
+    cells.nodes = b.nodes;
+    cells.entity.assign(b.count(), 0);
+    orientPlanarCells(mesh, cells, sides);
+    for (const std::int64_t id : cells.nodes) used[static_cast<std::size_t>(id)] = 1;
+    mesh.blocks.push_back(std::move(cells));
+  }
+  if (mesh.blocks.empty()) throw ParameterError("the mesh has no 2D cells to put on the CAD");
+  const Classifier classifier(cad, tolerance);
+  CadClassificationStats s;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (used[i] == 0) continue;
+    const Eigen::Vector3d p = nodePoint(mesh, static_cast<std::int64_t>(i));
+    std::pair<int, double> nearest{0, 0.0};
+    const Place place = classifier.classify(p, nearest);
+    if (place.dim < 0) {
+      // In the plane a node off the faces lies beyond their edges: the nearest edge says how far
+      // (a face's own distance, that of its untrimmed plane, would be 0).
+      int edge = 0;
+      double distance = std::numeric_limits<double>::infinity();
+      for (int e = 1; e <= cad.numEdges(); ++e) {
+        if (cad.isDegenerated(e)) continue;
+        const double d = cad.projectOnCurve(e, p).distance;
+        if (d < distance) distance = d, edge = e;
+      }
+      throw MeshingError("node " + std::to_string(i + 1) + " at " + describe(p) +
+                         " lies on no face of " + cad.sourceName() +
+                         (edge > 0 ? " (nearest: " + cadEntityName(1, edge) + " at distance " +
+                                         formatNumber(distance) + ")"
+                                   : "") +
+                         ": is the mesh of this shape?");
+    }
+    mesh.nodeCadDim[i] = static_cast<std::uint8_t>(place.dim);
+    mesh.nodeCadIndex[i] = place.index;
+    mesh.nodeCadParam[2 * i] = place.u;
+    mesh.nodeCadParam[2 * i + 1] = place.v;
+    Eigen::Vector3d::Map(&mesh.xyz[3 * i]) = place.point;
+    if (place.dim < 2) {
+      ++s.boundaryNodes;
+      ++(place.dim == 0 ? s.onVertices : s.onEdges);
+    } else {
+      ++s.onFaces;
+    }
+    s.maxDistance = std::max(s.maxDistance, place.distance);
+  }
+  for (ElementBlock& b : mesh.blocks) {
+    const int nv = cellNumVertices(b.type);
+    for (std::size_t e = 0; e < b.count(); ++e) {
+      Face f{-1, -1, -1, -1};
+      std::copy(b.element(e), b.element(e) + nv, f.begin());
+      b.entity[e] = faceOfBoundaryFace(f, mesh, classifier, cad);
+    }
+  }
+  ElementBlock lines;
+  lines.type = CellType::Line;
+  for (const auto& [key, use] : sides) {
+    if (use.count > 2)
+      throw ParameterError("the side of nodes " + std::to_string(key.first + 1) + ", " +
+                           std::to_string(key.second + 1) + " is a side of " +
+                           std::to_string(use.count) + " cells: the mesh is not a manifold");
+    if (use.count == 2) continue;
+    const int edge = edgeOfSegment(use.from, use.to, mesh, classifier, cad, tolerance);
+    if (edge == 0)
+      throw MeshingError("the boundary side of nodes " + std::to_string(use.from + 1) + ", " +
+                         std::to_string(use.to + 1) + " near " +
+                         describe(0.5 * (nodePoint(mesh, use.from) + nodePoint(mesh, use.to))) +
+                         " lies on no edge of " + cad.sourceName() +
+                         ": the mesh does not follow the CAD's edges");
+    lines.nodes.insert(lines.nodes.end(), {use.from, use.to});
+    lines.entity.push_back(edge);
+  }
+  s.boundarySegments = lines.count();
+  mesh.blocks.push_back(std::move(lines));
+  compactNodes(mesh);
+  mesh.checkConsistency();
+  if (stats != nullptr) *stats = s;
+  return mesh;
+}
+
 }  // namespace
 
 Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
                    CadClassificationStats* stats) {
+  if (linear.dim == 2) return classifyPlanarOnCad(linear, cad, tolerance, stats);
   const std::vector<const ElementBlock*> given = checkedCells(linear, cad);
   if (!(tolerance > 0.0))
     tolerance = parameterDefault("classify_tolerance") * cad.boundingDiagonal();

@@ -1,4 +1,4 @@
-// A linear volume mesh made elsewhere (tetrahedra, prisms, pyramids and hexahedra from FreeCAD
+// A linear volume (or planar 2D) mesh made elsewhere (tetrahedra, prisms, pyramids and hexahedra from FreeCAD
 // FEM's Gmsh or Netgen mesher, Gmsh, any tool whose boundary nodes lie on the CAD) put on the
 // CAD, so that the rest of the pipeline can curve it as if the linear mesher had made it.
 //
@@ -31,6 +31,12 @@ struct CadClassificationStats {
 // MeshingError naming two cells that overlap (both on one side of their shared face), and
 // MeshingError naming the node, its position and the nearest CAD face when a boundary node lies on
 // no CAD face.
+//
+// A planar 2D mesh (dim 2, triangles and quadrilaterals, in its plane) goes on a CAD of faces
+// without solids: every node is classified (interior nodes on their face with (u, v)), cells
+// are made counter-clockwise around the plane's normal and put on the face their nodes share, and
+// each boundary side becomes a line on the CAD edge its nodes share (MeshingError naming it when
+// there is none). A 2D mesh on curved faces is refused.
 Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance = 0.0,
                    CadClassificationStats* stats = nullptr);
 

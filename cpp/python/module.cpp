@@ -647,19 +647,20 @@ PyMesh meshBrep(const std::string& text, const std::string& name, const bp::dict
                      std::move(progress), cancel);
 }
 
-// Curves a linear volume mesh made elsewhere on the CAD of `source` (BRep text or a CAD file):
-// pipeline's curveMeshOnCad. nodes (N, 3); cells: {"tet": (E, 4), "prism": (E, 6), "pyramid":
-// (E, 5), "hex": (E, 8)}, 0-based corner nodes in Gmsh's order (api.curve checks the keys).
+// Curves a linear volume (or planar 2D) mesh made elsewhere on the CAD of `source` (BRep text or
+// a CAD file): pipeline's curveMeshOnCad. nodes (N, 3); cells: {"tet": (E, 4), "prism": (E, 6),
+// "pyramid": (E, 5), "hex": (E, 8)} or, in 2D, {"tri": (E, 3), "quad": (E, 4)}, 0-based corner
+// nodes in Gmsh's order (api.curve checks the keys).
 PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::dict& cells,
                   const bp::dict& given, bp::object progress, const bp::object& cancel) {
   const MeshingOptions options = optionsFrom(given, kCurveKeys, kNoExtras);
   Mesh linear;
-  linear.dim = 3;
+  linear.dim = cells.has_key("tri") || cells.has_key("quad") ? 2 : 3;
   linear.order = 1;
   linear.xyz = finiteNodes(nodes);
   if (linear.xyz.size() % 3 != 0) throw ParameterError("nodes must be an (N, 3) array");
-  for (const CellType type :
-       {CellType::Tetrahedron, CellType::Prism, CellType::Pyramid, CellType::Hexahedron}) {
+  for (const CellType type : {CellType::Tetrahedron, CellType::Prism, CellType::Pyramid,
+                              CellType::Hexahedron, CellType::Triangle, CellType::Quadrilateral}) {
     const std::string name = cellShortName(type);
     if (!cells.has_key(name)) continue;
     ElementBlock block;
@@ -672,10 +673,18 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::di
     block.entity.assign(block.nodes.size() / corners, 1);
     linear.blocks.push_back(std::move(block));
   }
+  for (const ElementBlock& b : linear.blocks)
+    if (cellDimension(b.type) != linear.dim)
+      throw ParameterError(
+          "cells: 2D cells (tri, quad) and volume cells cannot be curved together");
   const std::size_t n = linear.numNodes();
-  linear.nodeCadDim.assign(n, 3);
+  linear.nodeCadDim.assign(n, static_cast<std::uint8_t>(linear.dim));
   linear.nodeCadIndex.assign(n, 0);
   linear.nodeCadParam.assign(2 * n, std::numeric_limits<double>::quiet_NaN());
+  if (linear.dim == 2) {  // its plane, as the mesh readers find it (zero: on curved faces)
+    linear.checkConsistency();
+    if (const auto normal = planeOfCells(linear, 1e-5)) linear.planeNormal = *normal;
+  }
   return runObserved(std::move(progress), cancel, [&](PipelineObserver* observer) {
     return curveMeshOnCad(source, linear, options, observer);
   });

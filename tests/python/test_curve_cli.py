@@ -302,3 +302,56 @@ def test_a_cgns_file_another_tool_wrote_is_curved(homesh_bin, tmp_path, geo, kin
     # (The converter numbers its conditions 1, 2, ... in the order of the surface IDs.)
     assert {n for n in names if n.startswith("UserDefined ")} == \
         {"UserDefined %d" % (k + 1) for k in range(len(surfaces))}, names
+
+
+DISK_GEO = """SetFactory("OpenCASCADE");
+Disk(1) = {0, 0, 0, 1};
+Mesh.MeshSizeMax = 0.3;
+"""
+
+
+@pytest.mark.parametrize("recombine", [False, True], ids=["triangles", "quadrilaterals"])
+def test_a_planar_2d_mesh_is_curved_on_its_faces(homesh_bin, tmp_path, recombine):
+    """Gmsh's 2D mesh of a disk (triangles, or recombined into quadrilaterals) curved on the disk
+    at order 4 with --optimise, from the command line and from Python: certified valid, every
+    boundary node on the circle to 1e-9 of the diagonal, the plane kept; a node moved off the
+    circle by 1% of the size is refused by name, and nothing is written."""
+    gmsh = shutil.which("gmsh")
+    assert gmsh, "Debian's gmsh package is needed"
+    geo = tmp_path / "disk.geo"
+    geo.write_text(DISK_GEO + ("Recombine Surface{1};\n" if recombine else ""))
+    linear, step = tmp_path / "disk.msh", tmp_path / "disk.step"
+    for args in (["-2", "-format", "msh41", "-o", linear], ["-0", "-o", step]):
+        r = run([gmsh, geo] + args)
+        assert r.returncode == 0, r.stdout + r.stderr
+    curved, report = tmp_path / "curved.msh", tmp_path / "report.json"
+    r = run([homesh_bin, "curve", linear, "--cad", step, "--order", "4", "--optimise", "-o",
+             curved, "--report", report])
+    assert r.returncode == 0, r.stderr
+    rep = json.loads(report.read_text())
+    assert rep["quality"]["invalid_elements"] == 0 and rep["quality"]["undecided_elements"] == 0
+    before = meshio.read(linear)
+    kind = "quad" if recombine else "triangle"
+    mesh = meshio.read(curved)
+    assert len(mesh.cells_dict[kind + "25" if recombine else "triangle15"]) == \
+        len(before.cells_dict[kind])
+    boundary = np.unique(mesh.cells_dict["line5"].ravel())
+    assert np.abs(np.hypot(*mesh.points[boundary, :2].T) - 1.0).max() < 1e-9 * 2 * np.sqrt(2)
+    assert np.abs(mesh.points[:, 2]).max() == 0.0
+
+    cells = {"quad" if recombine else "tri": before.cells_dict[kind]}
+    python = homesh.curve(str(step), before.points, cells, order=4)
+    assert python.dim == 2 and python.quality()["invalid_elements"] == 0
+
+    # A boundary node moved outwards by 1% of the size (0.3): refused, naming it.
+    moved = before.points.copy()
+    node = int(before.cells_dict["line"][0][0])
+    moved[node, :2] *= 1.003
+    off = tmp_path / "off.vtu"
+    meshio.write(off, meshio.Mesh(moved, [(kind, before.cells_dict[kind])]))
+    out = tmp_path / "off_curved.msh"
+    r = run([homesh_bin, "curve", off, "--cad", step, "-o", out])
+    assert r.returncode != 0
+    assert "node %d at (" % (node + 1) in r.stderr and "lies on no face" in r.stderr, r.stderr
+    assert "at distance 0.003" in r.stderr, r.stderr
+    assert not out.exists()
