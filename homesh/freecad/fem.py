@@ -4,7 +4,8 @@ Quality: :func:`read_fem_mesh` gives a ``Fem::FemMesh`` as it is (linear or quad
 cell) with the certified validity of its curved elements, read from FEM's own UNV writer.
 
 In: the nodes and volume cells of a ``Fem::FemMesh`` (tetrahedra, pyramids, prisms, hexahedra
-from FEM's Gmsh or Netgen mesher, first or second order: only the corner nodes are used), for
+from FEM's Gmsh or Netgen mesher, first or second order: only the corner nodes are used; a 2D
+mesh's triangles and quadrilaterals), for
 :func:`homesh.curve` to put on the CAD and curve. Out: a ``Fem::FemMesh`` of order 2 at most
 (what FEM's solvers and post-processing hold) from a HOMesh mesh: order 1 and 2 meshes as they are, higher orders through their own map at the
 order-2 nodes, so the FEM mesh's edges are the parabolas through the curved elements' midpoints.
@@ -38,23 +39,31 @@ _VOLUME_TYPES = {4: ("tet", 4), 10: ("tet", 4), 5: ("pyramid", 5), 13: ("pyramid
                  20: ("hex", 8), 27: ("hex", 8)}
 
 
+# A FEM face element's type by its node count, for a 2D mesh (no volume elements): triangles
+# and quadrilaterals, linear or quadratic, corners first.
+_FACE_TYPES = {3: ("tri", 3), 6: ("tri", 3), 4: ("quad", 4), 8: ("quad", 4), 9: ("quad", 4)}
+
+
 def fem_mesh_arrays(fem_mesh):
     """(nodes (N, 3), cells {type: (E, corners) 0-based}) of a ``Fem::FemMesh``'s volume
     elements (tetrahedra, pyramids, prisms, hexahedra, linear or quadratic: their corners, in
-    :func:`homesh.curve`'s dict), with the nodes no corner uses left out. ValueError when it has
-    no volume elements or one of another kind."""
-    volumes = list(fem_mesh.Volumes)
-    if not volumes:
-        raise ValueError("the FEM mesh has no volume elements (a surface mesh cannot be "
-                         "curved as a solid)")
+    :func:`homesh.curve`'s dict) or, when it has none, of its face elements (a planar 2D mesh:
+    triangles, quadrilaterals), with the nodes no corner uses left out. ValueError when it has
+    neither or one of another kind."""
+    elements, types, what = list(fem_mesh.Volumes), _VOLUME_TYPES, "volume"
+    if not elements:
+        elements, types, what = list(getattr(fem_mesh, "Faces", ())), _FACE_TYPES, "face"
+    if not elements:
+        raise ValueError("the FEM mesh has no volume or face elements to curve")
     corners = {}
-    for v in volumes:
+    for v in elements:
         nodes = fem_mesh.getElementNodes(v)
-        if len(nodes) not in _VOLUME_TYPES:
-            raise ValueError("the FEM mesh has a volume element of %d nodes (element %d): only "
-                             "tetrahedra, pyramids, prisms and hexahedra (linear or quadratic) "
-                             "can be curved" % (len(nodes), v))
-        kind, count = _VOLUME_TYPES[len(nodes)]
+        if len(nodes) not in types:
+            raise ValueError("the FEM mesh has a %s element of %d nodes (element %d): only "
+                             "tetrahedra, pyramids, prisms and hexahedra, or in 2D triangles and "
+                             "quadrilaterals (linear or quadratic) can be curved"
+                             % (what, len(nodes), v))
+        kind, count = types[len(nodes)]
         corners.setdefault(kind, []).append(nodes[:count])
     used = sorted({n for cells in corners.values() for c in cells for n in c})
     index = {n: k for k, n in enumerate(used)}

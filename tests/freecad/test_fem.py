@@ -209,11 +209,35 @@ class FemBothWays(unittest.TestCase):
             volume = mesh.element_volumes().sum()
             self.assertLess(abs(volume - 2 * math.pi), 1e-4 * 2 * math.pi)
 
-    def test_a_surface_fem_mesh_is_refused_with_its_name(self):
-        class Surface:
+    def test_a_fem_mesh_without_volumes_or_faces_is_refused(self):
+        class Empty:
             Volumes = ()
-        with self.assertRaisesRegex(ValueError, "no volume elements"):
-            fem.fem_mesh_arrays(Surface())
+            Faces = ()
+        with self.assertRaisesRegex(ValueError, "no volume or face elements"):
+            fem.fem_mesh_arrays(Empty())
+
+    def test_curve_a_2d_gmsh_fem_mesh_of_a_disk(self):
+        """FEM's Gmsh mesher on a disk (a face, no solid) gives triangles; Curve FEM mesh makes
+        them order 4, certified valid, every boundary node on the circle."""
+        import Part
+        disk = self.doc.addObject("Part::Feature", "Disk")
+        disk.Shape = Part.Face(Part.Wire(Part.makeCircle(1.0)))
+        self.doc.recompute()
+        femmesh = gmsh_fem_mesh(self.doc, disk, order="1st", size=0.3)
+        triangles = femmesh.FemMesh.FaceCount
+        self.assertGreater(triangles, 20)
+        obj = homesh.freecad.make_high_order_mesh(self.doc, disk, order=4, fem_mesh=femmesh)
+        self.doc.recompute()
+        self.assertTrue(obj.isValid(), obj.Status)
+        mesh = homesh.freecad.get_mesh(obj)
+        self.assertEqual((mesh.dim, mesh.order, mesh.num_elements), (2, 4, triangles))
+        quality = mesh.quality()
+        self.assertEqual(quality["invalid_elements"], 0)
+        self.assertEqual(quality["undecided_elements"], 0)
+        on_curve = mesh.node_cad_dim <= 1
+        self.assertGreater(on_curve.sum(), 40)
+        radius = np.hypot(mesh.nodes[on_curve, 0], mesh.nodes[on_curve, 1])
+        self.assertLess(np.abs(radius - 1.0).max(), 1e-12)
 
 
 if __name__ == "__main__":
