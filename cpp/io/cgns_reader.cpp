@@ -16,6 +16,8 @@
 
 #include "cad/cad_model.hpp"
 #include "core/error.hpp"
+#include "core/isolated_call.hpp"
+#include "core/mesh_bytes.hpp"
 #include "io/cgns_elements.hpp"
 #include "io/foreign_mesh.hpp"
 
@@ -424,15 +426,76 @@ Mesh readCgnsFile(const std::string& path, std::vector<std::string>* notes,
   return assembleForeignMesh(std::move(raw), path, notes);
 }
 
+// The child's result (isolated_call.hpp) as bytes: the mesh, its notes and groups.
+void putCount(std::string& out, std::uint64_t n) {
+  out.append(reinterpret_cast<const char*>(&n), sizeof n);
+}
+void putText(std::string& out, const std::string& text) {
+  putCount(out, text.size());
+  out += text;
+}
+std::uint64_t takeCount(const std::string& in, std::size_t& at) {
+  std::uint64_t n = 0;
+  if (at + sizeof n > in.size()) throw Error("CGNS reader: short result from its child");
+  std::memcpy(&n, in.data() + at, sizeof n);
+  at += sizeof n;
+  return n;
+}
+std::string takeText(const std::string& in, std::size_t& at) {
+  const std::uint64_t n = takeCount(in, at);
+  if (at + n > in.size()) throw Error("CGNS reader: short result from its child");
+  std::string text = in.substr(at, n);
+  at += n;
+  return text;
+}
+
 }  // namespace
 
 Mesh readCgns(const std::string& path, std::vector<std::string>* notes,
               std::vector<NamedGroup>* groups) {
+  // In a child process: HDF5 can crash on a damaged file (a freed pointer freed again), which
+  // must not take FreeCAD down; the child's crash is an IoError here.
+  std::string bytes;
   try {
-    return readCgnsFile(path, notes, groups);
-  } catch (const std::bad_alloc&) {  // sizes the file states that this machine cannot hold
+    bytes = runIsolated("the CGNS library", IsolationLimits{}, [&path] {
+      std::vector<std::string> childNotes;
+      std::vector<NamedGroup> childGroups;
+      std::string out;
+      try {
+        appendMeshBytes(out, readCgnsFile(path, &childNotes, &childGroups));
+      } catch (const std::bad_alloc&) {  // sizes the file states that no memory can hold
+        throw IoError("'" + path + "': its arrays are too large for this machine's memory");
+      }
+      putCount(out, childNotes.size());
+      for (const std::string& note : childNotes) putText(out, note);
+      putCount(out, childGroups.size());
+      for (const NamedGroup& g : childGroups) {
+        putText(out, g.name);
+        putCount(out, g.entities.size());
+        for (const int entity : g.entities) putCount(out, static_cast<std::uint64_t>(entity));
+      }
+      return out;
+    });
+  } catch (const ChildCrashed& e) {
+    throw IoError("cannot read '" + path + "' as CGNS: " + e.what() +
+                  " on it: is the file damaged?");
+  } catch (const OutOfMemory&) {
     throw IoError("'" + path + "': its arrays are too large for this machine's memory");
   }
+  std::size_t at = 0;
+  Mesh mesh = readMeshBytes(bytes, at);
+  for (std::uint64_t n = takeCount(bytes, at), k = 0; k < n; ++k) {
+    std::string note = takeText(bytes, at);
+    if (notes != nullptr) notes->push_back(std::move(note));
+  }
+  for (std::uint64_t n = takeCount(bytes, at), k = 0; k < n; ++k) {
+    NamedGroup g;
+    g.name = takeText(bytes, at);
+    for (std::uint64_t m = takeCount(bytes, at), j = 0; j < m; ++j)
+      g.entities.push_back(static_cast<int>(takeCount(bytes, at)));
+    if (groups != nullptr) groups->push_back(std::move(g));
+  }
+  return mesh;
 }
 
 }  // namespace homesh
