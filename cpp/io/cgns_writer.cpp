@@ -64,7 +64,20 @@ cgsize_t index(std::size_t i, const std::string& path) {
   return static_cast<cgsize_t>(i);
 }
 
-// The name of the section holding a run of cells of one entity.
+// A block's cells by entity: the entities in the order they first appear, each with its cells
+// in block order.
+std::vector<std::pair<int, std::vector<std::size_t>>> cellsByEntity(const ElementBlock& block) {
+  std::vector<std::pair<int, std::vector<std::size_t>>> out;
+  std::map<int, std::size_t> slot;
+  for (std::size_t e = 0; e < block.count(); ++e) {
+    const auto [it, fresh] = slot.emplace(block.entity[e], out.size());
+    if (fresh) out.emplace_back(block.entity[e], std::vector<std::size_t>());
+    out[it->second].second.push_back(e);
+  }
+  return out;
+}
+
+// The name of the section holding the cells of one entity.
 std::string sectionName(int dim, int entity, int code) {
   return cadEntityName(dim, entity) + "_" + cgnsTypeName(code);
 }
@@ -103,36 +116,30 @@ void writeCgns(const Mesh& mesh, const std::string& path, const std::vector<Name
     out.check(cg_exponents_write(CGNS_ENUMV(RealSingle), length), names[k]);
   }
 
-  // Sections: runs of cells on one entity, numbered from 1 in block order.
+  // Sections: a block's cells of one entity each, the entities in the order they first appear
+  // and each one's cells in block order, numbered from 1.
   std::map<int, std::vector<cgsize_t>> cellsOfEntity;  // boundary entity -> CGNS cell numbers
   std::size_t next = 1;  // the next cell's number (checked into cgsize_t where it is used)
   std::vector<cgsize_t> connectivity;
-  std::map<std::string, int> runsOf;  // a name's runs so far: later ones are "<name>_2", ...
   for (const ElementBlock& block : mesh.blocks) {
     const int dim = cellDimension(block.type), code = cgnsElementType(block.type, block.order);
     const std::vector<int> perm = cgnsPermutationFromGmsh(block.type, block.order);
-    for (std::size_t first = 0; first < block.count();) {
-      std::size_t last = first;
-      while (last + 1 < block.count() && block.entity[last + 1] == block.entity[first]) ++last;
+    for (const auto& [entity, cells] : cellsByEntity(block)) {
       connectivity.clear();
-      for (std::size_t e = first; e <= last; ++e) {
-        const std::int64_t* nodes = block.element(e);
+      for (std::size_t i = 0; i < cells.size(); ++i) {
+        const std::int64_t* nodes = block.element(cells[i]);
         for (const int k : perm)
           connectivity.push_back(index(static_cast<std::size_t>(nodes[k]) + 1, path));
-        if (dim == mesh.dim - 1)
-          cellsOfEntity[block.entity[e]].push_back(index(next + (e - first), path));
+        if (dim == mesh.dim - 1) cellsOfEntity[entity].push_back(index(next + i, path));
       }
       index(connectivity.size(), path);  // the library sizes a section's array in 32 bits too
-      const std::size_t end = next + (last - first);
-      std::string name = sectionName(dim, block.entity[first], code);
-      if (const int run = ++runsOf[name]; run > 1) name += "_" + std::to_string(run);
+      const std::size_t end = next + cells.size() - 1;
       int section = 0;
-      out.check(cg_section_write(fn, base, zone, name.c_str(),
+      out.check(cg_section_write(fn, base, zone, sectionName(dim, entity, code).c_str(),
                                  static_cast<CGNS_ENUMT(ElementType_t)>(code), index(next, path),
                                  index(end, path), 0, connectivity.data(), &section),
                 "section of " + cgnsTypeName(code));
       next = end + 1;
-      first = last + 1;
     }
   }
 

@@ -1,9 +1,11 @@
 // CGNS writer (SIDS-conforming HDF5 file through Debian's CGNS library).
 //
-// One base ("HOMesh", cell dimension mesh.dim, physical dimension 3), one unstructured zone:
-// the nodes as CoordinateX/Y/Z (double), then the cells in block order, elements first, each
-// block's cells in sections of one CAD entity each ("Solid1_TETRA_35", "Face3_TRI_15"), so that
-// a reader rebuilds every cell's entity; then one boundary condition per named group and one per
+// One base ("HOMesh", cell dimension mesh.dim, physical dimension 3, or 2 for a 2D mesh in the
+// plane z = 0), one unstructured zone: the nodes as CoordinateX/Y/Z (double; no Z in 2D space),
+// then the cells block by block, elements first, each block's cells in sections of one CAD
+// entity each ("Solid1_TETRA_35", "Face3_TRI_15"; the entities in the order they first appear in
+// the block, each one's cells in block order), so that a reader rebuilds every cell's entity, and
+// a block whose cells were so grouped reads back as it was; then one boundary condition per named group and one per
 // other boundary entity ("Face7"), listing its cells (PointList at FaceCenter in 3D, EdgeCenter
 // in 2D; type BCTypeUserDefined: HOMesh knows the surfaces, not the physics). Node order:
 // io/cgns_elements.hpp. The file is written under a temporary name and renamed.

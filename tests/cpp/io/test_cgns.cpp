@@ -201,6 +201,73 @@ TEST(CgnsWriter, CurvedMeshRoundTripsBitForBitWithEntitiesAndGroups) {
   }
 }
 
+// A block whose cells interleave entities is written as one section per entity (not one per
+// run: a mesh curved from another tool's file lists its boundary in any order), and reads back
+// grouped: the entities in the order they first appear, each one's cells in block order.
+TEST(CgnsWriter, InterleavedEntitiesComeBackGroupedOneSectionEach) {
+  const auto dir = test::tempDir();
+  Mesh mesh = curvedBoxWithHole(2);
+  ElementBlock* tris = nullptr;
+  for (ElementBlock& b : mesh.blocks)
+    if (b.type == CellType::Triangle) tris = &b;
+  ASSERT_NE(tris, nullptr);
+  // Reverse the block: each entity's cells now come in reverse, and the entities too.
+  const int n = tris->nodesPerElement();
+  ElementBlock reversed = *tris;
+  for (std::size_t e = 0; e < tris->count(); ++e) {
+    const std::size_t r = tris->count() - 1 - e;
+    std::copy(tris->element(r), tris->element(r) + n, reversed.nodes.begin() + e * n);
+    reversed.entity[e] = tris->entity[r];
+  }
+  // Interleave: swap the first entity's last cell with the block's last cell (another entity's).
+  std::size_t last = 0;
+  while (reversed.entity[last + 1] == reversed.entity[0]) ++last;
+  const std::size_t final = reversed.count() - 1;
+  ASSERT_GE(last, 1u);
+  ASSERT_NE(reversed.entity[final], reversed.entity[0]);
+  const auto cell = [&](std::size_t e) {
+    return reversed.nodes.begin() + static_cast<std::ptrdiff_t>(e * static_cast<std::size_t>(n));
+  };
+  std::swap_ranges(cell(last), cell(last + 1), cell(final));
+  std::swap(reversed.entity[last], reversed.entity[final]);
+  *tris = reversed;
+  const std::string path = (dir / "interleaved.cgns").string();
+  writeMesh(mesh, path, {});
+  // Expected: the stable grouping of the block by entity, in first-appearance order.
+  std::vector<int> order;
+  std::map<int, std::vector<std::size_t>> cellsOf;
+  for (std::size_t e = 0; e < tris->count(); ++e) {
+    if (cellsOf[tris->entity[e]].empty()) order.push_back(tris->entity[e]);
+    cellsOf[tris->entity[e]].push_back(e);
+  }
+  ElementBlock grouped = *tris;
+  std::size_t at = 0;
+  for (const int entity : order)
+    for (const std::size_t e : cellsOf[entity]) {
+      std::copy(
+          tris->element(e), tris->element(e) + n,
+          grouped.nodes.begin() + static_cast<std::ptrdiff_t>(at * static_cast<std::size_t>(n)));
+      grouped.entity[at++] = entity;
+    }
+  *tris = grouped;
+  expectSameMesh(readMesh(path), mesh, "interleaved");
+  // One triangle section per face.
+  const std::set<int> faces(tris->entity.begin(), tris->entity.end());
+  int fn = 0, sections = 0, triSections = 0;
+  ASSERT_EQ(cg_open(path.c_str(), CG_MODE_READ, &fn), CG_OK);
+  ASSERT_EQ(cg_nsections(fn, 1, 1, &sections), CG_OK);
+  for (int s = 1; s <= sections; ++s) {
+    char name[33] = {0};
+    CGNS_ENUMT(ElementType_t) type{};
+    cgsize_t start = 0, end = 0;
+    int boundary = 0, parents = 0;
+    ASSERT_EQ(cg_section_read(fn, 1, 1, s, name, &type, &start, &end, &boundary, &parents), CG_OK);
+    if (type == CGNS_ENUMV(TRI_6)) ++triSections;
+  }
+  cg_close(fn);
+  EXPECT_EQ(triSections, static_cast<int>(faces.size()));
+}
+
 // A 2D mesh (the plane z = 0: written in 2D physical space) with its boundary lines and a named
 // group of two edges reads back bit for bit.
 TEST(CgnsWriter, TwoDimensionalMeshRoundTripsWithItsBoundaryLines) {
