@@ -311,6 +311,27 @@ std::vector<Face> boundaryFaces(const FaceUses& uses) {
   return boundary;
 }
 
+// The error for a node (`what`: "boundary node", "node") that lies on no face: its number,
+// position and the nearest entity of dimension `dim` (0: none found) at `distance`.
+MeshingError offCad(const std::string& what, std::size_t i, const Eigen::Vector3d& p,
+                    const CadModel& cad, int dim, int nearest, double distance) {
+  return MeshingError(what + " " + std::to_string(i + 1) + " at " + describe(p) +
+                      " lies on no face of " + cad.sourceName() +
+                      (nearest > 0 ? " (nearest: " + cadEntityName(dim, nearest) + " at distance " +
+                                         formatNumber(distance) + ")"
+                                   : "") +
+                      ": is the mesh of this shape?");
+}
+
+// Node i moved onto where it lies on the CAD, with its records.
+void setPlace(Mesh& mesh, std::size_t i, const Place& place) {
+  mesh.nodeCadDim[i] = static_cast<std::uint8_t>(place.dim);
+  mesh.nodeCadIndex[i] = place.index;
+  mesh.nodeCadParam[2 * i] = place.u;
+  mesh.nodeCadParam[2 * i + 1] = place.v;
+  Eigen::Vector3d::Map(&mesh.xyz[3 * i]) = place.point;
+}
+
 // Boundary nodes on the CAD (snapped onto it: within the tolerance of where they were).
 CadClassificationStats placeBoundaryNodes(Mesh& mesh, const std::vector<Face>& boundary,
                                           const Classifier& classifier, const CadModel& cad) {
@@ -324,19 +345,8 @@ CadClassificationStats placeBoundaryNodes(Mesh& mesh, const std::vector<Face>& b
     const Eigen::Vector3d p = nodePoint(mesh, static_cast<std::int64_t>(i));
     std::pair<int, double> nearest{0, 0.0};
     const Place place = classifier.classify(p, nearest);
-    if (place.dim < 0)
-      throw MeshingError("boundary node " + std::to_string(i + 1) + " at " + describe(p) +
-                         " lies on no face of " + cad.sourceName() +
-                         (nearest.first > 0
-                              ? " (nearest: " + cadEntityName(2, nearest.first) + " at distance " +
-                                    formatNumber(nearest.second) + ")"
-                              : "") +
-                         ": is the mesh of this shape?");
-    mesh.nodeCadDim[i] = static_cast<std::uint8_t>(place.dim);
-    mesh.nodeCadIndex[i] = place.index;
-    mesh.nodeCadParam[2 * i] = place.u;
-    mesh.nodeCadParam[2 * i + 1] = place.v;
-    Eigen::Vector3d::Map(&mesh.xyz[3 * i]) = place.point;
+    if (place.dim < 0) throw offCad("boundary node", i, p, cad, 2, nearest.first, nearest.second);
+    setPlace(mesh, i, place);
     ++s.boundaryNodes;
     ++(place.dim == 0 ? s.onVertices : place.dim == 1 ? s.onEdges : s.onFaces);
     s.maxDistance = std::max(s.maxDistance, place.distance);
@@ -539,18 +549,9 @@ Mesh classifyPlanarOnCad(const Mesh& linear, const CadModel& cad, double toleran
         const double d = cad.projectOnCurve(e, p).distance;
         if (d < distance) distance = d, edge = e;
       }
-      throw MeshingError("node " + std::to_string(i + 1) + " at " + describe(p) +
-                         " lies on no face of " + cad.sourceName() +
-                         (edge > 0 ? " (nearest: " + cadEntityName(1, edge) + " at distance " +
-                                         formatNumber(distance) + ")"
-                                   : "") +
-                         ": is the mesh of this shape?");
+      throw offCad("node", i, p, cad, 1, edge, distance);
     }
-    mesh.nodeCadDim[i] = static_cast<std::uint8_t>(place.dim);
-    mesh.nodeCadIndex[i] = place.index;
-    mesh.nodeCadParam[2 * i] = place.u;
-    mesh.nodeCadParam[2 * i + 1] = place.v;
-    Eigen::Vector3d::Map(&mesh.xyz[3 * i]) = place.point;
+    setPlace(mesh, i, place);
     if (place.dim < 2) {
       ++s.boundaryNodes;
       ++(place.dim == 0 ? s.onVertices : s.onEdges);

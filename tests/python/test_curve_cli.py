@@ -28,6 +28,18 @@ def distance_to_cad(points):
     return np.minimum(planes.min(axis=0), cylinder)
 
 
+def curved_valid(homesh_bin, tmp_path, linear, step, *args):
+    """Runs `homesh curve LINEAR --cad STEP ARGS -o curved.msh --report report.json`, asserts it
+    succeeded certified valid, and returns the report and the curved mesh (meshio)."""
+    curved, report = tmp_path / "curved.msh", tmp_path / "report.json"
+    r = run([homesh_bin, "curve", linear, "--cad", step] + list(args) +
+            ["-o", curved, "--report", report])
+    assert r.returncode == 0, r.stderr
+    rep = json.loads(report.read_text())
+    assert rep["quality"]["invalid_elements"] == 0 and rep["quality"]["undecided_elements"] == 0
+    return rep, meshio.read(curved)
+
+
 @pytest.fixture(scope="module")
 def gmsh_linear(tmp_path_factory, data):
     gmsh = shutil.which("gmsh")
@@ -212,15 +224,9 @@ def test_hexahedra_on_a_cylinder_are_curved(homesh_bin, tmp_path):
     for args in ([geo, "-3", "-format", "msh41", "-o", linear], [step_geo, "-0", "-o", step]):
         r = run([gmsh] + args)
         assert r.returncode == 0, r.stdout + r.stderr
-    curved, report = tmp_path / "curved.msh", tmp_path / "report.json"
-    r = run([homesh_bin, "curve", linear, "--cad", step, "--order", "4", "--optimise", "-o",
-             curved, "--report", report])
-    assert r.returncode == 0, r.stderr
-    rep = json.loads(report.read_text())
-    assert rep["quality"]["invalid_elements"] == 0 and rep["quality"]["undecided_elements"] == 0
+    rep, mesh = curved_valid(homesh_bin, tmp_path, linear, step, "--order", "4", "--optimise")
     assert rep["elements"]["hex"] == len(meshio.read(linear).cells_dict["hexahedron"])
     assert rep["boundary"]["quad"] == 112
-    mesh = meshio.read(curved)
     quads = np.concatenate([c.data for c in mesh.cells if c.type == "quad25"])
     boundary = np.unique(quads.ravel())
     x, y, z = mesh.points[boundary].T
@@ -277,13 +283,7 @@ def test_a_cgns_file_another_tool_wrote_is_curved(homesh_bin, tmp_path, geo, kin
     write_ugrid(ugrid, before)
     r = run(["aflr3_to_cgns", "-f", ugrid, cgns])
     assert r.returncode == 0 and cgns.is_file(), r.stdout + r.stderr
-    curved, report = tmp_path / "curved.msh", tmp_path / "report.json"
-    r = run([homesh_bin, "curve", cgns, "--cad", step, "--order", "3", "-o", curved, "--report",
-             report])
-    assert r.returncode == 0, r.stderr
-    rep = json.loads(report.read_text())
-    assert rep["quality"]["invalid_elements"] == 0 and rep["quality"]["undecided_elements"] == 0
-    mesh = meshio.read(curved)
+    _, mesh = curved_valid(homesh_bin, tmp_path, cgns, step, "--order", "3")
     order3 = {"wedge": "wedge40", "hexahedron": "hexahedron64"}[kind]
     assert len(mesh.cells_dict[order3]) == len(before.cells_dict[kind])
     boundary = np.unique(np.concatenate([c.data.ravel() for c in mesh.cells
@@ -324,15 +324,9 @@ def test_a_planar_2d_mesh_is_curved_on_its_faces(homesh_bin, tmp_path, recombine
     for args in (["-2", "-format", "msh41", "-o", linear], ["-0", "-o", step]):
         r = run([gmsh, geo] + args)
         assert r.returncode == 0, r.stdout + r.stderr
-    curved, report = tmp_path / "curved.msh", tmp_path / "report.json"
-    r = run([homesh_bin, "curve", linear, "--cad", step, "--order", "4", "--optimise", "-o",
-             curved, "--report", report])
-    assert r.returncode == 0, r.stderr
-    rep = json.loads(report.read_text())
-    assert rep["quality"]["invalid_elements"] == 0 and rep["quality"]["undecided_elements"] == 0
+    _, mesh = curved_valid(homesh_bin, tmp_path, linear, step, "--order", "4", "--optimise")
     before = meshio.read(linear)
     kind = "quad" if recombine else "triangle"
-    mesh = meshio.read(curved)
     assert len(mesh.cells_dict[kind + "25" if recombine else "triangle15"]) == \
         len(before.cells_dict[kind])
     boundary = np.unique(mesh.cells_dict["line5"].ravel())
