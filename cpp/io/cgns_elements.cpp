@@ -76,6 +76,11 @@ std::string cgnsTypeName(int code) {
   return "type " + std::to_string(code);
 }
 
+std::unique_lock<std::mutex> holdCgnsLibrary() {
+  static std::mutex library;
+  return std::unique_lock<std::mutex>(library);
+}
+
 std::vector<int> cgnsPermutationFromGmsh(CellType type, int order) {
   return nodePermutationFromGmsh(type, order, NodeConvention::Cgns);
 }

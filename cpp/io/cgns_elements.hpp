@@ -8,6 +8,7 @@
 // sub-triangles, PYRA_55's interior on lines from the apex); those positions are not used.
 #pragma once
 
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,11 @@ CgnsTypeReading cgnsTypeReading(int code);
 
 // The SIDS's name of a type code ("TETRA_35"), or "type N" for a code outside the table.
 std::string cgnsTypeName(int code);
+
+// The lock every use of the CGNS library (and its HDF5) in this process holds: the library is
+// not thread-safe, and a reader forks a child while holding it, so that no other thread is
+// inside the library (holding its locks) when the child starts.
+std::unique_lock<std::mutex> holdCgnsLibrary();
 
 // perm[i] = index, in Gmsh order, of the i-th node of the CGNS element.
 std::vector<int> cgnsPermutationFromGmsh(CellType type, int order);

@@ -10,8 +10,10 @@
 #include <cstring>
 #include <initializer_list>
 #include <map>
+#include <mutex>
 #include <new>
 #include <set>
+#include <stdexcept>
 #include <utility>
 
 #include "cad/cad_model.hpp"
@@ -344,6 +346,8 @@ Mesh readCgnsFile(const std::string& path, std::vector<std::string>* notes,
     const std::string where = "zone '" + std::string(zoneName) + "'";
     if (zoneType != CGNS_ENUMV(Unstructured))
       throw ioError({"'", path, "': ", where, " is structured; HOMesh reads unstructured zones"});
+    if (size[0] < 1)
+      throw ioError({"'", path, "': ", where, " has ", std::to_string(size[0]), " nodes"});
     const auto n = static_cast<std::size_t>(size[0]);
     std::array<std::vector<double>, 3> xyz;
     const char* coordinateNames[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
@@ -457,6 +461,7 @@ Mesh readCgns(const std::string& path, std::vector<std::string>* notes,
   // must not take FreeCAD down; the child's crash is an IoError here.
   std::string bytes;
   try {
+    const std::unique_lock<std::mutex> library = holdCgnsLibrary();
     bytes = runIsolated("the CGNS library", IsolationLimits{}, [&path] {
       std::vector<std::string> childNotes;
       std::vector<NamedGroup> childGroups;
@@ -464,6 +469,8 @@ Mesh readCgns(const std::string& path, std::vector<std::string>* notes,
       try {
         appendMeshBytes(out, readCgnsFile(path, &childNotes, &childGroups));
       } catch (const std::bad_alloc&) {  // sizes the file states that no memory can hold
+        throw IoError("'" + path + "': its arrays are too large for this machine's memory");
+      } catch (const std::length_error&) {
         throw IoError("'" + path + "': its arrays are too large for this machine's memory");
       }
       putCount(out, childNotes.size());
@@ -481,6 +488,12 @@ Mesh readCgns(const std::string& path, std::vector<std::string>* notes,
                   " on it: is the file damaged?");
   } catch (const OutOfMemory&) {
     throw IoError("'" + path + "': its arrays are too large for this machine's memory");
+  } catch (const IoError&) {
+    throw;
+  } catch (const ParameterError&) {
+    throw;
+  } catch (const Error& e) {  // anything else the child met reading the file
+    throw IoError("cannot read '" + path + "' as CGNS: " + e.what());
   }
   std::size_t at = 0;
   Mesh mesh = readMeshBytes(bytes, at);

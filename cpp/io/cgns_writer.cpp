@@ -86,6 +86,7 @@ std::string sectionName(int dim, int entity, int code) {
 
 void writeCgns(const Mesh& mesh, const std::string& path, const std::vector<NamedGroup>& groups) {
   for (const ElementBlock& block : mesh.blocks) cgnsElementType(block.type, block.order);
+  const std::unique_lock<std::mutex> library = holdCgnsLibrary();
   CgnsOutput out(path);
   const int fn = out.fn();
   int base = 0, zone = 0;

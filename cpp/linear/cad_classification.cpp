@@ -315,12 +315,12 @@ std::vector<Face> boundaryFaces(const FaceUses& uses) {
 // position and the nearest entity of dimension `dim` (0: none found) at `distance`.
 MeshingError offCad(const std::string& what, std::size_t i, const Eigen::Vector3d& p,
                     const CadModel& cad, int dim, int nearest, double distance) {
-  return MeshingError(what + " " + std::to_string(i + 1) + " at " + describe(p) +
+  return MeshingError{what + " " + std::to_string(i + 1) + " at " + describe(p) +
                       " lies on no face of " + cad.sourceName() +
                       (nearest > 0 ? " (nearest: " + cadEntityName(dim, nearest) + " at distance " +
                                          formatNumber(distance) + ")"
                                    : "") +
-                      ": is the mesh of this shape?");
+                      ": is the mesh of this shape?"};
 }
 
 // Node i moved onto where it lies on the CAD, with its records.
@@ -563,6 +563,17 @@ Mesh classifyPlanarOnCad(const Mesh& linear, const CadModel& cad, double toleran
   for (ElementBlock& b : mesh.blocks) {
     const int nv = cellNumVertices(b.type);
     for (std::size_t e = 0; e < b.count(); ++e) {
+      // The face whose trimmed domain holds the cell's centroid: the faces its nodes share may
+      // be none where a model's faces do not share their curves (a STEP file of a compound,
+      // each face with its own copy of the curve between them).
+      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+      for (int k = 0; k < nv; ++k) centroid += nodePoint(mesh, b.element(e)[k]);
+      std::pair<int, double> nearest{0, 0.0};
+      const Place inside = classifier.classify(centroid / nv, nearest);
+      if (inside.dim == 2) {
+        b.entity[e] = inside.index;
+        continue;
+      }
       Face f{-1, -1, -1, -1};
       std::copy(b.element(e), b.element(e) + nv, f.begin());
       b.entity[e] = faceOfBoundaryFace(f, mesh, classifier, cad);
@@ -575,8 +586,12 @@ Mesh classifyPlanarOnCad(const Mesh& linear, const CadModel& cad, double toleran
       throw ParameterError("the side of nodes " + std::to_string(key.first + 1) + ", " +
                            std::to_string(key.second + 1) + " is a side of " +
                            std::to_string(use.count) + " cells: the mesh is not a manifold");
-    if (use.count == 2) continue;
+    // An inner side on a CAD curve (between two faces of the model) is a line too, so that it
+    // is curved on the curve as `homesh mesh` curves it.
+    const bool inner = use.count == 2;
+    if (inner && (mesh.nodeCadDim[use.from] > 1 || mesh.nodeCadDim[use.to] > 1)) continue;
     const int edge = edgeOfSegment(use.from, use.to, mesh, classifier, cad, tolerance);
+    if (edge == 0 && inner) continue;
     if (edge == 0)
       throw MeshingError("the boundary side of nodes " + std::to_string(use.from + 1) + ", " +
                          std::to_string(use.to + 1) + " near " +

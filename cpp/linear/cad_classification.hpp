@@ -34,9 +34,10 @@ struct CadClassificationStats {
 //
 // A planar 2D mesh (dim 2, triangles and quadrilaterals, in its plane) goes on a CAD of faces
 // without solids: every node is classified (interior nodes on their face with (u, v)), cells
-// are made counter-clockwise around the plane's normal and put on the face their nodes share, and
-// each boundary side becomes a line on the CAD edge its nodes share (MeshingError naming it when
-// there is none). A 2D mesh on curved faces is refused.
+// are made counter-clockwise around the plane's normal and put on the face holding their
+// centroid, and each boundary side becomes a line on the CAD edge its nodes share (MeshingError
+// naming it when there is none), as does each inner side on a curve between two faces. A 2D mesh
+// on curved faces is refused.
 Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance = 0.0,
                    CadClassificationStats* stats = nullptr);
 

@@ -655,7 +655,7 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::di
                   const bp::dict& given, bp::object progress, const bp::object& cancel) {
   const MeshingOptions options = optionsFrom(given, kCurveKeys, kNoExtras);
   Mesh linear;
-  linear.dim = cells.has_key("tri") || cells.has_key("quad") ? 2 : 3;
+  linear.dim = 3;  // 2 once a 2D array holds cells (below)
   linear.order = 1;
   linear.xyz = finiteNodes(nodes);
   if (linear.xyz.size() % 3 != 0) throw ParameterError("nodes must be an (N, 3) array");
@@ -673,10 +673,17 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::di
     block.entity.assign(block.nodes.size() / corners, 1);
     linear.blocks.push_back(std::move(block));
   }
-  for (const ElementBlock& b : linear.blocks)
-    if (cellDimension(b.type) != linear.dim)
-      throw ParameterError(
-          "cells: 2D cells (tri, quad) and volume cells cannot be curved together");
+  bool planar = false, solid = false;
+  for (const ElementBlock& b : linear.blocks) {
+    (cellDimension(b.type) == 2 ? planar : solid) |= b.count() > 0;
+    for (const std::int64_t id : b.nodes)
+      if (id < 0 || static_cast<std::size_t>(id) >= linear.numNodes())
+        throw ParameterError(cellShortName(b.type) + " cells refer to node " + std::to_string(id) +
+                             ", outside the " + std::to_string(linear.numNodes()) + " nodes");
+  }
+  if (planar && solid)
+    throw ParameterError("cells: 2D cells (tri, quad) and volume cells cannot be curved together");
+  if (planar) linear.dim = 2;
   const std::size_t n = linear.numNodes();
   linear.nodeCadDim.assign(n, static_cast<std::uint8_t>(linear.dim));
   linear.nodeCadIndex.assign(n, 0);

@@ -349,3 +349,26 @@ def test_a_planar_2d_mesh_is_curved_on_its_faces(homesh_bin, tmp_path, recombine
     assert "node %d at (" % (node + 1) in r.stderr and "lies on no face" in r.stderr, r.stderr
     assert "at distance 0.003" in r.stderr, r.stderr
     assert not out.exists()
+
+
+def test_a_curve_between_two_faces_of_a_2d_mesh_is_followed(homesh_bin, tmp_path):
+    """A disk cut by a circle of radius 0.5 into two faces (Gmsh's conforming 2D mesh of both):
+    the sides on the inner circle, shared by a cell of each face, become lines on it, so that
+    curving puts their new nodes on the circle (to 1e-9), as on the outer one."""
+    gmsh = shutil.which("gmsh")
+    assert gmsh, "Debian's gmsh package is needed"
+    geo = tmp_path / "two.geo"
+    geo.write_text('SetFactory("OpenCASCADE");\nDisk(1) = {0, 0, 0, 1};\n'
+                   'Disk(2) = {0, 0, 0, 0.5};\nBooleanFragments{ Surface{1}; Delete; }'
+                   '{ Surface{2}; Delete; }\nMesh.MeshSizeMax = 0.25;\n')
+    linear, step = tmp_path / "two.msh", tmp_path / "two.step"
+    for args in (["-2", "-format", "msh41", "-o", linear], ["-0", "-o", step]):
+        r = run([gmsh, geo] + args)
+        assert r.returncode == 0, r.stdout + r.stderr
+    _, mesh = curved_valid(homesh_bin, tmp_path, linear, step, "--order", "4")
+    lines = mesh.cells_dict["line5"]
+    radius = np.hypot(*mesh.points[np.unique(lines.ravel()), :2].T)
+    inner = radius < 0.75
+    assert inner.sum() > 20 and (~inner).sum() > 20
+    assert np.abs(radius[inner] - 0.5).max() < 1e-9 * 2 * np.sqrt(2)
+    assert np.abs(radius[~inner] - 1.0).max() < 1e-9 * 2 * np.sqrt(2)
