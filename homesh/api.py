@@ -164,11 +164,12 @@ class HighOrderMesh:
 
     def write(self, path, binary=False, compressed=False, groups=None):
         """Writes .msh (Gmsh 4.1), .vtu (VTK Lagrange cells), .xml (Nektar++), .cgns (CGNS,
-        orders 1 to 4) or .npz (this object's arrays). ``binary``: binary MSH, raw appended VTU data; ``compressed``:
-        compressed Nektar++ XML (B64Z-LittleEndian). ``groups``: named boundary groups, a dict
-        such as ``{"wall": [1, 2], "inlet": [3]}`` (boundary faces, FaceN; 2D: curves, EdgeN)
-        written as one physical group (MSH), composite (Nektar++) or boundary condition (CGNS)
-        each, named so, in place of "FaceN"; VTU has no boundary cells, hence no groups."""
+        orders 1 to 4) or .npz (this object's arrays). ``binary``: binary MSH, raw appended VTU
+        data; ``compressed``: compressed Nektar++ XML (B64Z-LittleEndian). ``groups``: named
+        boundary groups, a dict such as ``{"wall": [1, 2], "inlet": [3]}`` (boundary faces,
+        FaceN; 2D: curves, EdgeN) written as one physical group (MSH), composite (Nektar++) or
+        boundary condition (CGNS) each, named so, in place of "FaceN"; VTU has no boundary
+        cells, hence no groups."""
         path = os.fspath(path)
         if path.lower().endswith(".npz"):
             self._save_npz(path)

@@ -17,6 +17,7 @@
 #include "core/version.hpp"
 #include "curving/order_elevation.hpp"
 #include "io/atomic_file.hpp"
+#include "io/cgns_writer.hpp"
 #include "io/mesh_readers.hpp"
 #include "io/mesh_writers.hpp"
 #include "optimise/optimiser.hpp"
@@ -105,19 +106,15 @@ homesh::WriteOptions writeOptions(const homesh::CommonOptions& c,
   return w;
 }
 
-// CGNS names elements up to order 4 and names of at most 32 characters: refused before the
-// work, not after it.
+// What no CGNS file can hold (io/cgns_writer.hpp) is refused before the work, not after it.
 void checkCgnsOrder(const homesh::CommonOptions& c, int order) {
   for (const std::string& path : c.outputs) {
     if (homesh::lowerExtension(path) != ".cgns") continue;
-    if (order > 4)
-      throw homesh::ParameterError("cannot write " + path + ": CGNS names elements up to order " +
-                                   "4, not order " + std::to_string(order) +
-                                   " (write .msh, .vtu or .xml)");
-    for (const auto& group : c.groups)
-      if (group.first.size() > 32)
-        throw homesh::ParameterError("boundary group '" + group.first +
-                                     "': CGNS names are at most 32 characters");
+    try {
+      homesh::checkCgnsOutput(order, writeOptions(c).groups);
+    } catch (const homesh::ParameterError& e) {
+      throw homesh::ParameterError("cannot write " + path + ": " + e.what());
+    }
   }
 }
 

@@ -25,7 +25,7 @@ void putVector(std::string& out, const std::vector<T>& values) {
 template <class T>
 T get(const std::string& bytes, std::size_t& offset) {
   if (offset > bytes.size() || bytes.size() - offset < sizeof(T))
-    throw MeshingError("the mesh handed back by Gmsh's process ends early");
+    throw MeshingError("the result handed back by a child process ends early");
   T value;
   std::memcpy(&value, bytes.data() + offset, sizeof(T));
   offset += sizeof(T);
@@ -36,7 +36,7 @@ template <class T>
 std::vector<T> getVector(const std::string& bytes, std::size_t& offset) {
   const auto n = get<std::uint64_t>(bytes, offset);
   if (n > (bytes.size() - offset) / sizeof(T))
-    throw MeshingError("the mesh handed back by Gmsh's process ends early");
+    throw MeshingError("the result handed back by a child process ends early");
   std::vector<T> values(n);
   if (n > 0) std::memcpy(values.data(), bytes.data() + offset, n * sizeof(T));
   offset += n * sizeof(T);
@@ -59,6 +59,29 @@ ElementBlock readBlockBytes(const std::string& bytes, std::size_t& offset) {
   block.nodes = getVector<std::int64_t>(bytes, offset);
   block.entity = getVector<std::int32_t>(bytes, offset);
   return block;
+}
+
+void appendTextsBytes(std::string& out, const std::vector<std::string>& texts) {
+  put(out, static_cast<std::uint64_t>(texts.size()));
+  for (const std::string& text : texts) putVector(out, std::vector<char>(text.begin(), text.end()));
+}
+
+std::vector<std::string> readTextsBytes(const std::string& bytes, std::size_t& offset) {
+  std::vector<std::string> texts;
+  const auto n = get<std::uint64_t>(bytes, offset);
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const std::vector<char> chars = getVector<char>(bytes, offset);
+    texts.emplace_back(chars.begin(), chars.end());
+  }
+  return texts;
+}
+
+void appendIntBytes(std::string& out, const std::vector<std::int32_t>& values) {
+  putVector(out, values);
+}
+
+std::vector<std::int32_t> readIntBytes(const std::string& bytes, std::size_t& offset) {
+  return getVector<std::int32_t>(bytes, offset);
 }
 
 void appendMeshBytes(std::string& out, const Mesh& mesh) {

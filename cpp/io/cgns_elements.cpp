@@ -40,10 +40,14 @@ const int kIncomplete[] = {
 
 }  // namespace
 
-int cgnsElementType(CellType type, int order) {
+void checkCgnsOrder(int order) {
   if (order < 1 || order > 4)
     throw ParameterError("CGNS names elements up to order 4, not order " + std::to_string(order) +
                          " (write .msh, .vtu or .xml for higher orders)");
+}
+
+int cgnsElementType(CellType type, int order) {
+  checkCgnsOrder(order);
   for (const Complete& c : kComplete)
     if (c.type == type) return c.codes[order - 1];
   throw ParameterError("no CGNS element type for " + cellShortName(type));

@@ -16,6 +16,9 @@
 
 namespace homesh {
 
+// Throws ParameterError unless 1 <= order <= 4 ("CGNS names elements up to order 4").
+void checkCgnsOrder(int order);
+
 // The CGNS ElementType_t code of a complete element. Throws ParameterError above order 4
 // ("CGNS names elements up to order 4") or for a shape CGNS has not (a point is NODE, 2).
 int cgnsElementType(CellType type, int order);

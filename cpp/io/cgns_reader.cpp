@@ -7,7 +7,6 @@
 #include <array>
 #include <cctype>
 #include <cmath>
-#include <cstring>
 #include <initializer_list>
 #include <map>
 #include <mutex>
@@ -430,29 +429,6 @@ Mesh readCgnsFile(const std::string& path, std::vector<std::string>* notes,
   return assembleForeignMesh(std::move(raw), path, notes);
 }
 
-// The child's result (isolated_call.hpp) as bytes: the mesh, its notes and groups.
-void putCount(std::string& out, std::uint64_t n) {
-  out.append(reinterpret_cast<const char*>(&n), sizeof n);
-}
-void putText(std::string& out, const std::string& text) {
-  putCount(out, text.size());
-  out += text;
-}
-std::uint64_t takeCount(const std::string& in, std::size_t& at) {
-  std::uint64_t n = 0;
-  if (at + sizeof n > in.size()) throw Error("CGNS reader: short result from its child");
-  std::memcpy(&n, in.data() + at, sizeof n);
-  at += sizeof n;
-  return n;
-}
-std::string takeText(const std::string& in, std::size_t& at) {
-  const std::uint64_t n = takeCount(in, at);
-  if (at + n > in.size()) throw Error("CGNS reader: short result from its child");
-  std::string text = in.substr(at, n);
-  at += n;
-  return text;
-}
-
 }  // namespace
 
 Mesh readCgns(const std::string& path, std::vector<std::string>* notes,
@@ -473,14 +449,12 @@ Mesh readCgns(const std::string& path, std::vector<std::string>* notes,
       } catch (const std::length_error&) {
         throw IoError("'" + path + "': its arrays are too large for this machine's memory");
       }
-      putCount(out, childNotes.size());
-      for (const std::string& note : childNotes) putText(out, note);
-      putCount(out, childGroups.size());
-      for (const NamedGroup& g : childGroups) {
-        putText(out, g.name);
-        putCount(out, g.entities.size());
-        for (const int entity : g.entities) putCount(out, static_cast<std::uint64_t>(entity));
-      }
+      appendTextsBytes(out, childNotes);
+      std::vector<std::string> names(childGroups.size());
+      for (std::size_t g = 0; g < childGroups.size(); ++g) names[g] = childGroups[g].name;
+      appendTextsBytes(out, names);
+      for (const NamedGroup& g : childGroups)
+        appendIntBytes(out, std::vector<std::int32_t>(g.entities.begin(), g.entities.end()));
       return out;
     });
   } catch (const ChildCrashed& e) {
@@ -497,16 +471,11 @@ Mesh readCgns(const std::string& path, std::vector<std::string>* notes,
   }
   std::size_t at = 0;
   Mesh mesh = readMeshBytes(bytes, at);
-  for (std::uint64_t n = takeCount(bytes, at), k = 0; k < n; ++k) {
-    std::string note = takeText(bytes, at);
+  for (std::string& note : readTextsBytes(bytes, at))
     if (notes != nullptr) notes->push_back(std::move(note));
-  }
-  for (std::uint64_t n = takeCount(bytes, at), k = 0; k < n; ++k) {
-    NamedGroup g;
-    g.name = takeText(bytes, at);
-    for (std::uint64_t m = takeCount(bytes, at), j = 0; j < m; ++j)
-      g.entities.push_back(static_cast<int>(takeCount(bytes, at)));
-    if (groups != nullptr) groups->push_back(std::move(g));
+  for (std::string& name : readTextsBytes(bytes, at)) {
+    const std::vector<std::int32_t> entities = readIntBytes(bytes, at);
+    if (groups != nullptr) groups->push_back({std::move(name), {entities.begin(), entities.end()}});
   }
   return mesh;
 }

@@ -84,8 +84,30 @@ std::string sectionName(int dim, int entity, int code) {
 
 }  // namespace
 
+void checkCgnsOutput(int order, const std::vector<NamedGroup>& groups) {
+  checkCgnsOrder(order);
+  for (const NamedGroup& g : groups)
+    if (g.name.size() > 32)
+      throw ParameterError("boundary group '" + g.name + "': CGNS names are at most 32 characters");
+}
+
 void writeCgns(const Mesh& mesh, const std::string& path, const std::vector<NamedGroup>& groups) {
+  checkCgnsOutput(mesh.order, groups);
   for (const ElementBlock& block : mesh.blocks) cgnsElementType(block.type, block.order);
+  // One zone's conditions need distinct names: a group may not take a name an ungrouped boundary
+  // entity's own condition has.
+  std::set<int> grouped;
+  for (const NamedGroup& g : groups) grouped.insert(g.entities.begin(), g.entities.end());
+  std::set<std::string> ungrouped;
+  for (const ElementBlock& block : mesh.blocks)
+    if (cellDimension(block.type) == mesh.dim - 1)
+      for (const int entity : block.entity)
+        if (grouped.count(entity) == 0) ungrouped.insert(cadEntityName(mesh.dim - 1, entity));
+  for (const NamedGroup& g : groups)
+    if (ungrouped.count(g.name) != 0)
+      throw ParameterError("boundary group '" + g.name +
+                           "' has the name of a boundary entity not in it; " +
+                           "rename the group for CGNS");
   const std::unique_lock<std::mutex> library = holdCgnsLibrary();
   CgnsOutput out(path);
   const int fn = out.fn();
@@ -159,16 +181,6 @@ void writeCgns(const Mesh& mesh, const std::string& path, const std::vector<Name
   }
   for (auto& [entity, cells] : cellsOfEntity)
     conditions.emplace_back(cadEntityName(mesh.dim - 1, entity), std::move(cells));
-  std::set<std::string> used;
-  for (const auto& [name, cells] : conditions) {
-    // (SIDS names are at most 32 characters, and one zone's conditions need distinct names.)
-    if (name.size() > 32)
-      throw ParameterError("boundary group '" + name + "': CGNS names are at most 32 characters");
-    if (!used.insert(name).second)
-      throw ParameterError("boundary group '" + name +
-                           "' has the name of a boundary entity not in it; " +
-                           "rename the group for CGNS");
-  }
   const auto location = mesh.dim == 3 ? CGNS_ENUMV(FaceCenter) : CGNS_ENUMV(EdgeCenter);
   for (const auto& [name, cells] : conditions) {
     if (cells.empty()) continue;

@@ -688,10 +688,8 @@ PyMesh curveOnCad(const CadSource& source, const bp::object& nodes, const bp::di
   linear.nodeCadDim.assign(n, static_cast<std::uint8_t>(linear.dim));
   linear.nodeCadIndex.assign(n, 0);
   linear.nodeCadParam.assign(2 * n, std::numeric_limits<double>::quiet_NaN());
-  if (linear.dim == 2) {  // its plane, as the mesh readers find it (zero: on curved faces)
-    linear.checkConsistency();
+  if (linear.dim == 2)  // its plane, as the mesh readers find it (zero: on curved faces)
     if (const auto normal = planeOfCells(linear, 1e-5)) linear.planeNormal = *normal;
-  }
   return runObserved(std::move(progress), cancel, [&](PipelineObserver* observer) {
     return curveMeshOnCad(source, linear, options, observer);
   });

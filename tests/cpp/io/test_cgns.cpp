@@ -336,8 +336,9 @@ TEST(CgnsWriter, EveryShapeRoundTripsAtOrdersOneToFourAndOrderFiveIsRefused) {
   EXPECT_FALSE(std::filesystem::exists(path + ".part"));
 }
 
-// A failure after the file is opened (a group name too long for CGNS, found once the cells are
-// written) leaves neither the temporary file nor a changed output behind.
+// A failed write leaves neither the temporary file nor a changed output behind: a group name
+// too long for CGNS (refused before the file is opened), and a failure once the whole file is
+// written (its name taken by a folder, so that the temporary file cannot be renamed onto it).
 TEST(CgnsWriter, AFailedWriteLeavesNoPartialFileAndKeepsThePreviousOne) {
   const auto dir = test::tempDir();
   const Mesh mesh = curvedBoxWithHole(2);
@@ -359,6 +360,14 @@ TEST(CgnsWriter, AFailedWriteLeavesNoPartialFileAndKeepsThePreviousOne) {
   std::string kept;
   in >> kept;
   EXPECT_EQ(kept, "previous");
+
+  const std::string folder = (dir / "taken.cgns").string();
+  std::filesystem::create_directory(folder);
+  std::ofstream(folder + "/inside") << "kept";
+  EXPECT_THROW(writeMesh(mesh, folder, {}), IoError);
+  EXPECT_FALSE(std::filesystem::exists(folder + ".part"));
+  EXPECT_TRUE(std::filesystem::is_directory(folder));
+  EXPECT_TRUE(std::filesystem::exists(folder + "/inside"));
 }
 
 // A file as other tools write them, made with the CGNS library: two zones of one hexahedron
