@@ -141,10 +141,10 @@ std::int64_t LayerSplitter::fanNode(const FanSector& s, const SectorPiece& piece
   const std::int64_t tb = s.v[s.b], td = s.v[s.d];
   NodeKey key{};
   if (apexWeight > 0 && w[1] > 0 && w[2] > 0) {
-    key = makeKey({{{tb, w[1]}, {td, w[2]}, {s.v[s.a], apexWeight}}}, -1);
+    key = makeKey({{{tb, w[1]}, {td, w[2]}, {s.v[s.a], apexWeight}, {kNone, 0}}}, -1);
   } else {
     const int sg = apexWeight > 0 ? (w[2] > 0 ? p_ : 0) : sigma / p_;
-    key = makeKey({{{tb, p_ - sg}, {td, sg}, {kNone, 0}}}, level / p_);
+    key = makeKey({{{tb, p_ - sg}, {td, sg}, {kNone, 0}, {kNone, 0}}}, level / p_);
   }
   const auto it = nodes_.find(key);
   if (it != nodes_.end()) return it->second;

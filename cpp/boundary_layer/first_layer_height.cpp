@@ -2,6 +2,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <optional>
@@ -25,9 +26,10 @@ namespace {
 std::optional<double> heightAlongNormal(const ElementMap& map, const Eigen::Vector3d& plane,
                                         double a, double b, const Eigen::Vector3d& bottom,
                                         const Eigen::Vector3d& n) {
-  const bool prism = map.reference().type() == CellType::Prism;
+  const LayerShape shape = layerShape(map.reference().type());
+  const bool volume = shape.across == 2;
   Eigen::Vector3d t1, t2 = Eigen::Vector3d::Zero();
-  if (prism) {
+  if (volume) {
     t1 = n.unitOrthogonal();
     t2 = n.cross(t1);
   } else {
@@ -41,12 +43,12 @@ std::optional<double> heightAlongNormal(const ElementMap& map, const Eigen::Vect
   constexpr int kIterations = 30;
   constexpr double kStep = 1e-12, kInside = 1e-9;
   for (int it = 0; it < kIterations; ++it) {
-    const double xi[3] = {a, prism ? b : 1.0, 1.0};
+    const double xi[3] = {a, volume ? b : 1.0, 1.0};
     const Eigen::Vector3d x = map.position(xi, d);
     const Eigen::Vector3d da = d.col(0), db = d.col(1);
     const Eigen::Vector3d offset = x - bottom;
     Eigen::Vector2d step(0.0, 0.0);
-    if (prism) {
+    if (volume) {
       Eigen::Matrix2d jac;
       jac << da.dot(t1), db.dot(t1), da.dot(t2), db.dot(t2);
       step = jac.fullPivLu().solve(-Eigen::Vector2d(offset.dot(t1), offset.dot(t2)));
@@ -54,8 +56,7 @@ std::optional<double> heightAlongNormal(const ElementMap& map, const Eigen::Vect
       step[0] = -offset.dot(t1) / da.dot(t1);
     }
     if (!step.allFinite()) return std::nullopt;
-    const bool inside = a >= -kInside && a <= 1.0 + kInside &&
-                        (!prism || (b >= -kInside && a + b <= 1.0 + kInside));
+    const bool inside = shape.inWall(a, b, kInside);
     if (step.norm() < kStep) return inside ? std::optional<double>(offset.dot(n)) : std::nullopt;
     a += step[0];
     b += step[1];
@@ -69,9 +70,10 @@ void LayerSplitter::measureFirstLayer() {
   std::size_t cell = 0;  // the macro cell, in split order
   for (const ElementBlock& b : out_.blocks) {
     if (!layerCell(b)) continue;
-    const bool prism = b.type == CellType::Prism;
+    const LayerShape shape = layerShape(b.type);
+    const bool volume = shape.across == 2;
     const ReferenceElement& ref = ReferenceElement::get(b.type, p_);
-    const QuadratureRule rule = quadratureRule(prism ? CellType::Triangle : CellType::Line, 2 * p_);
+    const QuadratureRule rule = quadratureRule(shape.wall, 2 * p_);
     const Eigen::Vector3d plane(out_.planeNormal[0], out_.planeNormal[1], out_.planeNormal[2]);
     for (std::size_t e = 0; e < b.count(); e += static_cast<std::size_t>(n_)) {
       const std::int64_t* v = b.element(e);  // the column's first layer
@@ -81,15 +83,16 @@ void LayerSplitter::measureFirstLayer() {
       for (int q = 0; q < rule.size(); ++q) {
         const auto qq = static_cast<std::size_t>(q);
         const double a = rule.points[qq * static_cast<std::size_t>(rule.dim)];
-        const double bb = prism ? rule.points[qq * 2 + 1] : 0.0;
-        const double atWall[3] = {a, prism ? bb : 0.0, 0.0}, atTop[3] = {a, prism ? bb : 1.0, 1.0};
+        const double bb = volume ? rule.points[qq * 2 + 1] : 0.0;
+        const double atWall[3] = {a, volume ? bb : 0.0, 0.0},
+                     atTop[3] = {a, volume ? bb : 1.0, 1.0};
         const Eigen::Vector3d bottom = map.position(atWall), top = map.position(atTop);
         const Eigen::Vector3d n = wallNormal(map, a, bb, plane, top - bottom);
         const std::optional<double> along = heightAlongNormal(map, plane, a, bb, bottom, n);
         if (!along) ++stats_.firstHeightOffNormal;
         const double h = along ? *along : (top - bottom).dot(n);
-        const double l[3] = {prism ? 1.0 - a - bb : 1.0 - a, a, bb};
-        const double target = z_[1] * grownHeight(v, wallVertices(b), l);
+        const std::array<double, 4> l = shape.weights(a, bb);
+        const double target = z_[1] * grownHeight(v, shape.walls, l.data());
         if (stats_.firstHeightMeasured == 0) stats_.firstHeightMin = stats_.firstHeightMax = h;
         stats_.firstHeightMin = std::min(stats_.firstHeightMin, h);
         stats_.firstHeightMax = std::max(stats_.firstHeightMax, h);

@@ -38,13 +38,13 @@ void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops) {
   };
   for (int pass = tops ? 0 : 1; pass < 2; ++pass)  // tops first: the inner levels blend to them
     for (const ElementBlock& b : mesh.blocks) {
-      // The layer's cells: prisms (wall 0, 1, 2, tops 3, 4, 5), in 2D quadrilaterals (wall 0,
-      // 1, tops 3, 2); the lattice axis across the layer is the last.
+      // The layer's cells (layer_cells.hpp: the lattice axis across the layer is the last).
       if (!isLayerCell(mesh, b) || b.order < 2) continue;
-      const bool prism = b.type == CellType::Prism;
+      const LayerShape shape = layerShape(b.type);
+      const bool volume = shape.across == 2;
       const int p = b.order;
-      const int walls = prism ? 3 : 2;
-      const std::size_t across = prism ? 2 : 1;
+      const int walls = shape.walls;
+      const std::size_t across = shape.across;
       const ReferenceElement& ref = ReferenceElement::get(b.type, p);
       const std::map<LatticePoint, int> index = latticeIndex(ref);
       for (std::size_t e = 0; e < b.count(); ++e) {
@@ -52,13 +52,13 @@ void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops) {
         const auto x = [&](std::int64_t n) {
           return Eigen::Vector3d(&mesh.xyz[3 * static_cast<std::size_t>(n)]);
         };
-        const auto top = [&](int k) { return prism ? v[k + 3] : v[3 - k]; };
+        const auto top = [&](int k) { return shape.top(v, k); };
         for (int r = 0; r < ref.numNodes(); ++r) {
           const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
           const auto id = static_cast<std::size_t>(v[r]);
-          const bool vertex =
-              prism ? (c[0] == 0 || c[0] == p) && (c[1] == 0 || c[1] == p) && c[0] + c[1] <= p
-                    : c[0] == 0 || c[0] == p;
+          const bool vertex = (c[0] == 0 || c[0] == p) &&
+                              (!volume || ((c[1] == 0 || c[1] == p) &&
+                                           (shape.wall != CellType::Triangle || c[0] + c[1] <= p)));
           if (c[across] == 0 || !movable(id) || done[id] != 0 || (pass == 0) != (c[across] == p))
             continue;
           if (pass == 0 && vertex) continue;
@@ -70,14 +70,15 @@ void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops) {
             // The top is the wall node offset along the wall's own normal there, corrected by
             // the vertices' deviations of their climbs from the wall normal (interpolated), by
             // the interpolated height: parallel to the curved wall, meeting the top vertices.
-            const double l[3] = {prism ? double(p - c[0] - c[1]) / p : double(p - c[0]) / p,
-                                 double(c[0]) / p, prism ? double(c[1]) / p : 0.0};
-            const double corner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+            const std::array<double, 4> l =
+                shape.weights(double(c[0]) / p, volume ? double(c[1]) / p : 0.0);
+            // The wall vertices' reference coordinates (the triangle's are the first three).
+            const double corner[4][2] = {{0, 0}, {1, 0}, {shape.walls == 4 ? 1.0 : 0.0, 1}, {0, 1}};
             Eigen::Vector3d rise = Eigen::Vector3d::Zero();
             double h = 0.0;
             for (int k = 0; k < walls; ++k) {
-              rise += l[k] * (x(top(k)) - x(v[k]));
-              h += l[k] * (x(top(k)) - x(v[k])).norm();
+              rise += l[static_cast<std::size_t>(k)] * (x(top(k)) - x(v[k]));
+              h += l[static_cast<std::size_t>(k)] * (x(top(k)) - x(v[k])).norm();
             }
             // In 2D the CAD curve's own normals where the wall nodes are on it: the wall's
             // polynomial tilts its normal by degrees near the ends of a short wall around a
@@ -86,7 +87,7 @@ void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops) {
             const int curve = mesh.dim == 2 && cad != nullptr && mesh.nodeCadDim[w] == 1
                                   ? mesh.nodeCadIndex[w]
                                   : 0;
-            std::array<Eigen::Vector3d, 3> atCorner;
+            std::array<Eigen::Vector3d, 4> atCorner;
             Eigen::Vector3d direction = Eigen::Vector3d::Zero();
             bool exact = curve > 0;
             if (exact) {
@@ -99,14 +100,15 @@ void blendLayerInteriors(Mesh& mesh, const CadModel* cad, bool tops) {
             }
             if (!exact) {
               direction =
-                  wallNormal(mesh, ref, v, double(c[0]) / p, prism ? double(c[1]) / p : 0.0, rise);
+                  wallNormal(mesh, ref, v, double(c[0]) / p, volume ? double(c[1]) / p : 0.0, rise);
               for (int k = 0; k < walls; ++k)
                 atCorner[static_cast<std::size_t>(k)] =
                     wallNormal(mesh, ref, v, corner[k][0], corner[k][1], x(top(k)) - x(v[k]));
             }
             for (int k = 0; k < walls; ++k) {
               const Eigen::Vector3d climb = x(top(k)) - x(v[k]);
-              direction += l[k] * (climb.normalized() - atCorner[static_cast<std::size_t>(k)]);
+              direction += l[static_cast<std::size_t>(k)] *
+                           (climb.normalized() - atCorner[static_cast<std::size_t>(k)]);
             }
             if (!(direction.norm() > 0.0)) continue;
             setOnCad(id, x(w) + h * direction.normalized());

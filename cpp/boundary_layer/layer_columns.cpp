@@ -1,5 +1,6 @@
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -34,7 +35,8 @@ double LayerSplitter::grownHeight(const std::int64_t* v, int walls, const double
 
 const Column& LayerSplitter::column(const ElementBlock& b, const std::map<LatticePoint, int>& index,
                                     const std::int64_t* v, LatticePoint c) {
-  const std::size_t across = b.type == CellType::Prism ? 2 : 1;
+  const LayerShape shape = layerShape(b.type);
+  const std::size_t across = shape.across;
   c[across] = 0;
   const std::int64_t w = v[index.at(c)];
   c[across] = p_;
@@ -43,10 +45,9 @@ const Column& LayerSplitter::column(const ElementBlock& b, const std::map<Lattic
   if (found != columns_.end()) return found->second;
   Column col;
   col.levels = z_;
-  const bool prism = b.type == CellType::Prism;
-  const double l[3] = {prism ? double(p_ - c[0] - c[1]) / p_ : double(p_ - c[0]) / p_,
-                       double(c[0]) / p_, prism ? double(c[1]) / p_ : 0.0};
-  const double target = grownHeight(v, wallVertices(b), l);
+  const std::array<double, 4> l =
+      shape.weights(double(c[0]) / p_, across == 2 ? double(c[1]) / p_ : 0.0);
+  const double target = grownHeight(v, shape.walls, l.data());
   const auto normal = normals_.find(topNode);
   if (n_ > 1 && plain_.count(topNode) == 0 && std::isfinite(target) && target > 0.0 &&
       normal != normals_.end() && normal->second.sum.norm() > 0.0) {
@@ -56,7 +57,7 @@ const Column& LayerSplitter::column(const ElementBlock& b, const std::map<Lattic
     const Eigen::Vector3d n = normal->second.sum.normalized();
     // A lengthened column at a sharp edge or corner leans between its walls by design and ends
     // at the height from each: measured along each wall's normal, unshifted.
-    if (normal->second.sharp() && lengthening(v, wallVertices(b), l) > 1.0 + 1e-9) {
+    if (normal->second.sharp() && lengthening(v, shape.walls, l.data()) > 1.0 + 1e-9) {
       const double height = normal->second.minAlong(rise);
       if (height > 0.0) setFirstLevel(col, z_[1] * target / height);
       return columns_.emplace(topNode, std::move(col)).first->second;

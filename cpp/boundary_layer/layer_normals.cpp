@@ -18,11 +18,11 @@ Eigen::Vector3d wallNormal(const Mesh& mesh, const ReferenceElement& ref, const 
 
 Eigen::Vector3d wallNormal(const ElementMap& map, double a, double b, const Eigen::Vector3d& plane,
                            const Eigen::Vector3d& towards) {
-  const bool prism = map.reference().type() == CellType::Prism;
-  const double xi[3] = {a, prism ? b : 0.0, 0.0};
+  const bool volume = map.reference().dim() == 3;
+  const double xi[3] = {a, volume ? b : 0.0, 0.0};
   Eigen::Matrix3d d;
   map.position(xi, d);
-  Eigen::Vector3d n = prism ? Eigen::Vector3d(d.col(0).cross(d.col(1))) : plane.cross(d.col(0));
+  Eigen::Vector3d n = volume ? Eigen::Vector3d(d.col(0).cross(d.col(1))) : plane.cross(d.col(0));
   if (!(n.norm() > 0.0)) return Eigen::Vector3d::Zero();
   n.normalize();
   return n.dot(towards) < 0.0 ? Eigen::Vector3d(-n) : n;

@@ -24,8 +24,9 @@ namespace homesh {
 // this (cos 15 degrees: the normals spread by more than about 30 degrees).
 constexpr double kCornerMeanNormal = 0.966;
 
-// The unit normal of a layer cell's curved wall (a prism's triangle at zeta 0; in 2D a
-// quadrilateral's edge, in the plane) at wall coordinates (a, b), on the side of `towards`.
+// The unit normal of a layer cell's curved wall (a prism's triangle or a hexahedron's
+// quadrilateral at zeta 0; in 2D a quadrilateral's edge, in the plane) at wall coordinates (a, b),
+// on the side of `towards`.
 Eigen::Vector3d wallNormal(const Mesh& mesh, const ReferenceElement& ref, const std::int64_t* v,
                            double a, double b, const Eigen::Vector3d& towards);
 // The same on the cell's map (element/element_map.hpp), `plane` the mesh's plane normal in 2D.
@@ -45,8 +46,7 @@ void forEachColumn(const Mesh& mesh, Visit&& visit) {
   for (const ElementBlock& b : mesh.blocks) {
     if (!isLayerCell(mesh, b)) continue;
     const int p = b.order;
-    const bool prism = b.type == CellType::Prism;
-    const std::size_t across = prism ? 2 : 1;
+    const std::size_t across = layerShape(b.type).across;
     const ReferenceElement& ref = ReferenceElement::get(b.type, p);
     const std::map<LatticePoint, int> index = latticeIndex(ref);
     for (std::size_t e = 0; e < b.count(); ++e) {
@@ -61,7 +61,7 @@ void forEachColumn(const Mesh& mesh, Visit&& visit) {
         const Eigen::Vector3d rise = Eigen::Vector3d(&mesh.xyz[3 * static_cast<std::size_t>(top)]) -
                                      Eigen::Vector3d(&mesh.xyz[3 * static_cast<std::size_t>(v[r])]);
         visit(v[r], top,
-              wallNormal(map, double(c[0]) / p, prism ? double(c[1]) / p : 0.0, plane, rise));
+              wallNormal(map, double(c[0]) / p, across == 2 ? double(c[1]) / p : 0.0, plane, rise));
       }
     }
   }
@@ -88,7 +88,7 @@ struct NormalSum {
   }
 };
 
-// Per node (3 values): for the nodes of a macro layer's top (prisms' and, in 2D,
+// Per node (3 values): for the nodes of a macro layer's top (prisms' and hexahedra's, in 2D the
 // quadrilaterals' far side), the unit wall normal below them (averaged over the cells sharing
 // the node); NaN for every other node and for nodes above a sharp corner (the cells' normals
 // spread by more than about 30 degrees: they may move freely). OptimiserOptions::normalLocked

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -72,15 +73,16 @@ void LayerSplitter::pairWallAndTop(const ElementBlock& b) {
 }
 
 ElementBlock LayerSplitter::splitCells(const ElementBlock& b) {
-  const bool prism = b.type == CellType::Prism;
+  const LayerShape shape = layerShape(b.type);
   const ReferenceElement& ref = ReferenceElement::get(b.type, p_);
   const std::map<LatticePoint, int> index = latticeIndex(ref);
   const int nn = ref.numNodes();
   const int dim = ref.dim();
-  const auto across = static_cast<std::size_t>(dim - 1);  // the lattice axis across the layer
+  const std::size_t across = shape.across;  // the lattice axis across the layer
   ElementBlock out;
   out.type = b.type;
   out.order = p_;
+  out.layerCells = b.layerCells;
   out.nodes.resize(b.count() * static_cast<std::size_t>(n_) * static_cast<std::size_t>(nn));
   out.entity.resize(b.count() * static_cast<std::size_t>(n_));
   Eigen::MatrixXd points(nn, dim);
@@ -93,8 +95,8 @@ ElementBlock LayerSplitter::splitCells(const ElementBlock& b) {
   for (int k = 0; k < n_; ++k) {
     for (std::size_t e = 0; e < b.count(); ++e) {
       const std::int64_t* v = b.element(e);
-      const std::int64_t t[3] = {topVertex(b, v, 0), topVertex(b, v, 1),
-                                 prism ? topVertex(b, v, 2) : kNone};
+      std::array<std::int64_t, 4> t{kNone, kNone, kNone, kNone};
+      for (int w = 0; w < shape.walls; ++w) t[static_cast<std::size_t>(w)] = shape.top(v, w);
       // The k-th thin cell's nodes in the macro cell's reference element, on its columns' levels.
       for (int r = 0; r < nn; ++r) {
         const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
@@ -113,9 +115,9 @@ ElementBlock LayerSplitter::splitCells(const ElementBlock& b) {
       for (int r = 0; r < nn; ++r) {
         const LatticePoint& c = ref.lattice()[static_cast<std::size_t>(r)];
         const std::int64_t level = std::int64_t(k) * p_ + c[across];
+        const std::array<int, 4> w = shape.latticeWeights(c, p_);
         const NodeKey key =
-            prism ? makeKey({{{t[0], p_ - c[0] - c[1]}, {t[1], c[0]}, {t[2], c[1]}}}, level)
-                  : makeKey({{{t[0], p_ - c[0]}, {t[1], c[0]}, {kNone, 0}}}, level);
+            makeKey({{{t[0], w[0]}, {t[1], w[1]}, {t[2], w[2]}, {t[3], w[3]}}}, level);
         std::int64_t id = 0;
         if (level == 0 || level == std::int64_t(n_) * p_) {
           LatticePoint m = c;
@@ -142,7 +144,7 @@ ElementBlock LayerSplitter::splitCells(const ElementBlock& b) {
       }
     }
   }
-  stats_.prisms += b.count();  // (quadrilaterals in 2D)
+  (b.type == CellType::Hexahedron ? stats_.hexahedra : stats_.prisms) += b.count();
   return out;
 }
 
@@ -168,7 +170,7 @@ void keepColumnsPlain(const Mesh& macro, int layers, std::size_t element, LayerH
       }
       const std::size_t e = (element - base) / static_cast<std::size_t>(layers);
       const ReferenceElement& ref = ReferenceElement::get(b.type, b.order);
-      const std::size_t across = b.type == CellType::Prism ? 2 : 1;
+      const std::size_t across = layerShape(b.type).across;
       for (int r = 0; r < ref.numNodes(); ++r)
         if (ref.lattice()[static_cast<std::size_t>(r)][across] == b.order)
           heights.plain.insert(b.element(e)[r]);
@@ -202,11 +204,11 @@ std::vector<double> grownLayerHeights(const Mesh& linear) {
   std::vector<double> heights(linear.numNodes(), std::nan(""));
   for (const ElementBlock& b : linear.blocks) {
     if (!isLayerCell(linear, b)) continue;
-    const bool prism = b.type == CellType::Prism;
+    const LayerShape shape = layerShape(b.type);
     for (std::size_t e = 0; e < b.count(); ++e) {
       const std::int64_t* v = b.element(e);
-      for (int k = 0; k < (prism ? 3 : 2); ++k) {
-        const std::int64_t t = prism ? v[k + 3] : v[3 - k];
+      for (int k = 0; k < shape.walls; ++k) {
+        const std::int64_t t = shape.top(v, k);
         heights[static_cast<std::size_t>(v[k])] =
             (Eigen::Vector3d(&linear.xyz[3 * static_cast<std::size_t>(t)]) -
              Eigen::Vector3d(&linear.xyz[3 * static_cast<std::size_t>(v[k])]))

@@ -1,8 +1,9 @@
 // Splits a curved macro boundary layer into thin layers (../shared/DESIGN.md section 8).
 //
-// Every prism is split across its wall-normal reference direction (the wall is its triangle
-// 0, 1, 2, as boundary_layer.hpp makes it) at the coordinates z_0 = 0 < ... < z_n = 1;
-// each new node is the macro prism's own curved map at its reference point, so each thin prism
+// Every layer cell is split across its wall-normal reference direction (the wall is a prism's
+// triangle 0, 1, 2, as boundary_layer.hpp makes it, or a marked hexahedron's quadrilateral
+// 0, 1, 2, 3, as layer_stacks.hpp makes it; layer_cells.hpp) at the coordinates z_0 = 0 < ... < z_n
+// = 1; each new node is the macro prism's own curved map at its reference point, so each thin prism
 // is a sub-map of the macro one (valid where the macro prism is, its Jacobian scaled by
 // z_{k+1} - z_k). With the heights the layer was grown to, the levels are set per column of
 // nodes instead, so that the first layer keeps its asked height where the optimiser moved the
@@ -30,8 +31,9 @@
 namespace homesh {
 
 struct LayerSplitStats {
-  std::size_t prisms = 0, quadrilaterals = 0, lines = 0;  // macro elements split
-  std::size_t projected = 0;                              // new nodes on a CAD face or curve
+  // Macro elements split: prisms (2D: quadrilaterals), hexahedra, side quadrilaterals, lines.
+  std::size_t prisms = 0, hexahedra = 0, quadrilaterals = 0, lines = 0;
+  std::size_t projected = 0;   // new nodes on a CAD face or curve
   double maxProjection = 0.0;  // largest move onto the CAD, relative to the layer's height
   // The first layer's height along the wall normal at the wall's quadrature points (degree
   // 2P), the distance to where the normal line meets the layer's top: its range over the points

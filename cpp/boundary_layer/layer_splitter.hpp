@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <optional>
 #include <set>
 #include <utility>
@@ -30,21 +31,26 @@ namespace homesh::layer_splitting {
 
 constexpr std::int64_t kNone = std::numeric_limits<std::int64_t>::max();
 
-// A node of the split layer: up to three columns (named by their macro top vertices, one per
-// column even where a fan's columns share a wall vertex) with integer weights (summing to the
-// order P) and the level across the layer, 0 (wall) .. n P (top).
-using NodeKey = std::array<std::int64_t, 7>;
+// A node of the split layer: up to four columns (named by their macro top vertices, one per
+// column even where a fan's columns share a wall vertex) with integer weights and the level
+// across the layer, 0 (wall) .. n P (top). The weights are divided by their greatest common
+// divisor, so that a node on a side a prism (weights summing to P) shares with a hexahedron
+// (summing to P^2) has one key.
+using NodeKey = std::array<std::int64_t, 9>;
 
-inline NodeKey makeKey(std::array<std::pair<std::int64_t, int>, 3> w, std::int64_t level) {
-  for (auto& [id, weight] : w)
+inline NodeKey makeKey(std::array<std::pair<std::int64_t, int>, 4> w, std::int64_t level) {
+  int common = 0;
+  for (auto& [id, weight] : w) {
     if (weight == 0) id = kNone;
+    common = std::gcd(common, weight);
+  }
   std::sort(w.begin(), w.end());
   NodeKey k{};
-  for (std::size_t i = 0; i < 3; ++i) {
+  for (std::size_t i = 0; i < 4; ++i) {
     k[2 * i] = w[i].first;
-    k[2 * i + 1] = w[i].first == kNone ? 0 : w[i].second;
+    k[2 * i + 1] = w[i].first == kNone || common == 0 ? 0 : w[i].second / common;
   }
-  k[6] = level;
+  k[8] = level;
   return k;
 }
 
@@ -141,12 +147,12 @@ class LayerSplitter {
   std::map<std::int64_t, Column> columns_;      // column (top node) -> how it is split
   static constexpr double kMaxShiftLean = 1.0;  // tangent of the lean: 45 degrees
 
-  // The macro layer's cells: prisms in 3D (wall 0, 1, 2; tops 3, 4, 5), quadrilaterals in 2D
-  // (wall 0, 1; tops 3 above 0 and 2 above 1).
+  // The macro layer's cells (layer_cells.hpp: prisms and marked hexahedra in 3D,
+  // quadrilaterals in 2D).
   bool layerCell(const ElementBlock& b) const { return isLayerCell(macro_, b); }
-  static int wallVertices(const ElementBlock& b) { return b.type == CellType::Prism ? 3 : 2; }
+  static int wallVertices(const ElementBlock& b) { return layerShape(b.type).walls; }
   static std::int64_t topVertex(const ElementBlock& b, const std::int64_t* v, int k) {
-    return b.type == CellType::Prism ? v[k + 3] : v[3 - k];
+    return layerShape(b.type).top(v, k);
   }
 
   // Records each layer cell's wall -> top vertex pairs (topOf_) and the heights (height_).

@@ -9,16 +9,23 @@
 #include <map>
 #include <utility>
 
+#include "boundary_layer/layer_cells.hpp"
 #include "linear/edge_split.hpp"
 
 namespace homesh {
 namespace {
 
-using Tri = std::array<std::int64_t, 3>;
+// A face of a volume cell or of the boundary, as its sorted vertices (a triangle's fourth is
+// kNoVertex).
+using FaceKey = std::array<std::int64_t, 4>;
+constexpr std::int64_t kNoVertex = -1;
 
-Tri sorted(Tri t) {
-  std::sort(t.begin(), t.end());
-  return t;
+template <class Vertices>
+FaceKey faceKey(const Vertices& vertices, std::size_t n) {
+  FaceKey k{kNoVertex, kNoVertex, kNoVertex, kNoVertex};
+  for (std::size_t i = 0; i < n; ++i) k[i] = vertices[i];
+  std::sort(k.begin(), k.end());
+  return k;
 }
 
 // A volume cell: its block and index there.
@@ -30,29 +37,67 @@ struct CellRef {
   bool operator==(const CellRef& o) const { return block == o.block && element == o.element; }
 };
 
-// The triangular faces of each volume type, as local corners.
-std::vector<std::array<int, 3>> triangleFaces(CellType type) {
+// The faces of each volume type, as local corners (a triangle's fourth is -1).
+const std::vector<std::array<int, 4>>& cellFaces(CellType type) {
+  static const std::vector<std::array<int, 4>> tetrahedron{
+      {0, 1, 2, -1}, {0, 1, 3, -1}, {0, 2, 3, -1}, {1, 2, 3, -1}};
+  static const std::vector<std::array<int, 4>> prism{
+      {0, 1, 2, -1}, {3, 4, 5, -1}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}};
+  static const std::vector<std::array<int, 4>> pyramid{
+      {0, 1, 4, -1}, {1, 2, 4, -1}, {2, 3, 4, -1}, {3, 0, 4, -1}, {0, 1, 2, 3}};
+  static const std::vector<std::array<int, 4>> hexahedron{{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                                          {3, 2, 6, 7}, {0, 3, 7, 4}, {1, 2, 6, 5}};
+  static const std::vector<std::array<int, 4>> none;
   switch (type) {
     case CellType::Tetrahedron:
-      return {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
+      return tetrahedron;
     case CellType::Prism:
-      return {{0, 1, 2}, {3, 4, 5}};
+      return prism;
     case CellType::Pyramid:
-      return {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+      return pyramid;
+    case CellType::Hexahedron:
+      return hexahedron;
     default:
-      return {};
+      return none;
   }
 }
 
-std::string prismName(const CellRef& c) {
-  return "prism " + std::to_string(c.element + 1);
+// A way through a layer cell: from the face `wall` to the opposite face `top`, wall[k] below
+// top[k]. Each wall is ordered so that its normal (right-handed) points into the cell: the cell
+// (wall, top) is then positive, as layer_cells.hpp orders a macro cell.
+struct Climb {
+  std::array<int, 4> wall, top;  // (a prism's fourth entries are unused)
+};
+
+const std::vector<Climb>& climbs(CellType type) {
+  static const std::vector<Climb> prism{{{0, 1, 2, -1}, {3, 4, 5, -1}},
+                                        {{3, 5, 4, -1}, {0, 2, 1, -1}}};
+  static const std::vector<Climb> hexahedron{
+      {{0, 1, 2, 3}, {4, 5, 6, 7}}, {{4, 7, 6, 5}, {0, 3, 2, 1}}, {{0, 4, 5, 1}, {3, 7, 6, 2}},
+      {{3, 2, 6, 7}, {0, 1, 5, 4}}, {{0, 3, 7, 4}, {1, 2, 6, 5}}, {{1, 5, 6, 2}, {0, 4, 7, 3}}};
+  return type == CellType::Prism ? prism : hexahedron;
 }
 
-// One stack: its columns' nodes, wall (level 0) to top, for the wall triangle's three corners
-// in an order that keeps the macro prism positive.
+std::size_t wallSize(CellType type) {
+  return type == CellType::Prism ? 3 : 4;
+}
+
+std::string cellName(CellType type, const CellRef& c) {
+  return (type == CellType::Prism ? "prism " : "hexahedron ") + std::to_string(c.element + 1);
+}
+
+// One stack: its cells, wall to top, and its columns' nodes, wall (level 0) to top, for the
+// wall face's corners in an order that keeps the macro cell positive.
 struct Stack {
-  std::array<std::vector<std::int64_t>, 3> columns;
+  CellType type = CellType::Prism;
+  std::vector<std::vector<std::int64_t>> columns;
+  std::vector<CellRef> cells;
+  int wall = 0;  // the CAD face it stands on
 };
+
+// How a climb ended: a stack, at the boundary again, back at a cell it passed, or at a cell that
+// ends no stack of its type (a hexahedral stack ends at a pyramid).
+enum class ClimbEnd { Stack, Spans, Loops, Blocked };
 
 class Recogniser {
  public:
@@ -62,94 +107,150 @@ class Recogniser {
       if (cellDimension(block.type) == 3) {
         for (std::size_t e = 0; e < block.count(); ++e) {
           const std::int64_t* v = block.element(e);
-          for (const auto& f : triangleFaces(block.type))
-            faceCells_[sorted({v[f[0]], v[f[1]], v[f[2]]})].push_back({b, e});
+          for (const auto& f : cellFaces(block.type)) {
+            const std::size_t n = f[3] < 0 ? 3 : 4;
+            std::array<std::int64_t, 4> corners{};
+            for (std::size_t i = 0; i < n; ++i) corners[i] = v[f[i]];
+            faceCells_[faceKey(corners, n)].push_back({b, e});
+          }
           if (block.type == CellType::Prism) prisms_.push_back({b, e});
+          if (block.type == CellType::Hexahedron) hexahedra_.push_back({b, e});
         }
-      } else if (block.type == CellType::Triangle) {
-        for (std::size_t e = 0; e < block.count(); ++e) {
-          const std::int64_t* v = block.element(e);
-          boundary_.emplace(sorted({v[0], v[1], v[2]}), block.entity[e]);
-        }
+      } else if (block.type == CellType::Triangle || block.type == CellType::Quadrilateral) {
+        const auto n = static_cast<std::size_t>(cellNumVertices(block.type));
+        for (std::size_t e = 0; e < block.count(); ++e)
+          boundary_.emplace(faceKey(block.element(e), n), block.entity[e]);
       }
     }
   }
 
   bool hasPrisms() const { return !prisms_.empty(); }
 
-  // The stacks, or nothing with the reason in `why`.
-  std::optional<std::vector<Stack>> stacks(std::string& why) {
+  // The prisms' stacks, or nothing with the reason in `why`: every prism must be in one.
+  std::optional<std::vector<Stack>> prismStacks(std::string& why) {
     std::vector<Stack> out;
+    std::set<CellRef> seen;
+    const std::vector<Climb>& ways = climbs(CellType::Prism);
     for (const CellRef& p : prisms_) {
-      const std::int64_t* v = cell(p);
-      const bool bottom = boundary_.count(sorted({v[0], v[1], v[2]})) != 0;
-      const bool top = boundary_.count(sorted({v[3], v[4], v[5]})) != 0;
+      const bool bottom = onBoundary(p, ways[0]), top = onBoundary(p, ways[1]);
       if (bottom && top) {
-        why = prismName(p) + " has both triangles on the boundary: it spans the domain";
+        why = cellName(CellType::Prism, p) +
+              " has both triangles on the boundary: it spans the domain";
         return std::nullopt;
       }
       if (!bottom && !top) continue;
-      const auto wall = bottom ? Tri{v[0], v[1], v[2]} : Tri{v[3], v[5], v[4]};
-      walls_.insert(boundary_.at(sorted(wall)));
-      std::optional<Stack> s = climb(p, bottom, why);
-      if (!s) return std::nullopt;
-      out.push_back(std::move(*s));
+      Stack s;
+      CellRef last;
+      const ClimbEnd end = climb(p, bottom ? ways[0] : ways[1], s, last);
+      if (end == ClimbEnd::Spans) {
+        why = "the column of prisms through " + cellName(CellType::Prism, last) +
+              " reaches the boundary at both ends: it spans the domain";
+        return std::nullopt;
+      }
+      for (const CellRef& c : s.cells)
+        if (!seen.insert(c).second || end == ClimbEnd::Loops) {
+          why = cellName(CellType::Prism, c) + " is in two stacks";
+          return std::nullopt;
+        }
+      out.push_back(std::move(s));
     }
     for (const CellRef& p : prisms_)
-      if (seen_.count(p) == 0) {
-        why = prismName(p) + " is in no stack of prisms standing on the boundary";
+      if (seen.count(p) == 0) {
+        why = cellName(CellType::Prism, p) + " is in no stack of prisms standing on the boundary";
         return std::nullopt;
       }
     return out;
   }
 
-  const std::set<int>& walls() const { return walls_; }
+  // The hexahedra's stacks: the climbs from every boundary face of a hexahedron that end at a
+  // pyramid. Nothing, with the reason in `why`, when a hexahedron is in two of them.
+  std::optional<std::vector<Stack>> hexahedralStacks(std::string& why) {
+    std::vector<Stack> out;
+    std::map<CellRef, int> owner;  // hexahedron -> the CAD face of the stack it is in
+    for (const CellRef& h : hexahedra_)
+      for (const Climb& way : climbs(CellType::Hexahedron)) {
+        if (!onBoundary(h, way)) continue;
+        Stack s;
+        CellRef last;
+        if (climb(h, way, s, last) != ClimbEnd::Stack) continue;
+        for (const CellRef& c : s.cells)
+          if (const auto [it, fresh] = owner.emplace(c, s.wall); !fresh) {
+            why = cellName(CellType::Hexahedron, c) + " is in two stacks of hexahedra, on Face" +
+                  std::to_string(it->second) + " and Face" + std::to_string(s.wall);
+            return std::nullopt;
+          }
+        out.push_back(std::move(s));
+      }
+    return out;
+  }
 
  private:
   const std::int64_t* cell(const CellRef& c) const {
     return mesh_.blocks[c.block].element(c.element);
   }
+  CellType type(const CellRef& c) const { return mesh_.blocks[c.block].type; }
 
-  // The stack standing on prism `p`'s bottom (or top) triangle.
-  std::optional<Stack> climb(CellRef p, bool fromBottom, std::string& why) {
-    Stack s;
-    const std::int64_t* v = cell(p);
-    // Standing on the top triangle, its corners 3, 5, 4 (0, 2, 1 of the triangle) keep the
-    // macro prism positive.
-    const std::array<int, 3> order =
-        fromBottom ? std::array<int, 3>{0, 1, 2} : std::array<int, 3>{3, 5, 4};
-    for (int k = 0; k < 3; ++k) s.columns[k] = {v[order[k]]};
+  // The face of cell c that `way` starts from.
+  FaceKey wallOf(const CellRef& c, const Climb& way) const {
+    const std::int64_t* v = cell(c);
+    std::array<std::int64_t, 4> corners{};
+    const std::size_t n = wallSize(type(c));
+    for (std::size_t i = 0; i < n; ++i) corners[i] = v[way.wall[i]];
+    return faceKey(corners, n);
+  }
+  bool onBoundary(const CellRef& c, const Climb& way) const {
+    return boundary_.count(wallOf(c, way)) != 0;
+  }
+
+  // The climb from cell c's face way.wall outwards through cells of c's type, each entered by
+  // the face the one before left by: its cells and columns in `s`, the last cell in `last`.
+  ClimbEnd climb(CellRef c, const Climb& way, Stack& s, CellRef& last) const {
+    const CellType t = type(c);
+    const std::size_t n = wallSize(t);
+    s.type = t;
+    s.wall = boundary_.at(wallOf(c, way));
+    s.columns.assign(n, {});
+    for (std::size_t k = 0; k < n; ++k) s.columns[k] = {cell(c)[way.wall[k]]};
+    std::set<CellRef> passed;
     for (;;) {
-      if (!seen_.insert(p).second) {
-        why = prismName(p) + " is in two stacks";
-        return std::nullopt;
-      }
-      const std::int64_t* c = cell(p);
-      // The next level: the vertex across the prism from each column's last node.
+      last = c;
+      if (!passed.insert(c).second) return ClimbEnd::Loops;
+      s.cells.push_back(c);
+      const std::int64_t* v = cell(c);
+      std::array<std::int64_t, 4> ends{};
+      for (std::size_t k = 0; k < n; ++k) ends[k] = s.columns[k].back();
+      const FaceKey in = faceKey(ends, n);
+      const auto through = std::find_if(climbs(t).begin(), climbs(t).end(),
+                                        [&](const Climb& w) { return wallOf(c, w) == in; });
+      // (The face the climb entered by is one of c's: the one before shares it.)
       for (auto& column : s.columns) {
-        const int at = static_cast<int>(std::find(c, c + 6, column.back()) - c);
-        column.push_back(c[at < 3 ? at + 3 : at - 3]);
+        const auto at = static_cast<std::size_t>(
+            std::find(through->wall.begin(), through->wall.begin() + static_cast<long>(n),
+                      std::find(v, v + cellNumVertices(t), column.back()) - v) -
+            through->wall.begin());
+        column.push_back(v[through->top[at]]);
       }
-      const Tri far = sorted({s.columns[0].back(), s.columns[1].back(), s.columns[2].back()});
-      if (boundary_.count(far) != 0) {
-        why = "the column of prisms through " + prismName(p) +
-              " reaches the boundary at both ends: it spans the domain";
-        return std::nullopt;
-      }
+      for (std::size_t k = 0; k < n; ++k) ends[k] = s.columns[k].back();
+      const FaceKey far = faceKey(ends, n);
+      if (boundary_.count(far) != 0) return ClimbEnd::Spans;
       const std::vector<CellRef>& across = faceCells_.at(far);
       const auto next =
-          std::find_if(across.begin(), across.end(), [&](const CellRef& o) { return !(o == p); });
-      if (next == across.end() || mesh_.blocks[next->block].type != CellType::Prism) return s;
-      p = *next;
+          std::find_if(across.begin(), across.end(), [&](const CellRef& o) { return !(o == c); });
+      if (next != across.end() && type(*next) == t) {
+        c = *next;
+        continue;
+      }
+      // A prism stack ends at a tetrahedron or pyramid; a hexahedral one at a pyramid.
+      const bool stack =
+          t == CellType::Prism || (next != across.end() && type(*next) == CellType::Pyramid);
+      return stack ? ClimbEnd::Stack : ClimbEnd::Blocked;
     }
   }
 
   const Mesh& mesh_;
-  std::map<Tri, std::vector<CellRef>> faceCells_;
-  std::map<Tri, int> boundary_;  // boundary triangle -> its CAD face
-  std::vector<CellRef> prisms_;
-  std::set<CellRef> seen_;
-  std::set<int> walls_;
+  std::map<FaceKey, std::vector<CellRef>> faceCells_;
+  std::map<FaceKey, int> boundary_;  // boundary triangle or quadrilateral -> its CAD face
+  std::vector<CellRef> prisms_, hexahedra_;
 };
 
 constexpr std::int64_t kInside = -1;
@@ -180,7 +281,7 @@ bool mergeSides(Mesh& macro, const std::vector<std::pair<std::int64_t, int>>& pl
                 const std::map<std::int64_t, std::int64_t>& topOf, int layers, std::size_t& merged,
                 std::string& why) {
   for (ElementBlock& b : macro.blocks) {
-    if (b.type == CellType::Prism) continue;
+    if (isLayerCell(macro, b)) continue;
     const int nv = cellNumVertices(b.type);
     ElementBlock out;
     out.type = b.type;
@@ -221,76 +322,99 @@ bool mergeSides(Mesh& macro, const std::vector<std::pair<std::int64_t, int>>& pl
   return true;
 }
 
-}  // namespace
-
-std::optional<LayerStacks> recogniseLayerStacks(const Mesh& mesh, std::string& why) {
-  why.clear();
-  Recogniser recogniser(mesh);
-  if (!recogniser.hasPrisms()) return std::nullopt;
-  std::optional<std::vector<Stack>> stacks = recogniser.stacks(why);
-  if (!stacks) return std::nullopt;
-  if (stacks->empty()) {
-    why = "no prism stands on the boundary";
-    return std::nullopt;
+// The given blocks with the stacks' cells replaced by macro cells (`stacks` of one type,
+// hexahedra marked as layer cells): a block of them where the first block of their type was, the
+// other cells of that type kept after it.
+void replaceByMacroCells(std::vector<ElementBlock>& blocks, const std::vector<Stack>& stacks,
+                         CellType type) {
+  ElementBlock macro;
+  macro.type = type;
+  macro.layerCells = type == CellType::Hexahedron;
+  std::set<std::pair<std::size_t, std::size_t>> inStacks;
+  for (const Stack& s : stacks) {
+    if (s.type != type) continue;
+    for (const auto& c : s.columns) macro.nodes.push_back(c.front());
+    for (const auto& c : s.columns) macro.nodes.push_back(c.back());
+    macro.entity.push_back(1);
+    for (const CellRef& c : s.cells) inStacks.insert({c.block, c.element});
   }
+  if (macro.count() == 0) return;
+  std::vector<ElementBlock> out;
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    ElementBlock& block = blocks[b];
+    if (block.type != type) {
+      out.push_back(std::move(block));
+      continue;
+    }
+    if (macro.count() > 0) out.push_back(std::move(macro));
+    macro = ElementBlock{};
+    ElementBlock kept;
+    kept.type = type;
+    kept.order = block.order;
+    const auto per = static_cast<std::size_t>(block.nodesPerElement());
+    for (std::size_t e = 0; e < block.count(); ++e) {
+      if (inStacks.count({b, e}) != 0) continue;
+      kept.nodes.insert(kept.nodes.end(), block.element(e), block.element(e) + per);
+      kept.entity.push_back(block.entity[e]);
+    }
+    if (kept.count() > 0) out.push_back(std::move(kept));
+  }
+  blocks = std::move(out);
+}
+
+// Each column's node fractions along it (levelNodes has checked that a wall node has one
+// column): their mean over the columns in `record.levels`, its spread in `record.levelSpread`.
+void meanLevels(const Mesh& mesh, const std::map<std::int64_t, std::vector<std::int64_t>>& columns,
+                LayerStacksRecord& record) {
+  std::vector<std::vector<double>> fractions;
+  record.levels.assign(static_cast<std::size_t>(record.layers) + 1, 0.0);
+  for (const auto& [wall, c] : columns) {
+    std::vector<double> f(c.size(), 0.0);
+    for (std::size_t k = 1; k < c.size(); ++k)
+      f[k] = f[k - 1] + (nodePoint(mesh, c[k]) - nodePoint(mesh, c[k - 1])).norm();
+    for (double& x : f) x /= f.back();
+    for (std::size_t k = 0; k < f.size(); ++k)
+      record.levels[k] += f[k] / static_cast<double>(columns.size());
+    fractions.push_back(std::move(f));
+  }
+  record.levels.back() = 1.0;
+  for (const std::vector<double>& f : fractions)
+    for (std::size_t k = 0; k < f.size(); ++k)
+      record.levelSpread = std::max(record.levelSpread, std::abs(f[k] - record.levels[k]));
+}
+
+// The stacks (prisms' and hexahedra's, not empty) agglomerated, or nothing with the reason.
+std::optional<LayerStacks> agglomerate(const Mesh& mesh, const std::vector<Stack>& stacks,
+                                       std::string& why) {
   LayerStacks out;
-  out.record.layers = static_cast<int>(stacks->front().columns[0].size()) - 1;
-  for (const Stack& s : *stacks)
+  out.record.layers = static_cast<int>(stacks.front().columns[0].size()) - 1;
+  for (const Stack& s : stacks)
     if (static_cast<int>(s.columns[0].size()) - 1 != out.record.layers) {
-      why = "its prism stacks have " + std::to_string(out.record.layers) + " and " +
+      why = "its stacks have " + std::to_string(out.record.layers) + " and " +
             std::to_string(s.columns[0].size() - 1) + " layers";
       return std::nullopt;
     }
   std::vector<std::pair<std::int64_t, int>> place;
-  if (!levelNodes(*stacks, mesh.numNodes(), place, why)) return std::nullopt;
-
-  // Levels and first-layer heights, per column.
+  if (!levelNodes(stacks, mesh.numNodes(), place, why)) return std::nullopt;
   std::map<std::int64_t, std::vector<std::int64_t>> columns;
-  for (const Stack& s : *stacks)
-    for (const auto& c : s.columns)
+  std::map<std::int64_t, std::int64_t> topOf;
+  for (const Stack& s : stacks) {
+    for (const auto& c : s.columns) {
       if (const auto [it, fresh] = columns.emplace(c[0], c); !fresh && it->second != c) {
-        why = "wall node " + std::to_string(c[0] + 1) + " has two columns of prisms";
+        why = "wall node " + std::to_string(c[0] + 1) + " has two columns of cells";
         return std::nullopt;
       }
-  const auto point = [&](std::int64_t n) { return nodePoint(mesh, n); };
-  std::map<std::int64_t, std::int64_t> topOf;
-  std::map<std::int64_t, std::vector<double>> fractions;
-  out.record.levels.assign(static_cast<std::size_t>(out.record.layers) + 1, 0.0);
-  for (const auto& [wall, c] : columns) {
-    topOf[wall] = c.back();
-    std::vector<double> f(c.size(), 0.0);
-    for (std::size_t k = 1; k < c.size(); ++k)
-      f[k] = f[k - 1] + (point(c[k]) - point(c[k - 1])).norm();
-    for (double& x : f) x /= f.back();
-    for (std::size_t k = 0; k < f.size(); ++k)
-      out.record.levels[k] += f[k] / static_cast<double>(columns.size());
-    fractions[wall] = std::move(f);
+      topOf[c[0]] = c.back();
+    }
+    out.record.walls.insert(s.wall);
+    out.record.hexStacks += s.type == CellType::Hexahedron ? 1 : 0;
   }
-  out.record.levels.back() = 1.0;
-  for (const auto& [wall, f] : fractions)
-    for (std::size_t k = 0; k < f.size(); ++k)
-      out.record.levelSpread =
-          std::max(out.record.levelSpread, std::abs(f[k] - out.record.levels[k]));
+  meanLevels(mesh, columns, out.record);
 
-  // The macro mesh: one prism per stack, sides merged, inner nodes dropped.
+  // The macro mesh: one cell per stack, sides merged, inner nodes dropped.
   out.macro = mesh;
-  ElementBlock macroPrisms;
-  macroPrisms.type = CellType::Prism;
-  for (const Stack& s : *stacks) {
-    for (const auto& c : s.columns) macroPrisms.nodes.push_back(c.front());
-    for (const auto& c : s.columns) macroPrisms.nodes.push_back(c.back());
-    macroPrisms.entity.push_back(1);
-  }
-  std::vector<ElementBlock> blocks;
-  for (ElementBlock& b : out.macro.blocks)
-    if (b.type != CellType::Prism) blocks.push_back(std::move(b));
-  const auto firstPrisms = std::find_if(mesh.blocks.begin(), mesh.blocks.end(),
-                                        [](const auto& b) { return b.type == CellType::Prism; });
-  // (Where the first prism block was, among the blocks kept before it.)
-  const auto before = std::count_if(mesh.blocks.begin(), firstPrisms,
-                                    [](const auto& b) { return b.type != CellType::Prism; });
-  blocks.insert(blocks.begin() + before, std::move(macroPrisms));
-  out.macro.blocks = std::move(blocks);
+  replaceByMacroCells(out.macro.blocks, stacks, CellType::Prism);
+  replaceByMacroCells(out.macro.blocks, stacks, CellType::Hexahedron);
   if (!mergeSides(out.macro, place, topOf, out.record.layers, out.record.sidesMerged, why))
     return std::nullopt;
 
@@ -298,7 +422,7 @@ std::optional<LayerStacks> recogniseLayerStacks(const Mesh& mesh, std::string& w
   std::vector<double> heights(mesh.numNodes(), std::numeric_limits<double>::quiet_NaN());
   out.record.firstHeightMin = std::numeric_limits<double>::infinity();
   for (const auto& [wall, c] : columns) {
-    const double h = (point(c[1]) - point(c[0])).norm();
+    const double h = (nodePoint(mesh, c[1]) - nodePoint(mesh, c[0])).norm();
     heights[static_cast<std::size_t>(wall)] = h;
     out.record.firstHeightMin = std::min(out.record.firstHeightMin, h);
     out.record.firstHeightMax = std::max(out.record.firstHeightMax, h);
@@ -310,9 +434,36 @@ std::optional<LayerStacks> recogniseLayerStacks(const Mesh& mesh, std::string& w
     if (used[i] != 0) out.firstHeights.push_back(heights[i]);
   compactNodes(out.macro);
   out.macro.checkConsistency();
-  out.record.stacks = stacks->size();
+  out.record.stacks = stacks.size();
   out.record.columns = columns.size();
-  out.record.walls = recogniser.walls();
+  return out;
+}
+
+}  // namespace
+
+std::optional<LayerStacks> recogniseLayerStacks(const Mesh& mesh, std::string& why) {
+  why.clear();
+  Recogniser recogniser(mesh);
+  std::vector<Stack> prisms;
+  if (recogniser.hasPrisms()) {
+    std::optional<std::vector<Stack>> found = recogniser.prismStacks(why);
+    if (!found) return std::nullopt;
+    prisms = std::move(*found);
+  }
+  // With the hexahedra's stacks where there are any, else (or where they fail) without.
+  std::string hexahedraWhy;
+  const std::optional<std::vector<Stack>> hexahedra = recogniser.hexahedralStacks(hexahedraWhy);
+  if (hexahedra && !hexahedra->empty()) {
+    std::vector<Stack> all = prisms;
+    all.insert(all.end(), hexahedra->begin(), hexahedra->end());
+    if (std::optional<LayerStacks> out = agglomerate(mesh, all, hexahedraWhy)) return out;
+  }
+  if (prisms.empty()) {
+    why = hexahedraWhy;
+    return std::nullopt;
+  }
+  std::optional<LayerStacks> out = agglomerate(mesh, prisms, why);
+  if (out) out->hexahedraLeftOut = hexahedraWhy;
   return out;
 }
 

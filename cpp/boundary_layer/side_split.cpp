@@ -59,8 +59,9 @@ ElementBlock LayerSplitter::splitSides(const ElementBlock& b) {
         const int a = frame->away ? acrossLocal : p_ - acrossLocal;
         const std::int64_t level = std::int64_t(k) * p_ + a;
         const std::int64_t t0 = topOf_.at(frame->wall[0]), t1 = topOf_.at(frame->wall[1]);
-        const NodeKey key = quad ? makeKey({{{t0, p_ - along}, {t1, along}, {kNone, 0}}}, level)
-                                 : makeKey({{{t0, p_}, {kNone, 0}, {kNone, 0}}}, level);
+        const NodeKey key = makeKey(
+            {{{t0, quad ? p_ - along : p_}, {t1, quad ? along : 0}, {kNone, 0}, {kNone, 0}}},
+            level);
         const auto it = nodes_.find(key);
         if (it == nodes_.end())
           throw MeshingError(std::string("boundary-layer split: a side ") +

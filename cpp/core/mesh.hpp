@@ -29,6 +29,9 @@ struct ElementBlock {
   int order = 1;
   std::vector<std::int64_t> nodes;   // size() == count() * nodesPerElement()
   std::vector<std::int32_t> entity;  // size() == count()
+  // Hexahedra that are a macro boundary layer's cells (boundary_layer/layer_cells.hpp: each one's
+  // wall is its face 0, 1, 2, 3); prisms and 2D quadrilaterals are told by their type alone.
+  bool layerCells = false;
 
   int nodesPerElement() const { return cellNumNodes(type, order); }
   std::size_t count() const { return entity.size(); }

@@ -27,6 +27,7 @@ ElementBlock reorderedBlock(const ElementBlock& b, const std::vector<std::size_t
   ElementBlock out;
   out.type = b.type;
   out.order = b.order;
+  out.layerCells = b.layerCells;
   std::vector<std::int64_t>& nodes = out.nodes;
   std::vector<std::int32_t>& entity = out.entity;
   nodes.resize(b.nodes.size());

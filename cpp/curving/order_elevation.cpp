@@ -322,6 +322,7 @@ struct Elevator {
     ElementBlock high;
     high.type = block.type;
     high.order = order;
+    high.layerCells = block.layerCells;
     high.entity = block.entity;
     high.nodes.reserve(block.count() * ref.numNodes());
     // A curved source, or a pyramid (whose straight-sided map is rational inside: vertexWeights):
@@ -472,10 +473,13 @@ class BoundaryPlacer {
     if (layer && raise && mesh_.dim == 3)
       for (const ElementBlock& b : mesh_.blocks) {
         if (!isLayerCell(mesh_, b)) continue;
+        const LayerShape shape = layerShape(b.type);
         for (std::size_t e = 0; e < b.count(); ++e) {
-          const std::int64_t* v = b.element(e);  // wall 0, 1, 2; tops 3, 4, 5
-          for (const auto& [i, j] : {std::pair{3, 4}, {4, 5}, {3, 5}})
-            keptTops_.insert({std::min(v[i], v[j]), std::max(v[i], v[j])});
+          const std::int64_t* v = b.element(e);  // the tops' cycle (layer_cells.hpp)
+          for (int k = 0; k < shape.walls; ++k) {
+            const std::int64_t i = shape.top(v, k), j = shape.top(v, (k + 1) % shape.walls);
+            keptTops_.insert({std::min(i, j), std::max(i, j)});
+          }
         }
       }
   }
@@ -715,12 +719,21 @@ class BoundaryPlacer {
     const FaceChart& ch = chart(mesh_.nodeCadIndex[nodes[at(1, 1)]]);
     std::array<FaceParameter, 4> corner;
     int ref = -1;
+    bool pole = false;
     for (int k = 0; k < 4; ++k) {
       corner[k] = nodeFaceParameter(ch, mesh_, c[k], std::nullopt);
       const auto s = ch.singular(corner[k]);
+      pole = pole || s[0] || s[1];
       if (ref < 0 && !s[0] && !s[1]) ref = k;
     }
-    if (ref < 0) ref = 0;
+    if (pole) {
+      // At a pole u is arbitrary: the (u, v) patch would take the corner's u for both edges
+      // meeting there (on a sphere's pole quadrilateral it put the centre node near a side, and
+      // the hexahedron on it was invalid).
+      ++stats_.quadInteriorsProjected;
+      placeByPositions(nodes);
+      return;
+    }
     std::vector<FaceParameter> uv(nodes.size());
     for (int k = 0; k <= p; ++k)
       for (const std::size_t b : {at(k, 0), at(p, k), at(k, p), at(0, k)})
@@ -746,6 +759,25 @@ class BoundaryPlacer {
         }
     for (int j = 1; j < p; ++j)
       for (int i = 1; i < p; ++i) setFaceNode(nodes[at(i, j)], ch, uv[at(i, j)]);
+  }
+
+  // A quadrilateral's interior nodes (lattice as placeQuadrilateral's) at the transfinite
+  // interpolation of its edges' positions, each projected onto its face from there.
+  void placeByPositions(const std::vector<std::int64_t>& nodes) {
+    const int p = order_;
+    const auto x = [&](int i, int j) { return point(nodes[quadIndex(p, i, j)]); };
+    for (int j = 1; j < p; ++j)
+      for (int i = 1; i < p; ++i) {
+        const double s = static_cast<double>(i) / p, t = static_cast<double>(j) / p;
+        const Eigen::Vector3d coons = (1 - t) * x(i, 0) + t * x(i, p) + (1 - s) * x(0, j) +
+                                      s * x(p, j) -
+                                      ((1 - s) * (1 - t) * x(0, 0) + s * (1 - t) * x(p, 0) +
+                                       s * t * x(p, p) + (1 - s) * t * x(0, p));
+        const std::int64_t node = nodes[quadIndex(p, i, j)];
+        for (int d = 0; d < 3; ++d) mesh_.xyz[3 * node + d] = coons[d];
+        projectNode(mesh_, node, cad_);
+        placed_[static_cast<std::size_t>(node)] = 1;
+      }
   }
 
   // Whether every cell of a (P+1) x (P+1) lattice in (u, v) has the same, non-zero orientation.

@@ -4,7 +4,9 @@
 #include <chrono>
 #include <limits>
 #include <sstream>
+#include <string>
 
+#include "boundary_layer/layer_blend.hpp"
 #include "boundary_layer/layer_stacks.hpp"
 #include "cad/model_dimension.hpp"
 #include "core/error.hpp"
@@ -18,6 +20,7 @@
 #include "pipeline/linear_stage.hpp"
 #include "pipeline/repair_rounds.hpp"
 #include "pipeline/stage_clock.hpp"
+#include "pipeline/straighten_invalid.hpp"
 #include "quality/mesh_quality.hpp"
 
 namespace homesh {
@@ -299,19 +302,51 @@ std::string firstInvalidCell(const Mesh& mesh, const char* what, int threads) {
   return {};
 }
 
-// The given mesh's prism stacks agglomerated (layer_stacks.hpp) when their macro prisms are
-// valid straight-sided (columns that bend or converge at a concave corner may make one that is
-// not: the prisms are then curved as given, with a note saying why).
+// The given mesh's stacks of prisms and hexahedra agglomerated (layer_stacks.hpp) when their
+// macro cells are valid straight-sided (columns that bend or converge at a concave corner may
+// make one that is not: the cells are then curved as given, with a note saying why).
 std::optional<LayerStacks> agglomerateLayer(const Mesh& onCad, MeshResult& result, int threads) {
   std::string why;
   std::optional<LayerStacks> stacks = recogniseLayerStacks(onCad, why);
   if (stacks) {
     why = firstInvalidCell(stacks->macro, "the macro layer", threads);
+    if (!stacks->hexahedraLeftOut.empty())
+      result.notes.push_back("the hexahedra were curved as given, not as a boundary layer: " +
+                             stacks->hexahedraLeftOut);
     if (why.empty()) return stacks;
   }
   if (!why.empty())
-    result.notes.push_back("the prisms were curved as given, not as a boundary layer: " + why);
+    result.notes.push_back("the layer's cells were curved as given, not as a boundary layer: " +
+                           why);
   return std::nullopt;
+}
+
+// The given mesh's elements left invalid (or undecided), straightened off the CAD
+// (straighten_invalid.hpp), up to kStraightenRounds times (a round's moves may leave a neighbour
+// invalid, which the next straightens); with a macro layer, its columns are then made straight
+// again between wall and top (its split assumes them straight). The best round is kept, if it
+// leaves fewer such elements; the note says how many it repaired.
+void straightenWhereInvalid(CurvedState& state, MeshResult& result, bool layered, int threads) {
+  constexpr int kStraightenRounds = 3;
+  const std::size_t before = state.quality.invalid + state.quality.undecided;
+  if (before == 0) return;
+  Mesh trial = state.mesh;
+  QualitySummary quality = state.quality;
+  for (int round = 0; round < kStraightenRounds; ++round) {
+    if (quality.invalid + quality.undecided == 0) break;
+    if (straightenInvalidElements(trial, quality) == 0) break;
+    if (layered) blendLayerInteriors(trial, result.cad.get(), false);
+    quality = evaluateQuality(trial, threads);
+    if (quality.invalid + quality.undecided < state.quality.invalid + state.quality.undecided) {
+      state.mesh = trial;
+      state.quality = quality;
+    }
+  }
+  const std::size_t after = state.quality.invalid + state.quality.undecided;
+  if (after < before)
+    result.notes.push_back(std::to_string(before - after) + " of " + std::to_string(before) +
+                           " elements not proven valid after the optimiser were repaired by "
+                           "straightening their nodes off the CAD");
 }
 
 }  // namespace
@@ -378,6 +413,7 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
   classify.done();
   CurvedState state = curve(std::move(onCad), options, *result.cad, result.timings, observer, true,
                             budget, "", nullptr, stacks.has_value());
+  straightenWhereInvalid(state, result, stacks.has_value(), options.threads);
   result.mesh = std::move(state.mesh);
   result.quality = std::move(state.quality);
   result.optimiser = std::move(state.optimiser);

@@ -42,9 +42,9 @@ std::string givenLayersLine(const StageRecords& records) {
   std::string walls;
   for (const int f : r.walls) walls += (walls.empty() ? "Face" : ", Face") + std::to_string(f);
   std::string line = formatted(
-      "given boundary layer: %zu stacks of %d prism layers (%zu columns) on %s, curved as macro "
-      "prisms",
-      r.stacks, r.layers, r.columns, walls.c_str());
+      "given boundary layer: %zu stacks (%zu of prisms, %zu of hexahedra) of %d layers (%zu "
+      "columns) on %s, curved as macro cells",
+      r.stacks, r.stacks - r.hexStacks, r.hexStacks, r.layers, r.columns, walls.c_str());
   if (records.macroQuality) line += formatted(" (worst %.4f)", records.macroQuality->scaled.min);
   if (records.layerSplit)
     line += formatted("; split back: first layer %g to %g (given %g to %g, worst %.2f %% off)",

@@ -180,6 +180,7 @@ void appendGivenLayers(JsonWriter& json, const StageRecords& records) {
   json.beginObject("given_layers");
   json.numbers("walls", std::vector<std::size_t>(r.walls.begin(), r.walls.end()));
   json.value("stacks", r.stacks);
+  json.value("hexahedral_stacks", r.hexStacks);
   json.value("layers", static_cast<std::size_t>(r.layers));
   json.value("columns", r.columns);
   json.value("side_quadrilaterals", r.sidesMerged);

@@ -32,6 +32,9 @@ namespace homesh::test {
 struct GmshLayer {
   int layers = 5;
   double firstHeight = 0.01, ratio = 1.3, size = 0.25;
+  // The wall's mesh recombined into quadrilaterals, so that the layer is (mostly) hexahedra;
+  // pyramids then stand on the layer's top.
+  bool quadWall = false;
 
   // Each layer's top, measured from the wall.
   std::vector<double> heights() const {
@@ -131,6 +134,8 @@ inline void writeGmshLayeredSphere(const std::string& mesh, const std::string& s
     g::addVolume({g::addSurfaceLoop(surfaces)});
     g::synchronize();
     for (const int f : box) gmsh::model::mesh::setRecombine(2, f);
+    if (s.quadWall)
+      for (const auto& [dim, tag] : sphere) gmsh::model::mesh::setRecombine(dim, tag);
     gmsh::model::mesh::generate(3);
     gmsh::write(mesh);
     gmsh_layered::writeBoxLess(step, a, -a, a,
@@ -198,6 +203,8 @@ inline void writeGmshLayeredCylinder(const std::string& mesh, const std::string&
     surfaces.insert(surfaces.end(), tops.begin(), tops.end());
     g::addVolume({g::addSurfaceLoop(surfaces)});
     g::synchronize();
+    if (s.quadWall)
+      for (const auto& [dim, tag] : wall) gmsh::model::mesh::setRecombine(dim, tag);
     gmsh::model::mesh::generate(3);
     gmsh::write(mesh);
     gmsh_layered::writeBoxLess(step, a, 0.0, 1.0,

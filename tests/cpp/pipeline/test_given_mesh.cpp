@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <BRepPrimAPI_MakeBox.hxx>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <string>
@@ -20,6 +21,7 @@
 #include "linear/cad_classification.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/report.hpp"
+#include "quality/mesh_quality.hpp"
 #include "test_support.hpp"
 
 namespace homesh {
@@ -46,6 +48,13 @@ double worstNodeDistance(const Mesh& mesh, const CadModel& cad) {
     }
   }
   return worst;
+}
+
+// The squared distance between two positions rounded to 1e-6 (as firstHeights keys them).
+double distance2(const std::array<long, 3>& a, const std::array<long, 3>& b) {
+  double d = 0.0;
+  for (std::size_t k = 0; k < 3; ++k) d += std::pow(static_cast<double>(a[k] - b[k]), 2);
+  return d;
 }
 
 // Per wall vertex (by position, rounded to 1e-6): the first layer's height of a mesh's stacks,
@@ -100,10 +109,17 @@ std::vector<MeshResult> curveWithLayers(const std::string& msh, const std::strin
     EXPECT_EQ(layers, layer.layers);
     EXPECT_EQ(heights.size(), givenHeights.size());
     double worst = 0.0;
-    for (const auto& [at, h] : heights) {
-      // (Wall vertices stay where they were, up to the classification's snap.)
+    for (const auto& [key, h] : heights) {
+      // Wall vertices stay where they were, up to the classification's snap, unless the layer
+      // had to be released (curve_stage.cpp's releaseLayer: they then slide on the CAD): the
+      // nearest given one's column.
+      const std::array<long, 3> at = key;  // (a structured binding cannot be captured in C++17)
       auto it = givenHeights.find(at);
-      EXPECT_NE(it, givenHeights.end());
+      if (it == givenHeights.end())
+        it = std::min_element(givenHeights.begin(), givenHeights.end(),
+                              [&at](const auto& a, const auto& b) {
+                                return distance2(a.first, at) < distance2(b.first, at);
+                              });
       if (it != givenHeights.end()) worst = std::max(worst, std::abs(h / it->second - 1.0));
     }
     EXPECT_LT(worst, 0.05);
@@ -127,11 +143,63 @@ TEST(GivenMesh, GmshsHybridLayeredSphereIsCurvedValidWithItsLayers) {
   const std::string report = meshReportJson(r, msh);
   const std::size_t at = report.find("\"given_layers\": {");
   ASSERT_NE(at, std::string::npos) << report;
-  EXPECT_NE(
-      report.find("\"stacks\": " + std::to_string(r.givenLayers->stacks) + ",\n    \"layers\": 5,",
-                  at),
-      std::string::npos)
+  EXPECT_NE(report.find("\"stacks\": " + std::to_string(r.givenLayers->stacks) +
+                            ",\n    \"hexahedral_stacks\": 0,\n    \"layers\": 5,",
+                        at),
+            std::string::npos)
       << report;
+}
+
+// The same with the wall's mesh recombined into quadrilaterals: the layer is stacks of
+// hexahedra, Gmsh's pyramids on its top (some as flat as 0.11 of their base edge, their apex
+// within the curved top's bulge: the optimiser leaves up to 9 invalid at order 4 and straightening
+// them repairs them), on the sphere (its quadrilaterals at the poles too) and on the cylinder
+// whose layer meets the end planes (its side quadrilaterals merged and split back).
+TEST(GivenMesh, GmshsHexahedralLayersOnQuadrilateralWallsAreCurvedValidWithTheirLayers) {
+  const auto dir = test::tempDir();
+  test::GmshLayer layer;
+  layer.quadWall = true;
+  for (const bool sphere : {true, false}) {
+    SCOPED_TRACE(sphere ? "sphere" : "cylinder");
+    const std::string msh = (dir / "layer.msh").string(), step = (dir / "layer.step").string();
+    if (sphere)
+      test::writeGmshLayeredSphere(msh, step, layer);
+    else
+      test::writeGmshLayeredCylinder(msh, step, layer);
+    const double tolerance = sphere ? parameterDefault("classify_tolerance") : 2e-3;
+    // (The sphere at order 2 only: at order 4 it has 205,000 nodes, and the cylinder has the
+    // same pyramids on a curved top.)
+    const std::vector<MeshResult> results = curveWithLayers(
+        msh, step, layer, sphere ? std::vector<int>{2} : std::vector<int>{2, 4}, tolerance);
+    for (const MeshResult& r : results) {
+      ASSERT_TRUE(r.givenLayers && r.layerSplit);
+      EXPECT_GT(r.givenLayers->hexStacks, 0U);
+      EXPECT_EQ(r.layerSplit->hexahedra, r.givenLayers->hexStacks);
+      EXPECT_EQ(r.layerSplit->prisms + r.layerSplit->hexahedra, r.givenLayers->stacks);
+      EXPECT_EQ(r.layerSplit->quadrilaterals, r.givenLayers->sidesMerged);
+      EXPECT_EQ(r.givenLayers->sidesMerged > 0, !sphere);
+    }
+  }
+}
+
+// A quadrilateral with a corner at the sphere's pole (where the face's u is arbitrary) gets its
+// interior nodes from its edges' positions: elevated on the CAD, the hexahedral macro layer of
+// Gmsh's sphere is valid (from the (u, v) patch, the three hexahedra at each pole were not).
+TEST(GivenMesh, QuadrilateralsAtASpheresPoleAreCurvedValid) {
+  const auto dir = test::tempDir();
+  const std::string msh = (dir / "sphere.msh").string(), step = (dir / "sphere.step").string();
+  test::GmshLayer layer;
+  layer.quadWall = true;
+  test::writeGmshLayeredSphere(msh, step, layer);
+  const CadModel cad = CadModel::fromFile(step);
+  const Mesh onCad = classifyOnCad(readMesh(msh), cad,
+                                   parameterDefault("classify_tolerance") * cad.boundingDiagonal());
+  std::string why;
+  const std::optional<LayerStacks> stacks = recogniseLayerStacks(onCad, why);
+  ASSERT_TRUE(stacks) << why;
+  EXPECT_EQ(stacks->record.hexStacks, stacks->record.stacks);
+  const QualitySummary quality = evaluateQuality(elevateOrder(stacks->macro, 2, &cad), 2);
+  EXPECT_EQ(quality.invalid + quality.undecided, 0U);
 }
 
 // A layer whose sides lie on the CAD: the cylinder's layer meets the box's end planes, where
