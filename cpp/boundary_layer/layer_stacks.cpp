@@ -322,34 +322,36 @@ bool mergeSides(Mesh& macro, const std::vector<std::pair<std::int64_t, int>>& pl
   return true;
 }
 
-// The given blocks with the stacks' cells replaced by macro cells (`stacks` of one type,
-// hexahedra marked as layer cells): a block of them where the first block of their type was, the
-// other cells of that type kept after it.
-void replaceByMacroCells(std::vector<ElementBlock>& blocks, const std::vector<Stack>& stacks,
-                         CellType type) {
-  ElementBlock macro;
-  macro.type = type;
-  macro.layerCells = type == CellType::Hexahedron;
+// The given blocks with the stacks' cells replaced by macro cells, the hexahedra's marked as
+// layer cells: each type's macro block where the first block of that type was, the cells of that
+// type in no stack kept after it. (One pass over the given blocks: `stacks` name cells by their
+// given block index.)
+void replaceByMacroCells(std::vector<ElementBlock>& blocks, const std::vector<Stack>& stacks) {
+  std::map<CellType, ElementBlock> macro;
   std::set<std::pair<std::size_t, std::size_t>> inStacks;
   for (const Stack& s : stacks) {
-    if (s.type != type) continue;
-    for (const auto& c : s.columns) macro.nodes.push_back(c.front());
-    for (const auto& c : s.columns) macro.nodes.push_back(c.back());
-    macro.entity.push_back(1);
+    ElementBlock& m = macro[s.type];
+    m.type = s.type;
+    m.layerCells = s.type == CellType::Hexahedron;
+    for (const auto& c : s.columns) m.nodes.push_back(c.front());
+    for (const auto& c : s.columns) m.nodes.push_back(c.back());
+    m.entity.push_back(1);
     for (const CellRef& c : s.cells) inStacks.insert({c.block, c.element});
   }
-  if (macro.count() == 0) return;
   std::vector<ElementBlock> out;
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     ElementBlock& block = blocks[b];
-    if (block.type != type) {
+    const auto m = macro.find(block.type);
+    if (m == macro.end()) {
       out.push_back(std::move(block));
       continue;
     }
-    if (macro.count() > 0) out.push_back(std::move(macro));
-    macro = ElementBlock{};
+    if (m->second.count() > 0) {
+      out.push_back(std::move(m->second));
+      m->second = ElementBlock{};
+    }
     ElementBlock kept;
-    kept.type = type;
+    kept.type = block.type;
     kept.order = block.order;
     const auto per = static_cast<std::size_t>(block.nodesPerElement());
     for (std::size_t e = 0; e < block.count(); ++e) {
@@ -413,8 +415,7 @@ std::optional<LayerStacks> agglomerate(const Mesh& mesh, const std::vector<Stack
 
   // The macro mesh: one cell per stack, sides merged, inner nodes dropped.
   out.macro = mesh;
-  replaceByMacroCells(out.macro.blocks, stacks, CellType::Prism);
-  replaceByMacroCells(out.macro.blocks, stacks, CellType::Hexahedron);
+  replaceByMacroCells(out.macro.blocks, stacks);
   if (!mergeSides(out.macro, place, topOf, out.record.layers, out.record.sidesMerged, why))
     return std::nullopt;
 
@@ -441,7 +442,8 @@ std::optional<LayerStacks> agglomerate(const Mesh& mesh, const std::vector<Stack
 
 }  // namespace
 
-std::optional<LayerStacks> recogniseLayerStacks(const Mesh& mesh, std::string& why) {
+std::optional<LayerStacks> recogniseLayerStacks(const Mesh& mesh, std::string& why,
+                                                bool hexahedra) {
   why.clear();
   Recogniser recogniser(mesh);
   std::vector<Stack> prisms;
@@ -452,10 +454,11 @@ std::optional<LayerStacks> recogniseLayerStacks(const Mesh& mesh, std::string& w
   }
   // With the hexahedra's stacks where there are any, else (or where they fail) without.
   std::string hexahedraWhy;
-  const std::optional<std::vector<Stack>> hexahedra = recogniser.hexahedralStacks(hexahedraWhy);
-  if (hexahedra && !hexahedra->empty()) {
+  const std::optional<std::vector<Stack>> hexahedral =
+      hexahedra ? recogniser.hexahedralStacks(hexahedraWhy) : std::vector<Stack>();
+  if (hexahedral && !hexahedral->empty()) {
     std::vector<Stack> all = prisms;
-    all.insert(all.end(), hexahedra->begin(), hexahedra->end());
+    all.insert(all.end(), hexahedral->begin(), hexahedral->end());
     if (std::optional<LayerStacks> out = agglomerate(mesh, all, hexahedraWhy)) return out;
   }
   if (prisms.empty()) {

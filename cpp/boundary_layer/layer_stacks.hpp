@@ -62,7 +62,9 @@ struct LayerStacks {
 // its prisms are not such stacks: a prism with both triangles on the boundary, one in no stack or
 // in two, stacks of different heights, a node inside the layer that another cell uses. Where the
 // stacks fail only with the hexahedra's (a hexahedron in two, their heights not the prisms'),
-// the prisms' are taken alone and hexahedraLeftOut says why.
-std::optional<LayerStacks> recogniseLayerStacks(const Mesh& mesh, std::string& why);
+// the prisms' are taken alone and hexahedraLeftOut says why. `hexahedra` false: the prisms'
+// stacks only (the hexahedra stay as given).
+std::optional<LayerStacks> recogniseLayerStacks(const Mesh& mesh, std::string& why,
+                                                bool hexahedra = true);
 
 }  // namespace homesh

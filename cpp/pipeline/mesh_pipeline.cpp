@@ -304,12 +304,23 @@ std::string firstInvalidCell(const Mesh& mesh, const char* what, int threads) {
 
 // The given mesh's stacks of prisms and hexahedra agglomerated (layer_stacks.hpp) when their
 // macro cells are valid straight-sided (columns that bend or converge at a concave corner may
-// make one that is not: the cells are then curved as given, with a note saying why).
+// make one that is not: the prisms' stacks are then tried alone, and the cells are otherwise
+// curved as given, with a note saying why).
 std::optional<LayerStacks> agglomerateLayer(const Mesh& onCad, MeshResult& result, int threads) {
   std::string why;
   std::optional<LayerStacks> stacks = recogniseLayerStacks(onCad, why);
   if (stacks) {
     why = firstInvalidCell(stacks->macro, "the macro layer", threads);
+    if (!why.empty() && stacks->record.hexStacks > 0 &&
+        stacks->record.hexStacks < stacks->record.stacks) {
+      std::string prismsWhy;
+      std::optional<LayerStacks> prisms = recogniseLayerStacks(onCad, prismsWhy, false);
+      if (prisms && firstInvalidCell(prisms->macro, "the macro layer", threads).empty()) {
+        prisms->hexahedraLeftOut = why;
+        stacks = std::move(prisms);
+        why.clear();
+      }
+    }
     if (!stacks->hexahedraLeftOut.empty())
       result.notes.push_back("the hexahedra were curved as given, not as a boundary layer: " +
                              stacks->hexahedraLeftOut);
@@ -326,14 +337,20 @@ std::optional<LayerStacks> agglomerateLayer(const Mesh& onCad, MeshResult& resul
 // invalid, which the next straightens); with a macro layer, its columns are then made straight
 // again between wall and top (its split assumes them straight). The best round is kept, if it
 // leaves fewer such elements; the note says how many it repaired.
-void straightenWhereInvalid(CurvedState& state, MeshResult& result, bool layered, int threads) {
+void straightenWhereInvalid(CurvedState& state, MeshResult& result, bool layered, int threads,
+                            JobBudget& budget, PipelineObserver* observer) {
   constexpr int kStraightenRounds = 3;
   const std::size_t before = state.quality.invalid + state.quality.undecided;
   if (before == 0) return;
+  if (budget.spent()) {
+    budget.skip("straighten");
+    return;
+  }
+  StageClock clock("straighten", result.timings, observer);
   Mesh trial = state.mesh;
   QualitySummary quality = state.quality;
   for (int round = 0; round < kStraightenRounds; ++round) {
-    if (quality.invalid + quality.undecided == 0) break;
+    if (quality.invalid + quality.undecided == 0 || (round > 0 && budget.spent())) break;
     if (straightenInvalidElements(trial, quality) == 0) break;
     if (layered) blendLayerInteriors(trial, result.cad.get(), false);
     quality = evaluateQuality(trial, threads);
@@ -342,6 +359,7 @@ void straightenWhereInvalid(CurvedState& state, MeshResult& result, bool layered
       state.quality = quality;
     }
   }
+  clock.done();
   const std::size_t after = state.quality.invalid + state.quality.undecided;
   if (after < before)
     result.notes.push_back(std::to_string(before - after) + " of " + std::to_string(before) +
@@ -413,7 +431,7 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
   classify.done();
   CurvedState state = curve(std::move(onCad), options, *result.cad, result.timings, observer, true,
                             budget, "", nullptr, stacks.has_value());
-  straightenWhereInvalid(state, result, stacks.has_value(), options.threads);
+  straightenWhereInvalid(state, result, stacks.has_value(), options.threads, budget, observer);
   result.mesh = std::move(state.mesh);
   result.quality = std::move(state.quality);
   result.optimiser = std::move(state.optimiser);

@@ -32,9 +32,10 @@ namespace homesh::test {
 struct GmshLayer {
   int layers = 5;
   double firstHeight = 0.01, ratio = 1.3, size = 0.25;
-  // The wall's mesh recombined into quadrilaterals, so that the layer is (mostly) hexahedra;
-  // pyramids then stand on the layer's top.
-  bool quadWall = false;
+  // How many of the wall's patches (the sphere's 8, the cylinder's 4, in the order they are
+  // made) have their mesh recombined into quadrilaterals: the layer there is hexahedra, with
+  // pyramids on its top; prisms elsewhere, the two sharing their columns where the patches meet.
+  std::size_t quadPatches = 0;
 
   // Each layer's top, measured from the wall.
   std::vector<double> heights() const {
@@ -134,8 +135,8 @@ inline void writeGmshLayeredSphere(const std::string& mesh, const std::string& s
     g::addVolume({g::addSurfaceLoop(surfaces)});
     g::synchronize();
     for (const int f : box) gmsh::model::mesh::setRecombine(2, f);
-    if (s.quadWall)
-      for (const auto& [dim, tag] : sphere) gmsh::model::mesh::setRecombine(dim, tag);
+    for (std::size_t k = 0; k < s.quadPatches && k < sphere.size(); ++k)
+      gmsh::model::mesh::setRecombine(sphere[k].first, sphere[k].second);
     gmsh::model::mesh::generate(3);
     gmsh::write(mesh);
     gmsh_layered::writeBoxLess(step, a, -a, a,
@@ -203,8 +204,8 @@ inline void writeGmshLayeredCylinder(const std::string& mesh, const std::string&
     surfaces.insert(surfaces.end(), tops.begin(), tops.end());
     g::addVolume({g::addSurfaceLoop(surfaces)});
     g::synchronize();
-    if (s.quadWall)
-      for (const auto& [dim, tag] : wall) gmsh::model::mesh::setRecombine(dim, tag);
+    for (std::size_t k = 0; k < s.quadPatches && k < wall.size(); ++k)
+      gmsh::model::mesh::setRecombine(wall[k].first, wall[k].second);
     gmsh::model::mesh::generate(3);
     gmsh::write(mesh);
     gmsh_layered::writeBoxLess(step, a, 0.0, 1.0,

@@ -3,6 +3,7 @@
 // prism each; prisms that are no such layer left alone, with the reason.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <set>
 
@@ -104,19 +105,27 @@ TEST(LayerStacks, PrismsFromWallToWallAreNoLayer) {
 
 // A stack may stand on a prism's top triangle (corners 3, 4, 5 on the wall, as a file may list
 // them): the macro prism then takes the top's corners 3, 5, 4 as its wall and stays positive.
-// One column of two prisms on the triangle (0,0,0) (1,0,0) (0,1,0), levels at 0.1 and 0.3, a
-// tetrahedron on top; the first prism listed upside down.
-TEST(LayerStacks, AStackOnAPrismsTopTriangleMakesAPositiveMacroPrism) {
+// The nodes of a column of cells on the polygon `corners` in the plane z = 0: its corners at the
+// levels z = 0, 0.1 and 0.3, then `apex`; all inside the domain (the test gives the cells).
+Mesh columnNodes(const std::vector<std::pair<double, double>>& corners,
+                 const std::array<double, 3>& apex) {
   Mesh mesh;
   mesh.dim = 3;
   for (const double z : {0.0, 0.1, 0.3})
-    for (const auto& [x, y] : std::vector<std::pair<double, double>>{{0, 0}, {1, 0}, {0, 1}})
-      mesh.xyz.insert(mesh.xyz.end(), {x, y, z});
-  mesh.xyz.insert(mesh.xyz.end(), {0.2, 0.2, 1.0});  // node 9: the tetrahedron's apex
-  const std::size_t n = mesh.xyz.size() / 3;
+    for (const auto& [x, y] : corners) mesh.xyz.insert(mesh.xyz.end(), {x, y, z});
+  mesh.xyz.insert(mesh.xyz.end(), apex.begin(), apex.end());
+  const std::size_t n = mesh.numNodes();
   mesh.nodeCadDim.assign(n, 3);
   mesh.nodeCadIndex.assign(n, 1);
   mesh.nodeCadParam.assign(2 * n, std::nan(""));
+  return mesh;
+}
+
+// One column of two prisms on the triangle (0,0,0) (1,0,0) (0,1,0), levels at 0.1 and 0.3, a
+// tetrahedron on top; the first prism listed upside down.
+TEST(LayerStacks, AStackOnAPrismsTopTriangleMakesAPositiveMacroPrism) {
+  Mesh mesh = columnNodes({{0, 0}, {1, 0}, {0, 1}}, {0.2, 0.2, 1.0});  // node 9: the apex
+  const std::size_t n = mesh.numNodes();
   // Positive both: (3, 5, 4, 0, 2, 1) has its top triangle (0, 2, 1) on the wall.
   ElementBlock prisms{CellType::Prism, 1, {3, 5, 4, 0, 2, 1, 3, 4, 5, 6, 7, 8}, {1, 1}};
   ElementBlock tets{CellType::Tetrahedron, 1, {6, 7, 8, 9}, {1}};
@@ -157,6 +166,62 @@ TEST(LayerStacks, AStackOnAPrismsTopTriangleMakesAPositiveMacroPrism) {
   uneven.blocks[2].entity.push_back(5);
   EXPECT_FALSE(recogniseLayerStacks(uneven, why));
   EXPECT_NE(why.find("have 2 and 1 layers"), std::string::npos) << why;
+}
+
+// A column of two hexahedra on a boundary quadrilateral, a pyramid on its top: one macro
+// hexahedron, positive, marked as layer cells, whichever of its six faces the first hexahedron
+// has on the wall (its vertices relabelled so that the wall is that face: the recogniser's
+// climbs must then order the macro cell's wall and top right). The same column reaching the
+// boundary at its top is no stack: the hexahedra stay as given, with no reason to give.
+TEST(LayerStacks, AColumnOfHexahedraOnAnyFaceMakesOnePositiveMacroHexahedron) {
+  Mesh mesh = columnNodes({{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {0.5, 0.5, 0.8});  // node 12: apex
+  const std::size_t n = mesh.numNodes();
+  // Each face of a positive hexahedron ordered so that its normal points into the cell, and the
+  // opposite face's vertices above its own.
+  const std::vector<std::pair<std::array<int, 4>, std::array<int, 4>>> faces{
+      {{0, 1, 2, 3}, {4, 5, 6, 7}}, {{4, 7, 6, 5}, {0, 3, 2, 1}}, {{0, 4, 5, 1}, {3, 7, 6, 2}},
+      {{3, 2, 6, 7}, {0, 1, 5, 4}}, {{0, 3, 7, 4}, {1, 2, 6, 5}}, {{1, 5, 6, 2}, {0, 4, 7, 3}}};
+  for (const auto& [wallFace, topFace] : faces) {
+    std::vector<std::int64_t> first(8);
+    for (std::size_t k = 0; k < 4; ++k) {
+      first[static_cast<std::size_t>(wallFace[k])] = static_cast<std::int64_t>(k);
+      first[static_cast<std::size_t>(topFace[k])] = static_cast<std::int64_t>(k + 4);
+    }
+    ElementBlock hexahedra{CellType::Hexahedron, 1, first, {1, 1}};
+    hexahedra.nodes.insert(hexahedra.nodes.end(), {4, 5, 6, 7, 8, 9, 10, 11});
+    ElementBlock pyramids{CellType::Pyramid, 1, {8, 9, 10, 11, 12}, {1}};
+    ElementBlock wall{CellType::Quadrilateral, 1, {0, 3, 2, 1}, {5}};
+    mesh.blocks = {hexahedra, pyramids, wall};
+    ASSERT_EQ(evaluateQuality(mesh, 1).invalid, 0U) << "the test's own cells must be positive";
+    std::string why;
+    const std::optional<LayerStacks> s = recogniseLayerStacks(mesh, why);
+    ASSERT_TRUE(s) << why;
+    EXPECT_EQ(s->record.stacks, 1U);
+    EXPECT_EQ(s->record.hexStacks, 1U);
+    EXPECT_EQ(s->record.layers, 2);
+    EXPECT_EQ(s->record.columns, 4U);
+    EXPECT_EQ(s->record.walls, std::set<int>{5});
+    EXPECT_EQ(s->macro.numNodes(), n - 4);  // the middle level's nodes go
+    const QualitySummary q = evaluateQuality(s->macro, 1);
+    EXPECT_EQ(q.invalid + q.undecided, 0U);
+    ASSERT_EQ(s->macro.blocks[0].type, CellType::Hexahedron);
+    EXPECT_TRUE(s->macro.blocks[0].layerCells);
+    ASSERT_EQ(s->macro.blocks[0].count(), 1U);
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d w = nodePoint(s->macro, s->macro.blocks[0].element(0)[k]);
+      const Eigen::Vector3d t = nodePoint(s->macro, s->macro.blocks[0].element(0)[k + 4]);
+      EXPECT_EQ(w.z(), 0.0);
+      EXPECT_EQ(t.z(), 0.3);
+      EXPECT_EQ(w.x(), t.x());  // each top above its wall vertex
+      EXPECT_EQ(w.y(), t.y());
+    }
+  }
+  Mesh spanning = mesh;
+  spanning.blocks = {mesh.blocks[0], mesh.blocks[2],
+                     ElementBlock{CellType::Quadrilateral, 1, {8, 9, 10, 11}, {6}}};
+  std::string why;
+  EXPECT_FALSE(recogniseLayerStacks(spanning, why));
+  EXPECT_TRUE(why.empty()) << why;
 }
 
 }  // namespace

@@ -153,12 +153,13 @@ TEST(GivenMesh, GmshsHybridLayeredSphereIsCurvedValidWithItsLayers) {
 // The same with the wall's mesh recombined into quadrilaterals: the layer is stacks of
 // hexahedra, Gmsh's pyramids on its top (some as flat as 0.11 of their base edge, their apex
 // within the curved top's bulge: the optimiser leaves up to 9 invalid at order 4 and straightening
-// them repairs them), on the sphere (its quadrilaterals at the poles too) and on the cylinder
-// whose layer meets the end planes (its side quadrilaterals merged and split back).
+// them repairs them). On the sphere half its patches are recombined: 116 prism and 50 hexahedral
+// stacks share the columns where the patches meet. On the cylinder all are: its layer meets the
+// end planes (its side quadrilaterals merged and split back).
 TEST(GivenMesh, GmshsHexahedralLayersOnQuadrilateralWallsAreCurvedValidWithTheirLayers) {
   const auto dir = test::tempDir();
   test::GmshLayer layer;
-  layer.quadWall = true;
+  layer.quadPatches = 4;
   for (const bool sphere : {true, false}) {
     SCOPED_TRACE(sphere ? "sphere" : "cylinder");
     const std::string msh = (dir / "layer.msh").string(), step = (dir / "layer.step").string();
@@ -167,13 +168,14 @@ TEST(GivenMesh, GmshsHexahedralLayersOnQuadrilateralWallsAreCurvedValidWithTheir
     else
       test::writeGmshLayeredCylinder(msh, step, layer);
     const double tolerance = sphere ? parameterDefault("classify_tolerance") : 2e-3;
-    // (The sphere at order 2 only: at order 4 it has 205,000 nodes, and the cylinder has the
+    // (The sphere at order 2 only: at order 4 it has 178,000 nodes, and the cylinder has the
     // same pyramids on a curved top.)
     const std::vector<MeshResult> results = curveWithLayers(
         msh, step, layer, sphere ? std::vector<int>{2} : std::vector<int>{2, 4}, tolerance);
     for (const MeshResult& r : results) {
       ASSERT_TRUE(r.givenLayers && r.layerSplit);
       EXPECT_GT(r.givenLayers->hexStacks, 0U);
+      EXPECT_EQ(r.givenLayers->hexStacks < r.givenLayers->stacks, sphere);  // prisms too
       EXPECT_EQ(r.layerSplit->hexahedra, r.givenLayers->hexStacks);
       EXPECT_EQ(r.layerSplit->prisms + r.layerSplit->hexahedra, r.givenLayers->stacks);
       EXPECT_EQ(r.layerSplit->quadrilaterals, r.givenLayers->sidesMerged);
@@ -189,7 +191,7 @@ TEST(GivenMesh, QuadrilateralsAtASpheresPoleAreCurvedValid) {
   const auto dir = test::tempDir();
   const std::string msh = (dir / "sphere.msh").string(), step = (dir / "sphere.step").string();
   test::GmshLayer layer;
-  layer.quadWall = true;
+  layer.quadPatches = 8;
   test::writeGmshLayeredSphere(msh, step, layer);
   const CadModel cad = CadModel::fromFile(step);
   const Mesh onCad = classifyOnCad(readMesh(msh), cad,
