@@ -48,6 +48,7 @@ std::vector<T> getVector(const std::string& bytes, std::size_t& offset) {
 void appendBlockBytes(std::string& out, const ElementBlock& block) {
   put(out, static_cast<std::int32_t>(block.type));
   put(out, static_cast<std::int32_t>(block.order));
+  put(out, static_cast<std::int32_t>(block.layerCells ? 1 : 0));
   putVector(out, block.nodes);
   putVector(out, block.entity);
 }
@@ -56,6 +57,7 @@ ElementBlock readBlockBytes(const std::string& bytes, std::size_t& offset) {
   ElementBlock block;
   block.type = static_cast<CellType>(get<std::int32_t>(bytes, offset));
   block.order = get<std::int32_t>(bytes, offset);
+  block.layerCells = get<std::int32_t>(bytes, offset) != 0;
   block.nodes = getVector<std::int64_t>(bytes, offset);
   block.entity = getVector<std::int32_t>(bytes, offset);
   return block;

@@ -202,12 +202,19 @@ TEST(MeshBytes, AMeshAndABlockRoundTripExactly) {
   tets.nodes = {0, 1, 2, 3};
   tets.entity = {7};
   mesh.blocks.push_back(tets);
+  ElementBlock layer{CellType::Hexahedron, 1, {0, 1, 2, 3, 0, 1, 2, 3}, {1}};
+  layer.layerCells = true;  // (a macro layer's hexahedra: the flag travels too)
   std::string bytes;
   appendMeshBytes(bytes, mesh);
   appendBlockBytes(bytes, tets);
+  appendBlockBytes(bytes, layer);
   std::size_t offset = 0;
   const Mesh back = readMeshBytes(bytes, offset);
   const ElementBlock block = readBlockBytes(bytes, offset);
+  const ElementBlock layerBack = readBlockBytes(bytes, offset);
+  EXPECT_FALSE(block.layerCells);
+  EXPECT_TRUE(layerBack.layerCells);
+  EXPECT_EQ(layerBack.nodes, layer.nodes);
   EXPECT_EQ(offset, bytes.size());
   EXPECT_EQ(back.xyz, mesh.xyz);
   EXPECT_EQ(back.nodeCadDim, mesh.nodeCadDim);
