@@ -588,11 +588,12 @@ it was made from (.step .stp .iges .igs .brep .brp, one solid), or a planar 2D m
 quadrilaterals) on its faces: each boundary node is put on the CAD vertex, edge or face it lies
 on (within --classify-tolerance of the CAD's bounding diagonal; a node that lies on none is an
 error naming it, its position and its distance to the nearest face (in 2D, edge), and nothing
-is written; so is a cell that cannot be curved valid), prisms stacked on the wall (a boundary
-layer) are joined into one macro prism per column, the mesh is raised to order P with its new
-boundary nodes on the CAD and, with --optimise, optimised with them sliding on it, and the macro
-layer is split back into the given layers. A quadratic mesh is curved from its corners (its
-mid-edge nodes are dropped, with a note).
+is written; so is a cell that cannot be curved valid), prisms and hexahedra stacked on the wall
+(a boundary layer) are joined into one macro cell per column, the mesh is raised to order P with
+its new boundary nodes on the CAD and, with --optimise, optimised with them sliding on it, the
+elements left invalid are straightened off the CAD, and the macro layer is split back into the
+given layers. A quadratic mesh is curved from its corners (its mid-edge nodes are dropped, with
+a note).
 
 options (the parameter table's, which Python's homesh.curve reads too):
 )" + tableHelp(kCurveOptionKeys) +
