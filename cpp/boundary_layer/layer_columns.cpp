@@ -44,9 +44,10 @@ const Column& LayerSplitter::column(const ElementBlock& b, const std::map<Lattic
   const auto found = columns_.find(topNode);
   if (found != columns_.end()) return found->second;
   Column col;
-  col.levels = z_;
   const std::array<double, 4> l =
       shape.weights(double(c[0]) / p_, across == 2 ? double(c[1]) / p_ : 0.0);
+  // (A plain column keeps z: its thin cells are then sub-maps of the macro cell.)
+  col.levels = plain_.count(topNode) != 0 ? z_ : startLevels(v, shape.walls, l.data());
   const double target = grownHeight(v, shape.walls, l.data());
   const auto normal = normals_.find(topNode);
   if (n_ > 1 && plain_.count(topNode) == 0 && std::isfinite(target) && target > 0.0 &&
@@ -75,12 +76,25 @@ const Column& LayerSplitter::column(const ElementBlock& b, const std::map<Lattic
   return columns_.emplace(topNode, std::move(col)).first->second;
 }
 
-double LayerSplitter::setFirstLevel(Column& col, double wanted) const {
-  const double z1 = z_[1];
-  const double first = std::clamp(wanted, 0.5 * z1, std::min(2.0 * z1, 0.5 * (z1 + z_[2])));
+double LayerSplitter::setFirstLevel(Column& col, double wanted) {
+  const std::vector<double> s = col.levels;
+  const double s1 = s[1];
+  const double first = std::clamp(wanted, 0.5 * s1, std::min(2.0 * s1, 0.5 * (s1 + s[2])));
   for (std::size_t k = 1; k + 1 < col.levels.size(); ++k)
-    col.levels[k] = first + (z_[k] - z1) * (1.0 - first) / (1.0 - z1);
+    col.levels[k] = first + (s[k] - s1) * (1.0 - first) / (1.0 - s1);
   return first;
+}
+
+std::vector<double> LayerSplitter::startLevels(const std::int64_t* v, int walls,
+                                               const double* l) const {
+  if (given_ == nullptr) return z_;
+  std::vector<double> levels(z_.size(), 0.0);
+  for (int k = 0; k < walls; ++k) {
+    const auto id = static_cast<std::size_t>(v[k]);
+    if (id >= given_->size() || (*given_)[id].size() != z_.size()) return z_;
+    for (std::size_t i = 0; i < levels.size(); ++i) levels[i] += l[k] * (*given_)[id][i];
+  }
+  return levels;
 }
 
 const Column& LayerSplitter::fanColumn(std::int64_t corner, std::int64_t top) {

@@ -62,6 +62,11 @@ struct LayerHeights {
   // (BoundaryLayerRecord::lengthened): its first level is then set and measured by the height
   // along each wall normal at the vertex, not along their mean.
   std::map<std::int64_t, double> lengthened;
+  // Per node: at a wall vertex, its column's own levels (0 .. 1, as many as z: a given layer's,
+  // LayerStacks::givenLevels), empty elsewhere. A column whose cell has them at every wall vertex
+  // starts from their interpolation (the cell's wall weights) instead of z, unless it is plain;
+  // none: z everywhere.
+  std::vector<std::vector<double>> levels;
 };
 
 // `z`: the split coordinates (BoundaryLayerParameters::splitCoordinates). `cad` may be null

@@ -114,6 +114,7 @@ class LayerSplitter {
         grown_(heights != nullptr ? &heights->grown : nullptr),
         plain_(heights != nullptr ? heights->plain : std::set<std::int64_t>()),
         lengthened_(heights != nullptr ? heights->lengthened : std::map<std::int64_t, double>()),
+        given_(heights != nullptr && !heights->levels.empty() ? &heights->levels : nullptr),
         stats_(stats),
         p_(macro.order),
         n_(static_cast<int>(z.size()) - 1) {
@@ -131,7 +132,8 @@ class LayerSplitter {
   const CadModel* cad_;
   const std::vector<double>* grown_;  // wall vertex -> height as grown (NaN elsewhere), or null
   std::set<std::int64_t> plain_;      // wall nodes whose columns are split at z as they are
-  std::map<std::int64_t, double> lengthened_;  // LayerHeights::lengthened
+  std::map<std::int64_t, double> lengthened_;      // LayerHeights::lengthened
+  const std::vector<std::vector<double>>* given_;  // LayerHeights::levels, or null
   LayerSplitStats& stats_;
   int p_, n_;
   Mesh out_;
@@ -195,9 +197,13 @@ class LayerSplitter {
   // The column above lattice point `c` of cell `v` (Column): made by the first cell reaching it.
   const Column& column(const ElementBlock& b, const std::map<LatticePoint, int>& index,
                        const std::int64_t* v, LatticePoint c);
-  // Sets the column's levels from its first, `wanted` kept within [z_1 / 2, 2 z_1] (and below the
-  // second level's share): the others keep their progression in what remains. Returns it.
-  double setFirstLevel(Column& col, double wanted) const;
+  // Sets the column's levels from its first, `wanted` kept within [s_1 / 2, 2 s_1] (and below the
+  // second level's share), s its levels as they are: the others keep their progression in what
+  // remains. Returns it.
+  static double setFirstLevel(Column& col, double wanted);
+  // The levels a column of cell v at wall weights `l` starts from: the given levels of the
+  // cell's wall vertices interpolated (LayerHeights::levels), else z.
+  std::vector<double> startLevels(const std::int64_t* v, int walls, const double* l) const;
   // A fan's column from its corner `corner` to `top` (straight, with no wall of its own): a
   // layer cell's where one shares it, else levels that give the first layer its grown height
   // along the column (z unchanged where the column is plain).

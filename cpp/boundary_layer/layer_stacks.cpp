@@ -365,10 +365,12 @@ void replaceByMacroCells(std::vector<ElementBlock>& blocks, const std::vector<St
 }
 
 // Each column's node fractions along it (levelNodes has checked that a wall node has one
-// column): their mean over the columns in `record.levels`, its spread in `record.levelSpread`.
-void meanLevels(const Mesh& mesh, const std::map<std::int64_t, std::vector<std::int64_t>>& columns,
-                LayerStacksRecord& record) {
-  std::vector<std::vector<double>> fractions;
+// column), by wall node: their mean over the columns in `record.levels`, its spread in
+// `record.levelSpread`.
+std::map<std::int64_t, std::vector<double>> meanLevels(
+    const Mesh& mesh, const std::map<std::int64_t, std::vector<std::int64_t>>& columns,
+    LayerStacksRecord& record) {
+  std::map<std::int64_t, std::vector<double>> fractions;
   record.levels.assign(static_cast<std::size_t>(record.layers) + 1, 0.0);
   for (const auto& [wall, c] : columns) {
     std::vector<double> f(c.size(), 0.0);
@@ -377,12 +379,13 @@ void meanLevels(const Mesh& mesh, const std::map<std::int64_t, std::vector<std::
     for (double& x : f) x /= f.back();
     for (std::size_t k = 0; k < f.size(); ++k)
       record.levels[k] += f[k] / static_cast<double>(columns.size());
-    fractions.push_back(std::move(f));
+    fractions[wall] = std::move(f);
   }
   record.levels.back() = 1.0;
-  for (const std::vector<double>& f : fractions)
+  for (const auto& [wall, f] : fractions)
     for (std::size_t k = 0; k < f.size(); ++k)
       record.levelSpread = std::max(record.levelSpread, std::abs(f[k] - record.levels[k]));
+  return fractions;
 }
 
 // The stacks (prisms' and hexahedra's, not empty) agglomerated, or nothing with the reason.
@@ -411,7 +414,7 @@ std::optional<LayerStacks> agglomerate(const Mesh& mesh, const std::vector<Stack
     out.record.walls.insert(s.wall);
     out.record.hexStacks += s.type == CellType::Hexahedron ? 1 : 0;
   }
-  meanLevels(mesh, columns, out.record);
+  std::map<std::int64_t, std::vector<double>> fractions = meanLevels(mesh, columns, out.record);
 
   // The macro mesh: one cell per stack, sides merged, inner nodes dropped.
   out.macro = mesh;
@@ -431,8 +434,12 @@ std::optional<LayerStacks> agglomerate(const Mesh& mesh, const std::vector<Stack
   std::vector<char> used(mesh.numNodes(), 0);
   for (const ElementBlock& b : out.macro.blocks)
     for (const std::int64_t n : b.nodes) used[static_cast<std::size_t>(n)] = 1;
-  for (std::size_t i = 0; i < used.size(); ++i)
-    if (used[i] != 0) out.firstHeights.push_back(heights[i]);
+  for (std::size_t i = 0; i < used.size(); ++i) {
+    if (used[i] == 0) continue;
+    out.firstHeights.push_back(heights[i]);
+    const auto f = fractions.find(static_cast<std::int64_t>(i));
+    out.givenLevels.push_back(f != fractions.end() ? std::move(f->second) : std::vector<double>());
+  }
   compactNodes(out.macro);
   out.macro.checkConsistency();
   out.record.stacks = stacks.size();

@@ -14,8 +14,8 @@
 // stack's last face; the boundary quadrilaterals of the stacks' sides (on the CAD faces the layer
 // meets) and the lines climbing along CAD curves merge alike, so every node inside the layer goes.
 // The levels are each column's node distances, cumulative along the column and divided by its
-// length; the split uses their mean over the columns, with each column's first level set by its
-// own first-layer height.
+// length; the split keeps each column's own levels (interpolated between the wall vertices inside
+// a cell), with its first level set by its own first-layer height.
 #pragma once
 
 #include <cstddef>
@@ -51,6 +51,9 @@ struct LayerStacks {
   // Per node of `macro`: at a wall vertex, the height of its column's first layer (the distance
   // to the next node up); NaN elsewhere.
   std::vector<double> firstHeights;
+  // Per node of `macro`: at a wall vertex, its column's levels (its node distances, cumulative
+  // and divided by its length: 0 .. 1, layers + 1 of them); empty elsewhere (LayerHeights::levels).
+  std::vector<std::vector<double>> givenLevels;
   // Why the hexahedra's stacks were left out (they then stay as given while the prisms' stacks
   // are agglomerated); empty when they were not.
   std::string hexahedraLeftOut;

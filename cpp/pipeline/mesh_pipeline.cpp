@@ -394,7 +394,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   takeCurved(result, best);
 
   if (options.boundaryLayer) {
-    LayerHeights heights{grownLayerHeights(best.linear), {}, {}};
+    LayerHeights heights{grownLayerHeights(best.linear), {}, {}, {}};
     if (result.boundaryLayer) heights.lengthened = result.boundaryLayer->lengthened;
     splitLayers(result, options.boundaryLayer->splitCoordinates(), std::move(heights),
                 options.threads, observer);
@@ -441,7 +441,8 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
     // height z_1 H* of a column grown to H*, so H* = h_1 / z_1.
     std::vector<double> grown = std::move(stacks->firstHeights);
     for (double& h : grown) h /= stacks->record.levels[1];
-    splitLayers(result, stacks->record.levels, LayerHeights{std::move(grown), {}, {}},
+    splitLayers(result, stacks->record.levels,
+                LayerHeights{std::move(grown), {}, {}, std::move(stacks->givenLevels)},
                 options.threads, observer);
   }
   finishJob(result, budget, observer, true);

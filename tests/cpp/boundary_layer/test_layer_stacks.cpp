@@ -3,10 +3,12 @@
 // prism each; prisms that are no such layer left alone, with the reason.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <set>
 
+#include "boundary_layer/layer_split.hpp"
 #include "boundary_layer/layer_stacks.hpp"
 #include "cad/cad_model.hpp"
 #include "gmsh_layered.hpp"
@@ -105,13 +107,14 @@ TEST(LayerStacks, PrismsFromWallToWallAreNoLayer) {
 
 // A stack may stand on a prism's top triangle (corners 3, 4, 5 on the wall, as a file may list
 // them): the macro prism then takes the top's corners 3, 5, 4 as its wall and stays positive.
-// The nodes of a column of cells on the polygon `corners` in the plane z = 0: its corners at the
-// levels z = 0, 0.1 and 0.3, then `apex`; all inside the domain (the test gives the cells).
+// The nodes of a column of cells on the polygon `corners` in the plane z = 0: its corners at each
+// of `levels`, then `apex`; all inside the domain (the test gives the cells).
 Mesh columnNodes(const std::vector<std::pair<double, double>>& corners,
-                 const std::array<double, 3>& apex) {
+                 const std::array<double, 3>& apex,
+                 const std::vector<double>& levels = {0.0, 0.1, 0.3}) {
   Mesh mesh;
   mesh.dim = 3;
-  for (const double z : {0.0, 0.1, 0.3})
+  for (const double z : levels)
     for (const auto& [x, y] : corners) mesh.xyz.insert(mesh.xyz.end(), {x, y, z});
   mesh.xyz.insert(mesh.xyz.end(), apex.begin(), apex.end());
   const std::size_t n = mesh.numNodes();
@@ -222,6 +225,35 @@ TEST(LayerStacks, AColumnOfHexahedraOnAnyFaceMakesOnePositiveMacroHexahedron) {
   std::string why;
   EXPECT_FALSE(recogniseLayerStacks(spanning, why));
   EXPECT_TRUE(why.empty()) << why;
+}
+
+// Three prism layers whose columns climb differently (levels 0, 0.1, 0.3, 0.6, but 0.4 for the
+// third in the second column): the split, from the straight macro prism, puts every given node
+// back where it was, each column at its own levels (the mean levels would put that node at 0.33).
+TEST(LayerStacks, TheSplitKeepsEachColumnsOwnLevels) {
+  Mesh mesh = columnNodes({{0, 0}, {1, 0}, {0, 1}}, {0.2, 0.2, 1.2}, {0.0, 0.1, 0.3, 0.6});
+  mesh.xyz[3 * 7 + 2] = 0.4;  // node 7: (1, 0) at the third level
+  ElementBlock prisms{
+      CellType::Prism, 1, {0, 1, 2, 3, 4, 5, 3, 4, 5, 6, 7, 8, 6, 7, 8, 9, 10, 11}, {1, 1, 1}};
+  ElementBlock tets{CellType::Tetrahedron, 1, {9, 10, 11, 12}, {1}};
+  ElementBlock wall{CellType::Triangle, 1, {0, 2, 1}, {5}};
+  mesh.blocks = {prisms, tets, wall};
+  ASSERT_EQ(evaluateQuality(mesh, 1).invalid, 0U) << "the test's own cells must be positive";
+  std::string why;
+  std::optional<LayerStacks> s = recogniseLayerStacks(mesh, why);
+  ASSERT_TRUE(s) << why;
+  EXPECT_GT(s->record.levelSpread, 0.05);
+  std::vector<double> grown = s->firstHeights;
+  for (double& h : grown) h /= s->record.levels[1];
+  const LayerHeights heights{grown, {}, {}, s->givenLevels};
+  const Mesh split = splitBoundaryLayer(s->macro, s->record.levels, nullptr, nullptr, &heights);
+  for (std::size_t i = 0; i < 12; ++i) {
+    const Eigen::Vector3d given = nodePoint(mesh, static_cast<std::int64_t>(i));
+    double nearest = 1.0;
+    for (std::size_t j = 0; j < split.numNodes(); ++j)
+      nearest = std::min(nearest, (nodePoint(split, static_cast<std::int64_t>(j)) - given).norm());
+    EXPECT_LT(nearest, 1e-14) << "given node " << i << " at " << given.transpose();
+  }
 }
 
 }  // namespace
