@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "boundary_layer/layer_cells.hpp"
+#include "linear/cad_classification.hpp"
 #include "linear/edge_split.hpp"
 
 namespace homesh {
@@ -36,31 +37,6 @@ struct CellRef {
   }
   bool operator==(const CellRef& o) const { return block == o.block && element == o.element; }
 };
-
-// The faces of each volume type, as local corners (a triangle's fourth is -1).
-const std::vector<std::array<int, 4>>& cellFaces(CellType type) {
-  static const std::vector<std::array<int, 4>> tetrahedron{
-      {0, 1, 2, -1}, {0, 1, 3, -1}, {0, 2, 3, -1}, {1, 2, 3, -1}};
-  static const std::vector<std::array<int, 4>> prism{
-      {0, 1, 2, -1}, {3, 4, 5, -1}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}};
-  static const std::vector<std::array<int, 4>> pyramid{
-      {0, 1, 4, -1}, {1, 2, 4, -1}, {2, 3, 4, -1}, {3, 0, 4, -1}, {0, 1, 2, 3}};
-  static const std::vector<std::array<int, 4>> hexahedron{{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4},
-                                                          {3, 2, 6, 7}, {0, 3, 7, 4}, {1, 2, 6, 5}};
-  static const std::vector<std::array<int, 4>> none;
-  switch (type) {
-    case CellType::Tetrahedron:
-      return tetrahedron;
-    case CellType::Prism:
-      return prism;
-    case CellType::Pyramid:
-      return pyramid;
-    case CellType::Hexahedron:
-      return hexahedron;
-    default:
-      return none;
-  }
-}
 
 // A way through a layer cell: from the face `wall` to the opposite face `top`, wall[k] below
 // top[k]. Each wall is ordered so that its normal (right-handed) points into the cell: the cell
@@ -107,11 +83,10 @@ class Recogniser {
       if (cellDimension(block.type) == 3) {
         for (std::size_t e = 0; e < block.count(); ++e) {
           const std::int64_t* v = block.element(e);
-          for (const auto& f : cellFaces(block.type)) {
-            const std::size_t n = f[3] < 0 ? 3 : 4;
+          for (const std::vector<int>& f : cellFaceCorners(block.type)) {
             std::array<std::int64_t, 4> corners{};
-            for (std::size_t i = 0; i < n; ++i) corners[i] = v[f[i]];
-            faceCells_[faceKey(corners, n)].push_back({b, e});
+            for (std::size_t i = 0; i < f.size(); ++i) corners[i] = v[f[i]];
+            faceCells_[faceKey(corners, f.size())].push_back({b, e});
           }
           if (block.type == CellType::Prism) prisms_.push_back({b, e});
           if (block.type == CellType::Hexahedron) hexahedra_.push_back({b, e});

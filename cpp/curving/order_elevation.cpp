@@ -739,14 +739,9 @@ class BoundaryPlacer {
       for (const std::size_t b : {at(k, 0), at(p, k), at(k, p), at(0, k)})
         uv[b] = ch.unwrapNear(nodeFaceParameter(ch, mesh_, nodes[b], corner[ref]), corner[ref]);
     for (int j = 1; j < p; ++j)
-      for (int i = 1; i < p; ++i) {
-        const double s = static_cast<double>(i) / p, t = static_cast<double>(j) / p;
-        for (int d = 0; d < 2; ++d)
-          uv[at(i, j)][d] = (1 - t) * uv[at(i, 0)][d] + t * uv[at(i, p)][d] +
-                            (1 - s) * uv[at(0, j)][d] + s * uv[at(p, j)][d] -
-                            ((1 - s) * (1 - t) * uv[at(0, 0)][d] + s * (1 - t) * uv[at(p, 0)][d] +
-                             s * t * uv[at(p, p)][d] + (1 - s) * t * uv[at(0, p)][d]);
-      }
+      for (int i = 1; i < p; ++i)
+        for (std::size_t d = 0; d < 2; ++d)
+          uv[at(i, j)][d] = coons(p, i, j, [&](int a, int b) { return uv[at(a, b)][d]; });
     if (!unflipped(uv, p)) {
       ++stats_.quadInteriorsProjected;
       return;
@@ -765,19 +760,25 @@ class BoundaryPlacer {
   // interpolation of its edges' positions, each projected onto its face from there.
   void placeByPositions(const std::vector<std::int64_t>& nodes) {
     const int p = order_;
-    const auto x = [&](int i, int j) { return point(nodes[quadIndex(p, i, j)]); };
     for (int j = 1; j < p; ++j)
       for (int i = 1; i < p; ++i) {
-        const double s = static_cast<double>(i) / p, t = static_cast<double>(j) / p;
-        const Eigen::Vector3d coons = (1 - t) * x(i, 0) + t * x(i, p) + (1 - s) * x(0, j) +
-                                      s * x(p, j) -
-                                      ((1 - s) * (1 - t) * x(0, 0) + s * (1 - t) * x(p, 0) +
-                                       s * t * x(p, p) + (1 - s) * t * x(0, p));
         const std::int64_t node = nodes[quadIndex(p, i, j)];
-        for (int d = 0; d < 3; ++d) mesh_.xyz[3 * node + d] = coons[d];
+        for (int d = 0; d < 3; ++d)
+          mesh_.xyz[3 * node + d] = coons(
+              p, i, j, [&](int a, int b) { return mesh_.xyz[3 * nodes[quadIndex(p, a, b)] + d]; });
         projectNode(mesh_, node, cad_);
         placed_[static_cast<std::size_t>(node)] = 1;
       }
+  }
+
+  // The transfinite (Coons) interpolation at lattice point (i, j) of an order-P quadrilateral of
+  // the values f(a, b) on its four edges (one coordinate).
+  template <class F>
+  static double coons(int p, int i, int j, const F& f) {
+    const double s = static_cast<double>(i) / p, t = static_cast<double>(j) / p;
+    return (1 - t) * f(i, 0) + t * f(i, p) + (1 - s) * f(0, j) + s * f(p, j) -
+           ((1 - s) * (1 - t) * f(0, 0) + s * (1 - t) * f(p, 0) + s * t * f(p, p) +
+            (1 - s) * t * f(0, p));
   }
 
   // Whether every cell of a (P+1) x (P+1) lattice in (u, v) has the same, non-zero orientation.

@@ -642,4 +642,8 @@ Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
   return mesh;
 }
 
+const std::vector<std::vector<int>>& cellFaceCorners(CellType type) {
+  return cellFaces(type).faces;
+}
+
 }  // namespace homesh

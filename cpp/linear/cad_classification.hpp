@@ -1,6 +1,6 @@
-// A linear volume (or planar 2D) mesh made elsewhere (tetrahedra, prisms, pyramids and hexahedra from FreeCAD
-// FEM's Gmsh or Netgen mesher, Gmsh, any tool whose boundary nodes lie on the CAD) put on the
-// CAD, so that the rest of the pipeline can curve it as if the linear mesher had made it.
+// A linear volume (or planar 2D) mesh made elsewhere (tetrahedra, prisms, pyramids and hexahedra
+// from FreeCAD FEM's Gmsh or Netgen mesher, Gmsh, any tool whose boundary nodes lie on the CAD) put
+// on the CAD, so that the rest of the pipeline can curve it as if the linear mesher had made it.
 //
 // Boundary faces (triangles and quadrilaterals) are the faces of exactly one cell. Each boundary
 // node is classified on the lowest-dimensional CAD entity it lies on within the tolerance: a
@@ -10,6 +10,8 @@
 // positive (the volume their faces enclose) and boundary faces point out of their cell, as the
 // linear mesher leaves them; nodes no cell uses are dropped.
 #pragma once
+
+#include <vector>
 
 #include "cad/cad_model.hpp"
 #include "core/mesh.hpp"
@@ -40,5 +42,9 @@ struct CadClassificationStats {
 // on curved faces is refused.
 Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance = 0.0,
                    CadClassificationStats* stats = nullptr);
+
+// The faces of a positive linear volume cell of `type` (tetrahedron, prism, pyramid, hexahedron)
+// as local corners in Gmsh's order, pointing out. Throws ParameterError for another type.
+const std::vector<std::vector<int>>& cellFaceCorners(CellType type);
 
 }  // namespace homesh
