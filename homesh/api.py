@@ -133,7 +133,9 @@ class HighOrderMesh:
         on interfaces between volumes unless ``free_interfaces``) stay fixed. ``facet_weight``:
         on a mesh made from CAD, once every element is proven valid, also keep the sliding
         boundary facets' nodes evenly spread, so that the curved boundary stays on the CAD
-        between them (as in :func:`mesh`).
+        between them (as in :func:`mesh`); ``fidelity_weight``: also pull the sliding boundary
+        facets towards the CAD (distance and normal at their quadrature points), node by node
+        once its elements are proven valid.
 
         The mesh kept is never worse than before in worst scaled Jacobian or invalid count.
         Returns a dict: functional, iterations, converged, stopped (the rule that ended the

@@ -248,7 +248,7 @@ void addOptimiseSwitch(OptionTable& table, bool& optimise) {
 // The optimiser's options do nothing without --optimise: refused by name (in the table's order).
 void checkOptimiseSwitch(bool optimise, OptionMap& values) {
   if (!optimise)
-    for (const char* key : {"optimise", "optimise_seconds", "facet_weight"})
+    for (const char* key : {"optimise", "optimise_seconds", "facet_weight", "fidelity_weight"})
       if (values.count(key) != 0)
         throw UsageError{std::string(parameterDefinition(key).option) + " needs --optimise"};
   if (optimise && values.count("optimise") == 0) values["optimise"] = true;  // the table's
@@ -262,7 +262,7 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   addSizing(table, cmd.sizing, values);
   addTableOptions(table, values,
                   {"order", "size", "optimise", "repair_rounds", "optimise_seconds", "facet_weight",
-                   "linear_seconds", "job_seconds"});
+                   "fidelity_weight", "linear_seconds", "job_seconds"});
   addTableOptions(table, values, kCadModes);
   bool optimise = false;
   addOptimiseSwitch(table, optimise);
@@ -493,8 +493,9 @@ options (the parameter table's, which Python and FreeCAD read too):
          R"(      --optimise      run the variational optimiser after curving (hyperelastic),
                       boundary nodes sliding on the CAD curves and faces
 )" +
-         tableHelp({"optimise", "optimise_seconds", "facet_weight", "repair_rounds",
-                    "linear_seconds", "job_seconds", "heal", "solids_only", "surface", "auto"}) +
+         tableHelp({"optimise", "optimise_seconds", "facet_weight", "fidelity_weight",
+                    "repair_rounds", "linear_seconds", "job_seconds", "heal", "solids_only",
+                    "surface", "auto"}) +
          R"(
 refinement of the sizing octree:
       --refine-line X1,Y1,Z1,X2,Y2,Z2,R,D    size at most D within R of a segment

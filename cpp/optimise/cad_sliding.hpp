@@ -37,6 +37,8 @@ class CadSliding {
 
   // The CAD model of the calling thread (OCCT's evaluators cache state).
   const CadModel& threadCad() const;
+  // One clone per thread (empty where no node slides).
+  const std::vector<CadModel>& threadCads() const { return cadPerThread_; }
 
   // The point (in the frame) of a sliding node at parameters `param` (t, or (u, v)).
   Vec pointOn(const CadModel& cad, std::int64_t node, const double* param) const;

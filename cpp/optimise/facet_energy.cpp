@@ -1,16 +1,22 @@
 #include "optimise/facet_energy.hpp"
 
+#include <omp.h>
+
 #include <Eigen/Dense>
+#include <algorithm>
+#include <optional>
 #include <string>
 
 #include "core/error.hpp"
+#include "core/first_failure.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 
 namespace homesh {
 
 FacetEnergy::FacetEnergy(const Mesh& mesh, const std::vector<Vec>& positions,
-                         const std::vector<std::uint8_t>& movable, double weight) {
+                         const std::vector<std::uint8_t>& movable, double weight, double fidelity)
+    : weight_(weight), fidelity_(fidelity) {
   if (mesh.dim != 3) return;
   for (const ElementBlock& cells : mesh.blocks) {
     if (cellDimension(cells.type) != 2 || cells.count() == 0) continue;
@@ -34,6 +40,11 @@ FacetEnergy::FacetEnergy(const Mesh& mesh, const std::vector<Vec>& positions,
     };
     tabulate(ref, s.gradients);
     tabulate(lin, s.linear);
+    const Eigen::MatrixXd values = ref.valuesAt(points);  // points x nodes
+    s.values.resize(static_cast<std::size_t>(s.nodes) * s.points);
+    for (int n = 0; n < s.nodes; ++n)
+      for (int q = 0; q < s.points; ++q)
+        s.values[static_cast<std::size_t>(n) * s.points + q] = values(q, n);
     const int shape = static_cast<int>(shapes_.size());
     for (std::size_t c = 0; c < cells.count(); ++c) {
       const std::int64_t* v = cells.element(c);
@@ -66,12 +77,15 @@ FacetEnergy::FacetEnergy(const Mesh& mesh, const std::vector<Vec>& positions,
         scale_.push_back(s.weights[static_cast<std::size_t>(q)] * std::abs(w.determinant()));
         area += scale_.back();
       }
-      const double size = std::sqrt(area);
-      for (std::size_t k = first; k < scale_.size(); ++k) scale_[k] *= weight * size;
+      f.size = std::sqrt(area);
+      for (std::size_t k = first; k < scale_.size(); ++k) scale_[k] *= f.size;
       facets_.push_back(f);
     }
     shapes_.push_back(std::move(s));
   }
+  foot_.assign(scale_.size(), Vec::Zero());
+  normal_.assign(scale_.size(), Vec::Zero());
+  footParam_.assign(scale_.size(), {std::numeric_limits<double>::quiet_NaN(), 0.0});
   // Node -> facets.
   start_.assign(positions.size() + 1, 0);
   for (const Facet& f : facets_) {
@@ -97,48 +111,80 @@ double FacetEnergy::facetEnergy(const Facet& f, const std::vector<Vec>& position
                                 Vec* g, Mat* h, Patch* patch, double* size) const {
   const Shape& s = shapes_[static_cast<std::size_t>(f.shape)];
   const std::int64_t* v = s.cells->element(f.cell);
+  const bool distortion = distortionOn_ && weight_ > 0.0, fidelity = fidelity_ > 0.0;
   double energy = 0.0;
   for (int q = 0; q < s.points; ++q) {
+    const auto k = f.first + static_cast<std::size_t>(q);
     Eigen::Matrix<double, 3, 2> t = Eigen::Matrix<double, 3, 2>::Zero();
+    Vec x = Vec::Zero();
     for (int n = 0; n < s.nodes; ++n) {
-      const double* dn = &s.gradients[(static_cast<std::size_t>(n) * s.points + q) * 2];
-      t.col(0) += positions[static_cast<std::size_t>(v[n])] * dn[0];
-      t.col(1) += positions[static_cast<std::size_t>(v[n])] * dn[1];
+      const auto at = static_cast<std::size_t>(n) * s.points + q;
+      const double* dn = &s.gradients[at * 2];
+      const Vec& xn = positions[static_cast<std::size_t>(v[n])];
+      t.col(0) += xn * dn[0];
+      t.col(1) += xn * dn[1];
+      if (fidelity) x += xn * s.values[at];
     }
-    const Eigen::Matrix2d& invW = invW_[f.first + static_cast<std::size_t>(q)];
+    const Eigen::Matrix2d& invW = invW_[k];
     const Eigen::Matrix<double, 3, 2> m = t * invW;
-    const double w = scale_[f.first + static_cast<std::size_t>(q)];
+    const Vec& normal = normal_[k];
+    const bool follows = fidelity && normal.squaredNorm() > 0.0;
+    const double rq = follows ? (x - foot_[k]).dot(normal) / f.size : 0.0;
+    const double c1 = follows ? m.col(0).dot(normal) : 0.0;
+    const double c2 = follows ? m.col(1).dot(normal) : 0.0;
+    const double wd = weight_ * scale_[k], wf = fidelity_ * scale_[k];
+    if (follows) energy += wf * (rq * rq + c1 * c1 + c2 * c2);
     if (patch == nullptr) {
-      energy += w * facet_detail::density<double>(m.col(0), m.col(1));
+      if (distortion) energy += wd * facet_detail::density<double>(m.col(0), m.col(1));
       continue;
     }
-    const double* dn = &s.gradients[(static_cast<std::size_t>(local) * s.points + q) * 2];
+    const auto at = static_cast<std::size_t>(local) * s.points + q;
+    const double* dn = &s.gradients[at * 2];
     const Eigen::Vector2d a = invW.transpose() * Eigen::Vector2d(dn[0], dn[1]);
+    if (follows) {
+      // W_f as a function of s = d . n: (r + l s)^2 + (c1 + a1 s)^2 + (c2 + a2 s)^2.
+      const double l = s.values[at] / f.size;
+      const double slope = 2.0 * (rq * l + c1 * a[0] + c2 * a[1]);
+      const double curvature = 2.0 * (l * l + a[0] * a[0] + a[1] * a[1]);
+      *g += wf * slope * normal;
+      *h += wf * curvature * normal * normal.transpose();
+      if (size != nullptr) *size += wf * (rq * rq + c1 * c1 + c2 * c2);
+      patch->normal.push_back(normal);
+      patch->r.push_back(rq);
+      patch->l.push_back(l);
+      patch->c1.push_back(c1);
+      patch->c2.push_back(c2);
+      patch->b1.push_back(a[0]);
+      patch->b2.push_back(a[1]);
+      patch->wf.push_back(wf);
+    }
+    if (!distortion) continue;
     double value = 0.0;
     Vec gq;
     Mat hq;
     if (!facet_detail::derivatives<double>(m.col(0), m.col(1), a[0], a[1], value, gq, hq))
       return std::numeric_limits<double>::infinity();
-    energy += w * value;
-    if (size != nullptr) *size += w * (std::abs(value) + m.squaredNorm());
-    *g += w * gq;
-    *h += w * hq;
+    energy += wd * value;
+    if (size != nullptr) *size += wd * (std::abs(value) + m.squaredNorm());
+    *g += wd * gq;
+    *h += wd * hq;
     patch->m1.emplace_back(m.col(0));
     patch->m2.emplace_back(m.col(1));
     patch->a1.push_back(a[0]);
     patch->a2.push_back(a[1]);
-    patch->w.push_back(w);
+    patch->w.push_back(wd);
   }
   return energy;
 }
 
+void FacetEnergy::Patch::clear() {
+  for (std::vector<Vec>* v : {&m1, &m2, &normal}) v->clear();
+  for (std::vector<double>* v : {&a1, &a2, &w, &r, &l, &c1, &c2, &b1, &b2, &wf}) v->clear();
+}
+
 double FacetEnergy::assemble(std::int64_t node, const std::vector<Vec>& positions, Vec& g, Mat& h,
                              Patch& patch, double* size) const {
-  patch.m1.clear();
-  patch.m2.clear();
-  patch.a1.clear();
-  patch.a2.clear();
-  patch.w.clear();
+  patch.clear();
   const auto n = static_cast<std::size_t>(node);
   if (n + 1 >= start_.size()) return 0.0;
   Vec gs = Vec::Zero();
@@ -159,7 +205,62 @@ double FacetEnergy::energyAfter(const Patch& patch, const Vec& d) {
   for (std::size_t i = 0; i < patch.w.size(); ++i)
     energy += patch.w[i] * facet_detail::density<double>(Vec(patch.m1[i] + patch.a1[i] * d),
                                                          Vec(patch.m2[i] + patch.a2[i] * d));
+  for (std::size_t i = 0; i < patch.wf.size(); ++i) {
+    const double s = patch.normal[i].dot(d);
+    const double r = patch.r[i] + patch.l[i] * s, c1 = patch.c1[i] + patch.b1[i] * s,
+                 c2 = patch.c2[i] + patch.b2[i] * s;
+    energy += patch.wf[i] * (r * r + c1 * c1 + c2 * c2);
+  }
   return energy;
+}
+
+void FacetEnergy::refreshTargets(const std::vector<Vec>& positions, const Mesh& mesh,
+                                 const std::vector<CadModel>& cads) {
+  if (!(fidelity_ > 0.0) || cads.empty()) return;
+  const auto count = static_cast<std::int64_t>(facets_.size());
+  FirstFailure failure;
+#pragma omp parallel for num_threads(static_cast <int>(cads.size())) schedule(dynamic, 16)
+  for (std::int64_t fi = 0; fi < count; ++fi) {
+    try {
+      const CadModel& cad = cads[static_cast<std::size_t>(omp_get_thread_num())];
+      const Facet& f = facets_[static_cast<std::size_t>(fi)];
+      const Shape& s = shapes_[static_cast<std::size_t>(f.shape)];
+      const std::int64_t* v = s.cells->element(f.cell);
+      const int face = s.cells->entity[f.cell];
+      if (face < 1 || face > cad.numFaces()) continue;
+      for (int q = 0; q < s.points; ++q) {
+        const auto k = f.first + static_cast<std::size_t>(q);
+        Vec x = Vec::Zero();
+        double largest = -1.0;
+        const bool first = !std::isfinite(footParam_[k][0]);
+        std::optional<std::array<double, 2>> guess;
+        if (!first) guess = footParam_[k];
+        for (int n = 0; n < s.nodes; ++n) {
+          const double l = s.values[static_cast<std::size_t>(n) * s.points + q];
+          const auto id = static_cast<std::size_t>(v[n]);
+          x += positions[id] * l;
+          if (!first || l <= largest) continue;
+          // First projection: from the face node whose basis function is largest here.
+          if (mesh.nodeCadDim[id] == 2 && mesh.nodeCadIndex[id] == face) {
+            largest = l;
+            guess = std::array<double, 2>{mesh.nodeCadParam[2 * id], mesh.nodeCadParam[2 * id + 1]};
+          }
+        }
+        const SurfaceProjection proj = cad.projectOnSurface(face, x, guess);
+        const SurfaceDerivatives d = cad.evaluateSurface(face, proj.u, proj.v);
+        const Vec m = d.du.cross(d.dv);
+        // Undefined where S_u and S_v are parallel or one vanishes (a pole), as the report's
+        // measure (geometry_accuracy.hpp) has it.
+        const double scale = std::max(d.du.squaredNorm(), d.dv.squaredNorm());
+        foot_[k] = proj.point;
+        normal_[k] = m.norm() > 1e-8 * scale ? Vec(m.normalized()) : Vec::Zero();
+        footParam_[k] = {proj.u, proj.v};
+      }
+    } catch (...) {
+      failure.capture();
+    }
+  }
+  failure.rethrow();
 }
 
 double FacetEnergy::total(const std::vector<Vec>& positions) const {

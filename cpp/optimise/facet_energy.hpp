@@ -14,14 +14,29 @@
 // its straight shape moved rigidly, and grows with its nodes' bunching and with its shearing and
 // stretching in the surface; bending out of the ideal's plane (the curving onto the CAD) costs
 // only the stretching it brings. Moving node n by d changes M by d a^T, a = W^-T grad_xi l_n.
+//
+// The fidelity part measures what the spacing only prevents: how far the facet's surface leaves
+// the CAD between its nodes. At each point, with p the point's foot on the CAD face and n the
+// CAD's unit normal there (targets, refreshed by refreshTargets: once per sweep),
+//   W_f = ((x - p) . n / h)^2 + |M^T n|^2,
+// h the ideal facet's size: the distance off the CAD's tangent plane relative to the facet, and
+// the squared sine of the angle between the facet's tangent plane and the CAD's (for a facet
+// the shape of its ideal), the two quantities the report's geometry measures. Moving node n by
+// d changes x by l_n d and M^T n by a (d . n), so W_f is a quadratic in d . n with exact
+// derivatives; a tangential slide of a node enters through the other points' normals, which
+// differ from its own by the curvature times their distance: the bump the slide makes in the
+// interpolant between the nodes. The targets are the last sweep's, a Taylor (lagged) model of
+// the distance as Gmsh's and NekMesh's fidelity terms use.
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <vector>
 
+#include "cad/cad_model.hpp"
 #include "core/mesh.hpp"
 #include "optimise/functional.hpp"
 
@@ -84,12 +99,14 @@ class FacetEnergy {
 
   // The facets are the cells of `mesh`'s 2D blocks (triangles, quadrilaterals) with at least
   // one node where movable[node] != 0; their ideal shapes are their straight-sided cells at
-  // `positions` (in the optimiser's frame; the start of the run). Each point's weight is
-  // `weight` x its quadrature weight x the ideal's area element x the ideal facet's size
-  // (sqrt of its area), so that the term scales as the volume energy of the elements below it.
-  // Throws ParameterError for a facet whose straight cell is degenerate.
+  // `positions` (in the optimiser's frame, which is the model's in 3D; the start of the run).
+  // Each point's weight is `weight` (the distortion's; `fidelity` for the fidelity part) x its
+  // quadrature weight x the ideal's area element x the ideal facet's size (sqrt of its area),
+  // so that the term scales as the volume energy of the elements below it. The fidelity part
+  // is off until refreshTargets(). Throws ParameterError for a facet whose straight cell is
+  // degenerate.
   FacetEnergy(const Mesh& mesh, const std::vector<Vec>& positions,
-              const std::vector<std::uint8_t>& movable, double weight);
+              const std::vector<std::uint8_t>& movable, double weight, double fidelity = 0.0);
 
   bool empty() const { return facets_.empty(); }
   std::size_t size() const { return facets_.size(); }
@@ -98,7 +115,23 @@ class FacetEnergy {
   struct Patch {
     std::vector<Vec> m1, m2;  // M's columns at the node's current position
     std::vector<double> a1, a2, w;
+    // The fidelity part's points: the CAD normal, (x - p) . n / h, l_n / h, M^T n, a, weight.
+    std::vector<Vec> normal;
+    std::vector<double> r, l, c1, c2, b1, b2, wf;
+    void clear();
   };
+
+  // The fidelity part's targets at `positions` (model coordinates in 3D): every point of every
+  // facet projected onto its CAD face, starting from its last foot (first: from the facet's
+  // node on that face whose basis function is largest there), on `threads` threads, the
+  // model's `cads` (a clone per thread). A point where the CAD's normal is undefined (a pole)
+  // drops out of the part. Nothing without a fidelity weight. Throws CadError where a
+  // projection fails.
+  void refreshTargets(const std::vector<Vec>& positions, const Mesh& mesh,
+                      const std::vector<CadModel>& cads);
+  bool hasFidelity() const { return fidelity_ > 0.0; }
+  // Switches the distortion part (on from construction) off and on.
+  void setDistortionOn(bool on) { distortionOn_ = on; }
 
   // The energy of `node`'s facets at `positions`, with its gradient and Hessian in the node's
   // displacement (added to g and h); fills `patch`. Infinite (g, h untouched) where a facet is
@@ -121,6 +154,7 @@ class FacetEnergy {
   struct Shape {  // one facet cell type and order
     const ElementBlock* cells;
     int nodes = 0, points = 0;
+    std::vector<double> values;     // [node][point]
     std::vector<double> gradients;  // [node][point][2]
     std::vector<double> weights;    // quadrature weights
     std::vector<double> linear;     // the linear cell's basis gradients: [vertex][point][2]
@@ -130,6 +164,7 @@ class FacetEnergy {
     int shape = 0;
     std::size_t cell = 0;
     std::size_t first = 0;  // its points' ideal data in invW_ and scale_
+    double size = 0.0;      // the ideal's sqrt(area), h
   };
   struct Incidence {
     std::uint32_t facet;
@@ -143,8 +178,14 @@ class FacetEnergy {
   std::vector<Shape> shapes_;
   std::vector<Facet> facets_;
   std::vector<Eigen::Matrix2d> invW_;  // per facet point: W^-1
-  std::vector<double> scale_;          // per facet point: weight x |det W| x facet size
-  std::vector<std::size_t> start_;     // per node: its facets in incidence_
+  std::vector<double> scale_;          // per facet point: |det W| x facet size x quadrature
+  double weight_ = 0.0, fidelity_ = 0.0;
+  bool distortionOn_ = true;
+  // The fidelity part's targets per facet point: the foot on the CAD, the unit normal there
+  // (zero: undefined, or not refreshed yet) and its face parameters (NaN: none yet).
+  std::vector<Vec> foot_, normal_;
+  std::vector<std::array<double, 2>> footParam_;
+  std::vector<std::size_t> start_;  // per node: its facets in incidence_
   std::vector<Incidence> incidence_;
 };
 

@@ -83,7 +83,7 @@ template <int D>
 void NodeStep<D>::buildFacets(const std::vector<std::int64_t>& free, const CadModel* cad) {
   facetEnergy_.reset();
   if constexpr (D == 3) {
-    if (!(options_.facetWeight > 0.0) || cad == nullptr) return;
+    if (!(options_.facetWeight > 0.0 || options_.fidelityWeight > 0.0) || cad == nullptr) return;
     std::vector<std::uint8_t> movable(mesh_.mesh.numNodes(), 0);
     bool any = false;
     for (const std::int64_t node : free)
@@ -92,9 +92,40 @@ void NodeStep<D>::buildFacets(const std::vector<std::int64_t>& free, const CadMo
         any = true;
       }
     if (!any) return;
-    facetEnergy_ =
-        std::make_unique<FacetEnergy>(mesh_.mesh, mesh_.position, movable, options_.facetWeight);
+    facetEnergy_ = std::make_unique<FacetEnergy>(mesh_.mesh, mesh_.position, movable,
+                                                 options_.facetWeight, options_.fidelityWeight);
     if (facetEnergy_->empty()) facetEnergy_.reset();
+  }
+}
+
+template <int D>
+void NodeStep<D>::setFacetsOn(bool on) {
+  facetsOn_ = on;
+  if constexpr (D == 3) {
+    if (facetEnergy_ != nullptr) facetEnergy_->setDistortionOn(on);
+  }
+}
+
+template <int D>
+bool NodeStep<D>::facetTermActive(std::int64_t node) const {
+  if (!hasFacets()) return false;
+  if (facetsOn_) return true;
+  if constexpr (D == 3) {
+    if (!facetEnergy_->hasFidelity() || validity_ == nullptr) return false;
+    const auto n = static_cast<std::size_t>(node);
+    for (std::size_t k = mesh_.incidenceStart[n]; k < mesh_.incidenceStart[n + 1]; ++k)
+      if ((*validity_)[mesh_.globalIndex(mesh_.incidence[k])] != Validity::Valid) return false;
+    return true;
+  } else {
+    return false;
+  }
+}
+
+template <int D>
+void NodeStep<D>::refreshFacetTargets() {
+  if constexpr (D == 3) {
+    if (facetEnergy_ != nullptr)
+      facetEnergy_->refreshTargets(mesh_.position, mesh_.mesh, sliding_.threadCads());
   }
 }
 
@@ -110,7 +141,8 @@ bool NodeStep<D>::touchesFacet(std::int64_t node) const {
 template <int D>
 double NodeStep<D>::facetTotal() const {
   if constexpr (D == 3) {
-    if (facetsOn_ && hasFacets()) return facetEnergy_->total(mesh_.position);
+    if (hasFacets() && (facetsOn_ || facetEnergy_->hasFidelity()))
+      return facetEnergy_->total(mesh_.position);
   }
   return 0.0;
 }
@@ -252,7 +284,7 @@ double NodeStep<D>::slideOn(const CadModel& cad, std::int64_t node, Patch<D>& pa
   double e0 = volumeEnergy;
   Vec grad = volumeGrad;
   Mat hess = volumeHess;
-  const bool facets = facetsOn_ && hasFacets();
+  const bool facets = facetTermActive(node);
   if (facets) {
     double size = 0.0;
     const double ef = facetAssemble(node, grad, hess, patch, size);

@@ -23,6 +23,7 @@
 #include "optimise/node_patch.hpp"
 #include "optimise/optimiser.hpp"
 #include "optimise/working_mesh.hpp"
+#include "quality/bezier_jacobian.hpp"
 
 namespace homesh::optimiser {
 
@@ -53,12 +54,25 @@ class NodeStep {
            const std::vector<Vec>& lockedNormal)
       : mesh_(mesh), sliding_(sliding), options_(options), lockedNormal_(lockedNormal) {}
 
-  // The boundary facets of the free sliding nodes (3D, with CAD and options.facetWeight > 0);
-  // none otherwise. The term is off until setFacetsOn().
+  // The boundary facets of the free sliding nodes (3D, with CAD and options.facetWeight or
+  // fidelityWeight > 0); none otherwise. The term is off until setFacetsOn().
   void buildFacets(const std::vector<std::int64_t>& free, const CadModel* cad);
+  // The facet term's fidelity targets (the CAD's foot points and normals) at the current
+  // positions (FacetEnergy::refreshTargets).
+  void refreshFacetTargets();
   bool hasFacets() const { return facetEnergy_ != nullptr; }
+  // Whether the facets' distortion part has joined (it waits for a proven-valid mesh;
+  // untangling comes first).
   bool facetsOn() const { return facetsOn_; }
-  void setFacetsOn(bool on) { facetsOn_ = on; }
+  void setFacetsOn(bool on);
+  // Whether the steps at `node` add the facet term: once its distortion part has joined; before,
+  // its fidelity part alone where the node's elements are all proven valid (validity(): the
+  // last evaluation), so that sliding untangles first and the CAD's pull joins node by node
+  // rather than only once the whole mesh is valid (a run that never gets there would not have
+  // it at all).
+  bool facetTermActive(std::int64_t node) const;
+  // Per element (global index), its validity at the last evaluation; read by facetTermActive.
+  void setValidity(const std::vector<Validity>* validity) { validity_ = validity; }
   // Whether the node is a vertex of a boundary facet of the term (after buildFacets).
   bool touchesFacet(std::int64_t node) const;
   // The facet term's total at the current positions, 0 while it is off.
@@ -92,10 +106,12 @@ class NodeStep {
   CadSliding<D>& sliding_;
   const OptimiserOptions& options_;
   const std::vector<Vec>& lockedNormal_;
-  // The boundary facets' term (OptimiserOptions::facetWeight); null without it. facetsOn_: the
+  // The boundary facets' term (OptimiserOptions::facetWeight, fidelityWeight); null without
+  // them. facetsOn_: the distortion part has joined; the
   // steps add it, once the mesh is proven valid.
   std::unique_ptr<FacetEnergy> facetEnergy_;
   bool facetsOn_ = false;
+  const std::vector<Validity>* validity_ = nullptr;
 };
 
 extern template class NodeStep<2>;

@@ -77,6 +77,7 @@ class Optimiser {
     result_.functional = options_.functional;
     mesh_.build();
     quality_.measureInput(startQuality_);  // certified quality of every element, before
+    step_.setValidity(&quality_.validity());
     const IterationRecord before = quality_.summarise(0, 0.0, t0);
     result_.worstBefore = before.worst;
     result_.invalidBefore = before.invalid;
@@ -99,6 +100,7 @@ class Optimiser {
     Kept best{before, {}, {}};
     // Before the energy: it counts the term.
     step_.setFacetsOn(before.invalid + before.undecided == 0);
+    step_.refreshFacetTargets();
     best.record.energy = result_.energyBefore = totalEnergy();
     Mesh& mesh = mesh_.mesh;
     const std::vector<double> input = mesh.xyz, inputParam = mesh.nodeCadParam;
@@ -127,6 +129,7 @@ class Optimiser {
     mesh_.build();
     chooseFreeNodes();
     step_.buildFacets(free_.nodes, cad_);
+    step_.refreshFacetTargets();
     colouring_.partition(mesh_, free_.changed);
     free_.changed.resize(mesh_.totalElements);
     for (std::size_t i = 0; i < mesh_.totalElements; ++i) free_.changed[i] = i;
@@ -205,9 +208,12 @@ class Optimiser {
       // The facet term joins once the mesh is proven valid: every node of a facet is visited
       // again (resting nodes too), and the sweep is not judged by the stop rules, whose energy
       // would compare totals with and without the term.
-      const bool switching =
-          !step_.facetsOn() && step_.hasFacets() && record.invalid + record.undecided == 0;
+      const bool switching = !step_.facetsOn() && step_.hasFacets() && options_.facetWeight > 0.0 &&
+                             record.invalid + record.undecided == 0;
       if (switching) switchFacetsOn();
+      // The fidelity targets follow the sweep (a lagged model of the distance to the CAD):
+      // the record's energy is the next sweep's start.
+      step_.refreshFacetTargets();
       record.energy = totalEnergy();
       finishSweep(record, before, best);
       const std::string reason =
@@ -298,7 +304,7 @@ class Optimiser {
     });
     double total = 0.0;
     for (const std::size_t i : energyOrder_) total += energy[i];
-    if (step_.facetsOn() && step_.hasFacets()) total += step_.facetTotal();
+    total += step_.facetTotal();
     return total;
   }
 

@@ -15,6 +15,7 @@ void OptimiserOptions::validate() const {
   checkParameter("region_layers", regionLayers);
   checkParameter("focus", focusPasses);
   checkParameter("facet_weight", facetWeight);
+  checkParameter("fidelity_weight", fidelityWeight);
   // The internal rules' settings (not user-facing: no table rows).
   if (!(energyTolerance >= 0.0) || !std::isfinite(energyTolerance))
     throw ParameterError("energy tolerance must be a finite number >= 0");
@@ -40,6 +41,7 @@ const OptionSetters<OptimiserOptions>& setters() {
       {"optimise", [](OptimiserOptions& o, double v) { o.maxIterations = static_cast<int>(v); }},
       {"optimise_seconds", [](OptimiserOptions& o, double v) { o.timeLimit = v; }},
       {"facet_weight", [](OptimiserOptions& o, double v) { o.facetWeight = v; }},
+      {"fidelity_weight", [](OptimiserOptions& o, double v) { o.fidelityWeight = v; }},
       {"threads", [](OptimiserOptions& o, double v) { o.threads = static_cast<int>(v); }},
       {"functional",
        [](OptimiserOptions& o, double v) { o.functional = static_cast<Functional>(v); }},

@@ -97,6 +97,11 @@ struct OptimiserOptions {
   // stop rules skip that sweep, and the reported energy includes the term from then on):
   // untangling comes first.
   double facetWeight = defaultOf<double>("facet_weight");
+  // Weight of the boundary facets' fidelity to the CAD (facet_energy.hpp: distance off the
+  // CAD's tangent plane and the angle between the normals, at the facets' quadrature points)
+  // in the same energy, joining with the facet term. The sliding nodes are otherwise free to
+  // move along the CAD however the volume prefers, and the surface between them leaves it.
+  double fidelityWeight = defaultOf<double>("fidelity_weight");
 
   // Throws ParameterError naming the offending option.
   void validate() const;

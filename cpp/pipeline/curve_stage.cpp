@@ -109,6 +109,7 @@ OptimiserOptions pipelineOptimiserOptions(const MeshingOptions& options) {
   o.threads = options.threads;
   o.timeLimit = options.optimiseSeconds;
   o.facetWeight = options.facetWeight;
+  o.fidelityWeight = options.fidelityWeight;
   return o;
 }
 

@@ -155,8 +155,9 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
 
 // The parameter table's keys curveMeshOnCad's front ends take (`homesh curve`, homesh.curve),
 // beside threads and verbosity, which each front end sets its own way.
-inline constexpr std::array<const char*, 6> kCurveOptionKeys = {
-    "order", "optimise", "optimise_seconds", "facet_weight", "job_seconds", "classify_tolerance"};
+inline constexpr std::array<const char*, 7> kCurveOptionKeys = {
+    "order",           "optimise",    "optimise_seconds",  "facet_weight",
+    "fidelity_weight", "job_seconds", "classify_tolerance"};
 
 // writeMeshFiles as the pipeline's last stage: records its "output" timing in the result.
 void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,

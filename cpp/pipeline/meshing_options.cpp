@@ -13,6 +13,7 @@ void MeshingOptions::validate() const {
   checkParameter("optimise", optimiseIterations);
   checkParameter("optimise_seconds", optimiseSeconds);
   checkParameter("facet_weight", facetWeight);
+  checkParameter("fidelity_weight", fidelityWeight);
   checkParameter("linear_seconds", linearSeconds);
   checkParameter("job_seconds", jobSeconds);
   checkParameter("repair_rounds", repairRounds);
@@ -55,6 +56,7 @@ const OptionSetters<MeshingOptions>& setters() {
       {"optimise", [](MeshingOptions& o, double v) { o.optimiseIterations = static_cast<int>(v); }},
       {"optimise_seconds", [](MeshingOptions& o, double v) { o.optimiseSeconds = v; }},
       {"facet_weight", [](MeshingOptions& o, double v) { o.facetWeight = v; }},
+      {"fidelity_weight", [](MeshingOptions& o, double v) { o.fidelityWeight = v; }},
       {"linear_seconds", [](MeshingOptions& o, double v) { o.linearSeconds = v; }},
       {"job_seconds", [](MeshingOptions& o, double v) { o.jobSeconds = v; }},
       {"repair_rounds", [](MeshingOptions& o, double v) { o.repairRounds = static_cast<int>(v); }},

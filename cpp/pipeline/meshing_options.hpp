@@ -34,6 +34,8 @@ struct MeshingOptions {
   double optimiseSeconds = defaultOf<double>("optimise_seconds");  // each run's limit (0: none)
   // The optimiser's boundary-facet term (OptimiserOptions::facetWeight).
   double facetWeight = defaultOf<double>("facet_weight");
+  // The optimiser's fidelity term (OptimiserOptions::fidelityWeight).
+  double fidelityWeight = defaultOf<double>("fidelity_weight");
   // Time limit of each Gmsh run of the linear mesher (0: none).
   double linearSeconds = defaultOf<double>("linear_seconds");
   // Wall-time budget of the whole job (0: none), from the start of runMeshPipeline

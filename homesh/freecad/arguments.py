@@ -43,6 +43,7 @@ def mesh_arguments(obj, values=None):
                  "optimise": int(get("OptimiserIterations")),
                  "optimise_seconds": get("OptimiserTimeLimit"),
                  "facet_weight": get("FacetWeight"),
+                 "fidelity_weight": get("FidelityWeight"),
                  "linear_seconds": get("LinearTimeLimit"),
                  "job_seconds": get("JobTimeLimit"),
                  "heal": bool(get("Heal")), "solids_only": bool(get("SolidsOnly")),

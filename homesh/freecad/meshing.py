@@ -43,7 +43,8 @@ def job_for(obj, values=None):
                       optimise=arguments["optimise"], threads=arguments["threads"],
                       optimise_seconds=arguments["optimise_seconds"],
                       job_seconds=arguments["job_seconds"],
-                      facet_weight=arguments["facet_weight"])
+                      facet_weight=arguments["facet_weight"],
+                      fidelity_weight=arguments["fidelity_weight"])
         job.fem_elements = sum(len(c) for c in cells.values())
     job.values = values or {}
     return job

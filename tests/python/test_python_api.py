@@ -390,6 +390,20 @@ def test_the_facet_weight_reaches_the_core_and_is_checked(data):
         homesh.mesh(text, order=2, size=0.5, optimise=5, facet_weight="1")
 
 
+def test_the_fidelity_weight_reaches_the_core_and_is_checked(data):
+    # The sphere at size 0.5, order 4: the term pulls the sliding facets towards the CAD; both
+    # runs valid, and the term changes the result (it is applied, not dropped).
+    text = (data / "sphere.brep").read_text()
+    plain = homesh.mesh(text, order=4, size=0.5, optimise=20)
+    pulled = homesh.mesh(text, order=4, size=0.5, optimise=20, fidelity_weight=10.0)
+    for m in (plain, pulled):
+        assert m.report()["optimiser"]["invalid_after"] == 0
+    assert not np.array_equal(plain.nodes, pulled.nodes)
+    with pytest.raises(homesh.ParameterError,
+                       match="fidelity weight must be a number from 0 to 1000, got -1"):
+        homesh.mesh(text, order=2, size=0.5, optimise=5, fidelity_weight=-1.0)
+
+
 def test_the_command_line_takes_a_time_limit(homesh_bin, data, tmp_path):
     from conftest import run
     report = tmp_path / "r.json"
@@ -438,6 +452,7 @@ def test_keywords_and_their_help_come_from_the_parameter_table(data):
         assert default is None if p["zero_is_automatic"] else default == p["default"], key
     assert signature["optimise"].default is False  # asked for with True or a number
     assert "facet_weight" in inspect.signature(homesh.curve).parameters
+    assert "fidelity_weight" in inspect.signature(homesh.curve).parameters
     assert "size" not in inspect.signature(homesh.curve).parameters
     # optimise=True is the table's number of sweeps, the most a run may take.
     record = homesh.mesh((data / "sphere.brep").read_text(), order=2, size=0.5,

@@ -75,6 +75,7 @@ class HighOrderMeshProxy(GuardedProxy):
         add_parameter_property(obj, "optimise", "Mesh", " Boundary nodes slide on the CAD.")
         add_parameter_property(obj, "optimise_seconds", "Mesh")
         add_parameter_property(obj, "facet_weight", "Mesh")
+        add_parameter_property(obj, "fidelity_weight", "Mesh")
         add_parameter_property(obj, "linear_seconds", "Mesh")
         add_parameter_property(obj, "job_seconds", "Mesh")
         for key in ("heal", "solids_only", "surface", "auto"):

@@ -1,8 +1,9 @@
 // The boundary facets' in-surface energy (optimise/facet_energy.hpp) on single triangles and
 // quadrilaterals: zero and stationary for a rigid motion of the straight facet, positive for
 // nodes bunched along it, the trial energy equal to the energy recomputed at the moved node, and
-// a clear error for a degenerate facet. Its derivatives are checked against AD and finite
-// differences in test_derivatives.cpp.
+// a clear error for a degenerate facet; its fidelity part zero for a facet on a planar CAD face
+// and for a slide within it, and an exact quadratic in a move off it. Its derivatives are checked
+// against AD and finite differences in test_derivatives.cpp.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -12,9 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "cad/cad_model.hpp"
 #include "core/error.hpp"
 #include "element/reference_element.hpp"
 #include "optimise/facet_energy.hpp"
+#include "test_support.hpp"
 
 namespace homesh {
 namespace {
@@ -150,6 +153,69 @@ TEST(FacetEnergy, OnlyFacetsOfMovableNodesAndADegenerateFacetIsNamed) {
   } catch (const ParameterError& e) {
     EXPECT_NE(std::string(e.what()).find("CAD face 7"), std::string::npos) << e.what();
   }
+}
+
+// The fidelity part on a planar CAD face: an order-3 facet of the unit box's face z = 0 (its
+// straight shape lies on it), targets refreshed from the CAD.
+TEST(FacetEnergy, TheFidelityPartIsZeroOnAPlaneAndAnExactQuadraticOffIt) {
+  std::vector<CadModel> cads;
+  cads.push_back(CadModel::fromBrepText(test::brepText(test::box(1.0, 1.0, 1.0))));
+  int face = 0;
+  for (int i = 1; i <= cads[0].numFaces() && face == 0; ++i)
+    if (cads[0].isPlanar(i) && std::abs(cads[0].plane(i).second.z()) > 0.5 &&
+        std::abs(cads[0].plane(i).first.z()) < 1e-12)
+      face = i;
+  ASSERT_NE(face, 0) << "no face z = 0";
+  const ReferenceElement& ref = ReferenceElement::get(CellType::Triangle, 3);
+  OneFacet f;
+  f.mesh.dim = 3;
+  f.mesh.order = 3;
+  for (int i = 0; i < ref.numNodes(); ++i) {
+    const Eigen::Vector3d x(0.2 + 0.5 * ref.nodes()(i, 0) + 0.2 * ref.nodes()(i, 1),
+                            0.1 + 0.6 * ref.nodes()(i, 1), 0.0);
+    const SurfaceProjection on = cads[0].projectOnSurface(face, x);
+    const double p[3] = {x[0], x[1], x[2]};
+    f.mesh.addNode(p, 2, face, on.u, on.v);
+    f.positions.push_back(x);
+  }
+  ElementBlock b;
+  b.type = CellType::Triangle;
+  b.order = 3;
+  for (int i = 0; i < ref.numNodes(); ++i) b.nodes.push_back(i);
+  b.entity = {face};
+  f.mesh.blocks.push_back(b);
+  const std::vector<std::uint8_t> movable(f.positions.size(), 1);
+  FacetEnergy energy(f.mesh, f.positions, movable, 0.0, 10.0);
+  EXPECT_EQ(energy.total(f.positions), 0.0) << "no targets yet: nothing to follow";
+  energy.refreshTargets(f.positions, f.mesh, cads);
+  // On the plane every point's residual and M^T n are rounding: (1e-16)^2-sized terms.
+  EXPECT_LE(energy.total(f.positions), 1e-20);
+  const std::int64_t node = 9;  // the interior node
+  Eigen::Vector3d g = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  FacetEnergy::Patch patch;
+  energy.assemble(node, f.positions, g, h, patch);
+  ASSERT_FALSE(patch.wf.empty());
+  // A slide within the plane keeps the facet on it: nothing; one off it, a quadratic in the
+  // distance, which the trial formula has exactly.
+  EXPECT_LE(FacetEnergy::energyAfter(patch, Eigen::Vector3d(0.05, -0.03, 0.0)), 1e-20);
+  double previous = 0.0;
+  for (const double s : {0.01, 0.02}) {
+    std::vector<Eigen::Vector3d> moved = f.positions;
+    moved[node].z() += s;
+    const double direct = energy.total(moved);
+    EXPECT_GT(direct, 0.0);
+    EXPECT_NEAR(FacetEnergy::energyAfter(patch, Eigen::Vector3d(0.0, 0.0, s)), direct,
+                1e-12 * direct);
+    if (previous > 0.0) {
+      EXPECT_NEAR(direct / previous, 4.0, 1e-9);
+    }
+    previous = direct;
+  }
+  // The gradient points along the normal, zero at the plane, and the Hessian is its rank one.
+  EXPECT_LE(g.norm(), 1e-12);
+  EXPECT_NEAR(h(2, 2), h.trace(), 1e-12 * h.trace());
+  EXPECT_GT(h(2, 2), 0.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(FacetEnergy, FacetShapes,
