@@ -374,34 +374,23 @@ def test_an_optimiser_time_limit_stops_it_with_the_best_state(data):
         homesh.mesh(text, order=2, size=0.5, optimise=5, optimise_seconds=-1.0)
 
 
-def test_the_facet_weight_reaches_the_core_and_is_checked(data):
+@pytest.mark.parametrize("key, value, name, top", [("facet_weight", 1.0, "facet weight", "100"),
+                                                    ("fidelity_weight", 10.0, "fidelity weight",
+                                                     "1000")])
+def test_the_boundary_terms_reach_the_core_and_are_checked(data, key, value, name, top):
     # The sphere at size 0.5, order 4: the optimiser slides its nodes with and without the
-    # facet term; both valid, and the term changes the result (it is applied, not dropped).
+    # term; both valid, and the term changes the result (it is applied, not dropped).
     text = (data / "sphere.brep").read_text()
     plain = homesh.mesh(text, order=4, size=0.5, optimise=20)
-    facets = homesh.mesh(text, order=4, size=0.5, optimise=20, facet_weight=1.0)
-    for m in (plain, facets):
+    term = homesh.mesh(text, order=4, size=0.5, optimise=20, **{key: value})
+    for m in (plain, term):
         assert m.report()["optimiser"]["invalid_after"] == 0
-    assert not np.array_equal(plain.nodes, facets.nodes)
-    with pytest.raises(homesh.ParameterError, match="facet weight must be a number from 0 to 100"):
-        homesh.mesh(text, order=2, size=0.5, optimise=5, facet_weight=-1.0)
+    assert not np.array_equal(plain.nodes, term.nodes)
+    with pytest.raises(homesh.ParameterError, match="%s must be a number from 0 to %s" % (name, top)):
+        homesh.mesh(text, order=2, size=0.5, optimise=5, **{key: -1.0})
     with pytest.raises(homesh.ParameterError,
-                       match="facet weight must be a number from 0 to 100, got '1'"):
-        homesh.mesh(text, order=2, size=0.5, optimise=5, facet_weight="1")
-
-
-def test_the_fidelity_weight_reaches_the_core_and_is_checked(data):
-    # The sphere at size 0.5, order 4: the term pulls the sliding facets towards the CAD; both
-    # runs valid, and the term changes the result (it is applied, not dropped).
-    text = (data / "sphere.brep").read_text()
-    plain = homesh.mesh(text, order=4, size=0.5, optimise=20)
-    pulled = homesh.mesh(text, order=4, size=0.5, optimise=20, fidelity_weight=10.0)
-    for m in (plain, pulled):
-        assert m.report()["optimiser"]["invalid_after"] == 0
-    assert not np.array_equal(plain.nodes, pulled.nodes)
-    with pytest.raises(homesh.ParameterError,
-                       match="fidelity weight must be a number from 0 to 1000, got -1"):
-        homesh.mesh(text, order=2, size=0.5, optimise=5, fidelity_weight=-1.0)
+                       match="%s must be a number from 0 to %s, got '1'" % (name, top)):
+        homesh.mesh(text, order=2, size=0.5, optimise=5, **{key: "1"})
 
 
 def test_the_command_line_takes_a_time_limit(homesh_bin, data, tmp_path):

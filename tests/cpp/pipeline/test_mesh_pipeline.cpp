@@ -34,6 +34,34 @@ class CountingObserver : public PipelineObserver {
   int cancelAfter_;
 };
 
+// The sphere in a box at `size`, order 4, optimised (2 threads), without and with a boundary
+// term (`turnOn` sets it): both runs, their geometry measured, every element proven valid in
+// both; prints the figures the callers' comments quote under `name`.
+template <class TurnOn>
+std::pair<MeshResult, MeshResult> withAndWithout(const char* name, double size, int repairRounds,
+                                                 const TurnOn& turnOn) {
+  const std::string sphereBox = std::string(HOMESH_SOURCE_DIR) + "/examples/sphere_box.step";
+  MeshingOptions options;
+  options.order = 4;
+  options.size = size;
+  options.optimiseIterations = 100;
+  options.repairRounds = repairRounds;
+  options.threads = 2;
+  std::pair<MeshResult, MeshResult> r{runMeshPipeline(CadSource::file(sphereBox), options), {}};
+  turnOn(options);
+  r.second = runMeshPipeline(CadSource::file(sphereBox), options);
+  for (const MeshResult* m : {&r.first, &r.second}) {
+    EXPECT_TRUE(m->geometry.has_value());
+    EXPECT_EQ(m->quality.invalid + m->quality.undecided, 0U);
+  }
+  if (r.first.geometry && r.second.geometry)
+    std::printf("%s: distance %.2e -> %.2e, angle %.2f -> %.2f deg, worst %.3f -> %.3f\n", name,
+                r.first.geometry->maxDistance, r.second.geometry->maxDistance,
+                r.first.geometry->maxAngleDeg, r.second.geometry->maxAngleDeg,
+                r.first.quality.scaled.min, r.second.quality.scaled.min);
+  return r;
+}
+
 // The optimiser's boundary-facet term (MeshingOptions::facetWeight) on the sphere in a box at
 // size 0.8, order 4: curving leaves 20 elements invalid and the optimiser untangles them by
 // sliding nodes along the sphere, which without the term bunches a facet's nodes and takes the
@@ -42,29 +70,16 @@ class CountingObserver : public PipelineObserver {
 // degrees, and the worst element 0.450 instead of 0.261 (2026-11-28); the test asks for half
 // the distance and angle, with every element proven valid in both runs.
 TEST(MeshPipeline, TheFacetTermKeepsSlidingBoundaryNodesSpreadOnTheCad) {
-  const std::string sphereBox = std::string(HOMESH_SOURCE_DIR) + "/examples/sphere_box.step";
-  MeshingOptions options;
-  options.order = 4;
-  options.size = 0.8;
-  options.optimiseIterations = 100;
-  options.repairRounds = 0;
-  options.threads = 2;
-  const MeshResult without = runMeshPipeline(CadSource::file(sphereBox), options);
-  options.facetWeight = 1.0;
-  const MeshResult with = runMeshPipeline(CadSource::file(sphereBox), options);
+  const auto [without, with] =
+      withAndWithout("facet term", 0.8, 0, [](MeshingOptions& o) { o.facetWeight = 1.0; });
+  ASSERT_TRUE(without.geometry && with.geometry);
   for (const MeshResult* r : {&without, &with}) {
-    ASSERT_TRUE(r->geometry.has_value());
     ASSERT_TRUE(r->optimiser.has_value());
     EXPECT_GT(r->optimiser->invalidBefore, 0U) << "the case no longer needs sliding to untangle";
-    EXPECT_EQ(r->quality.invalid + r->quality.undecided, 0U);
   }
   EXPECT_LT(with.geometry->maxDistance, 0.5 * without.geometry->maxDistance);
   EXPECT_LT(with.geometry->maxAngleDeg, 0.5 * without.geometry->maxAngleDeg);
   EXPECT_GT(with.quality.scaled.min, 0.0);
-  std::printf("facet term: distance %.2e -> %.2e, angle %.2f -> %.2f deg, worst %.3f -> %.3f\n",
-              without.geometry->maxDistance, with.geometry->maxDistance,
-              without.geometry->maxAngleDeg, with.geometry->maxAngleDeg, without.quality.scaled.min,
-              with.quality.scaled.min);
 }
 
 // The optimiser's fidelity term (MeshingOptions::fidelityWeight) on the sphere in a box at size
@@ -73,27 +88,13 @@ TEST(MeshPipeline, TheFacetTermKeepsSlidingBoundaryNodesSpreadOnTheCad) {
 // and 20 degrees off its normal (curving alone: the interpolation's 1e-5 and 0.03 degrees).
 // With weight 10, 8.4e-4 and 1.5 degrees, the worst element 0.298 instead of 0.157
 // (2026-11-29); the test asks for a quarter of the distance and angle, every element proven
-// valid both ways.
+// valid both ways (with the default repair rounds, which this size needs either way).
 TEST(MeshPipeline, TheFidelityTermKeepsTheSurfaceBetweenSlidingNodesOnTheCad) {
-  const std::string sphereBox = std::string(HOMESH_SOURCE_DIR) + "/examples/sphere_box.step";
-  MeshingOptions options;
-  options.order = 4;
-  options.size = 1.2;
-  options.optimiseIterations = 100;
-  options.threads = 2;
-  const MeshResult without = runMeshPipeline(CadSource::file(sphereBox), options);
-  options.fidelityWeight = 10.0;
-  const MeshResult with = runMeshPipeline(CadSource::file(sphereBox), options);
-  for (const MeshResult* r : {&without, &with}) {
-    ASSERT_TRUE(r->geometry.has_value());
-    EXPECT_EQ(r->quality.invalid + r->quality.undecided, 0U);
-  }
+  const auto [without, with] = withAndWithout("fidelity term", 1.2, MeshingOptions{}.repairRounds,
+                                              [](MeshingOptions& o) { o.fidelityWeight = 10.0; });
+  ASSERT_TRUE(without.geometry && with.geometry);
   EXPECT_LT(with.geometry->maxDistance, 0.25 * without.geometry->maxDistance);
   EXPECT_LT(with.geometry->maxAngleDeg, 0.25 * without.geometry->maxAngleDeg);
-  std::printf("fidelity term: distance %.2e -> %.2e, angle %.2f -> %.2f deg, worst %.3f -> %.3f\n",
-              without.geometry->maxDistance, with.geometry->maxDistance,
-              without.geometry->maxAngleDeg, with.geometry->maxAngleDeg, without.quality.scaled.min,
-              with.quality.scaled.min);
 }
 
 TEST(MeshPipeline, RunsEveryStageAndReports) {
