@@ -386,7 +386,8 @@ def test_the_boundary_terms_reach_the_core_and_are_checked(data, key, value, nam
     for m in (plain, term):
         assert m.report()["optimiser"]["invalid_after"] == 0
     assert not np.array_equal(plain.nodes, term.nodes)
-    with pytest.raises(homesh.ParameterError, match="%s must be a number from 0 to %s" % (name, top)):
+    with pytest.raises(homesh.ParameterError,
+                       match="%s must be a number from 0 to %s" % (name, top)):
         homesh.mesh(text, order=2, size=0.5, optimise=5, **{key: -1.0})
     with pytest.raises(homesh.ParameterError,
                        match="%s must be a number from 0 to %s, got '1'" % (name, top)):
