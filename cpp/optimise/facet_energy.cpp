@@ -55,7 +55,6 @@ FacetEnergy::FacetEnergy(const Mesh& mesh, const std::vector<Vec>& positions,
       Facet f{shape, c, invW_.size()};
       // The ideal's area, for its size: sum of |det W| x weight over the points.
       double area = 0.0;
-      const std::size_t first = invW_.size();
       for (int q = 0; q < s.points; ++q) {
         Eigen::Matrix<double, 3, 2> t = Eigen::Matrix<double, 3, 2>::Zero();
         for (int n = 0; n < s.vertices; ++n)
@@ -78,7 +77,6 @@ FacetEnergy::FacetEnergy(const Mesh& mesh, const std::vector<Vec>& positions,
         area += scale_.back();
       }
       f.size = std::sqrt(area);
-      for (std::size_t k = first; k < scale_.size(); ++k) scale_[k] *= f.size;
       facets_.push_back(f);
     }
     shapes_.push_back(std::move(s));
@@ -132,7 +130,7 @@ double FacetEnergy::facetEnergy(const Facet& f, const std::vector<Vec>& position
     const double rq = follows ? (x - foot_[k]).dot(normal) / f.size : 0.0;
     const double c1 = follows ? m.col(0).dot(normal) : 0.0;
     const double c2 = follows ? m.col(1).dot(normal) : 0.0;
-    const double wd = weight_ * scale_[k], wf = fidelity_ * scale_[k];
+    const double wd = scale_[k] * (weight_ * f.size), wf = scale_[k] * (fidelity_ * f.size);
     if (follows) energy += wf * (rq * rq + c1 * c1 + c2 * c2);
     if (patch == nullptr) {
       if (distortion) energy += wd * facet_detail::density<double>(m.col(0), m.col(1));
@@ -246,15 +244,21 @@ void FacetEnergy::refreshTargets(const std::vector<Vec>& positions, const Mesh& 
             guess = std::array<double, 2>{mesh.nodeCadParam[2 * id], mesh.nodeCadParam[2 * id + 1]};
           }
         }
-        const SurfaceProjection proj = cad.projectOnSurface(face, x, guess);
-        const SurfaceDerivatives d = cad.evaluateSurface(face, proj.u, proj.v);
-        const Vec m = d.du.cross(d.dv);
-        // Undefined where S_u and S_v are parallel or one vanishes (a pole), as the report's
-        // measure (geometry_accuracy.hpp) has it.
-        const double scale = std::max(d.du.squaredNorm(), d.dv.squaredNorm());
-        foot_[k] = proj.point;
-        normal_[k] = m.norm() > 1e-8 * scale ? Vec(m.normalized()) : Vec::Zero();
-        footParam_[k] = {proj.u, proj.v};
+        // A point the CAD cannot project or evaluate drops out of the part (as a pole does)
+        // rather than failing the run: the sliding steps leave such a node where it is too.
+        try {
+          const SurfaceProjection proj = cad.projectOnSurface(face, x, guess);
+          const SurfaceDerivatives d = cad.evaluateSurface(face, proj.u, proj.v);
+          const Vec m = d.du.cross(d.dv);
+          // Undefined where S_u and S_v are parallel or one vanishes (a pole), as the report's
+          // measure (geometry_accuracy.hpp) has it.
+          const double scale = std::max(d.du.squaredNorm(), d.dv.squaredNorm());
+          foot_[k] = proj.point;
+          normal_[k] = m.norm() > 1e-8 * scale ? Vec(m.normalized()) : Vec::Zero();
+          footParam_[k] = {proj.u, proj.v};
+        } catch (const CadError&) {
+          normal_[k] = Vec::Zero();
+        }
       }
     } catch (...) {
       failure.capture();

@@ -123,10 +123,9 @@ class FacetEnergy {
 
   // The fidelity part's targets at `positions` (model coordinates in 3D): every point of every
   // facet projected onto its CAD face, starting from its last foot (first: from the facet's
-  // node on that face whose basis function is largest there), on `threads` threads, the
-  // model's `cads` (a clone per thread). A point where the CAD's normal is undefined (a pole)
-  // drops out of the part. Nothing without a fidelity weight. Throws CadError where a
-  // projection fails.
+  // node on that face whose basis function is largest there), on one thread per model in
+  // `cads` (clones of one model). A point where the CAD's normal is undefined (a pole), or
+  // that the CAD cannot project, drops out of the part. Nothing without a fidelity weight.
   void refreshTargets(const std::vector<Vec>& positions, const Mesh& mesh,
                       const std::vector<CadModel>& cads);
   bool hasFidelity() const { return fidelity_ > 0.0; }
@@ -178,7 +177,7 @@ class FacetEnergy {
   std::vector<Shape> shapes_;
   std::vector<Facet> facets_;
   std::vector<Eigen::Matrix2d> invW_;  // per facet point: W^-1
-  std::vector<double> scale_;          // per facet point: |det W| x facet size x quadrature
+  std::vector<double> scale_;          // per facet point: quadrature weight x |det W|
   double weight_ = 0.0, fidelity_ = 0.0;
   bool distortionOn_ = true;
   // The fidelity part's targets per facet point: the foot on the CAD, the unit normal there

@@ -141,8 +141,7 @@ bool NodeStep<D>::touchesFacet(std::int64_t node) const {
 template <int D>
 double NodeStep<D>::facetTotal() const {
   if constexpr (D == 3) {
-    if (hasFacets() && (facetsOn_ || facetEnergy_->hasFidelity()))
-      return facetEnergy_->total(mesh_.position);
+    if (facetsOn_ && hasFacets()) return facetEnergy_->total(mesh_.position);
   }
   return 0.0;
 }
@@ -280,7 +279,8 @@ double NodeStep<D>::slideOn(const CadModel& cad, std::int64_t node, Patch<D>& pa
   double* param = &mesh_.mesh.nodeCadParam[2 * node];
   ++patch.slides;
   const LocalCadModel<D>& model = sliding_.currentModel(cad, node, patch.cadEvaluations);
-  // The boundary facets' term joins the volume patch's once the mesh is valid (facetsOn_).
+  // The boundary facets' term joins the volume patch's once the mesh is valid (facetsOn_),
+  // its fidelity part once the node's elements are (facetTermActive).
   double e0 = volumeEnergy;
   Vec grad = volumeGrad;
   Mat hess = volumeHess;

@@ -55,14 +55,16 @@ class NodeStep {
       : mesh_(mesh), sliding_(sliding), options_(options), lockedNormal_(lockedNormal) {}
 
   // The boundary facets of the free sliding nodes (3D, with CAD and options.facetWeight or
-  // fidelityWeight > 0); none otherwise. The term is off until setFacetsOn().
+  // fidelityWeight > 0); none otherwise. The term is off until setFacetsOn() (its fidelity
+  // part: at a node, until the node's elements are proven valid, facetTermActive).
   void buildFacets(const std::vector<std::int64_t>& free, const CadModel* cad);
   // The facet term's fidelity targets (the CAD's foot points and normals) at the current
   // positions (FacetEnergy::refreshTargets).
   void refreshFacetTargets();
   bool hasFacets() const { return facetEnergy_ != nullptr; }
-  // Whether the facets' distortion part has joined (it waits for a proven-valid mesh;
-  // untangling comes first).
+  bool hasFidelity() const { return hasFacets() && facetEnergy_->hasFidelity(); }
+  // Whether the facet term has joined the whole mesh and its total energy (it waits for a
+  // proven-valid mesh; untangling comes first).
   bool facetsOn() const { return facetsOn_; }
   void setFacetsOn(bool on);
   // Whether the steps at `node` add the facet term: once its distortion part has joined; before,
@@ -75,7 +77,7 @@ class NodeStep {
   void setValidity(const std::vector<Validity>* validity) { validity_ = validity; }
   // Whether the node is a vertex of a boundary facet of the term (after buildFacets).
   bool touchesFacet(std::int64_t node) const;
-  // The facet term's total at the current positions, 0 while it is off.
+  // The facet term's total at the current positions, 0 until it has joined (facetsOn()).
   double facetTotal() const;
 
   // The patch of a node: F, a and the weight at every quadrature point of its elements. Returns

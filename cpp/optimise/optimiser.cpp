@@ -193,6 +193,13 @@ class Optimiser {
         result_.stopReason = stop::kTimeBudget;
         break;
       }
+      // The fidelity targets follow the sweeps (a lagged model of the distance to the CAD): the
+      // last record's energy is taken again against the new ones, so that the stop rules
+      // compare a sweep's start and end under one model.
+      if (it > 1 && step_.hasFidelity()) {
+        step_.refreshFacetTargets();
+        previous.energy = totalEnergy();
+      }
       const auto s0 = Clock::now();
       Moves moved;
       try {
@@ -205,15 +212,13 @@ class Optimiser {
       }
       result_.sweepSeconds += since(s0);
       IterationRecord record = sweepRecord(it, moved, t0);
-      // The facet term joins once the mesh is proven valid: every node of a facet is visited
+      // The facet term joins once the mesh is proven valid (its fidelity part, already on at
+      // the nodes whose elements were, joins the total): every node of a facet is visited
       // again (resting nodes too), and the sweep is not judged by the stop rules, whose energy
       // would compare totals with and without the term.
-      const bool switching = !step_.facetsOn() && step_.hasFacets() && options_.facetWeight > 0.0 &&
-                             record.invalid + record.undecided == 0;
+      const bool switching =
+          !step_.facetsOn() && step_.hasFacets() && record.invalid + record.undecided == 0;
       if (switching) switchFacetsOn();
-      // The fidelity targets follow the sweep (a lagged model of the distance to the CAD):
-      // the record's energy is the next sweep's start.
-      step_.refreshFacetTargets();
       record.energy = totalEnergy();
       finishSweep(record, before, best);
       const std::string reason =

@@ -99,17 +99,18 @@ struct OptimiserOptions {
   double facetWeight = defaultOf<double>("facet_weight");
   // Weight of the boundary facets' fidelity to the CAD (facet_energy.hpp: distance off the
   // CAD's tangent plane and the angle between the normals, at the facets' quadrature points)
-  // in the same energy, joining with the facet term. The sliding nodes are otherwise free to
-  // move along the CAD however the volume prefers, and the surface between them leaves it.
+  // in the same energy, at a sliding node once its elements are proven valid (the total
+  // energy counts it once the whole mesh is). The sliding nodes are otherwise free to move
+  // along the CAD however the volume prefers, and the surface between them leaves it.
   double fidelityWeight = defaultOf<double>("fidelity_weight");
 
   // Throws ParameterError naming the offending option.
   void validate() const;
 
   // Sets the options a mapping keyed as the parameter table asks for (keys(): the optimiser's
-  // sweeps, time limit, facet weight, threads and the table's group "optimiser"), each value
-  // checked once against the table, then the whole by validate(). A region of 0 is no region;
-  // region layers without a region are refused. Any other key is refused by name.
+  // sweeps, time limit, facet and fidelity weights, threads and the table's group "optimiser"),
+  // each value checked once against the table, then the whole by validate(). A region of 0 is no
+  // region; region layers without a region are refused. Any other key is refused by name.
   void apply(const OptionMap& values);
   // The table keys apply takes, in the table's order.
   static std::vector<std::string> keys();
