@@ -9,6 +9,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <optional>
@@ -26,6 +27,16 @@ struct CurveDerivatives {
 
 struct SurfaceDerivatives {
   Eigen::Vector3d point, du, dv, duu, duv, dvv;
+
+  // The normal direction S_u x S_v (not normalised), or none where it is undefined: S_u and
+  // S_v parallel or one vanishing (a sphere's pole), where the cross product is rounding noise
+  // of relative size ~1e-16, far below the bound 1e-8 max(|S_u|^2, |S_v|^2).
+  std::optional<Eigen::Vector3d> normalDirection() const {
+    const Eigen::Vector3d m = du.cross(dv);
+    const double scale = std::max(du.squaredNorm(), dv.squaredNorm());
+    if (!(m.norm() > 1e-8 * scale)) return std::nullopt;
+    return m;
+  }
 };
 
 struct CurveProjection {

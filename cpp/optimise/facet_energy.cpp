@@ -3,7 +3,6 @@
 #include <omp.h>
 
 #include <Eigen/Dense>
-#include <algorithm>
 #include <optional>
 #include <string>
 
@@ -249,12 +248,10 @@ void FacetEnergy::refreshTargets(const std::vector<Vec>& positions, const Mesh& 
         try {
           const SurfaceProjection proj = cad.projectOnSurface(face, x, guess);
           const SurfaceDerivatives d = cad.evaluateSurface(face, proj.u, proj.v);
-          const Vec m = d.du.cross(d.dv);
-          // Undefined where S_u and S_v are parallel or one vanishes (a pole), as the report's
-          // measure (geometry_accuracy.hpp) has it.
-          const double scale = std::max(d.du.squaredNorm(), d.dv.squaredNorm());
+          // Undefined at a pole, as the report's measure (geometry_accuracy.hpp) has it.
+          const std::optional<Vec> m = d.normalDirection();
           foot_[k] = proj.point;
-          normal_[k] = m.norm() > 1e-8 * scale ? Vec(m.normalized()) : Vec::Zero();
+          normal_[k] = m ? Vec(m->normalized()) : Vec::Zero();
           footParam_[k] = {proj.u, proj.v};
         } catch (const CadError&) {
           normal_[k] = Vec::Zero();

@@ -198,7 +198,7 @@ class Optimiser {
       // compare a sweep's start and end under one model.
       if (it > 1 && step_.hasFidelity()) {
         step_.refreshFacetTargets();
-        previous.energy = totalEnergy();
+        if (step_.facetsOn()) previous.energy = totalEnergy();  // before, the total has no term
       }
       const auto s0 = Clock::now();
       Moves moved;

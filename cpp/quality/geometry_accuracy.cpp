@@ -173,16 +173,13 @@ CellRecord sampleCell(const Mesh& mesh, const std::int64_t* nodes, int n, const 
       const Eigen::Vector3d t1 = (s.grads[0].row(q) * x).transpose();
       const Eigen::Vector3d t2 = (s.grads[1].row(q) * x).transpose();
       const SurfaceDerivatives d = cad.evaluateSurface(entity, proj.u, proj.v);
-      const Eigen::Vector3d m = d.du.cross(d.dv);
-      // Undefined where S_u and S_v are parallel or one vanishes (a pole): their cross product
-      // there is rounding noise of relative size ~1e-16, far below this bound.
-      const double scale = std::max(d.du.squaredNorm(), d.dv.squaredNorm());
-      if (!(m.norm() > 1e-8 * scale)) {
+      const std::optional<Eigen::Vector3d> m = d.normalDirection();
+      if (!m) {
         ++r.undefined;
         continue;
       }
       const Eigen::Vector3d normal = t1.cross(t2);
-      r.addAngle(normal.norm() > 1e-12 * t1.norm() * t2.norm() ? lineAngle(normal, m) : 0.5 * kPi,
+      r.addAngle(normal.norm() > 1e-12 * t1.norm() * t2.norm() ? lineAngle(normal, *m) : 0.5 * kPi,
                  p);
     }
   } else {
