@@ -485,7 +485,8 @@ REFINEMENT lines and Order are used; the options below override them.
 Sizes come from the sizing octree: curvature-driven (a chord deviates from the CAD by at
 most EPS x the radius of curvature), between MinDelta and MaxDelta, graded by 0.2 per unit
 length away from curved boundaries. Without sizes: MaxDelta = bounding-box diagonal / 20,
-MinDelta = MaxDelta / 20, EPS = )" +
+MinDelta = the smallest size the shape asks for (at most MaxDelta / 20; the report's
+sizing.min_delta_set_by names it), EPS = )" +
          formatNumber(parameterDefault("eps")) + R"(.
 
 options (the parameter table's, which Python and FreeCAD read too):

@@ -110,9 +110,12 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        "Also move the nodes on internal interfaces between volumes of a mesh without CAD (as "
        "NekMesh does; the interface then leaves its geometry)"},
       {"min_delta", "MinDelta", "--min-delta", "", "MinDelta", ParameterKind::Length, 0, kNoLimit,
-       true, 0, true, false, "sizing", "Smallest element size, at high curvature"},
+       true, 0, true, false, "sizing",
+       "Smallest element size, at high curvature (0 or none: the smallest size the shape asks "
+       "for, from its curvature, thin walls and narrow faces, at most MaxDelta / 20)"},
       {"max_delta", "MaxDelta", "--max-delta", "", "MaxDelta", ParameterKind::Length, 0, kNoLimit,
-       true, 0, true, false, "sizing", "Largest element size"},
+       true, 0, true, false, "sizing",
+       "Largest element size (0 or none: a twentieth of the CAD's bounding-box diagonal)"},
       {"eps", "Eps", "--eps", "", "EPS", ParameterKind::Real, 0, 1, true, 0.05, false, false,
        "sizing",
        "Sagitta ratio: on a surface of curvature radius R the size is 2 R sqrt(eps (2 - eps))"},

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -10,6 +11,8 @@
 #include "boundary_layer/layer_stacks.hpp"
 #include "cad/model_dimension.hpp"
 #include "core/error.hpp"
+#include "core/format.hpp"
+#include "core/isolated_call.hpp"
 #include "core/job_budget.hpp"
 #include "core/system_memory.hpp"
 #include "io/octree_export.hpp"
@@ -22,6 +25,7 @@
 #include "pipeline/stage_clock.hpp"
 #include "pipeline/straighten_invalid.hpp"
 #include "quality/mesh_quality.hpp"
+#include "sizing/automatic_min_delta.hpp"
 
 namespace homesh {
 
@@ -44,15 +48,17 @@ CadModel CadSource::load() const {
 }
 
 SizingParameters defaultSizing(const CadModel& cad) {
-  SizingParameters p;
-  p.maxDelta = defaultMeshSize(cad);
-  p.minDelta = p.maxDelta / 20.0;  // eps: the table's default (SizingParameters)
-  return p;
+  return completeSizing(SizingParameters{}, cad);
 }
 
 SizingParameters completeSizing(SizingParameters p, const CadModel& cad) {
-  if (p.maxDelta == 0.0) p.maxDelta = std::max(defaultMeshSize(cad), p.minDelta);
-  if (p.minDelta == 0.0) p.minDelta = p.maxDelta / 20.0;
+  if (p.maxDelta == 0.0) {
+    const double diagonal = defaultMeshSize(cad);
+    p.maxDelta = std::max(diagonal, p.minDelta);
+    p.maxDeltaSetBy = diagonal >= p.minDelta ? "bounding-box diagonal / 20" : "MinDelta";
+  }
+  // An automatic (0) minDelta stays so: the sizing octree sets it from the shape
+  // (sizing/automatic_min_delta.hpp).
   return p;
 }
 
@@ -113,17 +119,55 @@ void checkMeshDimension(const CadModel& cad, std::optional<int> expected) {
                                                 : " is planar faces (a 2D mesh)"));
 }
 
-SizingResult runSizing(const CadModel& cad, const SizingParameters& params, int threads) {
-  const auto start = std::chrono::steady_clock::now();
+namespace {
+
+// The octree and its prediction for `params` as given.
+SizingResult buildSizing(const CadModel& cad, const SizingParameters& params, int threads) {
   SizingResult r;
   r.octree = std::make_shared<const SizingOctree>(SizingOctree::build(cad, params, threads));
   r.prediction = predictElementCount(*r.octree, threads);
+  return r;
+}
+
+}  // namespace
+
+SizingResult runSizing(const CadModel& cad, const SizingParameters& params, int threads) {
+  const auto start = std::chrono::steady_clock::now();
+  // An automatic MinDelta the shape asked for is raised while the octree would need more cells
+  // than it may have (doubled, from the floor it was sampled at) or the prediction exceeds the
+  // element limit (the surface's count grows as 1 / MinDelta^2 where the smallest sizes
+  // dominate it: that factor), at most to MaxDelta / 20, the automatic rule before.
+  const bool automatic = params.minDelta == 0.0;
+  const double ceiling = kMinDeltaCeiling * params.maxDelta;
+  SizingParameters p = params;
+  SizingResult r;
+  for (;;) {
+    try {
+      r = buildSizing(cad, p, threads);
+    } catch (const OctreeTooLarge&) {
+      const double tried = samplingMinDelta(p);
+      if (!automatic || tried >= ceiling) throw;
+      p.minDelta = std::min(ceiling, 2.0 * tried);
+      p.minDeltaSetBy = "the sizing octree's cell limit (the shape asks for less than " +
+                        formatNumber(tried) + ")";
+      continue;
+    }
+    const SizingParameters& used = r.octree->parameters();
+    if (!automatic || used.minDelta >= ceiling || !(r.prediction.elements > kMaxPredictedElements))
+      break;
+    const std::string why = used.minDeltaSetBy;
+    p.minDelta = std::min(
+        ceiling, 1.25 * used.minDelta * std::sqrt(r.prediction.elements / kMaxPredictedElements));
+    p.minDeltaSetBy =
+        "the element limit (" + why + " asks for " + formatNumber(used.minDelta) + ")";
+  }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (r.prediction.elements > kMaxPredictedElements) {
+    const SizingParameters& used = r.octree->parameters();
     std::ostringstream msg;
     msg.precision(3);
-    msg << "the sizes (MinDelta " << params.minDelta << ", MaxDelta " << params.maxDelta << ", EPS "
-        << params.eps << ") would make about " << r.prediction.elements << " elements for "
+    msg << "the sizes (MinDelta " << used.minDelta << ", MaxDelta " << used.maxDelta << ", EPS "
+        << used.eps << ") would make about " << r.prediction.elements << " elements for "
         << cad.sourceName() << ": too many (at most " << kMaxPredictedElements
         << "); use larger MinDelta, MaxDelta or EPS";
     throw ParameterError(msg.str());
@@ -205,7 +249,7 @@ void sizeLinearMesh(MeshResult& result, const MeshingOptions& options, const Job
   const SizingOctree& octree = *result.sizing->octree;
   linearOptions.sizeField = [&octree](const Eigen::Vector3d& x) { return octree.delta(x); };
   linearOptions.maxSize = options.sizing->maxDelta;
-  linearOptions.minSize = options.sizing->minDelta;
+  linearOptions.minSize = octree.parameters().minDelta;
   for (const RefinementSource& src : octree.parameters().sources)
     linearOptions.minSize = std::min(linearOptions.minSize, src.delta);
 }
@@ -367,6 +411,39 @@ void straightenWhereInvalid(CurvedState& state, MeshResult& result, bool layered
                            "straightening their nodes off the CAD");
 }
 
+// The first linear mesh. Where Gmsh cannot mesh the sizes an automatic MinDelta took from the
+// shape (below MaxDelta / 20: OpenCASCADE's bottle, whose thread ends in faces of radius
+// 0.024, failed with "a segment and a facet intersect" with both its surface algorithms), the
+// sizes are made again with MinDelta = MaxDelta / 20, the automatic rule before, and meshed
+// again, with a note; a second failure is the error. A run stopped by its time budget,
+// cancelled or out of memory is not tried again.
+Mesh makeFirstLinearMesh(MeshResult& result, const MeshingOptions& options, JobBudget& budget,
+                         PipelineObserver* observer, LinearStage& linear) {
+  try {
+    return linear.make(linear.baseOptions(), true, "linear");
+  } catch (const BudgetExceeded&) {
+    throw;
+  } catch (const OutOfMemory&) {
+    throw;
+  } catch (const MeshingError& failure) {
+    if (!result.sizing || !options.sizing || options.sizing->minDelta != 0.0) throw;
+    const SizingParameters& used = result.sizing->octree->parameters();
+    const double ceiling = kMinDeltaCeiling * used.maxDelta;
+    if (!(used.minDelta < ceiling)) throw;
+    MeshingOptions coarser = options;
+    coarser.sizing->minDelta = ceiling;
+    coarser.sizing->minDeltaSetBy = "MaxDelta / 20, after Gmsh could not mesh MinDelta " +
+                                    formatNumber(used.minDelta) + " (" + used.minDeltaSetBy + ")";
+    result.notes.push_back(std::string(failure.what()) + "; with MinDelta " +
+                           formatNumber(ceiling) + " (MaxDelta / 20) instead of " +
+                           formatNumber(used.minDelta) + " (" + used.minDeltaSetBy +
+                           ") Gmsh was given another try");
+    checkBudgetLeft(budget, "linear", result.timings);
+    sizeLinearMesh(result, coarser, budget, observer, linear.baseOptions());
+    return linear.make(linear.baseOptions(), true, "linear");
+  }
+}
+
 }  // namespace
 
 MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
@@ -382,7 +459,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   sizeLinearMesh(result, options, budget, observer, linear.baseOptions());
   checkBudgetLeft(budget, "linear", result.timings);
   const double firstStart = budget.elapsed();
-  Mesh linearMesh = linear.make(linear.baseOptions(), true, "linear");
+  Mesh linearMesh = makeFirstLinearMesh(result, options, budget, observer, linear);
 
   CurvedState first = curve(std::move(linearMesh), options, *result.cad, result.timings, observer,
                             true, budget, "");

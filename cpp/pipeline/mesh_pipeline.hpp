@@ -43,12 +43,13 @@ inline constexpr int kContinuationOrder = 4;
 // A uniform size giving a coarse mesh: a twentieth of the bounding-box diagonal.
 double defaultMeshSize(const CadModel& cad);
 
-// Automatic sizing for a model given no sizes: MaxDelta = defaultMeshSize, MinDelta =
-// MaxDelta / 20, EPS the parameter table's default.
+// Automatic sizing for a model given no sizes: MaxDelta = defaultMeshSize, MinDelta automatic
+// (0: the sizing octree takes it from the shape, sizing/automatic_min_delta.hpp), EPS the
+// parameter table's default.
 SizingParameters defaultSizing(const CadModel& cad);
 
-// `p` with an automatic (0) maxDelta set to defaultMeshSize (or minDelta if that is larger)
-// and an automatic minDelta to maxDelta / 20.
+// `p` with an automatic (0) maxDelta set to defaultMeshSize (or minDelta if that is larger),
+// saying so in maxDeltaSetBy; an automatic minDelta stays 0 for the octree to set.
 SizingParameters completeSizing(SizingParameters p, const CadModel& cad);
 
 // The sizes to use: `requested` completed, or defaultSizing when nothing was requested.
@@ -59,8 +60,10 @@ SizingParameters resolveSizing(const std::optional<SizingParameters>& requested,
 // gets the other kind of mesh (cad/model_dimension.hpp).
 void checkMeshDimension(const CadModel& cad, std::optional<int> expected);
 
-// Throws ParameterError (bad parameters, or a prediction above kMaxPredictedElements: sizes
-// far too small for the model) or CadError.
+// The sizing octree of `params` and its element-count prediction. An automatic MinDelta is
+// raised (toward MaxDelta / 20) while the prediction exceeds kMaxPredictedElements, saying so
+// in its minDeltaSetBy. Throws ParameterError (bad parameters, or a prediction above
+// kMaxPredictedElements: sizes far too small for the model) or CadError.
 inline constexpr double kMaxPredictedElements = 5e7;
 SizingResult runSizing(const CadModel& cad, const SizingParameters& params,
                        int threads = defaultOf<int>("threads"));

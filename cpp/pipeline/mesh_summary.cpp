@@ -84,12 +84,15 @@ std::string qualityHeadline(const Mesh& mesh, const QualitySummary& quality) {
 std::vector<std::string> predictionLines(const SizingResult& s, int dim) {
   const OctreeStatistics& st = s.octree->statistics();
   const SizingParameters& p = s.octree->parameters();
-  return {formatted("sizing octree: MinDelta %g, MaxDelta %g, EPS %g, %zu sources; %zu leaves "
-                    "(%zu inside, %zu boundary), depth %d, %zu boundary samples (%zu curved, %zu "
-                    "on thin walls, %zu on curves of narrow faces), smallest size %g, %.3f s",
-                    p.minDelta, p.maxDelta, p.eps, p.sources.size(), st.leaves, st.insideLeaves,
-                    st.boundaryLeaves, st.maxLevel, st.boundarySamples, st.sizedSamples,
-                    st.thinWallSamples, st.narrowFaceSamples, st.smallestDelta, s.seconds),
+  const auto setBy = [](const std::string& why) { return why.empty() ? "given" : why.c_str(); };
+  return {formatted("sizing octree: MinDelta %g (%s), MaxDelta %g (%s), EPS %g, %zu sources; %zu "
+                    "leaves (%zu inside, %zu boundary), depth %d, %zu boundary samples (%zu "
+                    "curved, %zu on thin walls, %zu on curves of narrow faces), smallest size %g, "
+                    "%.3f s",
+                    p.minDelta, setBy(p.minDeltaSetBy), p.maxDelta, setBy(p.maxDeltaSetBy), p.eps,
+                    p.sources.size(), st.leaves, st.insideLeaves, st.boundaryLeaves, st.maxLevel,
+                    st.boundarySamples, st.sizedSamples, st.thinWallSamples, st.narrowFaceSamples,
+                    st.smallestDelta, s.seconds),
           formatted("predicted %.0f %s (%s %g)", s.prediction.elements,
                     dim == 3 ? "tetrahedra" : "triangles",
                     dim == 3 ? "domain volume" : "domain area", s.prediction.domainMeasure)};

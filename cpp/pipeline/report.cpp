@@ -57,7 +57,9 @@ void appendSizing(JsonWriter& json, const SizingResult& sizing) {
   json.beginObject("sizing");
   json.value("method", "octree");
   json.value("min_delta", p.minDelta);
+  json.value("min_delta_set_by", p.minDeltaSetBy.empty() ? "given" : p.minDeltaSetBy);
   json.value("max_delta", p.maxDelta);
+  json.value("max_delta_set_by", p.maxDeltaSetBy.empty() ? "given" : p.maxDeltaSetBy);
   json.value("eps", p.eps);
   json.value("gradation", p.gradation);
   json.value("thin_wall", p.thinWall);

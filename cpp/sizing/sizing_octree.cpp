@@ -16,6 +16,7 @@
 #include "core/error.hpp"
 #include "core/first_failure.hpp"
 #include "core/format.hpp"
+#include "sizing/automatic_min_delta.hpp"
 #include "sizing/wall_thickness.hpp"
 
 namespace homesh {
@@ -105,10 +106,14 @@ class OctreeBuilder {
       t_.axes_.col(1) = n.cross(e1);
       t_.axes_.col(2) = n;
     }
-    t_.samples_ = sampleBoundary(cad_, t_.dim_, t_.params_);
+    // An automatic MinDelta is sampled at its floor and then set to what the samples ask for.
+    SizingParameters sampling = t_.params_;
+    sampling.minDelta = samplingMinDelta(t_.params_);
+    t_.samples_ = sampleBoundary(cad_, t_.dim_, sampling);
     if (t_.samples_.empty())
       throw CadError(cad_.sourceName() + " has no boundary to size the mesh from");
-    t_.stats_.thinWallSamples = applyThinWallSizes(t_.samples_, t_.params_, threads_);
+    t_.stats_.thinWallSamples = applyThinWallSizes(t_.samples_, sampling, threads_);
+    resolveAutomaticMinDelta(t_.samples_, t_.params_, t_.dim_);
     for (const BoundarySample& s : t_.samples_) {
       BoundarySample local = s;
       local.x = t_.toLocal(s.x);
@@ -187,7 +192,7 @@ class OctreeBuilder {
             "refinement source " + std::to_string(i + 1) + " (" + p.sources[i].describe() + ") is";
         break;
       }
-    throw ParameterError(culprit + " too small for " + cad_.sourceName() +
+    throw OctreeTooLarge(culprit + " too small for " + cad_.sourceName() +
                          " (bounding-box diagonal " + formatNumber(cad_.boundingDiagonal()) +
                          "): the sizing octree would need more than " + std::to_string(kMaxNodes) +
                          " cells");

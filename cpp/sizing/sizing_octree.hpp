@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/parameters.hpp"
 #include "sizing/boundary_sampling.hpp"
 #include "sizing/sizing_parameters.hpp"
@@ -27,6 +28,14 @@
 namespace homesh {
 
 class CadModel;
+
+// The sizes ask for more octree cells than the octree may have (a ParameterError naming the
+// sizes or the refinement source responsible): an automatic MinDelta is then raised
+// (pipeline/mesh_pipeline.cpp, runSizing).
+class OctreeTooLarge : public ParameterError {
+ public:
+  using ParameterError::ParameterError;
+};
 
 struct OctreeStatistics {
   std::size_t leaves = 0, insideLeaves = 0, boundaryLeaves = 0, outsideLeaves = 0;
@@ -50,8 +59,8 @@ class SizingOctree {
     double insideFraction = 0.0;  // of its volume (area in 2D)
   };
 
-  // Uses up to `threads` threads. Throws ParameterError (bad parameters, sizes too small for
-  // the model), CadError (no solid and not planar, OCCT failure).
+  // Uses up to `threads` threads. Throws ParameterError (bad parameters; OctreeTooLarge: sizes
+  // too small for the model), CadError (no solid and not planar, OCCT failure).
   static SizingOctree build(const CadModel& cad, const SizingParameters& params,
                             int threads = defaultOf<int>("threads"));
 

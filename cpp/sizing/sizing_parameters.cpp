@@ -16,7 +16,7 @@ bool positive(double x) {
 }  // namespace
 
 void SizingParameters::validate() const {
-  checkParameter("min_delta", minDelta);
+  if (minDelta != 0.0) checkParameter("min_delta", minDelta);  // 0: automatic
   checkParameter("max_delta", maxDelta);
   if (minDelta > maxDelta)
     throw ParameterError("MinDelta (" + formatNumber(minDelta) + ") must not exceed MaxDelta (" +

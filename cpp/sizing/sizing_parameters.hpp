@@ -8,6 +8,7 @@
 // min(eps R, thinWall t), at least a third of the curvature size (sizing/wall_thickness.hpp).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "core/parameters.hpp"
@@ -16,9 +17,15 @@
 namespace homesh {
 
 struct SizingParameters {
-  // 0 for minDelta or maxDelta: automatic (completeSizing in pipeline/mesh_pipeline.hpp).
-  double minDelta = 0.0;                 // smallest size curvature may ask for (> 0)
-  double maxDelta = 0.0;                 // size far from curved boundaries (>= minDelta)
+  // 0 for minDelta or maxDelta: automatic. An automatic maxDelta is a twentieth of the CAD's
+  // bounding-box diagonal (completeSizing in pipeline/mesh_pipeline.hpp); an automatic minDelta
+  // is what the shape itself asks for, found by the sizing octree from its samples (the
+  // smallest size curvature, a thin wall or a narrow face asks for), at most maxDelta / 20.
+  double minDelta = 0.0;  // smallest size curvature may ask for (> 0)
+  double maxDelta = 0.0;  // size far from curved boundaries (>= minDelta)
+  // What set each size, for the report: empty when given; filled in where an automatic one is
+  // resolved ("bounding-box diagonal / 20", "curvature radius 1 of face 3", ...).
+  std::string minDeltaSetBy, maxDeltaSetBy;
   double eps = parameterDefault("eps");  // sagitta over the radius of curvature
   double gradation = 0.2;                // largest |d delta / d x| (> 0)
   // Sagitta at most this fraction of the wall's local thickness, in [0, 1]; 0: no such bound

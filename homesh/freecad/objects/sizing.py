@@ -49,8 +49,8 @@ class SizingProxy(GuardedProxy):
         have = obj.PropertiesList
         if "Part" not in have:
             obj.addProperty("App::PropertyLink", "Part", "Sizing", "Shape whose sizing this is")
-        add_parameter_property(obj, "min_delta", "Sizing", " 0: MaxDelta / 20.")
-        add_parameter_property(obj, "max_delta", "Sizing", " 0: bounding-box diagonal / 20.")
+        add_parameter_property(obj, "min_delta", "Sizing")
+        add_parameter_property(obj, "max_delta", "Sizing")
         add_parameter_property(obj, "eps", "Sizing")
         if "Gradation" not in have:
             obj.addProperty("App::PropertyFloat", "Gradation", "Sizing",

@@ -99,7 +99,8 @@ std::vector<MeshResult> curveWithLayers(const std::string& msh, const std::strin
     options.classifyTolerance = classifyTolerance;
     results.push_back(curveMeshOnCad(CadSource::file(step), given, options));
     const MeshResult& r = results.back();
-    EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U);
+    // (On failure the report: the optimiser's record, the notes and where the element is.)
+    EXPECT_EQ(r.quality.invalid + r.quality.undecided, 0U) << meshReportJson(r, msh);
     EXPECT_LT(worstNodeDistance(r.mesh, *r.cad), 1e-9 * r.cad->boundingDiagonal());
     EXPECT_TRUE(r.givenLayers && r.layerSplit);
     if (!r.givenLayers) continue;

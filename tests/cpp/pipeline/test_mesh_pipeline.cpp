@@ -141,8 +141,13 @@ TEST(MeshPipeline, DefaultSizingIsTheOctreeWithATwentiethOfTheDiagonal) {
   EXPECT_FALSE(result.options.size.has_value());
   ASSERT_TRUE(result.options.sizing.has_value());
   EXPECT_NEAR(result.options.sizing->maxDelta, 3.0 / 20.0, 1e-12);
-  EXPECT_NEAR(result.options.sizing->minDelta, 3.0 / 400.0, 1e-12);
+  EXPECT_EQ(result.options.sizing->maxDeltaSetBy, "bounding-box diagonal / 20");
+  EXPECT_EQ(result.options.sizing->minDelta, 0.0);  // automatic: the octree sets it
   ASSERT_TRUE(result.sizing.has_value());
+  // A box asks for no size of its own: MinDelta is MaxDelta / 20, as before shapes set it.
+  const SizingParameters& used = result.sizing->octree->parameters();
+  EXPECT_NEAR(used.minDelta, 3.0 / 400.0, 1e-12);
+  EXPECT_EQ(used.minDeltaSetBy, "MaxDelta / 20 (no boundary asks for less)");
   EXPECT_GT(result.sizing->prediction.elements, 0.0);
 }
 

@@ -248,7 +248,8 @@ TEST(SizingOctree, CurveSourceFollowsTheEdge) {
 
 TEST(SizingOctree, RejectsBadParameters) {
   const CadModel cad = test::toModel(test::box(1.0, 1.0, 1.0));
-  EXPECT_THROW(SizingOctree::build(cad, params(0.0, 1.0, 0.1)), ParameterError);
+  EXPECT_THROW(SizingOctree::build(cad, params(-0.1, 1.0, 0.1)), ParameterError);
+  EXPECT_NO_THROW(SizingOctree::build(cad, params(0.0, 1.0, 0.1)));  // 0: automatic
   EXPECT_THROW(SizingOctree::build(cad, params(0.5, 0.1, 0.1)), ParameterError);
   EXPECT_THROW(SizingOctree::build(cad, params(0.1, 1.0, 0.0)), ParameterError);
   EXPECT_THROW(SizingOctree::build(cad, params(0.1, 1.0, 1.5)), ParameterError);
