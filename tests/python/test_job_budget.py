@@ -81,11 +81,13 @@ def test_python_job_budget():
 
 def test_a_job_budget_too_small_for_the_linear_mesh_is_one_error(homesh_bin, tmp_path):
     # Gmsh grinds on the needle for tens of seconds before it crashes: the budget's rest stops
-    # it, and the job fails naming the linear stage (there is no mesh to keep).
+    # it, and the job fails naming the linear stage (there is no mesh to keep). MinDelta is
+    # given (MaxDelta / 20, the automatic rule before shapes set it): the needle's own sizes
+    # take its sizing octree about 4 s, which the budget must not depend on.
     out = tmp_path / "n.msh"
     start = time.monotonic()
-    r = run([homesh_bin, "mesh", cad("needle.step"), "--job-time-limit", "4", "-o", out],
-            timeout=120)
+    r = run([homesh_bin, "mesh", cad("needle.step"), "--min-delta", "0.25",
+             "--job-time-limit", "4", "-o", out], timeout=120)
     print("needle with a 4 s budget: %.2f s wall" % (time.monotonic() - start))
     one_line_error(r, 1, "needle.step", "stopped at its time budget", "linear stage",
                    "what was left of the job time limit of 4 s", "--job-time-limit",

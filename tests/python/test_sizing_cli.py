@@ -330,3 +330,27 @@ def test_uniform_size_and_octree_sizing_are_refused_together(homesh_bin, tmp_pat
         assert result.returncode == 2, (extra, result.stderr)
         assert says in result.stderr, (extra, result.stderr)
         assert stages_run(result.stderr) == []  # refused before any stage ran
+
+
+# OpenCASCADE's sample data (Debian package occt-misc, installed by scripts/install-deps.sh).
+BOTTLE = Path("/usr/share/opencascade/data/occ/bottle.brep")
+
+
+def test_shape_sizes_gmsh_cannot_mesh_are_made_again_at_a_twentieth(homesh_bin, tmp_path):
+    """OpenCASCADE's bottle: a face of its thread has a radius of 0.024, below the floor of an
+    automatic MinDelta (MaxDelta / 200), and Gmsh 4.8 cannot mesh those sizes ("a segment and a
+    facet intersect", with both its surface algorithms). The linear mesh is made again with
+    MinDelta = MaxDelta / 20, the automatic rule before, and the report says so."""
+    assert BOTTLE.is_file(), "occt-misc is not installed (scripts/install-deps.sh)"
+    report = tmp_path / "bottle.json"
+    result = run([homesh_bin, "mesh", BOTTLE, "--order", "1", "-o", tmp_path / "bottle.msh",
+                  "--report", report])
+    assert result.returncode == 0, result.stderr
+    data = json.loads(report.read_text())
+    sizing = data["sizing"]
+    assert sizing["min_delta"] == pytest.approx(sizing["max_delta"] / 20, rel=1e-12)
+    assert sizing["min_delta_set_by"].startswith(
+        "MaxDelta / 20, after Gmsh could not mesh MinDelta"), sizing["min_delta_set_by"]
+    assert "the floor (curvature radius" in sizing["min_delta_set_by"]
+    assert any("Gmsh was given another try" in n for n in data["notes"]), data["notes"]
+    assert data["quality"]["invalid_elements"] == 0
