@@ -112,7 +112,9 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
       {"min_delta", "MinDelta", "--min-delta", "", "MinDelta", ParameterKind::Length, 0, kNoLimit,
        true, 0, true, false, "sizing",
        "Smallest element size, at high curvature (0 or none: the smallest size the shape asks "
-       "for, from its curvature, thin walls and narrow faces, at most MaxDelta / 20)"},
+       "for, from its curvature, thin walls and narrow faces, at most MaxDelta / 20 and at "
+       "least MaxDelta / 200, raised where the octree or the element count would exceed "
+       "their limits)"},
       {"max_delta", "MaxDelta", "--max-delta", "", "MaxDelta", ParameterKind::Length, 0, kNoLimit,
        true, 0, true, false, "sizing",
        "Largest element size (0 or none: a twentieth of the CAD's bounding-box diagonal)"},

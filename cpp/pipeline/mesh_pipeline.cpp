@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 
@@ -134,32 +135,32 @@ SizingResult buildSizing(const CadModel& cad, const SizingParameters& params, in
 SizingResult runSizing(const CadModel& cad, const SizingParameters& params, int threads) {
   const auto start = std::chrono::steady_clock::now();
   // An automatic MinDelta the shape asked for is raised while the octree would need more cells
-  // than it may have (doubled, from the floor it was sampled at) or the prediction exceeds the
+  // than it may have (doubled from the value it was built with) or the prediction exceeds the
   // element limit (the surface's count grows as 1 / MinDelta^2 where the smallest sizes
-  // dominate it: that factor), at most to MaxDelta / 20, the automatic rule before.
+  // dominate it: that factor), at most to MaxDelta / 20, the automatic rule before. The record
+  // keeps what the shape asked for first.
   const bool automatic = params.minDelta == 0.0;
   const double ceiling = kMinDeltaCeiling * params.maxDelta;
   SizingParameters p = params;
   SizingResult r;
+  std::string asked;  // what set the automatic MinDelta before a limit raised it
   for (;;) {
     try {
       r = buildSizing(cad, p, threads);
-    } catch (const OctreeTooLarge&) {
-      const double tried = samplingMinDelta(p);
-      if (!automatic || tried >= ceiling) throw;
-      p.minDelta = std::min(ceiling, 2.0 * tried);
-      p.minDeltaSetBy = "the sizing octree's cell limit (the shape asks for less than " +
-                        formatNumber(tried) + ")";
+    } catch (const OctreeTooLarge& e) {
+      if (!automatic || e.sourceTooSmall || e.minDelta >= ceiling) throw;
+      if (asked.empty()) asked = "too many cells at MinDelta " + formatNumber(e.minDelta);
+      p.minDelta = std::min(ceiling, 2.0 * e.minDelta);
+      p.minDeltaSetBy = "the sizing octree's cell limit (" + asked + ")";
       continue;
     }
     const SizingParameters& used = r.octree->parameters();
     if (!automatic || used.minDelta >= ceiling || !(r.prediction.elements > kMaxPredictedElements))
       break;
-    const std::string why = used.minDeltaSetBy;
+    if (asked.empty()) asked = used.minDeltaSetBy + " asks for " + formatNumber(used.minDelta);
     p.minDelta = std::min(
         ceiling, 1.25 * used.minDelta * std::sqrt(r.prediction.elements / kMaxPredictedElements));
-    p.minDeltaSetBy =
-        "the element limit (" + why + " asks for " + formatNumber(used.minDelta) + ")";
+    p.minDeltaSetBy = "the element limit (" + asked + ")";
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (r.prediction.elements > kMaxPredictedElements) {
@@ -230,15 +231,16 @@ void fitOptionsToModel(MeshResult& result, MeshingOptions& options) {
 // available, the octree written when asked) and the linear mesh's sizes from it; with a uniform
 // size, that size.
 void sizeLinearMesh(MeshResult& result, const MeshingOptions& options, const JobBudget& budget,
-                    PipelineObserver* observer, LinearMeshOptions& linearOptions) {
+                    PipelineObserver* observer, LinearMeshOptions& linearOptions,
+                    const std::string& stage = "sizing") {
   if (!options.sizing) {
     linearOptions.size = *options.size;
     // (No memory prediction here: the bounding-box estimate of a uniform size is no measure of
     // it, a thin plate fills little of its box. The linear mesh made is checked instead.)
     return;
   }
-  checkBudgetLeft(budget, "sizing", result.timings);
-  StageClock sizing("sizing", result.timings, observer);
+  checkBudgetLeft(budget, stage, result.timings);
+  StageClock sizing(stage, result.timings, observer);
   result.sizing = runSizing(*result.cad, *options.sizing, options.threads);
   if (!options.octreeOutput.empty()) writeOctree(*result.sizing->octree, options.octreeOutput);
   sizing.done();
@@ -246,8 +248,9 @@ void sizeLinearMesh(MeshResult& result, const MeshingOptions& options, const Job
   checkPredictedMemory(result.sizing->prediction.elements, options.order,
                        modelMeshDimension(*result.cad, normal),
                        "meshing " + result.cad->sourceName());
-  const SizingOctree& octree = *result.sizing->octree;
-  linearOptions.sizeField = [&octree](const Eigen::Vector3d& x) { return octree.delta(x); };
+  const std::shared_ptr<const SizingOctree> held = result.sizing->octree;  // (sizes again)
+  const SizingOctree& octree = *held;
+  linearOptions.sizeField = [held](const Eigen::Vector3d& x) { return held->delta(x); };
   linearOptions.maxSize = options.sizing->maxDelta;
   linearOptions.minSize = octree.parameters().minDelta;
   for (const RefinementSource& src : octree.parameters().sources)
@@ -411,12 +414,13 @@ void straightenWhereInvalid(CurvedState& state, MeshResult& result, bool layered
                            "straightening their nodes off the CAD");
 }
 
-// The first linear mesh. Where Gmsh cannot mesh the sizes an automatic MinDelta took from the
-// shape (below MaxDelta / 20: OpenCASCADE's bottle, whose thread ends in faces of radius
-// 0.024, failed with "a segment and a facet intersect" with both its surface algorithms), the
-// sizes are made again with MinDelta = MaxDelta / 20, the automatic rule before, and meshed
-// again, with a note; a second failure is the error. A run stopped by its time budget,
-// cancelled or out of memory is not tried again.
+// The first linear mesh. Where it cannot be made with the sizes an automatic MinDelta took from
+// the shape (below MaxDelta / 20: OpenCASCADE's bottle, whose thread ends in faces of radius
+// 0.024, failed in Gmsh with "a segment and a facet intersect" with both its surface
+// algorithms), the sizes are made again with MinDelta = MaxDelta / 20, the automatic rule
+// before (the stage "sizing again"), and the mesh again, with a note; a second failure is the
+// error, naming the first too. A run stopped by its time budget, cancelled or out of memory is
+// not tried again.
 Mesh makeFirstLinearMesh(MeshResult& result, const MeshingOptions& options, JobBudget& budget,
                          PipelineObserver* observer, LinearStage& linear) {
   try {
@@ -427,20 +431,29 @@ Mesh makeFirstLinearMesh(MeshResult& result, const MeshingOptions& options, JobB
     throw;
   } catch (const MeshingError& failure) {
     if (!result.sizing || !options.sizing || options.sizing->minDelta != 0.0) throw;
-    const SizingParameters& used = result.sizing->octree->parameters();
+    const SizingParameters used = result.sizing->octree->parameters();
     const double ceiling = kMinDeltaCeiling * used.maxDelta;
     if (!(used.minDelta < ceiling)) throw;
+    const std::string shape =
+        "MinDelta " + formatNumber(used.minDelta) + " (" + used.minDeltaSetBy + ")";
     MeshingOptions coarser = options;
     coarser.sizing->minDelta = ceiling;
-    coarser.sizing->minDeltaSetBy = "MaxDelta / 20, after Gmsh could not mesh MinDelta " +
-                                    formatNumber(used.minDelta) + " (" + used.minDeltaSetBy + ")";
-    result.notes.push_back(std::string(failure.what()) + "; with MinDelta " +
-                           formatNumber(ceiling) + " (MaxDelta / 20) instead of " +
-                           formatNumber(used.minDelta) + " (" + used.minDeltaSetBy +
-                           ") Gmsh was given another try");
-    checkBudgetLeft(budget, "linear", result.timings);
-    sizeLinearMesh(result, coarser, budget, observer, linear.baseOptions());
-    return linear.make(linear.baseOptions(), true, "linear");
+    coarser.sizing->minDeltaSetBy = "MaxDelta / 20, after the linear mesh failed at " + shape;
+    result.notes.push_back(std::string(failure.what()) + "; the linear mesh was made again with " +
+                           "MinDelta " + formatNumber(ceiling) + " (MaxDelta / 20) instead of " +
+                           shape);
+    try {
+      checkBudgetLeft(budget, "linear", result.timings);
+      sizeLinearMesh(result, coarser, budget, observer, linear.baseOptions(), "sizing again");
+      return linear.make(linear.baseOptions(), true, "linear");
+    } catch (const BudgetExceeded&) {
+      throw;
+    } catch (const OutOfMemory&) {
+      throw;
+    } catch (const MeshingError& second) {
+      throw MeshingError(std::string(second.what()) + " (with MinDelta " + formatNumber(ceiling) +
+                         ", MaxDelta / 20; with " + shape + ": " + failure.what() + ")");
+    }
   }
 }
 

@@ -61,8 +61,9 @@ SizingParameters resolveSizing(const std::optional<SizingParameters>& requested,
 void checkMeshDimension(const CadModel& cad, std::optional<int> expected);
 
 // The sizing octree of `params` and its element-count prediction. An automatic MinDelta is
-// raised (toward MaxDelta / 20) while the prediction exceeds kMaxPredictedElements, saying so
-// in its minDeltaSetBy. Throws ParameterError (bad parameters, or a prediction above
+// raised (toward MaxDelta / 20) while the octree would need more cells than it may have or the
+// prediction exceeds kMaxPredictedElements, saying so in its minDeltaSetBy. Throws
+// ParameterError (bad parameters, sizes the octree cannot hold, or a prediction above
 // kMaxPredictedElements: sizes far too small for the model) or CadError.
 inline constexpr double kMaxPredictedElements = 5e7;
 SizingResult runSizing(const CadModel& cad, const SizingParameters& params,

@@ -186,16 +186,19 @@ class OctreeBuilder {
     const SizingParameters& p = t_.params_;
     std::string culprit = "MinDelta " + formatNumber(p.minDelta) + " and MaxDelta " +
                           formatNumber(p.maxDelta) + " are";
+    bool source = false;
     for (std::size_t i = 0; i < p.sources.size(); ++i)
       if (p.sources[i].delta < p.minDelta) {
         culprit =
             "refinement source " + std::to_string(i + 1) + " (" + p.sources[i].describe() + ") is";
+        source = true;
         break;
       }
     throw OctreeTooLarge(culprit + " too small for " + cad_.sourceName() +
-                         " (bounding-box diagonal " + formatNumber(cad_.boundingDiagonal()) +
-                         "): the sizing octree would need more than " + std::to_string(kMaxNodes) +
-                         " cells");
+                             " (bounding-box diagonal " + formatNumber(cad_.boundingDiagonal()) +
+                             "): the sizing octree would need more than " +
+                             std::to_string(kMaxNodes) + " cells",
+                         p.minDelta, source);
   }
 
   void split(std::int32_t n) {

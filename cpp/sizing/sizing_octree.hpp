@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/error.hpp"
@@ -34,7 +35,10 @@ class CadModel;
 // (pipeline/mesh_pipeline.cpp, runSizing).
 class OctreeTooLarge : public ParameterError {
  public:
-  using ParameterError::ParameterError;
+  OctreeTooLarge(const std::string& message, double builtWith, bool sourceBlamed)
+      : ParameterError(message), minDelta(builtWith), sourceTooSmall(sourceBlamed) {}
+  double minDelta;      // the MinDelta the octree was built with (resolved, when automatic)
+  bool sourceTooSmall;  // a refinement source's size below it is to blame, not MinDelta
 };
 
 struct OctreeStatistics {

@@ -82,8 +82,8 @@ def test_python_job_budget():
 def test_a_job_budget_too_small_for_the_linear_mesh_is_one_error(homesh_bin, tmp_path):
     # Gmsh grinds on the needle for tens of seconds before it crashes: the budget's rest stops
     # it, and the job fails naming the linear stage (there is no mesh to keep). MinDelta is
-    # given (MaxDelta / 20, the automatic rule before shapes set it): the needle's own sizes
-    # take its sizing octree about 4 s, which the budget must not depend on.
+    # given (MaxDelta / 20, the automatic rule before shapes set it: its diagonal 100 / 400): the
+    # needle's own sizes take its sizing octree about 4 s, which the budget must not depend on.
     out = tmp_path / "n.msh"
     start = time.monotonic()
     r = run([homesh_bin, "mesh", cad("needle.step"), "--min-delta", "0.25",

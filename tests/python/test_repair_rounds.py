@@ -183,7 +183,8 @@ def test_slivers_the_splits_leave_are_flipped_away(homesh_bin, tmp_path):
     round made the mesh valid; with one layer the splits make it valid (worst 0.036) and a
     "flip poor" round flips 34 slivers away (0.104), which this test now covers. The sizes are
     those of the automatic rule before shapes set MinDelta (MaxDelta / 20, given here): with the
-    shape's own (MinDelta 0.125 from a radius 0.2) it is valid with a "split poor" round alone."""
+    shape's own (MinDelta 0.125 from a radius 0.2) it is valid with a "split poor" round alone.
+    0.39598768932055 is its bounding-box diagonal (158.395) / 400."""
     assert REFRIGERATOR.is_file(), "occt-misc is not installed (scripts/install-deps.sh)"
     msh, report = tmp_path / "fridge.msh", tmp_path / "fridge.json"
     result = run([homesh_bin, "mesh", REFRIGERATOR, "--order", "4", "--optimise", "-j", "2",

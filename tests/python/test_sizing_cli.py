@@ -340,7 +340,9 @@ def test_shape_sizes_gmsh_cannot_mesh_are_made_again_at_a_twentieth(homesh_bin, 
     """OpenCASCADE's bottle: a face of its thread has a radius of 0.024, below the floor of an
     automatic MinDelta (MaxDelta / 200), and Gmsh 4.8 cannot mesh those sizes ("a segment and a
     facet intersect", with both its surface algorithms). The linear mesh is made again with
-    MinDelta = MaxDelta / 20, the automatic rule before, and the report says so."""
+    MinDelta = MaxDelta / 20, the automatic rule before, and the report says so. (The test
+    stands on Gmsh 4.8's failure there: a Gmsh that meshes the bottle at its own sizes fails it,
+    and the fallback then needs another case.)"""
     assert BOTTLE.is_file(), "occt-misc is not installed (scripts/install-deps.sh)"
     report = tmp_path / "bottle.json"
     result = run([homesh_bin, "mesh", BOTTLE, "--order", "1", "-o", tmp_path / "bottle.msh",
@@ -350,7 +352,9 @@ def test_shape_sizes_gmsh_cannot_mesh_are_made_again_at_a_twentieth(homesh_bin, 
     sizing = data["sizing"]
     assert sizing["min_delta"] == pytest.approx(sizing["max_delta"] / 20, rel=1e-12)
     assert sizing["min_delta_set_by"].startswith(
-        "MaxDelta / 20, after Gmsh could not mesh MinDelta"), sizing["min_delta_set_by"]
+        "MaxDelta / 20, after the linear mesh failed at MinDelta"), sizing["min_delta_set_by"]
     assert "the floor (curvature radius" in sizing["min_delta_set_by"]
-    assert any("Gmsh was given another try" in n for n in data["notes"]), data["notes"]
+    assert any("the linear mesh was made again with MinDelta" in n and "PLC Error" in n
+               for n in data["notes"]), data["notes"]
+    assert "sizing again" in data["timings_s"], data["timings_s"]
     assert data["quality"]["invalid_elements"] == 0

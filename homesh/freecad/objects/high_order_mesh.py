@@ -22,7 +22,8 @@ def make_high_order_mesh(doc, part, order=None, size=None, name="HighOrderMesh",
     ``order`` and ``size`` left out (None) keep the parameter table's defaults. ``size`` 0
     means automatic: the sizing octree of ``sizing`` (a Sizing object, see
     :func:`make_sizing`) if given, else the automatic sizing octree (MaxDelta a twentieth of the
-    bounding-box diagonal, MinDelta a twentieth of that, EPS the table's default).
+    bounding-box diagonal, MinDelta the smallest size the shape asks for, at most a twentieth
+    of MaxDelta, EPS the table's default).
     ``boundary_layer``: a BoundaryLayer object on faces of ``part``
     (:func:`make_boundary_layer`). ``fem_mesh``: a
     FEM mesh object of ``part`` (FEM's Gmsh or Netgen mesher) to curve instead of meshing

@@ -17,7 +17,8 @@ def make_sizing(doc, part, min_delta=None, max_delta=None, eps=None, name="Sizin
     parameters and its predicted element count.
 
     Left out (None): the parameter table's defaults. ``min_delta`` / ``max_delta`` 0 mean
-    automatic (max: bounding-box diagonal / 20, min: max / 20). Refinement spheres go in RefinementSpheres (centres), RefinementRadii and
+    automatic (max: bounding-box diagonal / 20; min: the smallest size the shape asks for, at
+    most max / 20 and at least max / 200). Refinement spheres go in RefinementSpheres (centres), RefinementRadii and
     RefinementDeltas (parallel lists). The caller recomputes.
     """
     obj = doc.addObject("App::FeaturePython", name)
