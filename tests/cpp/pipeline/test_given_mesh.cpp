@@ -157,17 +157,25 @@ TEST(GivenMesh, GmshsHybridLayeredSphereIsCurvedValidWithItsLayers) {
 // them repairs them). On the sphere half its patches are recombined: 116 prism and 50 hexahedral
 // stacks share the columns where the patches meet. On the cylinder all are: its layer meets the
 // end planes (its side quadrilaterals merged and split back).
+//
+// Both meshes are made before anything is curved. Gmsh runs in a child forked from this process;
+// forked after the sphere's multithreaded curving it made another cylinder mesh now and then
+// (likely cause, not confirmed: Gmsh orders some containers by address, and the heap the child
+// inherits depends on the order the machine's load gave the threads' frees) (1,147 nodes instead of
+// 1,153), on which the optimiser leaves a pyramid at an end plane invalid (worst -0.021, not
+// repaired by straightening; CI and a fresh clone under load saw it).
 TEST(GivenMesh, GmshsHexahedralLayersOnQuadrilateralWallsAreCurvedValidWithTheirLayers) {
   const auto dir = test::tempDir();
   test::GmshLayer layer;
   layer.quadPatches = 4;
+  const auto path = [&dir](bool sphere, const char* ext) {
+    return (dir / ((sphere ? "sphere." : "cylinder.") + std::string(ext))).string();
+  };
+  test::writeGmshLayeredSphere(path(true, "msh"), path(true, "step"), layer);
+  test::writeGmshLayeredCylinder(path(false, "msh"), path(false, "step"), layer);
   for (const bool sphere : {true, false}) {
     SCOPED_TRACE(sphere ? "sphere" : "cylinder");
-    const std::string msh = (dir / "layer.msh").string(), step = (dir / "layer.step").string();
-    if (sphere)
-      test::writeGmshLayeredSphere(msh, step, layer);
-    else
-      test::writeGmshLayeredCylinder(msh, step, layer);
+    const std::string msh = path(sphere, "msh"), step = path(sphere, "step");
     const double tolerance = sphere ? parameterDefault("classify_tolerance") : 2e-3;
     // (The sphere at order 2 only: at order 4 it has 178,000 nodes, and the cylinder has the
     // same pyramids on a curved top.)
