@@ -791,8 +791,9 @@ void leaveOutLooseFaces(CadModel& cad, const LooseFaces& loose, const TopoDS_Sha
 }
 
 // Solids that touch on faces of their own (not one shared face) are meshed apart there: a
-// warning names the first pairs.
-void warnTouchingSolids(const CadModel& cad, HealingRecord& record) {
+// warning names the first pairs. `imprint`: whether imprinting was on (it failed, or the solids
+// overlap: record.imprint.warning says so).
+void warnTouchingSolids(const CadModel& cad, bool imprint, HealingRecord& record) {
   std::vector<CoincidentFaces> pairs = withOcctErrors("checking " + cad.sourceName(), [&] {
     return coincidentFaces(occtShape(cad), 10.0 * record.tolerance);
   });
@@ -809,8 +810,26 @@ void warnTouchingSolids(const CadModel& cad, HealingRecord& record) {
     record.warnings.push_back(
         "solids lie against each other on faces they do not share: " + where +
         "; each is meshed with its own nodes there, so the mesh does not conform across "
-        "them (fuse them first for one conforming mesh: FreeCAD Part > Boolean > Boolean "
-        "fragments)");
+        "them" +
+        (imprint ? std::string(" (make them touch without overlapping, or fuse them in the CAD: "
+                               "FreeCAD Part > Boolean > Boolean fragments)")
+                 : std::string(" (imprinting is off: --no-imprint, imprint=False, Imprint)")));
+}
+
+// Touching solids imprinted on each other (options.imprint), or the warnings of why not.
+CadModel imprintTouchingSolids(CadModel cad, const HealingOptions& options, HealingRecord& record) {
+  record.imprint.enabled = options.imprint;
+  cad = imprintSolids(std::move(cad), 10.0 * record.tolerance, record.imprint);
+  if (record.imprint.imprinted) {
+    record.facesAfter = cad.numFaces();
+    record.solidsAfter = cad.numSolids();
+    return cad;
+  }
+  if (!record.imprint.warning.empty())
+    record.warnings.push_back(record.imprint.warning);
+  else
+    warnTouchingSolids(cad, options.imprint, record);
+  return cad;
 }
 
 CadModel healAs(CadModel cad, const HealingOptions& options, HealingRecord& record) {
@@ -819,6 +838,7 @@ CadModel healAs(CadModel cad, const HealingOptions& options, HealingRecord& reco
   const TopoDS_Shape original = occtShape(cad);
   record = HealingRecord{};
   record.enabled = enabled;
+  record.imprint.enabled = options.imprint;
   const double diagonal = cad.boundingDiagonal();
   record.tolerance = kTolerance * diagonal;
   record.facesBefore = record.facesAfter = cad.numFaces();
@@ -853,7 +873,8 @@ CadModel healAs(CadModel cad, const HealingOptions& options, HealingRecord& reco
   if (solids.Extent() == 0 && !planar) refuseNoSolid(cad, edges, healingNote, options, record);
   const LooseFaces loose = solids.Extent() > 0 ? facesInNoSolid(occtShape(cad)) : LooseFaces{};
   if (!loose.indices.empty()) leaveOutLooseFaces(cad, loose, original, edges, options, record);
-  if (cad.numSolids() > 1) warnTouchingSolids(cad, record);
+  if (cad.numSolids() > 1) cad = imprintTouchingSolids(std::move(cad), options, record);
+  record.seconds = secondsSince(start);
   return cad;
 }
 

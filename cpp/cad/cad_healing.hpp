@@ -23,11 +23,12 @@
 #include <vector>
 
 #include "cad/cad_model.hpp"
+#include "cad/solid_imprint.hpp"
 
 namespace homesh {
 
 struct HealingOptions {
-  bool enabled = true;      // sew and fix what the check finds; false: check only
+  bool enabled = true;      // sew and fix what the check finds; false: check only (imprint apart)
   bool solidsOnly = false;  // faces in no solid are left out (recorded) instead of refused
   // A model without solids whose faces do not close is kept as faces (a surface mesh), sewn
   // into shells where that joins them, instead of refused.
@@ -39,6 +40,8 @@ struct HealingOptions {
   // model. Without it an open shell is refused: a user who meant a solid hears so instead of
   // getting triangles.
   bool automatic = false;
+  // Solids that touch are imprinted on each other (cad/solid_imprint.hpp), last, after healing.
+  bool imprint = true;
 
   // Throws ParameterError for modes that exclude each other.
   void validate() const;
@@ -68,14 +71,18 @@ struct HealingRecord {
   // HealingOptions::automatic's choice, in words (empty without it).
   std::string automatic;
   // What the mesh user must know that healing does not change: solids that lie against each
-  // other on faces of their own (coincident, not shared), whose meshes do not conform there.
+  // other on faces of their own (coincident, not shared) and were not imprinted (imprinting
+  // off, or not possible), whose meshes do not conform there.
   std::vector<std::string> warnings;
+  // Touching solids imprinted on each other, last (HealingOptions::imprint): the interfaces
+  // made and the numbering's map from the healed model to the one meshed.
+  ImprintRecord imprint;
   int facesBefore = 0, facesAfter = 0;
   int solidsBefore = 0, solidsAfter = 0;
   double seconds = 0.0;
   // The healed model's FaceN and EdgeN differ from the original's (counts, or a face or edge
   // whose centre of mass moved); a fix of tolerances alone keeps the numbering.
-  bool renumbered = false;
+  bool renumbered = false;  // (by healing's fixes; imprint.numbering maps imprinting's)
   bool changed() const { return !actions.empty(); }
   // What a user must read about the model meshed, one line each: the faces left out (solids
   // only, or copies) and the warnings. The pipeline's notes and `homesh predict` print these.
@@ -98,7 +105,8 @@ struct HealingRecord {
 // edge, when faces are in no solid (without solidsOnly), naming them, when it has no solid and
 // no face, and when `options.surface` is asked of a model with solids. `options.automatic`
 // chooses solidsOnly or surface for the model (see HealingOptions) and says which in
-// `record.automatic`.
+// `record.automatic`. Last, with `options.imprint`, touching solids are imprinted on each other
+// (record.imprint).
 CadModel healModel(CadModel cad, const HealingOptions& options, HealingRecord& record);
 
 }  // namespace homesh

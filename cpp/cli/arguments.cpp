@@ -43,7 +43,8 @@ double parseParameter(const std::string& key, const std::string& option, const s
       p.kind == ParameterKind::Integer ? parseInteger(option, text) : parseNumber(option, text);
   // Named by its long form whatever alias was typed (-j: --threads).
   const std::string name = *p.option != '\0' ? std::string(p.option) : option;
-  if (!inRange(p, value)) throw UsageError{name + " must be " + rangeText(p) + ", got " + text};
+  if (!(p.zeroIsAutomatic && value == 0.0) && !inRange(p, value))  // 0: automatic
+    throw UsageError{name + " must be " + rangeText(p) + ", got " + text};
   return value;
 }
 
@@ -238,7 +239,8 @@ constexpr std::initializer_list<const char*> kOptimiseKeys = {
     "region_layers", "focus",    "free_interfaces", "optimise_seconds"};
 
 // The CAD modes, which mesh and predict share.
-constexpr std::initializer_list<const char*> kCadModes = {"heal", "solids_only", "surface", "auto"};
+constexpr std::initializer_list<const char*> kCadModes = {"heal", "solids_only", "surface", "auto",
+                                                          "imprint"};
 
 // --optimise (mesh and curve): run the optimiser with the table's sweeps.
 void addOptimiseSwitch(OptionTable& table, bool& optimise) {
@@ -496,7 +498,7 @@ options (the parameter table's, which Python and FreeCAD read too):
 )" +
          tableHelp({"optimise", "optimise_seconds", "facet_weight", "fidelity_weight",
                     "repair_rounds", "linear_seconds", "job_seconds", "heal", "solids_only",
-                    "surface", "auto"}) +
+                    "surface", "auto", "imprint"}) +
          R"(
 refinement of the sizing octree:
       --refine-line X1,Y1,Z1,X2,Y2,Z2,R,D    size at most D within R of a segment
@@ -532,7 +534,7 @@ options:
       --max-delta D, --min-delta D, --eps E, --refine-line ..., --refine-sphere ...,
       --refine-box ..., --refine-curve ...   as for 'homesh mesh'
       --write-octree FILE.vtu   the octree's leaves with their sizes (ParaView)
-      --no-heal, --solids-only, --surface, --auto   as for 'homesh mesh'
+      --no-heal, --no-imprint, --solids-only, --surface, --auto   as for 'homesh mesh'
       --report FILE   write the JSON report ("-" for standard output)
 )" + commonHelp();
 }

@@ -11,11 +11,12 @@
 namespace homesh {
 
 namespace {
-constexpr double kNoLimit = std::numeric_limits<double>::infinity();
-}  // namespace
 
-const std::vector<ParameterDefinition>& parameterDefinitions() {
-  static const std::vector<ParameterDefinition> table = {
+constexpr double kNoLimit = std::numeric_limits<double>::infinity();
+
+// The rows in the order a panel shows them, in two parts: the mesh's and the CAD's ...
+std::vector<ParameterDefinition> meshAndCadRows() {
+  return {
       {"order", "Order", "--order", "-p", "order", ParameterKind::Integer, 1, 10, false, 4, false,
        false, "mesh", "Polynomial order of the elements"},
       {"size", "Size", "--size", "-s", "size", ParameterKind::Length, 0, kNoLimit, true, 0, true,
@@ -62,7 +63,9 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        "vertex, edge or face it is put on, relative to the CAD's bounding diagonal; the node is "
        "then moved onto it"},
       {"threads", "Threads", "--threads", "-j", "threads", ParameterKind::Integer, 1, 1024, false,
-       1, false, false, "mesh", "Threads the sizing octree and the optimiser use"},
+       0, true, false, "mesh",
+       "Threads the sizing, the optimiser and the quality checks use (0: every core this "
+       "process may run on)"},
       {"verbosity", "", "--verbose", "-v", "verbosity", ParameterKind::Integer, 0, 2, false, 0,
        false, false, "mesh",
        "How much of Gmsh's own output to pass on: 0 none, 1 its warnings, 2 also its "
@@ -72,7 +75,8 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        "Check the shape and, where the check finds a problem (faces not sewn into a solid, "
        "invalid geometry, tiny edges or sliver faces), repair it with OpenCASCADE's shape "
        "healing before meshing; a healed shape's faces are numbered afresh (the report's "
-       "\"healing\" says what was found and done); off: check only"},
+       "\"healing\" says what was found and done); off: check only (touching solids are still "
+       "imprinted: Imprint)"},
       {"solids_only", "SolidsOnly", "--solids-only", "", "solids only", ParameterKind::Boolean, 0,
        1, false, 0, false, false, "cad",
        "Mesh the solids and leave out faces in no solid (a loose shell that does not close), "
@@ -87,6 +91,20 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        "Choose per shape, for batch runs: with solids, as solids only (faces in no solid left "
        "out and named); without a solid, sewn into solids where every shell closes, else as "
        "surface; the report says which. Not with solids only or surface"},
+      {"imprint", "Imprint", "--no-imprint", "", "imprint", ParameterKind::Boolean, 0, 1, false, 1,
+       false, false, "cad",
+       "Imprint solids that touch on each other (OpenCASCADE's general fuse), so that they share "
+       "the faces where they touch and one mesh conforms across them, each solid its own volume "
+       "group; the faces are numbered afresh, and numbers given in the shape's own numbering "
+       "(boundary-layer faces, refinement curves, groups) are mapped (the report's "
+       "healing.imprint lists the interfaces and the numbers that changed); done with or "
+       "without healing; off: each solid is meshed with its own nodes where they touch"},
+  };
+}
+
+// ... then the optimiser's, the sizing's and the boundary layer's.
+std::vector<ParameterDefinition> optimiserSizingAndLayerRows() {
+  return {
       {"functional", "", "--functional", "-f", "functional", ParameterKind::Choice, 0, 3, false, 0,
        false, false, "optimiser", "Energy the optimiser minimises (docs/method.md describes each)",
        "hyperelastic|linearelastic|winslow|distortion"},
@@ -127,6 +145,17 @@ const std::vector<ParameterDefinition>& parameterDefinitions() {
        ParameterKind::Real, 0, 100, true, 2, false, false, "boundary_layer",
        "Height ratio of consecutive layers, from the wall"},
   };
+}
+
+}  // namespace
+
+const std::vector<ParameterDefinition>& parameterDefinitions() {
+  static const std::vector<ParameterDefinition> table = [] {
+    std::vector<ParameterDefinition> rows = meshAndCadRows();
+    const std::vector<ParameterDefinition> rest = optimiserSizingAndLayerRows();
+    rows.insert(rows.end(), rest.begin(), rest.end());
+    return rows;
+  }();
   return table;
 }
 

@@ -17,6 +17,7 @@
 #include "core/first_failure.hpp"
 #include "core/parameters.hpp"
 #include "core/spatial_order.hpp"
+#include "core/thread_count.hpp"
 #include "element/jacobian_sampler.hpp"
 #include "element/reference_element.hpp"
 #include "optimise/cad_sliding.hpp"
@@ -343,14 +344,15 @@ OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
   if (mesh.dim != 2 && mesh.dim != 3)
     throw ParameterError("the optimiser needs a 2D or 3D mesh, got dimension " +
                          std::to_string(mesh.dim));
+  OptimiserOptions local = options;
+  local.threads = threadsToUse(options.threads);  // 0: every core, resolved once for the run
   if (!options.spatialOrder)
-    return mesh.dim == 3 ? Optimiser<3>(mesh, options, observer, cad, startQuality).run()
-                         : Optimiser<2>(mesh, options, observer, cad, startQuality).run();
+    return mesh.dim == 3 ? Optimiser<3>(mesh, local, observer, cad, startQuality).run()
+                         : Optimiser<2>(mesh, local, observer, cad, startQuality).run();
   // The sweeps run on the mesh renumbered along a space-filling curve (OptimiserOptions::
   // spatialOrder), with the per-node and per-element options and the caller's quality
   // renumbered alongside; the caller's numbering is restored whatever happens.
   const SpatialOrder order(mesh);
-  OptimiserOptions local = options;
   local.fixedNodes = order.nodeValues(options.fixedNodes, 1);
   local.normalLocked = order.nodeValues(options.normalLocked, 3);
   local.regionSeed = order.elementValues(options.regionSeed);
@@ -386,12 +388,17 @@ class NodeEnergyProbe::Impl {
 
 namespace {
 
+OptimiserOptions withThreadsResolved(OptimiserOptions options) {
+  options.threads = threadsToUse(options.threads);
+  return options;
+}
+
 template <int D>
 class ProbeImpl : public NodeEnergyProbe::Impl {
  public:
   ProbeImpl(Mesh mesh, OptimiserOptions options, const CadModel* cad)
       : mesh_(std::move(mesh)),
-        options_(std::move(options)),
+        options_(withThreadsResolved(std::move(options))),
         optimiser_(mesh_, options_, nullptr, cad) {
     optimiser_.prepareProbe();
   }
@@ -468,7 +475,7 @@ double nodalScaledJacobian(const Mesh& mesh, int threads) {
     const int n = block.nodesPerElement();
     double blockWorst = 1.0;
     FirstFailure failure;
-#pragma omp parallel for num_threads(threads) reduction(min : blockWorst)
+#pragma omp parallel for num_threads(threadsToUse(threads)) reduction(min : blockWorst)
     for (std::int64_t e = 0; e < static_cast<std::int64_t>(block.count()); ++e) {
       try {
         NodeCoordinates x(n, 3);

@@ -10,7 +10,7 @@ void OptimiserOptions::validate() const {
   checkParameter("optimise", maxIterations);
   checkParameter("tolerance", tolerance);
   checkParameter("optimise_seconds", timeLimit);
-  checkParameter("threads", threads);
+  if (threads != 0) checkParameter("threads", threads);  // 0: every core
   if (regionThreshold) checkParameter("region", *regionThreshold);
   checkParameter("region_layers", regionLayers);
   checkParameter("focus", focusPasses);

@@ -94,13 +94,40 @@ void checkRenumbering(const HealingRecord& healing, const MeshingOptions& option
                        "without healing (--no-heal, heal=False, Heal off)");
 }
 
+// Imprinting numbers the model's faces and edges afresh: what the options name by number (a
+// boundary layer's faces, refinement along CAD curves) is mapped from the model as read, a face
+// or curve split by the imprint standing for all its pieces.
+void mapToImprintedNumbering(const ImprintRecord& imprint, MeshingOptions& options) {
+  if (!imprint.imprinted) return;
+  const std::string operation = kImprintOperation;
+  if (options.boundaryLayer)
+    options.boundaryLayer->faces =
+        imprint.numbering.map(2, options.boundaryLayer->faces, "boundary-layer face", operation);
+  if (!options.sizing) return;
+  std::vector<RefinementSource> sources;
+  for (const RefinementSource& s : options.sizing->sources) {
+    if (s.kind != RefinementSource::Kind::Curve) {
+      sources.push_back(s);
+      continue;
+    }
+    for (const int edge : imprint.numbering.map(1, {s.edge}, "refinement curve", operation)) {
+      RefinementSource piece = s;
+      piece.edge = edge;
+      sources.push_back(piece);
+    }
+  }
+  options.sizing->sources = std::move(sources);
+}
+
 }  // namespace
 
-SizingResult runSizingStage(const CadSource& source, const MeshingOptions& options) {
-  options.healing().validate();  // before the (possibly slow) CAD import
+SizingResult runSizingStage(const CadSource& source, const MeshingOptions& given) {
+  given.healing().validate();  // before the (possibly slow) CAD import
   HealingRecord healing;
-  const CadModel cad = healModel(source.load(), options.healing(), healing);
-  checkRenumbering(healing, options);
+  const CadModel cad = healModel(source.load(), given.healing(), healing);
+  checkRenumbering(healing, given);
+  MeshingOptions options = given;
+  mapToImprintedNumbering(healing.imprint, options);
   checkMeshDimension(cad, options.expectedDimension);
   SizingResult result = runSizing(cad, resolveSizing(options.sizing, cad), options.threads);
   result.healing = std::move(healing);
@@ -217,6 +244,7 @@ void fitOptionsToModel(MeshResult& result, MeshingOptions& options) {
     throw ParameterError("a boundary layer needs a volume or planar mesh, and " + cad.sourceName() +
                          " has no solid: automatic mode (--auto) gives it a surface mesh");
   checkRenumbering(result.healing, options);
+  mapToImprintedNumbering(result.healing.imprint, options);
   checkMeshDimension(cad, options.expectedDimension);
   if (!options.size) options.sizing = resolveSizing(options.sizing, cad);
   if (isSurfaceModel(cad) && options.optimiseIterations > 0) {
@@ -421,8 +449,9 @@ void straightenWhereInvalid(CurvedState& state, MeshResult& result, bool layered
 // before (the stage "sizing again"), and the mesh again, with a note; a second failure is the
 // error, naming the first too. A run stopped by its time budget, cancelled or out of memory is
 // not tried again.
-Mesh makeFirstLinearMesh(MeshResult& result, const MeshingOptions& options, JobBudget& budget,
-                         PipelineObserver* observer, LinearStage& linear) {
+Mesh makeFirstLinearMeshAtSizes(MeshResult& result, const MeshingOptions& options,
+                                JobBudget& budget, PipelineObserver* observer,
+                                LinearStage& linear) {
   try {
     return linear.make(linear.baseOptions(), true, "linear");
   } catch (const BudgetExceeded&) {
@@ -454,6 +483,25 @@ Mesh makeFirstLinearMesh(MeshResult& result, const MeshingOptions& options, JobB
       throw MeshingError(std::string(second.what()) + " (with MinDelta " + formatNumber(ceiling) +
                          ", MaxDelta / 20; with " + shape + ": " + failure.what() + ")");
     }
+  }
+}
+
+// makeFirstLinearMeshAtSizes; where it fails on a model whose touching solids were imprinted,
+// the error says so and how to mesh them apart (Gmsh 4.8 aborts on OpenCASCADE's imprinted
+// Axis_of_bearing.brep, which it meshes with the solids apart).
+Mesh makeFirstLinearMesh(MeshResult& result, const MeshingOptions& options, JobBudget& budget,
+                         PipelineObserver* observer, LinearStage& linear) {
+  try {
+    return makeFirstLinearMeshAtSizes(result, options, budget, observer, linear);
+  } catch (const BudgetExceeded&) {
+    throw;
+  } catch (const OutOfMemory&) {
+    throw;
+  } catch (const MeshingError& failure) {
+    if (!result.healing.imprint.imprinted) throw;
+    throw MeshingError(std::string(failure.what()) +
+                       "; its touching solids were imprinted on each other first: --no-imprint "
+                       "(Python imprint=False, FreeCAD Imprint off) meshes them apart");
   }
 }
 
@@ -539,10 +587,20 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
   return result;
 }
 
+WriteOptions inMeshedNumbering(WriteOptions options, const StageRecords& records, int meshDim) {
+  const ImprintRecord& imprint = records.healing.imprint;
+  if (!imprint.imprinted) return options;
+  for (NamedGroup& g : options.groups)
+    g.entities = imprint.numbering.map(
+        meshDim - 1, g.entities, "boundary group '" + g.name + "': entity", kImprintOperation);
+  return options;
+}
+
 void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,
                       const WriteOptions& options, PipelineObserver* observer) {
+  const WriteOptions mapped = inMeshedNumbering(options, result, result.mesh.dim);
   StageClock output("output", result.timings, observer);
-  writeMeshFiles(result, paths, options);
+  writeMeshFiles(result, paths, mapped);
   output.done();
   result.job.seconds += result.timings.seconds.back().second;  // the job ends with its output
 }

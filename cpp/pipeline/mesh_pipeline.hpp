@@ -108,10 +108,11 @@ struct CadSource {
 };
 
 // The sizing stage alone (`homesh predict`): loads (and heals, as runMeshPipeline) the CAD, checks
-// options.expectedDimension, builds the octree from resolveSizing(options.sizing) on
-// options.threads and predicts, and writes options.octreeOutput when set. Throws as
-// runMeshPipeline's first stages.
-SizingResult runSizingStage(const CadSource& source, const MeshingOptions& options);
+// given.expectedDimension, builds the octree from resolveSizing(given.sizing) on
+// given.threads and predicts, and writes given.octreeOutput when set; numbers given in the
+// model's own numbering are mapped as the pipeline maps them. Throws as runMeshPipeline's first
+// stages.
+SizingResult runSizingStage(const CadSource& source, const MeshingOptions& given);
 
 // Receives progress; may ask to stop, which is honoured when a stage starts or ends, between
 // the linear mesher's dimensions and between the optimiser's colour groups (the run then throws
@@ -163,7 +164,14 @@ inline constexpr std::array<const char*, 7> kCurveOptionKeys = {
     "order",           "optimise",    "optimise_seconds",  "facet_weight",
     "fidelity_weight", "job_seconds", "classify_tolerance"};
 
-// writeMeshFiles as the pipeline's last stage: records its "output" timing in the result.
+// `options` with its named groups' entities, given in the model's numbering as it was read,
+// mapped to the meshed model's: imprinting touching solids numbers faces and edges afresh
+// (HealingRecord::imprint). Throws ParameterError naming a group's entity that imprinting
+// removed or the model does not have.
+WriteOptions inMeshedNumbering(WriteOptions options, const StageRecords& records, int meshDim);
+
+// writeMeshFiles as the pipeline's last stage: records its "output" timing in the result; the
+// groups mapped by inMeshedNumbering.
 void writeMeshOutputs(MeshResult& result, const std::vector<std::string>& paths,
                       const WriteOptions& options = {}, PipelineObserver* observer = nullptr);
 

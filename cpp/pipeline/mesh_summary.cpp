@@ -65,6 +65,21 @@ std::string repairLine(std::size_t k, const RepairRound& r) {
       r.undecidedAfter, r.worstAfter, r.meshElements, r.reused, r.kept ? "" : ", not kept");
 }
 
+// "imprinted 2 touching solids: 1 interface (Face2: Solid1 | Solid2); ..."
+std::string imprintLine(const ImprintRecord& r) {
+  std::string line = "imprinted " + std::to_string(r.joined) +
+                     " touching solids: " + std::to_string(r.interfaces.size()) +
+                     (r.interfaces.size() == 1 ? " face shared" : " faces shared");
+  for (std::size_t k = 0; k < r.interfaces.size() && k < 3; ++k) {
+    const SolidInterface& i = r.interfaces[k];
+    line += (k == 0 ? " (" : ", ") + cadEntityName(2, i.face) + ": " + cadEntityName(3, i.solidA) +
+            " | " + cadEntityName(3, i.solidB);
+  }
+  if (r.interfaces.size() > 3) line += ", ...";
+  if (!r.interfaces.empty()) line += ")";
+  return line + "; faces and edges numbered afresh (the report's healing.imprint maps them)";
+}
+
 std::string listed(const std::vector<std::string>& stages) {
   return stages.empty() ? std::string("none") : joined(stages);
 }
@@ -105,6 +120,8 @@ std::vector<std::string> meshSummaryLines(const CurvedMesh& curved, const StageR
   if (records.healing.renumbered)
     lines.push_back(formatted("note: face numbers are the healed model's (%d faces, were %d)",
                               records.healing.facesAfter, records.healing.facesBefore));
+  if (const ImprintRecord& imprint = records.healing.imprint; imprint.imprinted)
+    lines.push_back(imprintLine(imprint));
   for (const std::string& note : records.notes) lines.push_back("note: " + note);
   if (records.sizing)
     for (std::string& line : predictionLines(*records.sizing, curved.mesh.dim))

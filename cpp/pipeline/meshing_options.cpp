@@ -9,7 +9,7 @@ namespace homesh {
 void MeshingOptions::validate() const {
   checkParameter("order", order);
   if (size) checkParameter("size", *size);
-  checkParameter("threads", threads);
+  if (threads != 0) checkParameter("threads", threads);  // 0: every core
   checkParameter("optimise", optimiseIterations);
   checkParameter("optimise_seconds", optimiseSeconds);
   checkParameter("facet_weight", facetWeight);
@@ -65,6 +65,7 @@ const OptionSetters<MeshingOptions>& setters() {
       {"verbosity", [](MeshingOptions& o, double v) { o.verbosity = static_cast<int>(v); }},
       {"heal", [](MeshingOptions& o, double v) { o.heal = v != 0.0; }},
       {"solids_only", [](MeshingOptions& o, double v) { o.solidsOnly = v != 0.0; }},
+      {"imprint", [](MeshingOptions& o, double v) { o.imprint = v != 0.0; }},
       {"surface", [](MeshingOptions& o, double v) { o.surface = v != 0.0; }},
       {"auto", [](MeshingOptions& o, double v) { o.automatic = v != 0.0; }},
       // 0 (automatic) still asks for the octree: completeSizing fills it in.

@@ -52,7 +52,8 @@ struct MeshingOptions {
   // A macro boundary layer on these CAD faces (boundary_layer/boundary_layer.hpp), curved and
   // optimised with the rest and split into its thin layers last (boundary_layer/layer_split.hpp).
   std::optional<BoundaryLayerParameters> boundaryLayer;
-  // CAD healing after loading (cad/cad_healing.hpp); false: the model is only checked.
+  // CAD healing after loading (cad/cad_healing.hpp); false: the model is only checked (touching
+  // solids are still imprinted, unless `imprint` is off).
   bool heal = defaultOf<bool>("heal");
   // Faces in no solid are left out (report: healing "left_out") instead of refusing the model.
   bool solidsOnly = defaultOf<bool>("solids_only");
@@ -62,7 +63,9 @@ struct MeshingOptions {
   // Each model gets the mode that fits it (solidsOnly with solids, surface without), for batch
   // runs: HealingOptions::automatic.
   bool automatic = defaultOf<bool>("auto");
-  HealingOptions healing() const { return {heal, solidsOnly, surface, automatic}; }
+  // Touching solids imprinted on each other (cad/solid_imprint.hpp): one conforming mesh.
+  bool imprint = defaultOf<bool>("imprint");
+  HealingOptions healing() const { return {heal, solidsOnly, surface, automatic, imprint}; }
 
   // Throws ParameterError naming the offending parameter.
   void validate() const;

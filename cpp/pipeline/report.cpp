@@ -11,6 +11,44 @@
 namespace homesh {
 namespace {
 
+// "imprint" (inside "healing"): whether touching solids were imprinted on each other, the
+// faces two solids now share (final FaceN, their SolidN) and every number that changed,
+// original -> final, per kind of sub-shape (none when the model was not imprinted).
+void appendImprint(JsonWriter& json, const ImprintRecord& r) {
+  json.beginObject("imprint");
+  json.value("enabled", r.enabled);
+  json.value("solids", r.solids);
+  json.value("touching", r.touching);  // solids whose boxes meet another's: the fuse's arguments
+  json.value("joined", r.joined);      // solids the imprint changed
+  json.value("imprinted", r.imprinted);
+  json.value("warning", r.warning);
+  json.beginArray("interfaces");
+  for (const SolidInterface& i : r.interfaces) {
+    json.beginObject();
+    json.value("face", i.face);
+    json.numbers("solids", std::vector<std::size_t>{static_cast<std::size_t>(i.solidA),
+                                                    static_cast<std::size_t>(i.solidB)});
+    json.endObject();
+  }
+  json.endArray();
+  json.beginObject("renumbered");
+  static const char* kinds[] = {"vertices", "edges", "faces", "solids"};
+  for (int dim = 0; dim < 4; ++dim) {
+    json.beginArray(kinds[dim]);
+    if (r.imprinted)
+      for (const auto& [from, to] : r.numbering.changes(dim)) {
+        json.beginObject();
+        json.value("from", from);
+        json.numbers("to", std::vector<std::size_t>(to.begin(), to.end()));
+        json.endObject();
+      }
+    json.endArray();
+  }
+  json.endObject();
+  json.value("seconds", r.seconds);
+  json.endObject();
+}
+
 void appendHealing(JsonWriter& json, const HealingRecord& h) {
   json.beginObject("healing");
   json.value("enabled", h.enabled);
@@ -32,6 +70,7 @@ void appendHealing(JsonWriter& json, const HealingRecord& h) {
   json.value("solids_before", h.solidsBefore);
   json.value("solids_after", h.solidsAfter);
   json.value("seconds", h.seconds);
+  appendImprint(json, h.imprint);
   json.endObject();
 }
 

@@ -322,6 +322,7 @@ class PyMesh {
         group.entities.push_back(bp::extract<int>(entities[k]));
       options.groups.push_back(std::move(group));
     }
+    options = inMeshedNumbering(std::move(options), *records_, curved_->mesh.dim);
     const ReleaseGil nogil;
     writeMeshFiles(*curved_, {path}, options);
     if (std::filesystem::path(path).extension() != ".xml") return "";
@@ -466,8 +467,9 @@ const std::vector<std::string> kCurveKeys = [] {
   keys.insert(keys.end(), kCurveOptionKeys.begin(), kCurveOptionKeys.end());
   return keys;
 }();
-const std::vector<std::string> kSizingKeys = {"threads", "heal",      "solids_only", "surface",
-                                              "auto",    "min_delta", "max_delta",   "eps"};
+const std::vector<std::string> kSizingKeys = {"threads",   "heal",      "solids_only",
+                                              "surface",   "auto",      "imprint",
+                                              "min_delta", "max_delta", "eps"};
 const std::vector<std::string> kReadKeys = {"threads"};
 
 // The table keys the front-end function `function` ("mesh", "curve", "sizing": predict and

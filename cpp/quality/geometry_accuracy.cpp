@@ -1,4 +1,5 @@
 #include "quality/geometry_accuracy.hpp"
+#include "core/thread_count.hpp"
 
 #include <omp.h>
 
@@ -209,7 +210,7 @@ CellRecord sampleCell(const Mesh& mesh, const std::int64_t* nodes, int n, const 
 }  // namespace
 
 GeometryAccuracy measureGeometryAccuracy(const Mesh& mesh, const CadModel& cad, int threads) {
-  threads = std::max(1, threads);
+  threads = threadsToUse(threads);
   GeometryAccuracy result;
   result.diagonal = cad.boundingDiagonal();
   std::vector<CadModel> perThread;  // CadModel's caches are not thread-safe

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/thread_count.hpp"
 #include "element/quadrature.hpp"
 #include "quality/distortion.hpp"
 
@@ -138,7 +139,7 @@ QualitySummary evaluateQuality(const Mesh& mesh, int threads, const KnownQuality
     const Eigen::Vector3d first = cellNormal(mesh, block.element(0));
     boundJacobian(block.type, block.order, gather(mesh, block.element(0), n),
                   mesh.dim == 2 ? &first : nullptr);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
+#pragma omp parallel for num_threads(threadsToUse(threads)) schedule(dynamic, 16)
     for (std::int64_t e = 0; e < count; ++e) {
       const std::int64_t source = from.empty() ? -1 : from[offset + static_cast<std::size_t>(e)];
       if (source >= 0 && earlier != nullptr) {  // unchanged: the values measured before

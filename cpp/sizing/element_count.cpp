@@ -1,4 +1,5 @@
 #include "sizing/element_count.hpp"
+#include "core/thread_count.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -58,7 +59,7 @@ ElementCountPrediction predictElementCount(const SizingOctree& tree, int threads
   const auto leaves = static_cast<std::int64_t>(tree.numLeaves());
   const bool withGradient = (d == 3 ? kGradientDensity3 : kGradientDensity2) != 0.0;
   FirstFailure failure;  // an allocation failure must not leave the parallel region
-#pragma omp parallel num_threads(std::max(1, threads)) reduction(+ : volume, gradient)
+#pragma omp parallel num_threads(threadsToUse(threads)) reduction(+ : volume, gradient)
   {
     std::vector<SizingOctree::QuadraturePoint> points;
 #pragma omp for schedule(dynamic, 256)
@@ -83,7 +84,7 @@ ElementCountPrediction predictElementCount(const SizingOctree& tree, int threads
   out.domainMeasure = tree.domainMeasure();
   const std::vector<BoundarySample>& samples = tree.samples();
   double boundary = 0.0;
-#pragma omp parallel for num_threads(std::max(1, threads)) reduction(+ : boundary) schedule(static)
+#pragma omp parallel for num_threads(threadsToUse(threads)) reduction(+ : boundary) schedule(static)
   for (std::int64_t i = 0; i < static_cast<std::int64_t>(samples.size()); ++i) {
     const BoundarySample& s = samples[static_cast<std::size_t>(i)];
     const double h = tree.delta(s.x);

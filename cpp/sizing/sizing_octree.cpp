@@ -1,4 +1,5 @@
 #include "sizing/sizing_octree.hpp"
+#include "core/thread_count.hpp"
 
 #include <BRepClass3d_SolidClassifier.hxx>
 #include <BRepClass_FaceClassifier.hxx>
@@ -52,7 +53,7 @@ std::uint64_t cornerKey(std::int64_t i, std::int64_t j, std::int64_t k) {
 class OctreeBuilder {
  public:
   OctreeBuilder(const CadModel& cad, SizingOctree& tree, int threads)
-      : cad_(cad), t_(tree), threads_(std::max(1, threads)) {}
+      : cad_(cad), t_(tree), threads_(threadsToUse(threads)) {}
 
   void run() {
     prepareFrame();

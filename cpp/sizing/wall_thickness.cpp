@@ -1,4 +1,5 @@
 #include "sizing/wall_thickness.hpp"
+#include "core/thread_count.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -102,7 +103,7 @@ std::vector<double> wallThickness(const std::vector<BoundarySample>& samples,
   for (const BoundarySample& s : samples)
     if (isWall(s)) widest = std::max(widest, s.spacing);
   const auto count = static_cast<std::int64_t>(samples.size());
-#pragma omp parallel for schedule(dynamic, 256) num_threads(std::max(1, threads))
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threadsToUse(threads))
   for (std::int64_t i = 0; i < count; ++i) {
     const BoundarySample& p = samples[static_cast<std::size_t>(i)];
     const double limit = reach[static_cast<std::size_t>(i)];

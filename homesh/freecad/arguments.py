@@ -48,6 +48,7 @@ def mesh_arguments(obj, values=None):
                  "job_seconds": get("JobTimeLimit"),
                  "heal": bool(get("Heal")), "solids_only": bool(get("SolidsOnly")),
                  "surface": bool(get("Surface")), "auto": bool(get("AutoMode")),
+                 "imprint": bool(get("Imprint")),
                  "repair_rounds": int(get("RepairRounds")), "threads": int(get("Threads"))}
     sizing = values.get("Sizing", getattr(obj, "Sizing", None))
     if arguments["size"] is None and sizing is not None:

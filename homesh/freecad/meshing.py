@@ -64,7 +64,7 @@ def predicted_elements(obj, job):
                   if k in arguments}
     else:
         sizing = {"min_delta": size, "max_delta": size}
-    cad = {k: arguments[k] for k in ("threads", "heal", "solids_only", "surface", "auto")
+    cad = {k: arguments[k] for k in ("threads", "heal", "solids_only", "surface", "auto", "imprint")
            if k in arguments}
     report = homesh.predict(job.brep_text, name=job.name, **cad, **sizing)
     return int(report["predicted_elements"])

@@ -24,7 +24,8 @@ def _out_of_range(p):
         return []
     values = []
     if p["kind"] == "integer":
-        values += [p["min"] - 1, p["min"] + 0.5 if p["max"] > p["min"] else None]
+        values += [p["min"] - 1 if not p["zero_is_automatic"] else None,  # (-1 below)
+                   p["min"] + 0.5 if p["max"] > p["min"] else None]
     elif p["min_exclusive"] and not p["zero_is_automatic"]:
         values.append(p["min"])
     values.append(p["min"] - 1.0 if not p["zero_is_automatic"] else -1.0)

@@ -104,20 +104,30 @@ def test_faces_in_no_solid_are_refused_by_name_or_left_out_with_a_note(homesh_bi
     assert "Face7-Face11" in json.loads(report.read_text())["healing"]["left_out"]
 
 
-def test_solids_on_faces_they_do_not_share_are_named(homesh_bin, tmp_path):
+def test_solids_on_faces_they_do_not_share_are_imprinted_or_named(homesh_bin, tmp_path):
     """examples/sphere_box.step holds a sphere and a box with a spherical hole, each with its own
-    sphere face: meshed apart there, which the note and the report's healing warnings say."""
+    sphere face: imprinted on each other by default (one face of both, Face8 of the file mapped
+    to it); with imprinting off, meshed apart there, which the note and the report's healing
+    warnings say."""
     sphere_box = os.path.join(os.path.dirname(__file__), "..", "..", "examples", "sphere_box.step")
     report = tmp_path / "r.json"
     r = run([homesh_bin, "mesh", sphere_box, "--order", "2", "--size", "1.2",
              "--report", report], timeout=300)
     assert r.returncode == 0, r.stderr
+    assert "homesh: imprinted 2 touching solids: 1 face shared (Face1: Solid1 | Solid2)" \
+        in r.stderr, r.stderr
+    healing = json.loads(report.read_text())["healing"]
+    assert healing["warnings"] == [] and healing["imprint"]["imprinted"]
+    assert {"from": 8, "to": [1]} in healing["imprint"]["renumbered"]["faces"]
     note = ("homesh: note: solids lie against each other on faces they do not share: Solid1 "
             "and Solid2 (Face1 on Face8)")
+    r = run([homesh_bin, "mesh", sphere_box, "--order", "2", "--size", "1.2", "--no-imprint",
+             "--report", report], timeout=300)
+    assert r.returncode == 0, r.stderr
     assert note in r.stderr, r.stderr
     [warning] = json.loads(report.read_text())["healing"]["warnings"]
-    assert "does not conform" in warning, warning
-    r = run([homesh_bin, "predict", sphere_box], timeout=120)
+    assert "does not conform" in warning and "imprinting is off" in warning, warning
+    r = run([homesh_bin, "predict", sphere_box, "--no-imprint"], timeout=120)
     assert r.returncode == 0 and note in r.stderr, r.stderr
 
 
@@ -151,7 +161,7 @@ def test_models_of_extreme_scale(homesh_bin, tmp_path):
 @pytest.mark.parametrize("option,value,phrase", [
     ("--size", "nan", "--size"), ("--size", "-3", "--size must be a length > 0"),
     ("--order", "11", "--order must be an integer from 1 to 10"),
-    ("--eps", "-0.1", "--eps"), ("--threads", "0", "--threads"),
+    ("--eps", "-0.1", "--eps"), ("--threads", "-1", "--threads"),
     ("--linear-time-limit", "-1", "--linear-time-limit"),
     ("--time-limit", "nan", "--time-limit"),
     ("--job-time-limit", "-1", "--job-time-limit must be a number >= 0"),

@@ -124,7 +124,7 @@ def test_planar_face_gives_a_2d_mesh(tmp_path):
     (dict(size=-1), homesh.ParameterError),
     (dict(size=float("nan")), homesh.ParameterError),  # 0 is automatic, as in FreeCAD
     (dict(size="big"), homesh.ParameterError),
-    (dict(threads=0), homesh.ParameterError),
+    (dict(threads=-1), homesh.ParameterError),  # (0 is every core)
     (dict(threads=100000), homesh.ParameterError),
     (dict(order=2**40), homesh.ParameterError),
     (dict(verbosity=2**40), homesh.ParameterError),

@@ -4,8 +4,6 @@ proxy only holds properties and runs the job; drawing lives in viewproviders.py,
 storage in stored_mesh.py.
 """
 
-import os
-
 import FreeCAD
 
 from ..meshing import (DEFAULT_ELEMENT_LIMIT, LargeMeshError, apply_result,
@@ -79,11 +77,10 @@ class HighOrderMeshProxy(GuardedProxy):
         add_parameter_property(obj, "fidelity_weight", "Mesh")
         add_parameter_property(obj, "linear_seconds", "Mesh")
         add_parameter_property(obj, "job_seconds", "Mesh")
-        for key in ("heal", "solids_only", "surface", "auto"):
+        for key in ("heal", "solids_only", "surface", "auto", "imprint"):
             add_parameter_property(obj, key, "Mesh")
         add_parameter_property(obj, "repair_rounds", "Mesh")
-        add_parameter_property(obj, "threads", "Mesh", " Default: all cores.",
-                               default=os.cpu_count() or 1)
+        add_parameter_property(obj, "threads", "Mesh")
         if "ElementLimit" not in have:
             obj.addProperty("App::PropertyInteger", "ElementLimit", "Mesh",
                             "A run whose predicted linear element count exceeds this asks "

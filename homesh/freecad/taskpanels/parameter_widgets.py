@@ -53,7 +53,8 @@ def _configure_spin_box(widget, p):
                         % (widget.window().objectName(), type(widget).__name__, p["kind"],
                            widget.objectName()))
     if integer:
-        widget.setRange(int(p["min"]), int(min(p["max"], 2 ** 31 - 1)))
+        low = 0 if p["zero_is_automatic"] else int(p["min"])  # 0: automatic ("auto")
+        widget.setRange(low, int(min(p["max"], 2 ** 31 - 1)))
     else:
         # Seconds need no more than a tenth (600.0000 did not fit the panel's field), weights
         # and ratios up to 100 a hundredth ("0.0000" did not fit either); fractions (EPS) 4.

@@ -450,10 +450,11 @@ TEST(CadHealing, SolidsOnlyWithoutHealingAndTheNumberingItChanges) {
 }
 
 // Two boxes side by side, each with its own face at x = 1 (as Gmsh's STEP export writes
-// fragments): the mesh would not conform there, and the record says which solids and faces.
-// Fused so that they share that face (OpenCASCADE's general fuse, FreeCAD's Boolean
-// fragments): nothing to say.
-TEST(CadHealing, SolidsOnFacesTheyDoNotShareAreNamed) {
+// fragments, and a STEP file of FreeCAD's Boolean fragments reads back): imprinted on each
+// other by default, so that they share that face (cad/solid_imprint.hpp); with imprinting off,
+// the mesh would not conform there, and the record says which solids and faces. Fused before
+// (OpenCASCADE's general fuse, FreeCAD's Boolean fragments kept in BRep): nothing to do or say.
+TEST(CadHealing, SolidsOnFacesTheyDoNotShareAreImprintedOrNamed) {
   const TopoDS_Shape left = BRepPrimAPI_MakeBox(1.0, 1.0, 1.0).Shape();
   const TopoDS_Shape right = BRepPrimAPI_MakeBox(gp_Pnt(1, 0, 0), 1.0, 1.0, 1.0).Shape();
   TopoDS_Compound apart;
@@ -461,8 +462,19 @@ TEST(CadHealing, SolidsOnFacesTheyDoNotShareAreNamed) {
   b.MakeCompound(apart);
   b.Add(apart, left);
   b.Add(apart, right);
+  HealingRecord imprinted;
+  const CadModel joined = healModel(cadModelFromShape(apart, "apart"), {}, imprinted);
+  EXPECT_EQ(joined.numSolids(), 2);
+  EXPECT_EQ(joined.numFaces(), 11);
+  EXPECT_TRUE(imprinted.imprint.imprinted);
+  EXPECT_EQ(imprinted.imprint.interfaces.size(), 1U);
+  EXPECT_TRUE(imprinted.warnings.empty()) << imprinted.warnings[0];
+  EXPECT_FALSE(imprinted.renumbered);  // (healing's fixes did not; the imprint's map did)
+
+  HealingOptions off;
+  off.imprint = false;
   HealingRecord record;
-  const CadModel cad = healModel(cadModelFromShape(apart, "apart"), {}, record);
+  const CadModel cad = healModel(cadModelFromShape(apart, "apart"), off, record);
   EXPECT_EQ(cad.numSolids(), 2);
   EXPECT_EQ(cad.numFaces(), 12);
   ASSERT_EQ(record.warnings.size(), 1U);
@@ -470,6 +482,7 @@ TEST(CadHealing, SolidsOnFacesTheyDoNotShareAreNamed) {
   // right box's at x = 1 its first: Face2 and Face7.
   EXPECT_NE(record.warnings[0].find("Solid1 and Solid2 (Face2 on Face7)"), std::string::npos)
       << record.warnings[0];
+  EXPECT_NE(record.warnings[0].find("imprinting is off"), std::string::npos) << record.warnings[0];
 
   TopTools_ListOfShape arguments;
   arguments.Append(left);
@@ -483,6 +496,7 @@ TEST(CadHealing, SolidsOnFacesTheyDoNotShareAreNamed) {
   EXPECT_EQ(fused.numSolids(), 2);
   EXPECT_EQ(fused.numFaces(), 11);  // the face at x = 1 is one face of both
   EXPECT_TRUE(shared.warnings.empty()) << shared.warnings[0];
+  EXPECT_FALSE(shared.imprint.imprinted);  // nothing left to imprint
 }
 
 }  // namespace

@@ -232,12 +232,15 @@ TEST(Arguments, BadCommandLinesNameTheProblem) {
   EXPECT_NE(usageError({"mesh", "a.step", "--order", "11"}).find("--order"), std::string::npos);
   EXPECT_NE(usageError({"mesh", "a.step", "--order", "two"}).find("integer"), std::string::npos);
   EXPECT_NE(usageError({"mesh", "a.step", "--size", "-1"}).find("a length > 0"), std::string::npos);
-  EXPECT_NE(usageError({"mesh", "a.step", "--size", "0"}).find("a length > 0"), std::string::npos);
   EXPECT_NE(usageError({"mesh", "a.step", "--size", "1x"}).find("number"), std::string::npos);
   EXPECT_NE(usageError({"mesh", "a.step", "--size"}).find("needs a value"), std::string::npos);
   EXPECT_NE(usageError({"mesh", "a.step", "--bogus"}).find("--bogus"), std::string::npos);
   EXPECT_NE(usageError({"mesh", "a.step", "b.step"}).find("b.step"), std::string::npos);
-  EXPECT_NE(usageError({"mesh", "a.step", "-j", "0"}).find("--threads"), std::string::npos);
+  EXPECT_NE(usageError({"mesh", "a.step", "-j", "-1"}).find("--threads"), std::string::npos);
+  // 0 where the table says 0 is automatic: every core, the sizing octree.
+  const ParsedCommand automatic = parse({"mesh", "a.step", "-j", "0", "--size", "0"});
+  EXPECT_EQ(automatic.mesh.common.threads, 0);
+  EXPECT_EQ(given(automatic.mesh.options, "size"), 0.0);
 }
 
 }  // namespace

@@ -1015,7 +1015,7 @@ TEST(Optimiser, BadOptionsAreRefused) {
   options.maxIterations = -1;
   EXPECT_THROW(optimiseMesh(mesh, options), ParameterError);
   options = {};
-  options.threads = 0;
+  options.threads = -1;  // (0 is every core)
   EXPECT_THROW(optimiseMesh(mesh, options), ParameterError);
   options = {};
   options.regionThreshold = 1.5;

@@ -1,0 +1,60 @@
+// How the numbered sub-shapes of a model (FreeCAD's VertexN, EdgeN, FaceN, SolidN) became those
+// of the model an OCCT operation made of it: per dimension, each original number's final
+// numbers. An operation that keeps a sub-shape maps it to the final number of that same shape;
+// one that splits it, to the numbers of its pieces; one that merges it with another (a face
+// two solids now share), to the one number both have; one that removes it, to none. Built from
+// the operation's history (OCCT's BRepTools_History: Modified and IsRemoved), so that what a
+// user named by number in the model they see (boundary-layer faces, refinement curves, groups)
+// is found in the model that is meshed.
+#pragma once
+
+#include <array>
+#include <string>
+#include <utility>
+#include <vector>
+
+class TopoDS_Shape;
+class BRepTools_History;
+
+namespace homesh {
+
+class NumberingMap {
+ public:
+  // No model: every lookup fails. Use identity() or fromHistory().
+  NumberingMap() = default;
+
+  // Each number of `shape` to itself.
+  static NumberingMap identity(const TopoDS_Shape& shape);
+
+  // Numbers of `before` to those of `after`, as `history` records the operation that made
+  // `after` from `before`'s sub-shapes.
+  static NumberingMap fromHistory(const TopoDS_Shape& before, const TopoDS_Shape& after,
+                                  const BRepTools_History& history);
+
+  // Whether any number maps to anything but itself alone (counts differ, or a number moved).
+  bool changed() const;
+
+  // How many sub-shapes of dimension `dim` (0 vertices ... 3 solids) the original has.
+  int originalCount(int dim) const;
+
+  // The final numbers of original number `index` of dimension `dim`, ascending (empty: removed).
+  // Throws ParameterError for a number the original does not have.
+  const std::vector<int>& finalNumbers(int dim, int index) const;
+
+  // The final numbers of `indices` (original numbers of dimension `dim`), ascending, without
+  // repeats. Throws ParameterError naming `what` and the first number the operation removed
+  // ("boundary-layer face 7: Face7 was removed by imprinting"), `operation` saying which one.
+  std::vector<int> map(int dim, const std::vector<int>& indices, const std::string& what,
+                       const std::string& operation) const;
+
+  // The numbers that did not map to themselves alone, as (original, finals) pairs, ascending:
+  // what a report lists.
+  std::vector<std::pair<int, std::vector<int>>> changes(int dim) const;
+
+ private:
+  // images_[dim][index - 1]: the final numbers of original number `index`.
+  std::array<std::vector<std::vector<int>>, 4> images_;
+  std::array<int, 4> finalCount_{};
+};
+
+}  // namespace homesh

@@ -1,0 +1,190 @@
+// Touching solids imprinted on each other (cad/solid_imprint.hpp): the faces where they touch
+// become one face of both, wholly or where they partly overlap; every solid stays a solid; the
+// numbering map takes each original number to the final ones; solids that share volume, or
+// stand apart, are left as they are (the first with a warning naming them).
+
+#include <gtest/gtest.h>
+
+#include <BRepAlgoAPI_Cut.hxx>
+#include <BRepBuilderAPI_Copy.hxx>
+#include <BRepGProp.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeSphere.hxx>
+#include <BRep_Builder.hxx>
+#include <GProp_GProps.hxx>
+#include <TopoDS_Compound.hxx>
+#include <gp_Pnt.hxx>
+#include <string>
+#include <vector>
+
+#include "cad/occt_access.hpp"
+#include "cad/solid_imprint.hpp"
+#include "core/error.hpp"
+
+namespace homesh {
+namespace {
+
+CadModel compoundOf(const std::vector<TopoDS_Shape>& solids, const std::string& name) {
+  TopoDS_Compound c;
+  BRep_Builder b;
+  b.MakeCompound(c);
+  for (const TopoDS_Shape& s : solids) b.Add(c, s);
+  return cadModelFromShape(c, name);
+}
+
+TopoDS_Shape box(double x, double y, double z) {
+  return BRepPrimAPI_MakeBox(gp_Pnt(x, y, z), 1.0, 1.0, 1.0).Shape();
+}
+
+double area(const CadModel& cad, int face) {
+  GProp_GProps props;
+  BRepGProp::SurfaceProperties(occtFace(cad, face), props);
+  return props.Mass();
+}
+
+double volume(const CadModel& cad, int solid) {
+  GProp_GProps props;
+  BRepGProp::VolumeProperties(occtSolid(cad, solid), props);
+  return props.Mass();
+}
+
+constexpr double kTolerance = 1e-7;
+
+// Two unit boxes side by side: OpenCASCADE's box numbers its faces x = 0, x = 1, y = 0, y = 1,
+// z = 0, z = 1, so the faces at x = 1 are Face2 (left) and Face7 (right).
+TEST(SolidImprint, BoxesSideBySideShareTheirFace) {
+  ImprintRecord record;
+  const CadModel cad =
+      imprintSolids(compoundOf({box(0, 0, 0), box(1, 0, 0)}, "two boxes"), kTolerance, record);
+  EXPECT_TRUE(record.imprinted);
+  EXPECT_TRUE(record.warning.empty()) << record.warning;
+  EXPECT_EQ(record.solids, 2);
+  EXPECT_EQ(record.touching, 2);
+  ASSERT_EQ(cad.numSolids(), 2);
+  EXPECT_EQ(cad.numFaces(), 11);
+  EXPECT_EQ(cad.numEdges(), 20);
+  EXPECT_EQ(cad.numVertices(), 12);
+  ASSERT_EQ(record.interfaces.size(), 1U);
+  const SolidInterface shared = record.interfaces[0];
+  EXPECT_EQ(shared.solidA, 1);
+  EXPECT_EQ(shared.solidB, 2);
+  EXPECT_NEAR(area(cad, shared.face), 1.0, 1e-12);
+  // Both original faces at x = 1 are that face; each solid still has six faces and its volume.
+  EXPECT_EQ(record.numbering.finalNumbers(2, 2), std::vector<int>{shared.face});
+  EXPECT_EQ(record.numbering.finalNumbers(2, 7), std::vector<int>{shared.face});
+  for (int s = 1; s <= 2; ++s) {
+    EXPECT_EQ(cad.subShapeIndices(3, s, 2).size(), 6U);
+    EXPECT_NEAR(volume(cad, s), 1.0, 1e-12);
+  }
+  // The right box's face at x = 2 keeps its place among the faces: after the shared one.
+  const std::vector<int> far = record.numbering.finalNumbers(2, 8);
+  ASSERT_EQ(far.size(), 1U);
+  const auto [point, normal] = cad.plane(far[0]);
+  EXPECT_NEAR(point.x(), 2.0, 1e-12);
+  EXPECT_TRUE(record.numbering.changed());
+  EXPECT_FALSE(record.numbering.changes(2).empty());
+}
+
+// The right box moved up by half: the faces at x = 1 overlap on half their area, which becomes
+// a face of both; each original face at x = 1 is split into that face and the rest of it.
+TEST(SolidImprint, FacesThatPartlyOverlapAreImprintedWhereTheyOverlap) {
+  ImprintRecord record;
+  const CadModel cad =
+      imprintSolids(compoundOf({box(0, 0, 0), box(1, 0.5, 0)}, "offset boxes"), kTolerance, record);
+  ASSERT_TRUE(record.imprinted) << record.warning;
+  ASSERT_EQ(cad.numSolids(), 2);
+  ASSERT_EQ(record.interfaces.size(), 1U);
+  EXPECT_NEAR(area(cad, record.interfaces[0].face), 0.5, 1e-12);
+  for (const int original : {2, 7}) {
+    const std::vector<int> pieces = record.numbering.finalNumbers(2, original);
+    ASSERT_EQ(pieces.size(), 2U) << "Face" << original;
+    EXPECT_NE(std::find(pieces.begin(), pieces.end(), record.interfaces[0].face), pieces.end());
+    EXPECT_NEAR(area(cad, pieces[0]) + area(cad, pieces[1]), 1.0, 1e-12);
+  }
+  for (int s = 1; s <= 2; ++s) EXPECT_NEAR(volume(cad, s), 1.0, 1e-12);
+}
+
+// A sphere inside a box with that sphere cut out, each with its own sphere face (a copy: the
+// cut shares the sphere's own face with the cavity, a STEP file does not): the sphere's face,
+// its seam and its pole edges (degenerated, which the fuse's history records as removed) map
+// to the cavity's.
+TEST(SolidImprint, ASphereInItsCavityIsOneFaceOfBoth) {
+  const TopoDS_Shape ball = BRepPrimAPI_MakeSphere(gp_Pnt(0.5, 0.5, 0.5), 0.3).Shape();
+  const TopoDS_Shape cavity = BRepAlgoAPI_Cut(box(0, 0, 0), ball).Shape();
+  const TopoDS_Shape sphere = BRepBuilderAPI_Copy(ball).Shape();
+  ImprintRecord record;
+  const CadModel original = compoundOf({cavity, sphere}, "sphere in a box");
+  const int edgesBefore = original.numEdges();
+  const CadModel cad =
+      imprintSolids(compoundOf({cavity, sphere}, "sphere in a box"), kTolerance, record);
+  ASSERT_TRUE(record.imprinted) << record.warning;
+  EXPECT_EQ(cad.numFaces(), 7);
+  EXPECT_EQ(cad.numEdges(), edgesBefore - 3);
+  ASSERT_EQ(record.interfaces.size(), 1U);
+  EXPECT_EQ(record.numbering.finalNumbers(2, 8), std::vector<int>{record.interfaces[0].face});
+  for (int e = 1; e <= edgesBefore; ++e)
+    EXPECT_EQ(record.numbering.finalNumbers(1, e).size(), 1U) << "Edge" << e;
+  EXPECT_EQ(record.numbering.map(1, {13, 14, 15, 16, 17, 18}, "curve", "imprinting").size(), 3U);
+}
+
+// Boxes that overlap by half their width share volume: the fuse would cut them into three
+// solids. Not imprinted; the warning names them.
+TEST(SolidImprint, SolidsThatShareVolumeAreLeftAsTheyAreWithAWarning) {
+  ImprintRecord record;
+  const CadModel cad = imprintSolids(
+      compoundOf({box(0, 0, 0), box(0.5, 0, 0)}, "overlapping boxes"), kTolerance, record);
+  EXPECT_FALSE(record.imprinted);
+  EXPECT_EQ(cad.numSolids(), 2);
+  EXPECT_EQ(cad.numFaces(), 12);
+  EXPECT_NE(record.warning.find("Solid1 and Solid2 share volume"), std::string::npos)
+      << record.warning;
+  EXPECT_NE(record.warning.find("does not conform"), std::string::npos) << record.warning;
+  EXPECT_FALSE(record.numbering.changed());
+  // A box and its copy: the fuse makes them one solid, which would leave one solid of two.
+  ImprintRecord copy;
+  const CadModel twice =
+      imprintSolids(compoundOf({box(0, 0, 0), box(0, 0, 0)}, "a box twice"), kTolerance, copy);
+  EXPECT_FALSE(copy.imprinted);
+  EXPECT_EQ(twice.numSolids(), 2);
+  EXPECT_NE(copy.warning.find("Solid1 and Solid2"), std::string::npos) << copy.warning;
+}
+
+// Boxes a gap apart, and a single box: nothing to imprint, nothing to say, numbering as it was.
+TEST(SolidImprint, SolidsApartAndASingleSolidAreLeftAsTheyAre) {
+  for (const auto& [solids, touching] : std::vector<std::pair<std::vector<TopoDS_Shape>, int>>{
+           {{box(0, 0, 0), box(3, 0, 0)}, 0}, {{box(0, 0, 0)}, 0}}) {
+    ImprintRecord record;
+    const CadModel cad = imprintSolids(compoundOf(solids, "apart"), kTolerance, record);
+    EXPECT_FALSE(record.imprinted);
+    EXPECT_TRUE(record.warning.empty()) << record.warning;
+    EXPECT_EQ(record.touching, touching);
+    EXPECT_EQ(cad.numFaces(), 6 * static_cast<int>(solids.size()));
+    EXPECT_FALSE(record.numbering.changed());
+    EXPECT_EQ(record.numbering.finalNumbers(2, 6), std::vector<int>{6});
+  }
+  // Imprinting off: two touching boxes stay apart.
+  ImprintRecord off;
+  off.enabled = false;
+  const CadModel cad =
+      imprintSolids(compoundOf({box(0, 0, 0), box(1, 0, 0)}, "off"), kTolerance, off);
+  EXPECT_FALSE(off.imprinted);
+  EXPECT_EQ(cad.numFaces(), 12);
+}
+
+// What a user named by a number the model does not have, or one the imprint removed, is
+// refused naming the number, the entity and the operation.
+TEST(SolidImprint, TheNumberingMapRefusesNumbersItCannotMap) {
+  ImprintRecord record;
+  imprintSolids(compoundOf({box(0, 0, 0), box(1, 0, 0)}, "two boxes"), kTolerance, record);
+  try {
+    record.numbering.map(2, {3, 13}, "boundary-layer face", "imprinting the touching solids");
+    FAIL() << "face 13 of 12 was mapped";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(std::string(e.what()), "boundary-layer face 13: the model has 12 (Face1 to Face12)");
+  }
+  // The two faces at x = 1 and the right box's at x = 2 map to two faces.
+  EXPECT_EQ(record.numbering.map(2, {2, 7, 8}, "group", "imprinting").size(), 2U);
+}
+
+}  // namespace
+}  // namespace homesh
