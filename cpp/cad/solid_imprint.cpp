@@ -83,12 +83,13 @@ CadModel imprintSolids(CadModel cad, double tolerance, ImprintRecord& record) {
   TopExp::MapShapes(shape, TopAbs_SOLID, solids);
   record.solids = solids.Extent();
   if (!enabled || record.solids < 2) return cad;
+  const auto unchanged = [&] {  // the model as it was, nothing to say
+    record.seconds = secondsSince(start);
+    return std::move(cad);
+  };
   const std::vector<char> touching = touchingBoxes(solids, tolerance);
   record.touching = static_cast<int>(std::count(touching.begin(), touching.end(), 1));
-  if (record.touching == 0) {
-    record.seconds = secondsSince(start);
-    return cad;
-  }
+  if (record.touching == 0) return unchanged();
   BOPAlgo_Builder fuse;
   fuse.SetNonDestructive(true);  // the model's own shapes stay as they are
   fuse.SetFuzzyValue(tolerance);
@@ -116,11 +117,15 @@ CadModel imprintSolids(CadModel cad, double tolerance, ImprintRecord& record) {
     return std::move(cad);
   };
   if (!failure.empty()) return notImprinted("the touching solids were not imprinted: " + failure);
-  // A solid the fuse cut into pieces shares volume with another.
+  // A solid the fuse cut into pieces shares volume with another. (A solid that was not an
+  // argument has no history: Modified is empty, its image itself.)
   std::vector<int> overlapping;
-  for (int s = 1; s <= solids.Extent(); ++s)
-    if (touching[static_cast<std::size_t>(s)] != 0 && fuse.Modified(solids(s)).Extent() > 1)
-      overlapping.push_back(s);
+  std::vector<TopoDS_Shape> images(static_cast<std::size_t>(solids.Extent()) + 1);
+  for (int s = 1; s <= solids.Extent(); ++s) {
+    const TopTools_ListOfShape& modified = fuse.Modified(solids(s));
+    if (modified.Extent() > 1) overlapping.push_back(s);
+    images[static_cast<std::size_t>(s)] = modified.IsEmpty() ? solids(s) : modified.First();
+  }
   if (!overlapping.empty())
     return notImprinted(namesOf(overlapping) +
                         " share volume with other solids (they overlap, not only touch): the "
@@ -130,8 +135,7 @@ CadModel imprintSolids(CadModel cad, double tolerance, ImprintRecord& record) {
   TopTools_DataMapOfShapeInteger owner;  // image -> the first solid that became it
   std::set<int> merged;
   for (int s = 1; s <= solids.Extent(); ++s) {
-    const TopTools_ListOfShape& image = fuse.Modified(solids(s));
-    const TopoDS_Shape& solid = image.IsEmpty() ? solids(s) : image.First();
+    const TopoDS_Shape& solid = images[static_cast<std::size_t>(s)];
     if (fuse.IsDeleted(solids(s))) {
       merged.insert(s);
     } else if (owner.IsBound(solid)) {
@@ -145,27 +149,19 @@ CadModel imprintSolids(CadModel cad, double tolerance, ImprintRecord& record) {
     return notImprinted(namesOf(std::vector<int>(merged.begin(), merged.end())) +
                         ": the fuse made one solid of two, or removed one (a solid and its "
                         "copy?): the solids were not imprinted");
-  if (!fuse.HasModified()) {  // the boxes met, the solids did not
-    record.seconds = secondsSince(start);
-    return cad;
-  }
+  if (!fuse.HasModified()) return unchanged();  // the boxes met, the solids did not
   BRep_Builder builder;
   TopoDS_Compound result;
   builder.MakeCompound(result);
-  for (int s = 1; s <= solids.Extent(); ++s) {
-    const TopTools_ListOfShape& image = fuse.Modified(solids(s));
-    builder.Add(result, image.IsEmpty() ? solids(s) : image.First());
-  }
+  for (int s = 1; s <= solids.Extent(); ++s)
+    builder.Add(result, images[static_cast<std::size_t>(s)]);
   const NumberingMap numbering = NumberingMap::fromHistory(shape, result, *fuse.History());
-  if (!numbering.changed()) {  // the solids already shared what they touch (fused before)
-    record.seconds = secondsSince(start);
-    return cad;
-  }
+  // The solids already shared what they touch (fused before): their numbering stays.
+  if (!numbering.changed()) return unchanged();
   record.numbering = numbering;
   record.interfaces = interfacesOf(result);
   for (int s = 1; s <= solids.Extent(); ++s)
-    if (touching[static_cast<std::size_t>(s)] != 0 && !fuse.Modified(solids(s)).IsEmpty())
-      ++record.joined;
+    if (!images[static_cast<std::size_t>(s)].IsSame(solids(s))) ++record.joined;
   record.imprinted = true;
   CadModel imprinted = cadModelFromShape(result, cad.sourceName());
   record.seconds = secondsSince(start);

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstddef>
+#include <exception>
 #include <functional>
 #include <string>
 
@@ -74,5 +75,13 @@ class ChildCrashed : public MeshingError {
  public:
   using MeshingError::MeshingError;
 };
+
+// Whether a failure ends the job as it is, whatever another way of doing the work would do: its
+// time budget is spent (BudgetExceeded) or memory is exhausted (OutOfMemory). Callers that try
+// again another way rethrow these.
+inline bool endsTheJob(const std::exception& failure) {
+  return dynamic_cast<const BudgetExceeded*>(&failure) != nullptr ||
+         dynamic_cast<const OutOfMemory*>(&failure) != nullptr;
+}
 
 }  // namespace homesh

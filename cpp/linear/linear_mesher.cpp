@@ -373,10 +373,6 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
   Mesh mesh;
   try {
     mesh = attempt(run);
-  } catch (const BudgetExceeded&) {
-    throw;
-  } catch (const OutOfMemory&) {
-    throw;
   } catch (const ChildCrashed& crash) {
     try {
       mesh = retry(crash.what());
@@ -387,15 +383,13 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
                          "may help)");
     }
   } catch (const MeshingError& failure) {
+    if (endsTheJob(failure)) throw;
     try {
       mesh = retry(failure.what());
-    } catch (const BudgetExceeded&) {
-      throw;
-    } catch (const OutOfMemory&) {
-      throw;
     } catch (const CancelledError&) {
       throw;
-    } catch (const Error&) {
+    } catch (const Error& second) {
+      if (endsTheJob(second)) throw;
       throw failure;  // the first algorithm's message says more
     }
   }

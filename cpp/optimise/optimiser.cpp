@@ -332,6 +332,16 @@ class Optimiser {
 
 }  // namespace
 
+namespace {
+
+// The options with their thread count resolved once for the run (0: every core).
+OptimiserOptions withThreadsResolved(OptimiserOptions options) {
+  options.threads = threadsToUse(options.threads);
+  return options;
+}
+
+}  // namespace
+
 OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
                              OptimiserObserver* observer, const CadModel* cad,
                              const QualitySummary* startQuality) {
@@ -344,8 +354,7 @@ OptimiserResult optimiseMesh(Mesh& mesh, const OptimiserOptions& options,
   if (mesh.dim != 2 && mesh.dim != 3)
     throw ParameterError("the optimiser needs a 2D or 3D mesh, got dimension " +
                          std::to_string(mesh.dim));
-  OptimiserOptions local = options;
-  local.threads = threadsToUse(options.threads);  // 0: every core, resolved once for the run
+  OptimiserOptions local = withThreadsResolved(options);
   if (!options.spatialOrder)
     return mesh.dim == 3 ? Optimiser<3>(mesh, local, observer, cad, startQuality).run()
                          : Optimiser<2>(mesh, local, observer, cad, startQuality).run();
@@ -387,11 +396,6 @@ class NodeEnergyProbe::Impl {
 };
 
 namespace {
-
-OptimiserOptions withThreadsResolved(OptimiserOptions options) {
-  options.threads = threadsToUse(options.threads);
-  return options;
-}
 
 template <int D>
 class ProbeImpl : public NodeEnergyProbe::Impl {

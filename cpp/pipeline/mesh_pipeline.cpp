@@ -99,10 +99,9 @@ void checkRenumbering(const HealingRecord& healing, const MeshingOptions& option
 // or curve split by the imprint standing for all its pieces.
 void mapToImprintedNumbering(const ImprintRecord& imprint, MeshingOptions& options) {
   if (!imprint.imprinted) return;
-  const std::string operation = kImprintOperation;
   if (options.boundaryLayer)
-    options.boundaryLayer->faces =
-        imprint.numbering.map(2, options.boundaryLayer->faces, "boundary-layer face", operation);
+    options.boundaryLayer->faces = imprint.numbering.map(2, options.boundaryLayer->faces,
+                                                         "boundary-layer face", kImprintOperation);
   if (!options.sizing) return;
   std::vector<RefinementSource> sources;
   for (const RefinementSource& s : options.sizing->sources) {
@@ -110,7 +109,8 @@ void mapToImprintedNumbering(const ImprintRecord& imprint, MeshingOptions& optio
       sources.push_back(s);
       continue;
     }
-    for (const int edge : imprint.numbering.map(1, {s.edge}, "refinement curve", operation)) {
+    for (const int edge :
+         imprint.numbering.map(1, {s.edge}, "refinement curve", kImprintOperation)) {
       RefinementSource piece = s;
       piece.edge = edge;
       sources.push_back(piece);
@@ -454,12 +454,9 @@ Mesh makeFirstLinearMeshAtSizes(MeshResult& result, const MeshingOptions& option
                                 LinearStage& linear) {
   try {
     return linear.make(linear.baseOptions(), true, "linear");
-  } catch (const BudgetExceeded&) {
-    throw;
-  } catch (const OutOfMemory&) {
-    throw;
   } catch (const MeshingError& failure) {
-    if (!result.sizing || !options.sizing || options.sizing->minDelta != 0.0) throw;
+    if (endsTheJob(failure) || !result.sizing || !options.sizing || options.sizing->minDelta != 0.0)
+      throw;
     const SizingParameters used = result.sizing->octree->parameters();
     const double ceiling = kMinDeltaCeiling * used.maxDelta;
     if (!(used.minDelta < ceiling)) throw;
@@ -475,11 +472,8 @@ Mesh makeFirstLinearMeshAtSizes(MeshResult& result, const MeshingOptions& option
       checkBudgetLeft(budget, "linear", result.timings);
       sizeLinearMesh(result, coarser, budget, observer, linear.baseOptions(), "sizing again");
       return linear.make(linear.baseOptions(), true, "linear");
-    } catch (const BudgetExceeded&) {
-      throw;
-    } catch (const OutOfMemory&) {
-      throw;
     } catch (const MeshingError& second) {
+      if (endsTheJob(second)) throw;
       throw MeshingError(std::string(second.what()) + " (with MinDelta " + formatNumber(ceiling) +
                          ", MaxDelta / 20; with " + shape + ": " + failure.what() + ")");
     }
@@ -493,12 +487,8 @@ Mesh makeFirstLinearMesh(MeshResult& result, const MeshingOptions& options, JobB
                          PipelineObserver* observer, LinearStage& linear) {
   try {
     return makeFirstLinearMeshAtSizes(result, options, budget, observer, linear);
-  } catch (const BudgetExceeded&) {
-    throw;
-  } catch (const OutOfMemory&) {
-    throw;
   } catch (const MeshingError& failure) {
-    if (!result.healing.imprint.imprinted) throw;
+    if (endsTheJob(failure) || !result.healing.imprint.imprinted) throw;
     throw MeshingError(std::string(failure.what()) +
                        "; its touching solids were imprinted on each other first: --no-imprint "
                        "(Python imprint=False, FreeCAD Imprint off) meshes them apart");
