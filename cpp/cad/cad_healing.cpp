@@ -7,6 +7,7 @@
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepClass3d_SolidClassifier.hxx>
 #include <BRepGProp.hxx>
+#include <BRepTools_History.hxx>
 #include <BRepTools_ReShape.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
@@ -14,6 +15,7 @@
 #include <GCPnts_AbscissaPoint.hxx>
 #include <GProp_GProps.hxx>
 #include <ShapeAnalysis_CheckSmallFace.hxx>
+#include <ShapeBuild_ReShape.hxx>
 #include <ShapeFix_FixSmallFace.hxx>
 #include <ShapeFix_Shape.hxx>
 #include <ShapeFix_Solid.hxx>
@@ -34,6 +36,7 @@
 #include <set>
 #include <vector>
 
+#include "cad/coincident_faces.hpp"
 #include "cad/model_dimension.hpp"
 #include "cad/occt_access.hpp"
 #include "core/error.hpp"
@@ -51,6 +54,31 @@ int count(const TopoDS_Shape& shape, TopAbs_ShapeEnum type) {
   TopTools_IndexedMapOfShape map;
   TopExp::MapShapes(shape, type, map);
   return map.Extent();
+}
+
+// The numbering's map carried through a healing step that made `after` of `before`, as
+// `history` (the step's context) records it; what the step did, `action`, names what it
+// removed. A sub-shape that a fix rebuilt without recording it is found by its place, to the
+// length of the edges healing merges away.
+void trace(HealingRecord& record, const TopoDS_Shape& before, const TopoDS_Shape& after,
+           const Handle(BRepTools_History) & history, const std::string& action) {
+  const BRepTools_History none;
+  record.numbering = record.numbering.then(NumberingMap::fromHistory(
+      before, after, history.IsNull() ? none : *history, "healing (" + action + ")",
+      kSmallEdge / kTolerance * record.tolerance));
+}
+
+// Whether healing gave a face or edge it kept another number (those it removed do not count:
+// faces left out after the solids' leave their numbers as they were).
+bool renumbered(const NumberingMap& numbering) {
+  for (const int dim : {1, 2})
+    for (const auto& [from, to] : numbering.changes(dim))
+      if (!to.empty()) return true;
+  return false;
+}
+
+Handle(BRepTools_History) historyOf(const Handle(BRepTools_ReShape) & context) {
+  return context.IsNull() ? Handle(BRepTools_History)() : context->History();
 }
 
 bool bounding(TopAbs_Orientation o) {
@@ -111,6 +139,7 @@ TopoDS_Shape sewSurface(const TopoDS_Shape& shape, double tolerance, HealingReco
   record.actions.push_back("sewed the faces (tolerance " + formatNumber(tolerance) +
                            ") for the surface mesh: " + std::to_string(before) + " -> " +
                            std::to_string(after) + " edges bounding one face");
+  trace(record, shape, sewn, historyOf(sewing.GetContext()), record.actions.back());
   return sewn;
 }
 
@@ -128,31 +157,6 @@ bool hasNoVolume(const TopoDS_Shape& solid, double diagonal, double& volume) {
   BRepGProp::SurfaceProperties(solid, props);
   volume = volumeOf(solid);
   return volume < std::abs(props.Mass()) * kTolerance * diagonal;
-}
-
-// Whether `after` numbers its faces and edges as `before` does: the same counts (with
-// `fewer`, the same or fewer: faces and edges left out at the end keep the others' numbers),
-// and the i-th face (edge) of each has the same centre of mass within `tolerance`.
-bool sameNumbering(const TopoDS_Shape& before, const TopoDS_Shape& after, double tolerance,
-                   bool fewer = false) {
-  for (const TopAbs_ShapeEnum type : {TopAbs_FACE, TopAbs_EDGE}) {
-    TopTools_IndexedMapOfShape a, b;
-    TopExp::MapShapes(before, type, a);
-    TopExp::MapShapes(after, type, b);
-    if (fewer ? b.Extent() > a.Extent() : a.Extent() != b.Extent()) return false;
-    for (int i = 1; i <= b.Extent(); ++i) {
-      GProp_GProps pa, pb;
-      if (type == TopAbs_FACE) {
-        BRepGProp::SurfaceProperties(a(i), pa);
-        BRepGProp::SurfaceProperties(b(i), pb);
-      } else {
-        BRepGProp::LinearProperties(a(i), pa);
-        BRepGProp::LinearProperties(b(i), pb);
-      }
-      if (pa.CentreOfMass().Distance(pb.CentreOfMass()) > tolerance) return false;
-    }
-  }
-  return true;
 }
 
 // The faces of `shape` that no solid of it bounds, as their indices in its face map (1-based,
@@ -213,72 +217,6 @@ std::string boxText(const TopoDS_Shape& shape) {
     return "[" + formatNumber(a) + ", " + formatNumber(b) + "]";
   };
   return "x " + range(x0, x1) + ", y " + range(y0, y1) + ", z " + range(z0, z1);
-}
-
-// Whether two boxes have the same corners, to `tolerance`: the first test of two shapes being
-// one (a copied solid, coincident faces), before their volumes or areas are measured.
-bool sameBox(const Bnd_Box& a, const Bnd_Box& b, double tolerance) {
-  return a.CornerMin().Distance(b.CornerMin()) <= tolerance &&
-         a.CornerMax().Distance(b.CornerMax()) <= tolerance;
-}
-
-// Faces of different solids that lie on each other without being one shared face (the same
-// box, area and centre of mass, to `tolerance`): each solid's mesh gets its own triangles and
-// nodes there, so the mesh does not conform across them. As "Face7 on Face8" (FaceN in the
-// shape's numbering), with the two solids' SolidN. A face in no solid counts as one of solid
-// 0: a pair with solidB 0 is a loose face (faceB) lying on a solid's face (faceA), a copy.
-struct CoincidentFaces {
-  int solidA = 0, solidB = 0, faceA = 0, faceB = 0;
-};
-
-std::vector<CoincidentFaces> coincidentFaces(const TopoDS_Shape& shape, double tolerance) {
-  TopTools_IndexedMapOfShape faces, solids;
-  TopExp::MapShapes(shape, TopAbs_FACE, faces);
-  TopExp::MapShapes(shape, TopAbs_SOLID, solids);
-  std::vector<int> owner(static_cast<std::size_t>(faces.Extent()) + 1, 0);  // 0: none, -1: two
-  for (int s = 1; s <= solids.Extent(); ++s)
-    for (TopExp_Explorer f(solids(s), TopAbs_FACE); f.More(); f.Next()) {
-      int& o = owner[static_cast<std::size_t>(faces.FindIndex(f.Current()))];
-      o = (o == 0 || o == s) ? s : -1;
-    }
-  struct Candidate {
-    int face = 0, solid = 0;
-    Bnd_Box box;
-    std::optional<GProp_GProps> props;  // area and centre, measured once a box matches
-  };
-  std::vector<Candidate> candidates;
-  for (int i = 1; i <= faces.Extent(); ++i) {
-    const int solid = owner[static_cast<std::size_t>(i)];
-    if (solid < 0) continue;
-    Candidate c;
-    c.face = i;
-    c.solid = solid;
-    BRepBndLib::AddOptimal(faces(i), c.box, /*useTriangulation=*/false,
-                           /*useShapeTolerance=*/false);
-    candidates.push_back(c);
-  }
-  const auto props = [&](Candidate& c) -> const GProp_GProps& {
-    if (!c.props) {
-      c.props.emplace();
-      BRepGProp::SurfaceProperties(faces(c.face), *c.props);
-    }
-    return *c.props;
-  };
-  std::vector<CoincidentFaces> found;
-  for (std::size_t a = 0; a < candidates.size(); ++a)
-    for (std::size_t b = a + 1; b < candidates.size(); ++b) {
-      Candidate* p = &candidates[a];
-      Candidate* q = &candidates[b];
-      if (p->solid == q->solid || !sameBox(p->box, q->box, tolerance)) continue;
-      if (p->solid == 0) std::swap(p, q);  // the loose face second
-      const GProp_GProps& pp = props(*p);
-      const GProp_GProps& qp = props(*q);
-      if (std::abs(pp.Mass() - qp.Mass()) > 1e-6 * std::max(pp.Mass(), qp.Mass()) ||
-          pp.CentreOfMass().Distance(qp.CentreOfMass()) > tolerance)
-        continue;
-      found.push_back({p->solid, q->solid, p->face, q->face});
-    }
-  return found;
 }
 
 struct Findings {
@@ -363,14 +301,17 @@ Findings inspect(const TopoDS_Shape& shape, double diagonal, bool planar,
 // when some face ends up in no solid and `keepOpen` is false, or when a new solid lies inside
 // another or in one of `existing` (the model's solids the faces were sewn beside), or
 // duplicates one of those. With `keepOpen`, the shells that do not close (and faces in no
-// shell) come back beside the solids, to be left out and named by healModel.
+// shell) come back beside the solids, to be left out and named by healModel. `history`: what
+// sewing made of `shape`'s faces, edges and vertices.
 std::optional<TopoDS_Shape> sewIntoSolids(const TopoDS_Shape& shape, double tolerance,
                                           double diagonal, bool keepOpen,
-                                          const TopoDS_Shape& existing, HealingRecord& record) {
+                                          const TopoDS_Shape& existing, HealingRecord& record,
+                                          Handle(BRepTools_History) & history) {
   BRepBuilderAPI_Sewing sewing(tolerance);
   sewing.Add(shape);
   sewing.Perform();
   const TopoDS_Shape sewn = sewing.SewedShape();
+  history = historyOf(sewing.GetContext());
   TopoDS_Compound solids, rest;
   BRep_Builder builder;
   builder.MakeCompound(solids);
@@ -482,16 +423,20 @@ TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal, bo
   if (!found.emptySolids.empty()) {
     const Handle(BRepTools_ReShape) reshape = new BRepTools_ReShape;
     for (const TopoDS_Shape& solid : found.emptySolids) reshape->Remove(solid);
+    const TopoDS_Shape before = shape;
     shape = reshape->Apply(shape);
     record.actions.push_back("removed " + std::to_string(found.emptySolids.size()) +
                              (found.emptySolids.size() == 1 ? " empty solid" : " empty solids"));
+    trace(record, before, shape, reshape->History(), record.actions.back());
   }
   const double tolerance = kTolerance * diagonal;
   bool sewn = false;
+  Handle(BRepTools_History) sewing;
+  const TopoDS_Shape unsewn = shape;
   if (found.unsewn || found.openSolid) {
     // An open solid stays refused by name: solids only leaves out faces that were in no solid.
     if (auto solids = sewIntoSolids(shape, 10.0 * tolerance, diagonal, keepOpen && !found.openSolid,
-                                    TopoDS_Shape(), record)) {
+                                    TopoDS_Shape(), record, sewing)) {
       shape = *solids;
       sewn = true;
     }
@@ -499,7 +444,7 @@ TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal, bo
     // The solids stay as they are; the faces beside them are sewn alone.
     const TopoDS_Shape solids = solidsOf(shape);
     if (auto more = sewIntoSolids(facesInNoSolid(shape).faces, 10.0 * tolerance, diagonal, keepOpen,
-                                  solids, record)) {
+                                  solids, record, sewing)) {
       TopoDS_Compound both;
       BRep_Builder builder;
       builder.MakeCompound(both);
@@ -509,14 +454,16 @@ TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal, bo
       sewn = true;
     }
   }
+  if (sewn) trace(record, unsewn, shape, sewing, record.actions.back());
   if (found.invalid || sewn) {
     ShapeFix_Shape fix(shape);
     fix.SetPrecision(tolerance);
     fix.SetMaxTolerance(kMaxWiden * diagonal);
     if (fix.Perform()) {
-      shape = fix.Shape();
       record.actions.emplace_back(
           "fixed wires, edges, tolerances and orientation (ShapeFix_Shape)");
+      trace(record, shape, fix.Shape(), historyOf(fix.Context()), record.actions.back());
+      shape = fix.Shape();
     }
   }
   if (found.smallEdges > 0) {
@@ -526,9 +473,10 @@ TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal, bo
     const bool gaps = wires.FixWireGaps();
     const bool small = wires.FixSmallEdges();
     if (gaps || small) {
-      shape = wires.Shape();
       record.actions.push_back("merged edges shorter than " + formatNumber(kSmallEdge * diagonal) +
                                " and closed wire gaps");
+      trace(record, shape, wires.Shape(), historyOf(wires.Context()), record.actions.back());
+      shape = wires.Shape();
     }
   }
   if (found.smallFaces > 0) {
@@ -542,6 +490,7 @@ TopoDS_Shape heal(TopoDS_Shape shape, const Findings& found, double diagonal, bo
       record.actions.push_back(
           "removed " + std::to_string(count(shape, TopAbs_FACE) - count(fixed, TopAbs_FACE)) +
           " tiny or sliver faces");
+      trace(record, shape, fixed, historyOf(faces.Context()), record.actions.back());
       shape = fixed;
     }
   }
@@ -659,7 +608,6 @@ void healFindings(CadModel& cad, const Findings& found, double diagonal, bool so
     return heal(occtShape(cad), found, diagonal, solidsOnly, record);
   });
   if (!record.changed()) return;
-  record.renumbered = !sameNumbering(occtShape(cad), healed, 10.0 * record.tolerance);
   cad = cadModelFromShape(healed, cad.sourceName());
   record.facesAfter = cad.numFaces();
   record.solidsAfter = cad.numSolids();
@@ -684,8 +632,7 @@ void refuseUnmeshableSolids(const CadModel& cad, const TopTools_IndexedMapOfShap
 
 // A model without solids meshed as a surface: its faces sewn (when healing is on) and the
 // surface described in the record.
-CadModel surfaceModel(CadModel cad, const TopoDS_Shape& original, bool enabled,
-                      HealingRecord& record) {
+CadModel surfaceModel(CadModel cad, bool enabled, HealingRecord& record) {
   if (cad.numFaces() == 0)
     throw CadError(cad.sourceName() + " has no face: nothing for a surface mesh");
   if (enabled && cad.numFaces() > 1) {
@@ -695,7 +642,6 @@ CadModel surfaceModel(CadModel cad, const TopoDS_Shape& original, bool enabled,
     });
     if (!sewn.IsSame(shape)) {
       cad = cadModelFromShape(sewn, cad.sourceName());
-      record.renumbered = !sameNumbering(original, sewn, 10.0 * record.tolerance);
       record.facesAfter = cad.numFaces();
     }
   }
@@ -749,16 +695,27 @@ std::vector<int> copiedFaces(const CadModel& cad, const LooseFaces& loose, doubl
 
 // Faces beside the solids would not be meshed: refused, or (solidsOnly, or copies of the
 // solids' faces) left out and recorded.
-void leaveOutLooseFaces(CadModel& cad, const LooseFaces& loose, const TopoDS_Shape& original,
+void leaveOutLooseFaces(CadModel& cad, const LooseFaces& loose,
                         const TopTools_IndexedMapOfShape& edges, const HealingOptions& options,
                         HealingRecord& record) {
   const TopoDS_Shape kept = solidsOf(occtShape(cad));
   const bool one = loose.indices.size() == 1;
-  // Face and edge names only while they are the file's own (healing changed nothing).
   const bool ownNumbers = !record.changed();
-  const int edge = ownNumbers ? firstFreeEdge(loose.faces, edges) : 0;
+  // Faces and edges named by the file's numbers (healing's map back), when each is one of the
+  // file's.
+  const auto fileNumber = [&](int dim, int index) {
+    const std::vector<int> originals = record.numbering.originals(dim, index);
+    return originals.size() == 1 ? originals.front() : 0;
+  };
+  std::vector<int> named;
+  for (const int face : loose.indices)
+    if (const int n = fileNumber(2, face); n > 0) named.push_back(n);
+  std::sort(named.begin(), named.end());
+  if (named.size() != loose.indices.size()) named.clear();
+  const int free = firstFreeEdge(loose.faces, edges);
+  const int edge = free == 0 ? 0 : fileNumber(1, free);
   const std::string which = std::to_string(loose.indices.size()) + (one ? " face" : " faces") +
-                            (ownNumbers ? " (" + faceNames(loose.indices) + ")" : std::string()) +
+                            (named.empty() ? std::string() : " (" + faceNames(named) + ")") +
                             " in no solid, within " + boxText(loose.faces);
   const std::string what =
       which + (edge != 0 ? (one ? ": it does not close (" : ": they do not close (") +
@@ -783,9 +740,18 @@ void leaveOutLooseFaces(CadModel& cad, const LooseFaces& loose, const TopoDS_Sha
                      " of the solids; nothing of the model is lost";
     record.leftOutCopies = true;
   }
+  // The faces left out, and their edges and vertices the solids do not have, are removed.
+  BRepTools_History history;
+  for (const TopAbs_ShapeEnum type : {TopAbs_FACE, TopAbs_EDGE, TopAbs_VERTEX}) {
+    TopTools_IndexedMapOfShape inSolids, inLoose;
+    TopExp::MapShapes(kept, type, inSolids);
+    TopExp::MapShapes(loose.faces, type, inLoose);
+    for (int i = 1; i <= inLoose.Extent(); ++i)
+      if (!inSolids.Contains(inLoose(i))) history.Remove(inLoose(i));
+  }
+  record.numbering = record.numbering.then(NumberingMap::fromHistory(
+      occtShape(cad), kept, history, "leaving out the faces in no solid (" + which + ")"));
   cad = cadModelFromShape(kept, cad.sourceName());
-  record.renumbered =
-      !sameNumbering(original, occtShape(cad), 10.0 * record.tolerance, /*fewer=*/true);
   record.facesAfter = cad.numFaces();
   record.solidsAfter = cad.numSolids();
 }
@@ -843,6 +809,7 @@ CadModel healAs(CadModel cad, const HealingOptions& options, HealingRecord& reco
   record.tolerance = kTolerance * diagonal;
   record.facesBefore = record.facesAfter = cad.numFaces();
   record.solidsBefore = record.solidsAfter = cad.numSolids();
+  record.numbering = NumberingMap::identity(original);
   // (Solids without a face are removed below: they do not count.)
   const int withFaces = solidsWithFaces(cad);
   if (options.surface && withFaces > 0)
@@ -866,14 +833,17 @@ CadModel healAs(CadModel cad, const HealingOptions& options, HealingRecord& reco
               : "; healing is off (it may close it)";
   refuseUnmeshableSolids(cad, solids, edges, diagonal, healingNote);
   if (solids.Extent() == 0 && faces && !planar) {
-    cad = surfaceModel(std::move(cad), original, enabled, record);
+    cad = surfaceModel(std::move(cad), enabled, record);
+    record.renumbered = renumbered(record.numbering);
     record.seconds = secondsSince(start);
     return cad;
   }
   if (solids.Extent() == 0 && !planar) refuseNoSolid(cad, edges, healingNote, options, record);
   const LooseFaces loose = solids.Extent() > 0 ? facesInNoSolid(occtShape(cad)) : LooseFaces{};
-  if (!loose.indices.empty()) leaveOutLooseFaces(cad, loose, original, edges, options, record);
+  if (!loose.indices.empty()) leaveOutLooseFaces(cad, loose, edges, options, record);
+  record.renumbered = renumbered(record.numbering);
   if (cad.numSolids() > 1) cad = imprintTouchingSolids(std::move(cad), options, record);
+  if (record.imprint.imprinted) record.numbering = record.numbering.then(record.imprint.numbering);
   record.seconds = secondsSince(start);
   return cad;
 }

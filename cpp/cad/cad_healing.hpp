@@ -15,14 +15,16 @@
 // of the solids are left out and recorded without solidsOnly: nothing is lost.
 //
 // A model with nothing to heal is returned as it is: its FaceN numbering, which boundary layers
-// and boundary groups refer to, is unchanged. Whether a healed model's numbering changed is
-// measured and recorded (HealingRecord::renumbered).
+// and boundary groups refer to, is unchanged. A healed model's numbering is mapped from the
+// original's through each step's history (HealingRecord::numbering, cad/numbering_map.hpp), so
+// that what a user names by number in the file is found in the model meshed.
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "cad/cad_model.hpp"
+#include "cad/numbering_map.hpp"
 #include "cad/solid_imprint.hpp"
 
 namespace homesh {
@@ -80,9 +82,12 @@ struct HealingRecord {
   int facesBefore = 0, facesAfter = 0;
   int solidsBefore = 0, solidsAfter = 0;
   double seconds = 0.0;
-  // The healed model's FaceN and EdgeN differ from the original's (counts, or a face or edge
-  // whose centre of mass moved); a fix of tolerances alone keeps the numbering.
-  bool renumbered = false;  // (by healing's fixes; imprint.numbering maps imprinting's)
+  // The model's numbers (VertexN ... SolidN) as read, to those of the model meshed: through
+  // healing's steps (sewing, fixes, faces left out), then imprinting. Where a step removed a
+  // number, it says which step.
+  NumberingMap numbering;
+  // Healing's steps (imprinting apart: imprint.numbering) numbered the faces or edges afresh.
+  bool renumbered = false;
   bool changed() const { return !actions.empty(); }
   // What a user must read about the model meshed, one line each: the faces left out (solids
   // only, or copies) and the warnings. The pipeline's notes and `homesh predict` print these.

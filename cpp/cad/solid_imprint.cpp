@@ -155,7 +155,7 @@ CadModel imprintSolids(CadModel cad, double tolerance, ImprintRecord& record) {
   builder.MakeCompound(result);
   for (int s = 1; s <= solids.Extent(); ++s)
     builder.Add(result, images[static_cast<std::size_t>(s)]);
-  const NumberingMap numbering = NumberingMap::fromHistory(shape, result, *fuse.History());
+  const NumberingMap numbering = NumberingMap::fromHistory(shape, result, *fuse.History(), kImprintOperation);
   // The solids already shared what they touch (fused before): their numbering stays.
   if (!numbering.changed()) return unchanged();
   record.numbering = numbering;

@@ -70,38 +70,17 @@ SizingParameters resolveSizing(const std::optional<SizingParameters>& requested,
 
 namespace {
 
-// Healing numbers a changed model's faces and edges afresh: a boundary layer's faces or a
-// refinement along a CAD curve, given in the original numbering, could land elsewhere.
-void checkRenumbering(const HealingRecord& healing, const MeshingOptions& options) {
-  if (!healing.renumbered) return;
-  std::string what;
-  if (options.boundaryLayer) what = "the boundary layer";
-  if (options.sizing)
-    for (const RefinementSource& s : options.sizing->sources)
-      if (s.kind == RefinementSource::Kind::Curve)
-        what = "a refinement along CAD curve " + std::to_string(s.edge);
-  if (what.empty()) return;
-  if (healing.actions.empty())  // renumbered by leaving faces out alone
-    throw ParameterError(
-        "leaving out the faces in no solid (--solids-only, or --auto's choice of it) numbered "
-        "the CAD's faces and edges afresh, and " +
-        what +
-        " is given in the original numbering: make a solid of those faces, or "
-        "remove them, in the CAD file");
-  throw ParameterError("healing changed the CAD (" + healing.actions.front() +
-                       ") and the numbering of its faces and edges, and " + what +
-                       " is given in the original numbering: repair the CAD file, or mesh "
-                       "without healing (--no-heal, heal=False, Heal off)");
-}
-
-// Imprinting numbers the model's faces and edges afresh: what the options name by number (a
-// boundary layer's faces, refinement along CAD curves) is mapped from the model as read, a face
-// or curve split by the imprint standing for all its pieces.
-void mapToImprintedNumbering(const ImprintRecord& imprint, MeshingOptions& options) {
-  if (!imprint.imprinted) return;
+// Healing and imprinting number the model's faces and edges afresh: what the options name by
+// number (a boundary layer's faces, refinement along CAD curves) is mapped from the model as
+// read, a face or curve split standing for all its pieces; a number they removed is refused,
+// naming the step that removed it.
+void mapToMeshedNumbering(const HealingRecord& healing, MeshingOptions& options) {
+  const NumberingMap& numbering = healing.numbering;
+  if (!numbering.changed()) return;
+  const char* const operation = "healing";
   if (options.boundaryLayer)
-    options.boundaryLayer->faces = imprint.numbering.map(2, options.boundaryLayer->faces,
-                                                         "boundary-layer face", kImprintOperation);
+    options.boundaryLayer->faces =
+        numbering.map(2, options.boundaryLayer->faces, "boundary-layer face", operation);
   if (!options.sizing) return;
   std::vector<RefinementSource> sources;
   for (const RefinementSource& s : options.sizing->sources) {
@@ -109,8 +88,7 @@ void mapToImprintedNumbering(const ImprintRecord& imprint, MeshingOptions& optio
       sources.push_back(s);
       continue;
     }
-    for (const int edge :
-         imprint.numbering.map(1, {s.edge}, "refinement curve", kImprintOperation)) {
+    for (const int edge : numbering.map(1, {s.edge}, "refinement curve", operation)) {
       RefinementSource piece = s;
       piece.edge = edge;
       sources.push_back(piece);
@@ -125,9 +103,8 @@ SizingResult runSizingStage(const CadSource& source, const MeshingOptions& given
   given.healing().validate();  // before the (possibly slow) CAD import
   HealingRecord healing;
   const CadModel cad = healModel(source.load(), given.healing(), healing);
-  checkRenumbering(healing, given);
   MeshingOptions options = given;
-  mapToImprintedNumbering(healing.imprint, options);
+  mapToMeshedNumbering(healing, options);
   checkMeshDimension(cad, options.expectedDimension);
   SizingResult result = runSizing(cad, resolveSizing(options.sizing, cad), options.threads);
   result.healing = std::move(healing);
@@ -243,8 +220,7 @@ void fitOptionsToModel(MeshResult& result, MeshingOptions& options) {
   if (options.boundaryLayer && isSurfaceModel(cad))  // (automatic mode's choice)
     throw ParameterError("a boundary layer needs a volume or planar mesh, and " + cad.sourceName() +
                          " has no solid: automatic mode (--auto) gives it a surface mesh");
-  checkRenumbering(result.healing, options);
-  mapToImprintedNumbering(result.healing.imprint, options);
+  mapToMeshedNumbering(result.healing, options);
   checkMeshDimension(cad, options.expectedDimension);
   if (!options.size) options.sizing = resolveSizing(options.sizing, cad);
   if (isSurfaceModel(cad) && options.optimiseIterations > 0) {
@@ -578,11 +554,11 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
 }
 
 WriteOptions inMeshedNumbering(WriteOptions options, const StageRecords& records, int meshDim) {
-  const ImprintRecord& imprint = records.healing.imprint;
-  if (!imprint.imprinted) return options;
+  const NumberingMap& numbering = records.healing.numbering;
+  if (!numbering.changed()) return options;
   for (NamedGroup& g : options.groups)
-    g.entities = imprint.numbering.map(
-        meshDim - 1, g.entities, "boundary group '" + g.name + "': entity", kImprintOperation);
+    g.entities = numbering.map(meshDim - 1, g.entities, "boundary group '" + g.name + "': entity",
+                               "healing");
   return options;
 }
 

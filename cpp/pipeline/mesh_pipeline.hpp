@@ -165,9 +165,9 @@ inline constexpr std::array<const char*, 7> kCurveOptionKeys = {
     "fidelity_weight", "job_seconds", "classify_tolerance"};
 
 // `options` with its named groups' entities, given in the model's numbering as it was read,
-// mapped to the meshed model's: imprinting touching solids numbers faces and edges afresh
-// (HealingRecord::imprint). Throws ParameterError naming a group's entity that imprinting
-// removed or the model does not have.
+// mapped to the meshed model's: healing and imprinting touching solids number faces and edges
+// afresh (HealingRecord::numbering). Throws ParameterError naming a group's entity that healing
+// or imprinting removed (and which step), or the model does not have.
 WriteOptions inMeshedNumbering(WriteOptions options, const StageRecords& records, int meshDim);
 
 // writeMeshFiles as the pipeline's last stage: records its "output" timing in the result; the

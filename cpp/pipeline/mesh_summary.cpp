@@ -118,8 +118,11 @@ std::vector<std::string> meshSummaryLines(const CurvedMesh& curved, const StageR
   for (const std::string& action : records.healing.actions)
     lines.push_back("healed the CAD: " + action);
   if (records.healing.renumbered)
-    lines.push_back(formatted("note: face numbers are the healed model's (%d faces, were %d)",
-                              records.healing.facesAfter, records.healing.facesBefore));
+    lines.push_back(formatted(
+        "note: healing numbered the faces and edges afresh (%d faces, were %d): numbers given "
+        "(boundary-layer faces, groups, refinement curves) are the file's, mapped; the mesh's "
+        "FaceN are the healed model's (the report's healing.numbering maps them)",
+        records.healing.facesAfter, records.healing.facesBefore));
   if (const ImprintRecord& imprint = records.healing.imprint; imprint.imprinted)
     lines.push_back(imprintLine(imprint));
   for (const std::string& note : records.notes) lines.push_back("note: " + note);

@@ -11,6 +11,26 @@
 namespace homesh {
 namespace {
 
+// `key`: every number of `numbering` that changed, original -> final numbers, per kind of
+// sub-shape ({"faces": [{"from": 8, "to": [1]}, ...], ...}); none when `changed` is false.
+void appendNumbering(JsonWriter& json, const char* key, const NumberingMap& numbering,
+                     bool changed) {
+  json.beginObject(key);
+  static const char* kinds[] = {"vertices", "edges", "faces", "solids"};
+  for (int dim = 0; dim < 4; ++dim) {
+    json.beginArray(kinds[dim]);
+    if (changed)
+      for (const auto& [from, to] : numbering.changes(dim)) {
+        json.beginObject();
+        json.value("from", from);
+        json.numbers("to", std::vector<std::size_t>(to.begin(), to.end()));
+        json.endObject();
+      }
+    json.endArray();
+  }
+  json.endObject();
+}
+
 // "imprint" (inside "healing"): whether touching solids were imprinted on each other, the
 // faces two solids now share (final FaceN, their SolidN) and every number that changed,
 // original -> final, per kind of sub-shape (none when the model was not imprinted).
@@ -31,20 +51,7 @@ void appendImprint(JsonWriter& json, const ImprintRecord& r) {
     json.endObject();
   }
   json.endArray();
-  json.beginObject("renumbered");
-  static const char* kinds[] = {"vertices", "edges", "faces", "solids"};
-  for (int dim = 0; dim < 4; ++dim) {
-    json.beginArray(kinds[dim]);
-    if (r.imprinted)
-      for (const auto& [from, to] : r.numbering.changes(dim)) {
-        json.beginObject();
-        json.value("from", from);
-        json.numbers("to", std::vector<std::size_t>(to.begin(), to.end()));
-        json.endObject();
-      }
-    json.endArray();
-  }
-  json.endObject();
+  appendNumbering(json, "renumbered", r.numbering, r.imprinted);
   json.value("seconds", r.seconds);
   json.endObject();
 }
@@ -63,8 +70,12 @@ void appendHealing(JsonWriter& json, const HealingRecord& h) {
   json.value("surface", h.surface);
   // Automatic mode's choice (--auto), in words; empty: not asked for, or nothing to choose.
   json.value("automatic", h.automatic);
-  // Face numbers (boundary layers, groups) are the healed model's when it was renumbered.
+  // Whether healing's steps (imprinting apart) numbered the faces or edges afresh.
   json.value("renumbered", h.renumbered);
+  // The file's numbers to the meshed model's, through healing and imprinting: how the numbers
+  // given (boundary-layer faces, groups, refinement curves) were mapped, and what the mesh's
+  // FaceN groups were in the file.
+  appendNumbering(json, "numbering", h.numbering, h.numbering.changed());
   json.value("faces_before", h.facesBefore);
   json.value("faces_after", h.facesAfter);
   json.value("solids_before", h.solidsBefore);

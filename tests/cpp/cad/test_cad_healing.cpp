@@ -7,16 +7,25 @@
 #include <BRepAlgoAPI_BuilderAlgo.hxx>
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepBuilderAPI_Copy.hxx>
+#include <BRepGProp.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRep_Builder.hxx>
+#include <GProp_GProps.hxx>
+#include <TopExp.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopLoc_Location.hxx>
+#include <TopTools_IndexedDataMapOfShapeListOfShape.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
 #include <TopoDS_Shell.hxx>
 #include <TopoDS_Solid.hxx>
+#include <gp.hxx>
+#include <gp_Ax2.hxx>
 #include <gp_Trsf.hxx>
 #include <string>
+#include <vector>
 
 #include "cad/cad_healing.hpp"
 #include "cad/occt_access.hpp"
@@ -86,6 +95,64 @@ TEST(CadHealing, FacesThatCloseAreSewnIntoASolid) {
   EXPECT_EQ(cad.numFaces(), 6);
   ASSERT_FALSE(record.actions.empty());
   EXPECT_NE(record.actions[0].find("sewed"), std::string::npos);
+}
+
+gp_Pnt centreOf(const TopoDS_Shape& shape, TopAbs_ShapeEnum type) {
+  GProp_GProps props;
+  if (type == TopAbs_FACE)
+    BRepGProp::SurfaceProperties(shape, props);
+  else
+    BRepGProp::LinearProperties(shape, props);
+  return props.CentreOfMass();
+}
+
+// A block with a round hole, its faces each copied on its own (no edge shared, as a STEP of
+// loose faces reads back) and listed last first: sewing makes a solid of them and numbers the
+// faces and edges afresh. The healing record maps each of the file's numbers to the one face
+// or edge made of it, at the same place; the two copies of an edge to the same edge.
+TEST(CadHealing, SewingNumbersAfreshAndTheRecordMapsTheFilesNumbers) {
+  const TopoDS_Shape block = BRepAlgoAPI_Cut(
+      BRepPrimAPI_MakeBox(4.0, 2.0, 2.0).Shape(),
+      BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(1.5, 1.0, 0.0), gp::DZ()), 0.4, 2.0).Shape());
+  std::vector<TopoDS_Shape> faces;
+  for (TopExp_Explorer f(block, TopAbs_FACE); f.More(); f.Next())
+    faces.push_back(BRepBuilderAPI_Copy(f.Current()).Shape());
+  TopoDS_Compound file;
+  BRep_Builder b;
+  b.MakeCompound(file);
+  for (auto f = faces.rbegin(); f != faces.rend(); ++f) b.Add(file, *f);
+  HealingRecord record;
+  const CadModel cad = healModel(cadModelFromShape(file, "faces"), {}, record);
+  ASSERT_EQ(cad.numSolids(), 1);
+  EXPECT_TRUE(record.renumbered);
+  const NumberingMap& map = record.numbering;
+  EXPECT_TRUE(map.changed(2));
+  for (const TopAbs_ShapeEnum type : {TopAbs_FACE, TopAbs_EDGE}) {
+    const int dim = type == TopAbs_FACE ? 2 : 1;
+    TopTools_IndexedMapOfShape before, after;
+    TopExp::MapShapes(file, type, before);
+    TopExp::MapShapes(occtShape(cad), type, after);
+    ASSERT_EQ(map.originalCount(dim), before.Extent());
+    ASSERT_EQ(map.finalCount(dim), after.Extent());
+    std::vector<int> uses(static_cast<std::size_t>(after.Extent()) + 1, 0);
+    for (int i = 1; i <= before.Extent(); ++i) {
+      const std::vector<int>& finals = map.finalNumbers(dim, i);
+      ASSERT_EQ(finals.size(), 1U) << dim << " " << i;
+      // Sewing moves nothing by more than its tolerance.
+      EXPECT_LT(centreOf(before(i), type).Distance(centreOf(after(finals[0]), type)),
+                10.0 * record.tolerance)
+          << dim << " " << i;
+      ++uses[static_cast<std::size_t>(finals[0])];
+    }
+    // Each face of the solid is one of the file's; each edge as many copies as faces use it
+    // (two, a seam one).
+    TopTools_IndexedDataMapOfShapeListOfShape faceOf;
+    TopExp::MapShapesAndUniqueAncestors(occtShape(cad), type, TopAbs_FACE, faceOf);
+    for (int k = 1; k <= after.Extent(); ++k)
+      EXPECT_EQ(uses[static_cast<std::size_t>(k)],
+                dim == 2 ? 1 : faceOf.FindFromKey(after(k)).Extent())
+          << dim << " " << k;
+  }
 }
 
 // Two closed shells whose bounding boxes nest: one inside the other's material is a void and
@@ -289,7 +356,9 @@ TEST(CadHealing, SolidsOnlyKeepsTheShellsThatCloseAndRecordsTheRest) {
       healModel(cadModelFromShape(c, "some close"), HealingOptions{true, true}, record);
   EXPECT_EQ(cad.numSolids(), 1);
   EXPECT_EQ(cad.numFaces(), 6);
-  EXPECT_NE(record.leftOut.find("5 faces in no solid, within x [5, 6]"), std::string::npos)
+  // Named by the file's numbers, though sewing numbered the faces afresh.
+  EXPECT_NE(record.leftOut.find("5 faces (Face7-Face11) in no solid, within x [5, 6]"),
+            std::string::npos)
       << record.leftOut;
 }
 
@@ -307,7 +376,8 @@ TEST(CadHealing, SolidsOnlySewsWhatClosesBesideSolidsAndLeavesOutTheRest) {
   const CadModel cad = healModel(cadModelFromShape(c, "three"), HealingOptions{true, true}, record);
   EXPECT_EQ(cad.numSolids(), 2);
   EXPECT_EQ(cad.numFaces(), 12);
-  EXPECT_NE(record.leftOut.find("5 faces in no solid, within x [10, 11]"), std::string::npos)
+  EXPECT_NE(record.leftOut.find("5 faces (Face13-Face17) in no solid, within x [10, 11]"),
+            std::string::npos)
       << record.leftOut;
 }
 
@@ -447,6 +517,19 @@ TEST(CadHealing, SolidsOnlyWithoutHealingAndTheNumberingItChanges) {
             std::string::npos)
       << record.leftOut;
   EXPECT_TRUE(record.renumbered);
+  // The solid's faces keep their own through the map; a face left out is refused saying why.
+  EXPECT_EQ(record.numbering.map(2, {7, 12}, "boundary-layer face", "healing"),
+            (std::vector<int>{1, 6}));
+  try {
+    record.numbering.map(2, {8, 3}, "boundary-layer face", "healing");
+    FAIL() << "a face left out was mapped";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("boundary-layer face 3: Face3 was removed by leaving "
+                                          "out the faces in no solid (6 faces",
+                                          0),
+              0U)
+        << e.what();
+  }
 }
 
 // Two boxes side by side, each with its own face at x = 1 (as Gmsh's STEP export writes
