@@ -456,18 +456,53 @@ Mesh makeFirstLinearMeshAtSizes(MeshResult& result, const MeshingOptions& option
   }
 }
 
-// makeFirstLinearMeshAtSizes; where it fails on a model whose touching solids were imprinted,
-// the error says so and how to mesh them apart (Gmsh 4.8 aborts on OpenCASCADE's imprinted
-// Axis_of_bearing.brep, which it meshes with the solids apart).
-Mesh makeFirstLinearMesh(MeshResult& result, const MeshingOptions& options, JobBudget& budget,
-                         PipelineObserver* observer, LinearStage& linear) {
+// The front of the pipeline: the CAD loaded and healed, the options fitted to it, the sizes and
+// the first linear mesh (`firstStart`: the budget's clock when that mesh was started).
+// `linear` is made for `options`, which it refers to.
+Mesh startPipeline(MeshResult& result, const CadSource& source, MeshingOptions& options,
+                   JobBudget& budget, PipelineObserver* observer,
+                   std::optional<LinearStage>& linear, double& firstStart) {
+  loadCad(result, source, options, observer);
+  fitOptionsToModel(result, options);
+  result.options = options;
+  linear.emplace(result, options, budget, observer);
+  sizeLinearMesh(result, options, budget, observer, linear->baseOptions());
+  checkBudgetLeft(budget, "linear", result.timings);
+  firstStart = budget.elapsed();
+  return makeFirstLinearMeshAtSizes(result, options, budget, observer, *linear);
+}
+
+// startPipeline; where Gmsh fails on a model whose touching solids were imprinted (4.8 aborts
+// on OpenCASCADE's imprinted Axis_of_bearing.brep, which it meshes with the solids apart), the
+// model is started again without imprinting, `options` then `given` less imprinting, with a
+// note: a mesh that does not conform where the solids touch, said so, rather than none.
+Mesh startWithImprintFallback(MeshResult& result, const CadSource& source,
+                              const MeshingOptions& given, MeshingOptions& options,
+                              JobBudget& budget, PipelineObserver* observer,
+                              std::optional<LinearStage>& linear, double& firstStart) {
   try {
-    return makeFirstLinearMeshAtSizes(result, options, budget, observer, linear);
+    return startPipeline(result, source, options, budget, observer, linear, firstStart);
   } catch (const MeshingError& failure) {
     if (endsTheJob(failure) || !result.healing.imprint.imprinted) throw;
-    throw MeshingError(std::string(failure.what()) +
-                       "; its touching solids were imprinted on each other first: --no-imprint "
-                       "(Python imprint=False, FreeCAD Imprint off) meshes them apart");
+    const std::string imprinted = failure.what();
+    linear.reset();
+    StageTimings timings = std::move(result.timings);  // (the time spent counts)
+    result = MeshResult{};
+    result.timings = std::move(timings);
+    options = given;
+    options.imprint = false;
+    try {
+      Mesh mesh = startPipeline(result, source, options, budget, observer, linear, firstStart);
+      result.notes.push_back(
+          "Gmsh could not mesh the model with its touching solids imprinted on each other (" +
+          imprinted +
+          "), so they were meshed apart: the mesh does not conform where they touch");
+      return mesh;
+    } catch (const MeshingError& second) {
+      if (endsTheJob(second)) throw;
+      throw MeshingError(std::string(second.what()) + " (meshed with the touching solids apart; " +
+                         "with them imprinted: " + imprinted + ")");
+    }
   }
 }
 
@@ -476,17 +511,14 @@ Mesh makeFirstLinearMesh(MeshResult& result, const MeshingOptions& options, JobB
 MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
                            PipelineObserver* observer) {
   options.validate();  // before the (possibly slow) CAD import
+  const MeshingOptions given = options;
   MeshResult result;
   JobBudget budget(options.jobSeconds);  // its clock starts here
-  loadCad(result, source, options, observer);
-  fitOptionsToModel(result, options);
-  result.options = options;
-
-  LinearStage linear(result, options, budget, observer);
-  sizeLinearMesh(result, options, budget, observer, linear.baseOptions());
-  checkBudgetLeft(budget, "linear", result.timings);
-  const double firstStart = budget.elapsed();
-  Mesh linearMesh = makeFirstLinearMesh(result, options, budget, observer, linear);
+  std::optional<LinearStage> stage;
+  double firstStart = 0.0;
+  Mesh linearMesh = startWithImprintFallback(result, source, given, options, budget, observer,
+                                             stage, firstStart);
+  LinearStage& linear = *stage;
 
   CurvedState first = curve(std::move(linearMesh), options, *result.cad, result.timings, observer,
                             true, budget, "");

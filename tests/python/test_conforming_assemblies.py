@@ -8,6 +8,7 @@ are mapped; solids that overlap, or imprinting turned off, are meshed apart with
 
 import collections
 import json
+import os
 import re
 import subprocess
 import xml.etree.ElementTree as ET
@@ -167,3 +168,26 @@ def test_overlapping_solids_and_imprinting_off_are_meshed_apart_with_a_warning(
     m = meshio.read(msh)
     at_one = m.points[np.abs(m.points[:, 0] - 1.0) < 1e-12]
     assert len(np.unique(np.round(at_one, 9), axis=0)) < len(at_one)  # each side its own nodes
+
+
+# OpenCASCADE's sample data (Debian package occt-misc, installed by scripts/install-deps.sh):
+# Gmsh 4.8 aborts on this bearing axis with its touching solids imprinted, with every surface
+# algorithm and at both MinDeltas, and meshes it with them apart.
+BEARING = "/usr/share/opencascade/data/occ/Axis_of_bearing.brep"
+
+
+def test_a_model_gmsh_cannot_mesh_imprinted_is_meshed_with_the_solids_apart(homesh_bin,
+                                                                            tmp_path):
+    assert os.path.isfile(BEARING), "occt-misc is not installed (scripts/install-deps.sh)"
+    r, msh, _, report = mesh(homesh_bin, BEARING, tmp_path, "--order", "2")
+    assert r.returncode == 0, r.stderr  # certified valid, not an error
+    assert re.search(r"note: Gmsh could not mesh the model with its touching solids imprinted "
+                     r"on each other \(.*crashed.*\), so they were meshed apart: the mesh does "
+                     r"not conform where they touch", r.stderr), r.stderr
+    # The report is of the model meshed: healed again, not imprinted.
+    imprint = report["healing"]["imprint"]
+    assert not imprint["enabled"] and not imprint["imprinted"], imprint
+    m = meshio.read(msh)
+    solids = {int(t) for c, tags in zip(m.cells, m.cell_data["gmsh:geometrical"])
+              if c.type.startswith("tetra") for t in np.unique(tags)}
+    assert len(solids) == report["cad"]["solids"] > 1, (solids, report["cad"])
