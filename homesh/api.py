@@ -204,6 +204,11 @@ class HighOrderMesh:
         for i, (_, _, conn, ent) in enumerate(self._blocks):
             arrays["block%d_elements" % i] = conn
             arrays["block%d_entity" % i] = ent
+        # The CAD file's numbers to the meshed model's, where healing or imprinting changed
+        # them: write(groups=...) of the loaded mesh maps the file's numbers as this one does.
+        numbering = self._core.numbering_text()
+        if numbering:
+            arrays["numbering"] = np.array([numbering])
         try:
             with open(path, "wb") as f:
                 np.savez_compressed(f, **arrays)
@@ -252,7 +257,8 @@ def load(path):
             core = _core.mesh_from_arrays(
                 int(data["dim"][0]), int(data["order"][0]), data["nodes"],
                 data["node_cad_dim"], data["node_cad_index"], data["node_cad_params"],
-                blocks, tuple(float(x) for x in data["plane_normal"]))
+                blocks, tuple(float(x) for x in data["plane_normal"]),
+                str(data["numbering"][0]) if "numbering" in data.files else "")
     except HOMeshError:
         raise
     except (KeyError, ValueError, TypeError, OSError, zipfile.BadZipFile) as e:

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include "cad/cad_model.hpp"
 #include "core/error.hpp"
@@ -182,6 +183,54 @@ NumberingMap NumberingMap::then(const NumberingMap& next) const {
             next.removedBy_[dim][static_cast<std::size_t>(images_[dim][i].front() - 1)];
     }
     m.finalCount_[dim] = next.finalCount_[dim];
+  }
+  return m;
+}
+
+std::string NumberingMap::toText() const {
+  std::ostringstream out;
+  for (std::size_t dim = 0; dim < 4; ++dim) {
+    out << dim << ' ' << images_[dim].size() << ' ' << finalCount_[dim] << '\n';
+    for (std::size_t i = 0; i < images_[dim].size(); ++i) {
+      for (std::size_t k = 0; k < images_[dim][i].size(); ++k)
+        out << (k == 0 ? "" : " ") << images_[dim][i][k];
+      out << '|' << removedBy_[dim][i] << '\n';
+    }
+  }
+  return out.str();
+}
+
+NumberingMap NumberingMap::fromText(const std::string& text) {
+  NumberingMap m;
+  std::istringstream in(text);
+  std::string line;
+  int lineNumber = 0;
+  const auto fail = [&](const std::string& why) {
+    throw ParameterError("numbering map: line " + std::to_string(lineNumber) + ": " + why);
+  };
+  for (std::size_t dim = 0; dim < 4; ++dim) {
+    ++lineNumber;
+    std::size_t d = 0, originals = 0;
+    int finals = -1;
+    if (!std::getline(in, line) || !(std::istringstream(line) >> d >> originals >> finals) ||
+        d != dim || finals < 0)
+      fail("expected \"" + std::to_string(dim) + " ORIGINAL FINAL\"");
+    m.finalCount_[dim] = finals;
+    for (std::size_t i = 0; i < originals; ++i) {
+      ++lineNumber;
+      if (!std::getline(in, line)) fail("the map ends early");
+      const std::size_t bar = line.find('|');
+      if (bar == std::string::npos) fail("no '|'");
+      std::istringstream numbers(line.substr(0, bar));
+      std::vector<int> images;
+      for (int k = 0; numbers >> k;) {
+        if (k < 1 || k > finals) fail(std::to_string(k) + " is not a final number");
+        images.push_back(k);
+      }
+      if (!numbers.eof()) fail("not a number");
+      m.images_[dim].push_back(std::move(images));
+      m.removedBy_[dim].push_back(line.substr(bar + 1));
+    }
   }
   return m;
 }

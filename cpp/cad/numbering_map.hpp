@@ -43,6 +43,13 @@ class NumberingMap {
   // number to `next`'s images of its images; a number removed says by which of the two.
   NumberingMap then(const NumberingMap& next) const;
 
+  // The map as text, to keep it beside a mesh saved without its CAD (homesh's .npz): a line
+  // "D ORIGINAL FINAL" per dimension, then one line per original number, its final numbers
+  // separated by spaces, "|" and what removed it (empty for one kept). fromText reads it back;
+  // throws ParameterError naming the line of text that is not so.
+  std::string toText() const;
+  static NumberingMap fromText(const std::string& text);
+
   // Whether any number maps to anything but itself alone (counts differ, or a number moved);
   // of dimension `dim` alone.
   bool changed() const;

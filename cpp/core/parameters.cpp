@@ -97,8 +97,9 @@ std::vector<ParameterDefinition> meshAndCadRows() {
        "the faces where they touch and one mesh conforms across them, each solid its own volume "
        "group; the faces are numbered afresh, and numbers given in the shape's own numbering "
        "(boundary-layer faces, refinement curves, groups) are mapped (the report's "
-       "healing.imprint lists the interfaces and the numbers that changed); done with or "
-       "without healing; off: each solid is meshed with its own nodes where they touch"},
+       "healing.imprint lists the interfaces, healing.numbering the numbers that changed); "
+       "done with or without healing; off: each solid is meshed with its own nodes where they "
+       "touch"},
   };
 }
 

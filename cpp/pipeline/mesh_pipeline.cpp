@@ -495,8 +495,7 @@ Mesh startWithImprintFallback(MeshResult& result, const CadSource& source,
       Mesh mesh = startPipeline(result, source, options, budget, observer, linear, firstStart);
       result.notes.push_back(
           "Gmsh could not mesh the model with its touching solids imprinted on each other (" +
-          imprinted +
-          "), so they were meshed apart: the mesh does not conform where they touch");
+          imprinted + "), so they were meshed apart: the mesh does not conform where they touch");
       return mesh;
     } catch (const MeshingError& second) {
       if (endsTheJob(second)) throw;
@@ -516,8 +515,8 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   JobBudget budget(options.jobSeconds);  // its clock starts here
   std::optional<LinearStage> stage;
   double firstStart = 0.0;
-  Mesh linearMesh = startWithImprintFallback(result, source, given, options, budget, observer,
-                                             stage, firstStart);
+  Mesh linearMesh =
+      startWithImprintFallback(result, source, given, options, budget, observer, stage, firstStart);
   LinearStage& linear = *stage;
 
   CurvedState first = curve(std::move(linearMesh), options, *result.cad, result.timings, observer,

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "cad/numbering_map.hpp"
 #include "core/error.hpp"
 #include "core/parameters.hpp"
 #include "core/version.hpp"
@@ -234,6 +235,12 @@ class PyMesh {
   std::size_t numNodes() const { return curved_->mesh.numNodes(); }
   std::size_t numElements() const { return curved_->mesh.numElements(); }
   bool hasCad() const { return static_cast<bool>(curved_->cad); }
+  // The CAD file's numbers to the meshed model's (HealingRecord::numbering) as text, "" when
+  // they are the same: kept in a saved .npz so that groups stay in the file's numbering.
+  std::string numberingText() const {
+    const NumberingMap& n = records_->healing.numbering;
+    return n.changed() ? n.toText() : std::string();
+  }
 
   np::ndarray nodes() const { return toArray(curved_->mesh.xyz, numNodes(), 3); }
   np::ndarray nodeCadDim() const { return toArray(curved_->mesh.nodeCadDim, numNodes(), 0); }
@@ -713,7 +720,8 @@ PyMesh curveFile(const std::string& path, const bp::object& nodes, const bp::dic
 // blocks: [(type name, order, connectivity, entity), ...] as returned by PyMesh.blocks().
 PyMesh meshFromArrays(int dim, int order, const bp::object& nodes, const bp::object& cadDim,
                       const bp::object& cadIndex, const bp::object& cadParams,
-                      const bp::list& blocks, const bp::tuple& normal) {
+                      const bp::list& blocks, const bp::tuple& normal,
+                      const std::string& numbering) {
   CurvedMesh curved;
   Mesh& mesh = curved.mesh;
   mesh.dim = dim;
@@ -738,6 +746,7 @@ PyMesh meshFromArrays(int dim, int order, const bp::object& nodes, const bp::obj
   curved.quality = evaluateQuality(mesh);
   StageRecords records;
   records.options.order = order;
+  if (!numbering.empty()) records.healing.numbering = NumberingMap::fromText(numbering);
   return {std::move(curved), std::move(records)};
 }
 
@@ -852,6 +861,7 @@ BOOST_PYTHON_MODULE(_core) {
       .def("report_json", &PyMesh::reportJson)
       .def("summary_lines", &PyMesh::summaryLines)
       .def("headline", &PyMesh::headline)
+      .def("numbering_text", &PyMesh::numberingText)
       .def("optimise", &PyMesh::optimise, (bp::arg("options")));
 
   bp::def("mesh_file", &meshFile,
@@ -881,5 +891,5 @@ BOOST_PYTHON_MODULE(_core) {
   bp::def("mesh_from_arrays", &meshFromArrays,
           (bp::arg("dim"), bp::arg("order"), bp::arg("nodes"), bp::arg("node_cad_dim"),
            bp::arg("node_cad_index"), bp::arg("node_cad_params"), bp::arg("blocks"),
-           bp::arg("plane_normal")));
+           bp::arg("plane_normal"), bp::arg("numbering") = std::string()));
 }

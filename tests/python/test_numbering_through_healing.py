@@ -108,3 +108,35 @@ def test_a_face_healing_removed_is_refused_naming_it_and_why(homesh_bin, files, 
     m = meshio.read(out)
     wedges = np.concatenate([c.data for c in m.cells if c.type.startswith("wedge")])
     assert radius(m.points[np.unique(wedges)]).min() > RADIUS - CAD_TOLERANCE
+
+
+def hole_group_on_wall(msh):
+    """The triangles of group 'hole' in the MSH file: how far their nodes are from the hole's
+    wall at most, and how many there are."""
+    m = meshio.read(msh)
+    tag = m.field_data["hole"][0]
+    tris = [c.data for c, tags in zip(m.cells, m.cell_data["gmsh:physical"])
+            if c.type.startswith("triangle") and np.all(tags == tag)]
+    nodes = m.points[np.unique(np.concatenate(tris))]
+    return np.abs(radius(nodes) - RADIUS).max(), sum(len(t) for t in tris)
+
+
+def test_a_saved_mesh_keeps_the_files_numbering_for_its_groups(files, tmp_path):
+    """The Python API's mesh, saved (.npz, as FreeCAD stores a HighOrderMesh object's mesh in
+    its document) and loaded again, maps groups given in the file's numbering as the mesh just
+    made does."""
+    import homesh
+    paths, seen = files
+    hole = seen["plain"]["hole"][0]
+    made = homesh.mesh(paths["plain"], order=2)
+    assert made.report()["healing"]["renumbered"]
+    saved = tmp_path / "m.npz"
+    made.write(saved)
+    for name, mesh in (("made", made), ("loaded", homesh.load(saved))):
+        out = tmp_path / (name + ".msh")
+        mesh.write(out, groups={"hole": [hole]})
+        off, count = hole_group_on_wall(out)
+        assert count > 0 and off < CAD_TOLERANCE, (name, off, count)
+    # A number the file does not have is refused by the loaded mesh too.
+    with pytest.raises(homesh.ParameterError, match="the model has 7 \\(Face1 to Face7\\)"):
+        homesh.load(saved).write(tmp_path / "bad.msh", groups={"hole": [8]})

@@ -186,5 +186,37 @@ TEST(SolidImprint, TheNumberingMapRefusesNumbersItCannotMap) {
   EXPECT_EQ(record.numbering.map(2, {2, 7, 8}, "group", "imprinting").size(), 2U);
 }
 
+// Kept beside a mesh saved without its CAD: the map read back from its text maps every number
+// as the original does, says what removed one, and text that is not a map is refused by line.
+TEST(SolidImprint, TheNumberingMapReadsBackFromItsText) {
+  ImprintRecord record;
+  imprintSolids(compoundOf({box(0, 0, 0), box(1, 0, 0)}, "two boxes"), kTolerance, record);
+  const NumberingMap& map = record.numbering;
+  const NumberingMap back = NumberingMap::fromText(map.toText());
+  EXPECT_EQ(back.toText(), map.toText());
+  for (int dim = 0; dim < 4; ++dim) {
+    ASSERT_EQ(back.originalCount(dim), map.originalCount(dim));
+    EXPECT_EQ(back.finalCount(dim), map.finalCount(dim));
+    for (int i = 1; i <= map.originalCount(dim); ++i)
+      EXPECT_EQ(back.finalNumbers(dim, i), map.finalNumbers(dim, i)) << dim << " " << i;
+  }
+  const NumberingMap removed =
+      NumberingMap::fromText("0 0 0\n1 0 0\n2 2 1\n1|\n|healing (x)\n3 0 0\n");
+  EXPECT_EQ(removed.finalNumbers(2, 1), std::vector<int>{1});
+  EXPECT_EQ(removed.removedBy(2, 2), "healing (x)");
+  for (const auto& [text, why] : std::vector<std::pair<std::string, std::string>>{
+           {"0 0 0\n1 0 0\n2 1 1\n2|\n3 0 0\n", "line 4: 2 is not a final number"},
+           {"0 0 0\n1 0 0\n2 1 1\nx|\n3 0 0\n", "line 4: not a number"},
+           {"0 0 0\n1 0 0\n2 2 1\n1|\n", "line 5: the map ends early"},
+           {"0 0 0\n2 0 0\n", "line 2: expected \"1 ORIGINAL FINAL\""}}) {
+    try {
+      NumberingMap::fromText(text);
+      FAIL() << "read: " << text;
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(std::string(e.what()), "numbering map: " + why);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace homesh
