@@ -789,6 +789,7 @@ CadModel imprintTouchingSolids(CadModel cad, const HealingOptions& options, Heal
   if (record.imprint.imprinted) {
     record.facesAfter = cad.numFaces();
     record.solidsAfter = cad.numSolids();
+    if (!record.imprint.overlap.empty()) record.warnings.push_back(record.imprint.overlap);
     return cad;
   }
   if (!record.imprint.warning.empty())

@@ -8,6 +8,7 @@
 #include <TopTools_DataMapOfShapeInteger.hxx>
 #include <TopTools_IndexedDataMapOfShapeListOfShape.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
+#include <TopTools_ListOfShape.hxx>
 #include <TopoDS_Compound.hxx>
 
 #include <algorithm>
@@ -117,53 +118,69 @@ CadModel imprintSolids(CadModel cad, double tolerance, ImprintRecord& record) {
     return std::move(cad);
   };
   if (!failure.empty()) return notImprinted("the touching solids were not imprinted: " + failure);
-  // A solid the fuse cut into pieces shares volume with another. (A solid that was not an
-  // argument has no history: Modified is empty, its image itself.)
-  std::vector<int> overlapping;
-  std::vector<TopoDS_Shape> images(static_cast<std::size_t>(solids.Extent()) + 1);
+  // Each solid's pieces: itself (a solid that was not an argument has no history), or what the
+  // fuse made of it. Solids that share volume are cut where they overlap, the overlap a piece
+  // of both; a solid and its copy become one piece. A solid the fuse removed leaves nothing.
+  std::vector<TopTools_ListOfShape> pieces(static_cast<std::size_t>(solids.Extent()) + 1);
+  std::vector<int> removed;
   for (int s = 1; s <= solids.Extent(); ++s) {
     const TopTools_ListOfShape& modified = fuse.Modified(solids(s));
-    if (modified.Extent() > 1) overlapping.push_back(s);
-    images[static_cast<std::size_t>(s)] = modified.IsEmpty() ? solids(s) : modified.First();
+    if (fuse.IsDeleted(solids(s))) removed.push_back(s);
+    if (modified.IsEmpty())
+      pieces[static_cast<std::size_t>(s)].Append(solids(s));
+    else
+      pieces[static_cast<std::size_t>(s)] = modified;
   }
-  if (!overlapping.empty())
-    return notImprinted(namesOf(overlapping) +
-                        " share volume with other solids (they overlap, not only touch): the "
-                        "solids were not imprinted");
-  // Each solid must become one solid of its own: a solid the fuse removed, or two that became
-  // one (a copy of a solid), would leave fewer solids than the model has.
-  TopTools_DataMapOfShapeInteger owner;  // image -> the first solid that became it
-  std::set<int> merged;
+  if (!removed.empty())
+    return notImprinted(namesOf(removed) +
+                        ": the fuse removed them: the solids were not imprinted");
+  // The result's solids in the model's order, a piece two solids share listed once.
+  TopTools_DataMapOfShapeInteger firstOwner;  // piece -> the first solid it is a piece of
+  std::vector<TopoDS_Shape> result;
+  std::set<int> cut;  // solids cut into pieces, or sharing one with another
   for (int s = 1; s <= solids.Extent(); ++s) {
-    const TopoDS_Shape& solid = images[static_cast<std::size_t>(s)];
-    if (fuse.IsDeleted(solids(s))) {
-      merged.insert(s);
-    } else if (owner.IsBound(solid)) {
-      merged.insert(owner(solid));
-      merged.insert(s);
-    } else {
-      owner.Bind(solid, s);
+    const TopTools_ListOfShape& mine = pieces[static_cast<std::size_t>(s)];
+    if (mine.Extent() > 1) cut.insert(s);
+    for (const TopoDS_Shape& piece : mine) {
+      if (firstOwner.IsBound(piece)) {
+        cut.insert(firstOwner(piece));
+        cut.insert(s);
+        continue;
+      }
+      firstOwner.Bind(piece, s);
+      result.push_back(piece);
     }
   }
-  if (!merged.empty())
-    return notImprinted(namesOf(std::vector<int>(merged.begin(), merged.end())) +
-                        ": the fuse made one solid of two, or removed one (a solid and its "
-                        "copy?): the solids were not imprinted");
   if (!fuse.HasModified()) return unchanged();  // the boxes met, the solids did not
   BRep_Builder builder;
-  TopoDS_Compound result;
-  builder.MakeCompound(result);
-  for (int s = 1; s <= solids.Extent(); ++s)
-    builder.Add(result, images[static_cast<std::size_t>(s)]);
-  const NumberingMap numbering = NumberingMap::fromHistory(shape, result, *fuse.History(), kImprintOperation);
+  TopoDS_Compound compound;
+  builder.MakeCompound(compound);
+  for (const TopoDS_Shape& piece : result) builder.Add(compound, piece);
+  const NumberingMap numbering =
+      NumberingMap::fromHistory(shape, compound, *fuse.History(), kImprintOperation);
   // The solids already shared what they touch (fused before): their numbering stays.
   if (!numbering.changed()) return unchanged();
   record.numbering = numbering;
-  record.interfaces = interfacesOf(result);
+  record.interfaces = interfacesOf(compound);
   for (int s = 1; s <= solids.Extent(); ++s)
-    if (!images[static_cast<std::size_t>(s)].IsSame(solids(s))) ++record.joined;
+    if (!pieces[static_cast<std::size_t>(s)].First().IsSame(solids(s)) ||
+        pieces[static_cast<std::size_t>(s)].Extent() > 1)
+      ++record.joined;
+  if (!cut.empty()) {
+    std::string into;
+    for (const int s : cut) {
+      const std::vector<int>& finals = numbering.finalNumbers(3, s);
+      into += (into.empty() ? "" : ", ") + cadEntityName(3, s) + " -> ";
+      for (std::size_t k = 0; k < finals.size(); ++k)
+        into += (k == 0 ? "" : " + ") + cadEntityName(3, finals[k]);
+    }
+    record.overlap = namesOf(std::vector<int>(cut.begin(), cut.end())) +
+                     " share volume (they overlap, not only touch): cut where they overlap, "
+                     "each overlap a solid of its own meshed once (" +
+                     into + ")";
+  }
   record.imprinted = true;
-  CadModel imprinted = cadModelFromShape(result, cad.sourceName());
+  CadModel imprinted = cadModelFromShape(compound, cad.sourceName());
   record.seconds = secondsSince(start);
   return imprinted;
 }

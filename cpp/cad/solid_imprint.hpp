@@ -6,10 +6,11 @@
 // faces, edges and vertices are numbered afresh (FreeCAD's numbering of the result), and the
 // record maps each original number to the final ones (the operation's history).
 //
-// Not imprinted, with a warning naming them: solids that share volume (they overlap, not only
-// touch: the fuse would cut them into more solids than the model has), a solid and its copy
-// (the fuse would make them one), and a fuse OCCT fails.
-// Their model is meshed as it is, each solid with its own nodes where they touch.
+// Solids that share volume (they overlap, not only touch) are cut where they overlap: each
+// overlap becomes a solid of its own, meshed once, so that no two elements cover one place; a
+// solid and its copy become one solid. The record says so (overlap) and maps each original
+// solid to its pieces. Not imprinted, with a warning: a fuse OCCT fails, or one that removes a
+// solid; that model is meshed as it is, each solid with its own nodes where they touch.
 #pragma once
 
 #include <string>
@@ -37,6 +38,9 @@ struct ImprintRecord {
   std::vector<SolidInterface> interfaces;
   NumberingMap numbering;  // original numbers to final ones (identity when not imprinted)
   std::string warning;     // why touching solids were not imprinted ("" when they were)
+  // Solids that shared volume and were cut where they overlap, with their pieces' final
+  // numbers, in words ("" when none did).
+  std::string overlap;
   double seconds = 0.0;
 };
 

@@ -95,7 +95,8 @@ std::vector<ParameterDefinition> meshAndCadRows() {
        false, false, "cad",
        "Imprint solids that touch on each other (OpenCASCADE's general fuse), so that they share "
        "the faces where they touch and one mesh conforms across them, each solid its own volume "
-       "group; the faces are numbered afresh, and numbers given in the shape's own numbering "
+       "group (solids that overlap are cut where they do, each overlap a solid of its own); the "
+       "faces are numbered afresh, and numbers given in the shape's own numbering "
        "(boundary-layer faces, refinement curves, groups) are mapped (the report's "
        "healing.imprint lists the interfaces, healing.numbering the numbers that changed); "
        "done with or without healing; off: each solid is meshed with its own nodes where they "

@@ -42,6 +42,7 @@ void appendImprint(JsonWriter& json, const ImprintRecord& r) {
   json.value("joined", r.joined);      // solids the imprint changed
   json.value("imprinted", r.imprinted);
   json.value("warning", r.warning);
+  json.value("overlap", r.overlap);  // solids that shared volume, cut where they overlap
   json.beginArray("interfaces");
   for (const SolidInterface& i : r.interfaces) {
     json.beginObject();

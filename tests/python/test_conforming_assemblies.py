@@ -154,12 +154,31 @@ def test_numbers_in_the_files_own_numbering_are_mapped(homesh_bin, shapes, tmp_p
             in r.stderr), r.stderr
 
 
-def test_overlapping_solids_and_imprinting_off_are_meshed_apart_with_a_warning(
+def test_overlapping_solids_are_cut_and_imprinting_off_meshes_apart_with_a_warning(
         homesh_bin, shapes, tmp_path):
-    r, _, _, report = mesh(homesh_bin, shapes["overlapping_boxes"], tmp_path, "--order", "1")
+    # Two unit boxes overlapping by half: cut where they overlap, the overlap a solid of its own,
+    # so that the tetrahedra fill the union once (volume 1.5, not 2) and conform.
+    r, msh, _, report = mesh(homesh_bin, shapes["overlapping_boxes"], tmp_path, "--order", "1")
     assert r.returncode == 0, r.stderr
-    assert "Solid1 and Solid2 share volume" in r.stderr, r.stderr
-    assert not report["healing"]["imprint"]["imprinted"]
+    assert ("Solid1 and Solid2 share volume (they overlap, not only touch): cut where they "
+            "overlap") in r.stderr, r.stderr
+    imprint = report["healing"]["imprint"]
+    assert imprint["imprinted"] and "Solid1 -> " in imprint["overlap"], imprint
+    m = meshio.read(msh)
+    volume, solids = 0.0, set()
+    for cells, tags in zip(m.cells, m.cell_data["gmsh:geometrical"]):
+        if cells.type == "tetra":
+            p = m.points[cells.data]
+            volume += np.abs(np.einsum("ij,ij->i", p[:, 1] - p[:, 0],
+                                       np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]))).sum() / 6
+            solids |= set(int(t) for t in np.unique(tags))
+    assert solids == {1, 2, 3}, solids
+    assert abs(volume - 1.5) < 1e-9, volume
+    # The solids share their interfaces' triangles: tetrahedra of different solids meet face
+    # to face there, and no face has more than two tetrahedra.
+    faces = tet_faces(m).values()
+    assert any(len(s) == 2 and s[0] != s[1] for s in faces)
+    assert all(len(s) <= 2 for s in faces)
     r, msh, _, report = mesh(homesh_bin, shapes["two_boxes"], tmp_path, "--order", "1",
                              "--no-imprint")
     assert r.returncode == 0, r.stderr

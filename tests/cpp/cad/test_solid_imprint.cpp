@@ -1,7 +1,7 @@
 // Touching solids imprinted on each other (cad/solid_imprint.hpp): the faces where they touch
 // become one face of both, wholly or where they partly overlap; every solid stays a solid; the
-// numbering map takes each original number to the final ones; solids that share volume, or
-// stand apart, are left as they are (the first with a warning naming them).
+// numbering map takes each original number to the final ones; solids that share volume are cut
+// where they overlap; solids that stand apart are left as they are.
 
 #include <gtest/gtest.h>
 
@@ -14,6 +14,9 @@
 #include <GProp_GProps.hxx>
 #include <TopoDS_Compound.hxx>
 #include <gp_Pnt.hxx>
+
+#include <algorithm>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -127,26 +130,40 @@ TEST(SolidImprint, ASphereInItsCavityIsOneFaceOfBoth) {
   EXPECT_EQ(record.numbering.map(1, {13, 14, 15, 16, 17, 18}, "curve", "imprinting").size(), 3U);
 }
 
-// Boxes that overlap by half their width share volume: the fuse would cut them into three
-// solids. Not imprinted; the warning names them.
-TEST(SolidImprint, SolidsThatShareVolumeAreLeftAsTheyAreWithAWarning) {
+// Boxes that overlap by half their width share volume: cut where they overlap, into three
+// solids (each box's own half and the overlap, a solid of both, meshed once), every piece of
+// volume 0.5, and the map gives each box its two pieces. A box and its copy become one solid.
+TEST(SolidImprint, SolidsThatShareVolumeAreCutWhereTheyOverlap) {
   ImprintRecord record;
   const CadModel cad = imprintSolids(
       compoundOf({box(0, 0, 0), box(0.5, 0, 0)}, "overlapping boxes"), kTolerance, record);
-  EXPECT_FALSE(record.imprinted);
-  EXPECT_EQ(cad.numSolids(), 2);
-  EXPECT_EQ(cad.numFaces(), 12);
-  EXPECT_NE(record.warning.find("Solid1 and Solid2 share volume"), std::string::npos)
-      << record.warning;
-  EXPECT_NE(record.warning.find("does not conform"), std::string::npos) << record.warning;
-  EXPECT_FALSE(record.numbering.changed());
-  // A box and its copy: the fuse makes them one solid, which would leave one solid of two.
+  EXPECT_TRUE(record.imprinted);
+  EXPECT_TRUE(record.warning.empty()) << record.warning;
+  ASSERT_EQ(cad.numSolids(), 3);
+  for (int s = 1; s <= 3; ++s) {
+    GProp_GProps props;
+    BRepGProp::VolumeProperties(occtSolid(cad, s), props);
+    EXPECT_NEAR(props.Mass(), 0.5, 1e-9) << "Solid" << s;
+  }
+  const std::vector<int>& one = record.numbering.finalNumbers(3, 1);
+  const std::vector<int>& two = record.numbering.finalNumbers(3, 2);
+  ASSERT_EQ(one.size(), 2U);
+  ASSERT_EQ(two.size(), 2U);
+  std::vector<int> shared;
+  std::set_intersection(one.begin(), one.end(), two.begin(), two.end(), std::back_inserter(shared));
+  ASSERT_EQ(shared.size(), 1U);  // the overlap, x in [0.5, 1]
+  GProp_GProps overlap;
+  BRepGProp::VolumeProperties(occtSolid(cad, shared[0]), overlap);
+  EXPECT_NEAR(overlap.CentreOfMass().X(), 0.75, 1e-9);
+  EXPECT_EQ(record.interfaces.size(), 2U);  // at x = 0.5 and x = 1
+  EXPECT_NE(record.overlap.find("Solid1 and Solid2 share volume"), std::string::npos)
+      << record.overlap;
   ImprintRecord copy;
   const CadModel twice =
       imprintSolids(compoundOf({box(0, 0, 0), box(0, 0, 0)}, "a box twice"), kTolerance, copy);
-  EXPECT_FALSE(copy.imprinted);
-  EXPECT_EQ(twice.numSolids(), 2);
-  EXPECT_NE(copy.warning.find("Solid1 and Solid2"), std::string::npos) << copy.warning;
+  EXPECT_EQ(twice.numSolids(), 1);
+  EXPECT_EQ(copy.numbering.finalNumbers(3, 1), std::vector<int>{1});
+  EXPECT_EQ(copy.numbering.finalNumbers(3, 2), std::vector<int>{1});
 }
 
 // Boxes a gap apart, and a single box: nothing to imprint, nothing to say, numbering as it was.
