@@ -223,11 +223,19 @@ NumberingMap NumberingMap::fromText(const std::string& text) {
       if (bar == std::string::npos) fail("no '|'");
       std::istringstream numbers(line.substr(0, bar));
       std::vector<int> images;
-      for (int k = 0; numbers >> k;) {
-        if (k < 1 || k > finals) fail(std::to_string(k) + " is not a final number");
-        images.push_back(k);
+      for (std::string token; numbers >> token;) {
+        std::size_t used = 0;
+        long k = 0;
+        try {
+          k = std::stol(token, &used);
+        } catch (const std::exception&) {  // (not a number, or out of range)
+          used = 0;
+        }
+        if (used != token.size()) fail("not a number");
+        if (k < 1 || k > finals) fail(token + " is not a final number");
+        if (!images.empty() && k <= images.back()) fail("final numbers not ascending");
+        images.push_back(static_cast<int>(k));
       }
-      if (!numbers.eof()) fail("not a number");
       m.images_[dim].push_back(std::move(images));
       m.removedBy_[dim].push_back(line.substr(bar + 1));
     }

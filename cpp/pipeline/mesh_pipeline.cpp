@@ -71,16 +71,21 @@ SizingParameters resolveSizing(const std::optional<SizingParameters>& requested,
 namespace {
 
 // Healing and imprinting number the model's faces and edges afresh: what the options name by
-// number (a boundary layer's faces, refinement along CAD curves) is mapped from the model as
-// read, a face or curve split standing for all its pieces; a number they removed is refused,
-// naming the step that removed it.
-void mapToMeshedNumbering(const HealingRecord& healing, MeshingOptions& options) {
+// number (a boundary layer's faces, its curves in a 2D model, refinement along CAD curves) is
+// mapped from the model as read (`cad`: the model meshed), a face or curve split standing for
+// all its pieces; a number they removed is refused, naming the step that removed it.
+void mapToMeshedNumbering(const HealingRecord& healing, const CadModel& cad,
+                          MeshingOptions& options) {
   const NumberingMap& numbering = healing.numbering;
   if (!numbering.changed()) return;
   const char* const operation = "healing";
-  if (options.boundaryLayer)
+  if (options.boundaryLayer) {
+    Eigen::Vector3d normal;
+    const bool planar = modelMeshDimension(cad, normal) == 2;
     options.boundaryLayer->faces =
-        numbering.map(2, options.boundaryLayer->faces, "boundary-layer face", operation);
+        numbering.map(planar ? 1 : 2, options.boundaryLayer->faces,
+                      planar ? "boundary-layer curve" : "boundary-layer face", operation);
+  }
   if (!options.sizing) return;
   std::vector<RefinementSource> sources;
   for (const RefinementSource& s : options.sizing->sources) {
@@ -104,7 +109,7 @@ SizingResult runSizingStage(const CadSource& source, const MeshingOptions& given
   HealingRecord healing;
   const CadModel cad = healModel(source.load(), given.healing(), healing);
   MeshingOptions options = given;
-  mapToMeshedNumbering(healing, options);
+  mapToMeshedNumbering(healing, cad, options);
   checkMeshDimension(cad, options.expectedDimension);
   SizingResult result = runSizing(cad, resolveSizing(options.sizing, cad), options.threads);
   result.healing = std::move(healing);
@@ -220,7 +225,7 @@ void fitOptionsToModel(MeshResult& result, MeshingOptions& options) {
   if (options.boundaryLayer && isSurfaceModel(cad))  // (automatic mode's choice)
     throw ParameterError("a boundary layer needs a volume or planar mesh, and " + cad.sourceName() +
                          " has no solid: automatic mode (--auto) gives it a surface mesh");
-  mapToMeshedNumbering(result.healing, options);
+  mapToMeshedNumbering(result.healing, cad, options);
   checkMeshDimension(cad, options.expectedDimension);
   if (!options.size) options.sizing = resolveSizing(options.sizing, cad);
   if (isSurfaceModel(cad) && options.optimiseIterations > 0) {

@@ -31,6 +31,15 @@ for name, path in (("plain", %(plain)r), ("stray", %(stray)r)):
                            if f.Surface.__class__.__name__ == "Cylinder"],
                   "stray": [i + 1 for i, f in enumerate(shape.Faces)
                             if f.BoundBox.XMin > 5.0]}
+# A 2D plate (6 x 4, a round hole of radius 0.5 at the origin) whose right side has a kink
+# 1e-7 long: healing merges that edge away and numbers the curves afresh.
+w = Part.makePolygon([V(-2, -2, 0), V(4, -2, 0), V(4, 2 - 1e-7, 0), V(4, 2, 0), V(-2, 2, 0),
+                      V(-2, -2, 0)])
+Part.Face(w).cut(Part.Face(Part.Wire(Part.makeCircle(0.5)))).exportStep(%(plate)r)
+shape = Part.read(%(plate)r)
+seen["plate"] = {"hole": [i + 1 for i, e in enumerate(shape.Edges)
+                          if e.Curve.__class__.__name__ == "Circle"],
+                 "kink": [i + 1 for i, e in enumerate(shape.Edges) if e.Length < 1e-6]}
 json.dump(seen, open(%(seen)r, "w"))
 """
 
@@ -43,7 +52,7 @@ CAD_TOLERANCE = 1e-6 * np.sqrt(4**2 + 2**2 + 2**2)
 def files(tmp_path_factory):
     folder = tmp_path_factory.mktemp("loose_faces")
     paths = {"plain": str(folder / "holed.step"), "stray": str(folder / "holed_stray.step"),
-             "seen": str(folder / "seen.json")}
+             "plate": str(folder / "plate.step"), "seen": str(folder / "seen.json")}
     subprocess.run(["freecadcmd", "-c", MAKE % paths], check=True, capture_output=True,
                    timeout=300)
     seen = json.load(open(paths["seen"]))
@@ -140,3 +149,29 @@ def test_a_saved_mesh_keeps_the_files_numbering_for_its_groups(files, tmp_path):
     # A number the file does not have is refused by the loaded mesh too.
     with pytest.raises(homesh.ParameterError, match="the model has 7 \\(Face1 to Face7\\)"):
         homesh.load(saved).write(tmp_path / "bad.msh", groups={"hole": [8]})
+
+
+def test_a_2d_layer_follows_the_files_curve_numbers_through_healing(homesh_bin, files,
+                                                                     tmp_path):
+    """In a 2D model the layer is given on curves (EdgeN): mapped as curves."""
+    paths, seen = files
+    hole, kink = seen["plate"]["hole"], seen["plate"]["kink"]
+    assert len(hole) == 1 and len(kink) == 1 and kink[0] < hole[0], seen["plate"]
+    out = tmp_path / "p.msh"
+    r = run([homesh_bin, "mesh", paths["plate"], "--order", "2", "--bl-faces", str(hole[0]),
+             "--bl-thickness", "0.05", "--bl-layers", "3", "-o", out])
+    assert r.returncode == 0, r.stderr
+    assert "healing numbered the faces and edges afresh" in r.stderr, r.stderr
+    m = meshio.read(out)
+    quads = np.concatenate([c.data for c in m.cells if c.type.startswith("quad")])
+    # Every layer node between the hole's wall and the layer's top, to the CAD's tolerance
+    # (1e-6 of the plate's diagonal).
+    tolerance = 1e-6 * np.hypot(6, 4)
+    r_layer = np.hypot(*m.points[np.unique(quads)][:, :2].T)
+    assert r_layer.min() > 0.5 - tolerance, r_layer.min()
+    assert r_layer.max() < 0.55 + tolerance, r_layer.max()
+    r = run([homesh_bin, "mesh", paths["plate"], "--bl-faces", str(kink[0]), "--bl-thickness",
+             "0.05", "-o", tmp_path / "k.msh"])
+    assert r.returncode == 2, r.stderr
+    assert ("boundary-layer curve {0}: Edge{0} was removed by healing (merged edges shorter "
+            "than").format(kink[0]) in r.stderr, r.stderr

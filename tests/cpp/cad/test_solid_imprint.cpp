@@ -225,7 +225,9 @@ TEST(SolidImprint, TheNumberingMapReadsBackFromItsText) {
            {"0 0 0\n1 0 0\n2 1 1\n2|\n3 0 0\n", "line 4: 2 is not a final number"},
            {"0 0 0\n1 0 0\n2 1 1\nx|\n3 0 0\n", "line 4: not a number"},
            {"0 0 0\n1 0 0\n2 2 1\n1|\n", "line 5: the map ends early"},
-           {"0 0 0\n2 0 0\n", "line 2: expected \"1 ORIGINAL FINAL\""}}) {
+           {"0 0 0\n2 0 0\n", "line 2: expected \"1 ORIGINAL FINAL\""},
+           {"0 0 0\n1 0 0\n2 1 2\n2 1|\n3 0 0\n", "line 4: final numbers not ascending"},
+           {"0 0 0\n1 0 0\n2 1 2\n1 99999999999999999999|\n3 0 0\n", "line 4: not a number"}}) {
     try {
       NumberingMap::fromText(text);
       FAIL() << "read: " << text;
