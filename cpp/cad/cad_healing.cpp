@@ -63,9 +63,10 @@ int count(const TopoDS_Shape& shape, TopAbs_ShapeEnum type) {
 void trace(HealingRecord& record, const TopoDS_Shape& before, const TopoDS_Shape& after,
            const Handle(BRepTools_History) & history, const std::string& action) {
   const BRepTools_History none;
-  record.numbering = record.numbering.then(NumberingMap::fromHistory(
-      before, after, history.IsNull() ? none : *history, "healing (" + action + ")",
-      kSmallEdge / kTolerance * record.tolerance));
+  record.numbering = record.numbering.then(
+      NumberingMap::fromHistory(before, after, history.IsNull() ? none : *history,
+                                std::string(kHealingOperation) + " (" + action + ")",
+                                kSmallEdge / kTolerance * record.tolerance));
 }
 
 // Whether healing gave a face or edge it kept another number (those it removed do not count:

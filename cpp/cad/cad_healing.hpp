@@ -29,6 +29,9 @@
 
 namespace homesh {
 
+// How messages name healing where it removed a number (a step's own words follow it).
+inline constexpr const char* kHealingOperation = "healing";
+
 struct HealingOptions {
   bool enabled = true;      // sew and fix what the check finds; false: check only (imprint apart)
   bool solidsOnly = false;  // faces in no solid are left out (recorded) instead of refused

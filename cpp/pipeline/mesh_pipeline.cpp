@@ -78,7 +78,7 @@ void mapToMeshedNumbering(const HealingRecord& healing, const CadModel& cad,
                           MeshingOptions& options) {
   const NumberingMap& numbering = healing.numbering;
   if (!numbering.changed()) return;
-  const char* const operation = "healing";
+  const char* const operation = kHealingOperation;
   if (options.boundaryLayer) {
     Eigen::Vector3d normal;
     const bool planar = modelMeshDimension(cad, normal) == 2;
@@ -594,7 +594,7 @@ WriteOptions inMeshedNumbering(WriteOptions options, const StageRecords& records
   if (!numbering.changed()) return options;
   for (NamedGroup& g : options.groups)
     g.entities = numbering.map(meshDim - 1, g.entities, "boundary group '" + g.name + "': entity",
-                               "healing");
+                               kHealingOperation);
   return options;
 }
 
