@@ -45,7 +45,8 @@ bool writeAll(int fd, const char* data, std::size_t n) {
   return true;
 }
 
-[[noreturn]] void runChild(int fd, pid_t parent, const IsolationLimits& limits,
+// `output`: where the child's stdout and stderr go (the watched pipe), or -1 to keep them.
+[[noreturn]] void runChild(int fd, int output, pid_t parent, const IsolationLimits& limits,
                            const std::function<std::string()>& work) {
   // A crash must end the child with its signal, whatever handlers the caller (FreeCAD) set, and
   // the child must not outlive the thread that waits for it (nor start after it died).
@@ -53,8 +54,10 @@ bool writeAll(int fd, const char* data, std::size_t n) {
     std::signal(sig, SIG_DFL);
   prctl(PR_SET_PDEATHSIG, SIGKILL);
   if (getppid() != parent) _exit(3);
-  // Only stdin, stdout, stderr and the result pipe stay open: the caller's other files, pipes
-  // and sockets (FreeCAD's) must not be held open by a child that may run for minutes.
+  if (output >= 0 && (dup2(output, STDOUT_FILENO) < 0 || dup2(output, STDERR_FILENO) < 0)) _exit(3);
+  // Only stdin, stdout, stderr (the watched pipe, if any) and the result pipe stay open: the
+  // caller's other files, pipes and sockets (FreeCAD's) must not be held open by a child that may
+  // run for minutes.
   if (fd != 3) {
     if (dup2(fd, 3) < 0) _exit(3);
     fd = 3;
@@ -128,31 +131,41 @@ std::string signalName(int sig) {
 
 using Clock = std::chrono::steady_clock;
 
-// A forked child running `work` and the read end of the pipe it answers on. Whatever happens
-// while it runs (an allocation failing, a cancel callback throwing), the child is killed and
-// reaped and the pipe closed when this is dropped.
+// A forked child running `work`, the read end of the pipe it answers on and, when it is
+// watched, of the pipe its stdout and stderr go to. Whatever happens while it runs (an
+// allocation failing, a cancel callback throwing), the child is killed and reaped and the pipes
+// closed when this is dropped.
 class Child {
  public:
   Child(const std::string& what, const IsolationLimits& limits,
         const std::function<std::string()>& work) {
-    std::array<int, 2> fds{-1, -1};
-    if (pipe2(fds.data(), O_CLOEXEC) != 0)
-      throw Error("cannot start a process for " + what + ": " + std::strerror(errno));
+    std::array<int, 2> fds{-1, -1}, out{-1, -1};
+    const auto closeAll = [&] {
+      for (const int f : {fds[0], fds[1], out[0], out[1]})
+        if (f >= 0) ::close(f);
+    };
+    if (pipe2(fds.data(), O_CLOEXEC) != 0 || (limits.watch && pipe2(out.data(), O_CLOEXEC) != 0)) {
+      const int error = errno;
+      closeAll();
+      throw Error("cannot start a process for " + what + ": " + std::strerror(error));
+    }
     std::fflush(nullptr);
     const pid_t parent = getpid();
     pid_ = fork();
     if (pid_ < 0) {
       const int error = errno;
-      ::close(fds[0]);
-      ::close(fds[1]);
+      closeAll();
       throw Error("cannot start a process for " + what + ": " + std::strerror(error));
     }
     if (pid_ == 0) {
       ::close(fds[0]);
-      runChild(fds[1], parent, limits, work);
+      if (out[0] >= 0) ::close(out[0]);
+      runChild(fds[1], out[1], parent, limits, work);
     }
     ::close(fds[1]);
+    if (out[1] >= 0) ::close(out[1]);
     fd_ = fds[0];
+    output_ = out[0];
     reaped_ = false;
   }
   ~Child() { reap(true); }
@@ -162,10 +175,12 @@ class Child {
   Child& operator=(Child&&) = delete;
 
   int fd() const { return fd_; }
-  // Closes the pipe and waits for the child, killing it first if `kill`; once only.
+  int output() const { return output_; }  // -1 when not watched
+  // Closes the pipes and waits for the child, killing it first if `kill`; once only.
   void reap(bool kill) {
     if (reaped_) return;
     ::close(fd_);
+    if (output_ >= 0) ::close(output_);
     if (kill) ::kill(pid_, SIGKILL);
     while ((waited_ = waitpid(pid_, &status_, 0)) < 0 && errno == EINTR) {
     }
@@ -179,41 +194,95 @@ class Child {
  private:
   pid_t pid_ = -1;
   int fd_ = -1;
+  int output_ = -1;
   bool reaped_ = true;
   int status_ = 0;
   pid_t waited_ = 0;
 };
 
 // How the wait for a child's answer ended.
-enum class WaitEnd { Closed, Stuck, Cancelled, OverTime };
+enum class WaitEnd { Closed, Stuck, Cancelled, OverTime, Stalled };
+
+// A watched child's output, cut into lines for limits.watch; remembers the first stall.
+class WatchedOutput {
+ public:
+  explicit WatchedOutput(const IsolationLimits& limits) : watch_(limits.watch) {}
+  void add(const char* data, std::size_t n) {
+    pending_.append(data, n);
+    std::size_t from = 0;
+    for (std::size_t end = 0; (end = pending_.find('\n', from)) != std::string::npos;
+         from = end + 1)
+      see(pending_.substr(from, end - from));
+    pending_.erase(0, from);
+  }
+  // The last line, if it had no newline.
+  void finish() {
+    if (!pending_.empty()) see(pending_);
+    pending_.clear();
+  }
+  const std::string& stall() const { return stall_; }
+
+ private:
+  void see(const std::string& line) {
+    std::string answer = watch_(line);
+    if (stall_.empty()) stall_ = std::move(answer);
+  }
+  const std::function<std::string(const std::string&)>& watch_;
+  std::string pending_, stall_;
+};
+
+// Reads what is ready on `fd` into `to`; false once the writer closed its end.
+template <class Append>
+bool readReady(int fd, const std::string& what, Append&& to) {
+  std::array<char, 65536> buffer{};
+  const ssize_t n = ::read(fd, buffer.data(), buffer.size());
+  if (n > 0) {
+    to(buffer.data(), static_cast<std::size_t>(n));
+    return true;
+  }
+  if (n == 0) return false;
+  if (errno == EINTR || errno == EAGAIN) return true;
+  throw Error("cannot read the result of " + what + ": " + std::strerror(errno));
+}
 
 // Reads the child's answer into `bytes` until it closes its end, the caller cancels, the budget
-// (counted from `start`) is spent, or (`awaitStart`, not the last attempt) the start probe has
-// not returned within limits.startSeconds.
+// (counted from `start`) is spent, the watch of its output says it stalls (`output`), or
+// (`awaitStart`, not the last attempt) the start probe has not returned within
+// limits.startSeconds.
 WaitEnd readAnswer(const Child& child, const std::string& what, const IsolationLimits& limits,
-                   Clock::time_point start, bool awaitStart, bool lastAttempt, std::string& bytes) {
+                   Clock::time_point start, bool awaitStart, bool lastAttempt, std::string& bytes,
+                   WatchedOutput& output) {
   const auto forked = Clock::now();
-  std::array<char, 65536> buffer{};
   bool started = !awaitStart;
   bytes.clear();
+  std::array<pollfd, 2> in{pollfd{child.fd(), POLLIN, 0}, pollfd{child.output(), POLLIN, 0}};
+  const auto watched = [&](const char* data, std::size_t n) { output.add(data, n); };
   for (;;) {
-    pollfd in{child.fd(), POLLIN, 0};
-    const int ready = poll(&in, 1, 50);
-    if (ready > 0) {
-      const ssize_t n = ::read(child.fd(), buffer.data(), buffer.size());
-      if (n > 0) {
-        bytes.append(buffer.data(), static_cast<std::size_t>(n));
-        if (!started) {
-          started = bytes[0] == kStarted;
-          if (started) bytes.erase(0, 1);
-        }
-      } else if (n == 0) {
-        return WaitEnd::Closed;  // the child closed its end (finished or died)
-      } else if (errno != EINTR) {
-        throw Error("cannot read the result of " + what + ": " + std::strerror(errno));
-      }
-    } else if (ready < 0 && errno != EINTR) {
+    const int ready = poll(in.data(), in.size(), 50);
+    if (ready < 0 && errno != EINTR)
       throw Error("cannot wait for " + what + ": " + std::strerror(errno));
+    if (ready > 0 && in[1].revents != 0 && !readReady(in[1].fd, what, watched)) {
+      output.finish();
+      in[1].fd = -1;  // poll skips it from now on
+    }
+    if (!output.stall().empty()) return WaitEnd::Stalled;
+    if (ready > 0 && in[0].revents != 0 &&
+        !readReady(in[0].fd, what, [&](const char* data, std::size_t n) {
+          bytes.append(data, n);
+          if (!started) {
+            started = bytes[0] == kStarted;
+            if (started) bytes.erase(0, 1);
+          }
+        })) {
+      // The child closed its end (finished or died): what it wrote last is read to its end (it
+      // closes with the child's exit), for at most a second.
+      const auto deadline = Clock::now() + std::chrono::seconds(1);
+      for (pollfd last{in[1].fd, POLLIN, 0}; last.fd >= 0 && Clock::now() < deadline;) {
+        const int more = poll(&last, 1, 100);
+        if ((more < 0 && errno != EINTR) || (more > 0 && !readReady(last.fd, what, watched))) break;
+      }
+      output.finish();
+      return WaitEnd::Closed;
     }
     if (limits.cancelled && limits.cancelled()) return WaitEnd::Cancelled;
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
@@ -276,17 +345,24 @@ std::string runIsolated(const std::string& what, const IsolationLimits& limits,
   const int attempts = probed ? std::max(1, limits.startAttempts) : 1;
   std::string bytes;
   std::optional<Child> child;
+  std::optional<WatchedOutput> output;
   WaitEnd end = WaitEnd::Closed;
   for (int attempt = 1;; ++attempt) {
     child.emplace(what, limits, work);
-    end = readAnswer(*child, what, limits, start, probed, attempt >= attempts, bytes);
+    output.emplace(limits);
+    end = readAnswer(*child, what, limits, start, probed, attempt >= attempts, bytes, *output);
     if (end != WaitEnd::Stuck) break;
     child.reset();  // killed and reaped before the next attempt starts
     if (limits.restarted) limits.restarted(attempt);
   }
-  child->reap(end == WaitEnd::Cancelled || end == WaitEnd::OverTime);
+  child->reap(end != WaitEnd::Closed);
 
   if (end == WaitEnd::Cancelled) throw CancelledError("cancelled during " + what);
+  if (end == WaitEnd::Stalled)
+    throw Stalled(
+        what + " made no progress after " +
+        formatNumber(std::round(std::chrono::duration<double>(Clock::now() - start).count())) +
+        " s: " + output->stall());
   if (end == WaitEnd::OverTime)
     throw BudgetExceeded(
         what + " stopped at its time budget of " +

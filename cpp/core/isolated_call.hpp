@@ -43,6 +43,11 @@ struct IsolationLimits {
   int startAttempts = 3;
   // Told, in the caller, of each child given up before it started (its number, from 1).
   std::function<void(int)> restarted;
+  // With a watch: what the child writes on its standard output and error comes to the caller
+  // instead, and each line (without its newline) is given to `watch` as it arrives, which
+  // passes on what the user should see. An answer that is not empty says the work makes no
+  // progress: the child is killed and Stalled thrown with that answer as its message.
+  std::function<std::string(const std::string& line)> watch;
 };
 
 // Runs `work` in a child process and returns the bytes it returned.
@@ -53,6 +58,7 @@ struct IsolationLimits {
 //   (Segmentation fault)";
 // - the budget runs out: the child is killed, BudgetExceeded "<what> stopped at its time budget
 //   of S s (<budgetName>)";
+// - the watch says the work stalls: the child is killed, Stalled with the watch's message;
 // - cancelled: the child is killed, CancelledError.
 // If the child cannot be started: Error.
 std::string runIsolated(const std::string& what, const IsolationLimits& limits,
@@ -72,6 +78,13 @@ class BudgetExceeded : public MeshingError {
 
 // The child died (a signal, or an exit without a result): the work may be retried another way.
 class ChildCrashed : public MeshingError {
+ public:
+  using MeshingError::MeshingError;
+};
+
+// The child's output showed that its work makes no progress (and it was killed): the work may
+// be retried another way.
+class Stalled : public MeshingError {
  public:
   using MeshingError::MeshingError;
 };

@@ -21,13 +21,17 @@ std::unique_lock<std::mutex> holdGmsh() {
 GmshSession::GmshSession(int verbosity, int threads)
     : GmshSession(holdGmsh(), verbosity, threads) {}
 
-GmshSession::GmshSession(std::unique_lock<std::mutex> held, int verbosity, int threads)
-    : lock_(std::move(held)), verbosity_(verbosity) {
+GmshSession::GmshSession(std::unique_lock<std::mutex> held, int verbosity, int threads,
+                         GmshOutput output)
+    : lock_(std::move(held)), verbosity_(verbosity), output_(output) {
   withGmshErrors("starting Gmsh", [&] {
     gmsh::initialize(0, nullptr, false);
-    gmsh::option::setNumber("General.Terminal", 0);
-    // Errors are always logged (gmshLastError explains failures).
-    gmsh::option::setNumber("General.Verbosity", verbosity >= 2 ? 5 : (verbosity == 1 ? 2 : 1));
+    const bool terminal = output == GmshOutput::Terminal;
+    gmsh::option::setNumber("General.Terminal", terminal ? 1 : 0);
+    // Errors are always logged (gmshLastError explains failures); on a terminal, information
+    // too (what meshes what, for the watch).
+    gmsh::option::setNumber("General.Verbosity",
+                            verbosity >= 2 ? 5 : (terminal ? 4 : (verbosity == 1 ? 2 : 1)));
     gmsh::option::setNumber("General.NumThreads", threads);
     gmsh::logger::start();
   });
@@ -35,7 +39,7 @@ GmshSession::GmshSession(std::unique_lock<std::mutex> held, int verbosity, int t
 
 GmshSession::~GmshSession() {
   try {
-    if (verbosity_ > 0) {
+    if (verbosity_ > 0 && output_ == GmshOutput::Collected) {
       std::vector<std::string> log;
       gmsh::logger::get(log);
       for (const std::string& line : log) std::fprintf(stderr, "gmsh: %s\n", line.c_str());

@@ -16,16 +16,22 @@
 
 namespace homesh {
 
+// Where Gmsh's messages go. Collected: Gmsh's own terminal output (stdout) stays off; its
+// messages are collected and written to stderr when the session ends, so that stdout stays
+// clean for a report. Terminal: every message, information included, is written as Gmsh writes
+// it (information on stdout, warnings and errors on stderr) and nothing when the session ends,
+// for a child process whose output its caller watches (GmshProgressWatch) and filters.
+enum class GmshOutput { Collected, Terminal };
+
 class GmshSession {
  public:
-  // verbosity 0: silent; 1: Gmsh's errors and warnings; 2: and its information. Gmsh's own
-  // terminal output (stdout) stays off: its messages are collected and written to stderr when
-  // the session ends, so that stdout stays clean for a report.
+  // verbosity 0: silent; 1: Gmsh's errors and warnings; 2: and its information.
   explicit GmshSession(int verbosity = defaultOf<int>("verbosity"),
                        int threads = defaultOf<int>("threads"));
   // The same with the exclusive right to Gmsh already held (holdGmsh), as in a child process
   // forked while its parent held it.
-  GmshSession(std::unique_lock<std::mutex> held, int verbosity, int threads);
+  GmshSession(std::unique_lock<std::mutex> held, int verbosity, int threads,
+              GmshOutput output = GmshOutput::Collected);
   ~GmshSession();
   GmshSession(const GmshSession&) = delete;
   GmshSession& operator=(const GmshSession&) = delete;
@@ -33,6 +39,7 @@ class GmshSession {
  private:
   std::unique_lock<std::mutex> lock_;
   int verbosity_;
+  GmshOutput output_;
 };
 
 // The exclusive right to use Gmsh in this process, without starting it.

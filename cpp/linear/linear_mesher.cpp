@@ -14,6 +14,7 @@
 #include <iomanip>
 #include <limits>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -25,6 +26,7 @@
 #include "core/isolated_call.hpp"
 #include "core/mesh_bytes.hpp"
 #include "linear/gmsh_entity_map.hpp"
+#include "linear/gmsh_progress_watch.hpp"
 #include "linear/gmsh_session.hpp"
 
 namespace homesh {
@@ -205,6 +207,8 @@ struct GmshRun {
   double minSize = 0.0, maxSize = 0.0;
   std::string sizes;  // "with the sizing field" or "with size 0.1", for messages
   int surfaceAlgorithm = kDefaultSurfaceAlgorithm;
+  // Write which CAD sub-shape each Gmsh entity is on stdout, for a GmshProgressWatch.
+  bool tellEntities = false;
 };
 
 // Meshes `cad` with Gmsh in this process (session held) and reads the mesh back.
@@ -220,6 +224,13 @@ Mesh meshWithGmsh(const CadModel& cad, const GmshRun& run) {
     gmsh::model::occ::importShapesNativePointer(&occtShape(cad), imported, false);
     gmsh::model::occ::synchronize();
     const GmshEntityMap entities = GmshEntityMap::build(cad);
+    if (run.tellEntities) {
+      gmsh::vectorpair all;
+      gmsh::model::getEntities(all);
+      for (const auto& [d, tag] : all)
+        if (d > 0) std::printf("%s\n", gmshEntityLine(d, tag, entities.cadIndex(d, tag)).c_str());
+      std::fflush(stdout);
+    }
 
     gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
     gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
@@ -300,20 +311,31 @@ IsolationLimits isolationLimits(const LinearMeshOptions& options, double stated 
 
 // `work` (which uses Gmsh, holding the session it is given) in a child process when
 // options.isolate, else here; `work` returns its result as bytes either way. `stated`: as for
-// isolationLimits.
+// isolationLimits. `watch`: the child's Gmsh writes to its terminal and `watch` reads it (a run
+// that stalls: Stalled; one that crashes: ChildCrashed saying where).
 std::string withGmsh(const LinearMeshOptions& options, const std::string& what,
-                     const std::function<std::string(GmshSession&)>& work, double stated = 0.0) {
+                     const std::function<std::string(GmshSession&)>& work, double stated = 0.0,
+                     const std::shared_ptr<GmshProgressWatch>& watch = nullptr) {
   if (!options.isolate) {
     GmshSession session(options.verbosity, 1);
     return work(session);
   }
+  IsolationLimits limits = isolationLimits(options, stated);
+  if (watch) limits.watch = [watch](const std::string& line) { return (*watch)(line); };
   // Held across the fork: no other thread of this process is inside Gmsh while the child
   // starts (its copy of a held lock would never be released), and the child's session uses it.
   std::unique_lock<std::mutex> held = holdGmsh();
-  return runIsolated(what, isolationLimits(options, stated), [&] {
-    GmshSession session(std::move(held), options.verbosity, 1);
-    return work(session);
-  });
+  try {
+    return runIsolated(what, limits, [&] {
+      GmshSession session(std::move(held), options.verbosity, 1,
+                          watch ? GmshOutput::Terminal : GmshOutput::Collected);
+      return work(session);
+    });
+  } catch (const ChildCrashed& crash) {
+    const std::string where = watch ? watch->lastActivity() : std::string();
+    if (where.empty()) throw;
+    throw ChildCrashed(std::string(crash.what()) + " (" + where + ")");
+  }
 }
 
 }  // namespace
@@ -348,14 +370,17 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       o.timeLimit = std::max(o.timeLimit - spent, 1e-3);
     }
+    GmshRun told = r;
+    told.tellEntities = o.isolate;
+    const auto watch = o.isolate ? std::make_shared<GmshProgressWatch>(o.verbosity) : nullptr;
     const std::string bytes = withGmsh(
         o, "Gmsh's meshing of " + cad.sourceName(),
         [&](GmshSession&) {
           std::string out;
-          appendMeshBytes(out, meshWithGmsh(cad, r));
+          appendMeshBytes(out, meshWithGmsh(cad, told));
           return out;
         },
-        options.timeLimit);
+        options.timeLimit, watch);
     std::size_t offset = 0;
     return readMeshBytes(bytes, offset);
   };
@@ -390,6 +415,10 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
       throw;
     } catch (const Error& second) {
       if (endsTheJob(second)) throw;
+      if (dynamic_cast<const Stalled*>(&failure) != nullptr)
+        throw MeshingError(std::string(failure.what()) + " (" + run.sizes +
+                           "; Gmsh's MeshAdapt algorithm failed too): sizes below that face's "
+                           "radius of curvature may help (--min-delta, --max-delta)");
       throw failure;  // the first algorithm's message says more
     }
   }

@@ -110,6 +110,51 @@ TEST(IsolatedCall, AShareOfABudgetIsReportedAsTheBudget) {
   EXPECT_NE(message.find("stopped at its time budget of 3 s"), std::string::npos) << message;
 }
 
+// A watched child's stdout and stderr come here line by line, in order, the last line even
+// without its newline; the child's result is unchanged.
+TEST(IsolatedCall, AWatchSeesTheChildsOutputLineByLine) {
+  std::vector<std::string> lines;
+  IsolationLimits limits;
+  limits.watch = [&lines](const std::string& line) {
+    lines.push_back(line);
+    return std::string();
+  };
+  const std::string bytes = runIsolated("the talking work", limits, [] {
+    std::printf("one\ntwo ");
+    std::fflush(stdout);
+    std::fprintf(stderr, "three\n");
+    std::printf("four");
+    std::fflush(stdout);
+    return std::string("done");
+  });
+  EXPECT_EQ(bytes, "done");
+  EXPECT_EQ(lines, (std::vector<std::string>{"one", "two three", "four"}));
+}
+
+// A watch that says the work stalls ends the child at once (left alone it would sleep its
+// minute and return normally), with Stalled and the watch's words.
+TEST(IsolatedCall, AWatchThatSeesAStallEndsTheChild) {
+  IsolationLimits limits;
+  limits.watch = [](const std::string& line) {
+    return line == "again 3" ? std::string("it said again three times") : std::string();
+  };
+  std::string message;
+  try {
+    runIsolated("the looping work", limits, []() -> std::string {
+      for (int i = 1; i <= 5; ++i) {
+        std::printf("again %d\n", i);
+        std::fflush(stdout);
+      }
+      std::this_thread::sleep_for(std::chrono::seconds(60));
+      return "";
+    });
+  } catch (const Stalled& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("the looping work made no progress after "), std::string::npos) << message;
+  EXPECT_NE(message.find(" s: it said again three times"), std::string::npos) << message;
+}
+
 TEST(IsolatedCall, CancellingEndsTheChild) {
   IsolationLimits limits;
   const auto start = std::chrono::steady_clock::now();

@@ -12,6 +12,7 @@
 #include <TopTools_ListOfShape.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
+#include <algorithm>
 #include <cmath>
 #include <gp_Pln.hxx>
 #include <map>
@@ -19,6 +20,7 @@
 
 #include "core/error.hpp"
 #include "linear/linear_mesher.hpp"
+#include "sizing/sizing_octree.hpp"
 #include "test_support.hpp"
 
 namespace homesh {
@@ -214,6 +216,33 @@ TEST(LinearMesher, RejectsWhatItCannotMesh) {
   EXPECT_THROW(generateLinearMesh(cube, LinearMeshOptions::uniform(-1.0)), ParameterError);
   EXPECT_THROW(generateLinearMesh(cube, LinearMeshOptions::uniform(1e-5)),
                ParameterError);  // ~1e16 elements
+}
+
+// The sizing octree's sizes on a slender cylinder (radius 1, length 150) from 2.5 to 50: Gmsh
+// 4.8 refines the curved face's edges round after round while its invalid elements grow, each
+// round longer than the last (on a cylinder 1000 long it ran out its whole 600 s budget). The
+// watch on its output ends the run, MeshAdapt is tried and stalls too, and the error names the
+// CAD face.
+TEST(LinearMesher, AGmshRunThatMakesNoProgressIsRefusedNamingTheFace) {
+  const CadModel cad = test::toModel(BRepPrimAPI_MakeCylinder(1.0, 150.0).Shape());
+  SizingParameters sizing;
+  sizing.minDelta = 2.5;
+  sizing.maxDelta = 50.0;
+  const SizingOctree octree = SizingOctree::build(cad, sizing);
+  LinearMeshOptions options;
+  options.sizeField = [&octree](const Eigen::Vector3d& p) { return octree.delta(p); };
+  options.minSize = 2.5;
+  options.maxSize = 50.0;
+  options.timeLimit = 600.0;
+  std::string message;
+  try {
+    generateLinearMesh(cad, options);
+  } catch (const MeshingError& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("made no progress"), std::string::npos) << message;
+  EXPECT_NE(message.find("(CAD face 1)"), std::string::npos) << message;
+  EXPECT_NE(message.find("MeshAdapt algorithm failed too"), std::string::npos) << message;
 }
 
 }  // namespace
