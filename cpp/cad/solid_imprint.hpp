@@ -10,7 +10,9 @@
 // overlap becomes a solid of its own, meshed once, so that no two elements cover one place; a
 // solid and its copy become one solid. The record says so (overlap) and maps each original
 // solid to its pieces. Not imprinted, with a warning: a fuse OCCT fails, or one that removes a
-// solid; that model is meshed as it is, each solid with its own nodes where they touch.
+// solid; that model is meshed as it is, each solid with its own nodes where they touch. Where
+// solids touch only at a point or along a line, the edges the fuse leaves inside their faces
+// are taken out (ImprintRecord::contactEdges).
 #pragma once
 
 #include <string>
@@ -41,6 +43,10 @@ struct ImprintRecord {
   // Solids that shared volume and were cut where they overlap, with their pieces' final
   // numbers, in words ("" when none did).
   std::string overlap;
+  // Edges the fuse left inside faces where solids touch at a point or along a line (balls on
+  // their races), taken out (counted once per face they were in): they bound no face (nothing
+  // to conform across) and Gmsh cannot mesh those shorter than its elements.
+  int contactEdges = 0;
   double seconds = 0.0;
 };
 

@@ -42,7 +42,8 @@ void appendImprint(JsonWriter& json, const ImprintRecord& r) {
   json.value("joined", r.joined);      // solids the imprint changed
   json.value("imprinted", r.imprinted);
   json.value("warning", r.warning);
-  json.value("overlap", r.overlap);  // solids that shared volume, cut where they overlap
+  json.value("overlap", r.overlap);             // solids that shared volume, cut where they overlap
+  json.value("contact_edges", r.contactEdges);  // point and line contacts' edges taken out
   json.beginArray("interfaces");
   for (const SolidInterface& i : r.interfaces) {
     json.beginObject();
