@@ -47,6 +47,9 @@ struct ImprintRecord {
   // their races), taken out (counted once per face they were in): they bound no face (nothing
   // to conform across) and Gmsh cannot mesh those shorter than its elements.
   int contactEdges = 0;
+  // The fuzzy value the fuse used: the tolerance given, or a tenth of it where the first fuse
+  // stretched a vertex's or edge's tolerance past ten times the value (0: no fuse ran).
+  double fuzzy = 0.0;
   double seconds = 0.0;
 };
 

@@ -44,6 +44,7 @@ void appendImprint(JsonWriter& json, const ImprintRecord& r) {
   json.value("warning", r.warning);
   json.value("overlap", r.overlap);             // solids that shared volume, cut where they overlap
   json.value("contact_edges", r.contactEdges);  // point and line contacts' edges taken out
+  json.value("fuzzy", r.fuzzy);                 // the fuse's fuzzy value (0: none ran)
   json.beginArray("interfaces");
   for (const SolidInterface& i : r.interfaces) {
     json.beginObject();
