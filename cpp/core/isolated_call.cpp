@@ -54,14 +54,17 @@ bool writeAll(int fd, const char* data, std::size_t n) {
     std::signal(sig, SIG_DFL);
   prctl(PR_SET_PDEATHSIG, SIGKILL);
   if (getppid() != parent) _exit(3);
-  if (output >= 0 && (dup2(output, STDOUT_FILENO) < 0 || dup2(output, STDERR_FILENO) < 0)) _exit(3);
-  // Only stdin, stdout, stderr (the watched pipe, if any) and the result pipe stay open: the
-  // caller's other files, pipes and sockets (FreeCAD's) must not be held open by a child that may
-  // run for minutes.
-  if (fd != 3) {
-    if (dup2(fd, 3) < 0) _exit(3);
-    fd = 3;
-  }
+  // Only stdin, stdout, stderr (the watched pipe, if any) and the result pipe (as 3) stay open:
+  // the caller's other files, pipes and sockets (FreeCAD's) must not be held open by a child that
+  // may run for minutes. Both pipes are first moved above 3, so that neither is overwritten
+  // whichever numbers they had (1 or 2 where the caller had closed its stdout or stderr).
+  const bool watched = output >= 0;
+  fd = fcntl(fd, F_DUPFD, 4);
+  if (watched) output = fcntl(output, F_DUPFD, 4);
+  if (fd < 0 || (watched && output < 0)) _exit(3);
+  if (watched && (dup2(output, STDOUT_FILENO) < 0 || dup2(output, STDERR_FILENO) < 0)) _exit(3);
+  if (dup2(fd, 3) < 0) _exit(3);
+  fd = 3;
   close_range(4, ~0U, 0);
   const std::size_t extra = limits.extraBytes > 0 ? limits.extraBytes : availableMemoryBytes();
   if (extra > 0) {
@@ -102,6 +105,7 @@ bool writeAll(int fd, const char* data, std::size_t n) {
     kind = kOther;
     payload = "an exception of unknown type";
   }
+  if (watched) std::fflush(nullptr);  // what the work left buffered, for the watch
   const bool sent = writeAll(fd, &kind, 1) && writeAll(fd, payload.data(), payload.size());
   ::close(fd);
   // _exit: no atexit handlers, no flushing of the caller's stdio buffers a second time.
@@ -210,7 +214,8 @@ class WatchedOutput {
   void add(const char* data, std::size_t n) {
     pending_.append(data, n);
     std::size_t from = 0;
-    for (std::size_t end = 0; (end = pending_.find('\n', from)) != std::string::npos;
+    // Gmsh's progress meter ends its lines with a carriage return.
+    for (std::size_t end = 0; (end = pending_.find_first_of("\n\r", from)) != std::string::npos;
          from = end + 1)
       see(pending_.substr(from, end - from));
     pending_.erase(0, from);
@@ -233,7 +238,7 @@ class WatchedOutput {
 
 // Reads what is ready on `fd` into `to`; false once the writer closed its end.
 template <class Append>
-bool readReady(int fd, const std::string& what, Append&& to) {
+bool readReady(int fd, const std::string& what, Append&& to) {  // `what`: "the result of ..."
   std::array<char, 65536> buffer{};
   const ssize_t n = ::read(fd, buffer.data(), buffer.size());
   if (n > 0) {
@@ -242,7 +247,7 @@ bool readReady(int fd, const std::string& what, Append&& to) {
   }
   if (n == 0) return false;
   if (errno == EINTR || errno == EAGAIN) return true;
-  throw Error("cannot read the result of " + what + ": " + std::strerror(errno));
+  throw Error("cannot read " + what + ": " + std::strerror(errno));
 }
 
 // Reads the child's answer into `bytes` until it closes its end, the caller cancels, the budget
@@ -261,13 +266,13 @@ WaitEnd readAnswer(const Child& child, const std::string& what, const IsolationL
     const int ready = poll(in.data(), in.size(), 50);
     if (ready < 0 && errno != EINTR)
       throw Error("cannot wait for " + what + ": " + std::strerror(errno));
-    if (ready > 0 && in[1].revents != 0 && !readReady(in[1].fd, what, watched)) {
+    if (ready > 0 && in[1].revents != 0 && !readReady(in[1].fd, "the output of " + what, watched)) {
       output.finish();
       in[1].fd = -1;  // poll skips it from now on
     }
-    if (!output.stall().empty()) return WaitEnd::Stalled;
+    // The answer first: a child that has finished is not taken for stalled.
     if (ready > 0 && in[0].revents != 0 &&
-        !readReady(in[0].fd, what, [&](const char* data, std::size_t n) {
+        !readReady(in[0].fd, "the result of " + what, [&](const char* data, std::size_t n) {
           bytes.append(data, n);
           if (!started) {
             started = bytes[0] == kStarted;
@@ -279,11 +284,14 @@ WaitEnd readAnswer(const Child& child, const std::string& what, const IsolationL
       const auto deadline = Clock::now() + std::chrono::seconds(1);
       for (pollfd last{in[1].fd, POLLIN, 0}; last.fd >= 0 && Clock::now() < deadline;) {
         const int more = poll(&last, 1, 100);
-        if ((more < 0 && errno != EINTR) || (more > 0 && !readReady(last.fd, what, watched))) break;
+        if ((more < 0 && errno != EINTR) ||
+            (more > 0 && !readReady(last.fd, "the output of " + what, watched)))
+          break;
       }
       output.finish();
       return WaitEnd::Closed;
     }
+    if (!output.stall().empty()) return WaitEnd::Stalled;
     if (limits.cancelled && limits.cancelled()) return WaitEnd::Cancelled;
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     if (limits.seconds > 0.0 && elapsed > limits.seconds) return WaitEnd::OverTime;

@@ -65,7 +65,7 @@ std::string GmshProgressWatch::operator()(const std::string& line) {
     if (std::string(level.name) == "Error") lastError_ = message;
     return seeMessage(message);
   }
-  std::fprintf(stderr, "%s\n", line.c_str());
+  if (verbosity_ >= 1 && !line.empty()) std::fprintf(stderr, "%s\n", line.c_str());
   return {};
 }
 
@@ -81,14 +81,24 @@ std::string GmshProgressWatch::seeMessage(const std::string& message) {
   static const char* const kEntered[] = {"Meshing curve ", "Meshing surface ", "Meshing volume "};
   for (int dim = 1; dim <= 3; ++dim) {
     const long tag = numberAfter(message, kEntered[dim - 1]);
-    if (tag > 0) current_ = {dim, static_cast<int>(tag)};
+    if (tag > 0) {
+      current_ = {dim, static_cast<int>(tag)};
+      lastError_.clear();  // an error said before is not this entity's
+    }
+  }
+  // Between entities ("Done meshing 2D", "Meshing 3D...", the optimisation): none is current,
+  // and an error said before is not what a crash from here on met.
+  if (startsWith(message, "Done meshing") || startsWith(message, "Meshing 3D") ||
+      startsWith(message, "Optimizing")) {
+    current_ = {-1, 0};
+    lastError_.clear();
   }
   const long entered = numberAfter(message, "Meshing surface ");
   if (entered > 0 && ++entries_[static_cast<int>(entered)] >= kStallEntries)
     return name(2, static_cast<int>(entered)) + ": Gmsh meshed it " +
            std::to_string(kStallEntries) + " times without finishing it";
-  // "16 elements remain invalid in surface 1"
-  const std::string key = " elements remain invalid in surface ";
+  // "16 elements remain invalid in surface 1", "1 element remain invalid in surface 1"
+  const std::string key = " remain invalid in surface ";
   const std::size_t at = message.find(key);
   if (at == std::string::npos) return {};
   const long surface = numberAfter(message, key);

@@ -10,7 +10,7 @@
 // enters one. The stall is named by the CAD face it is on.
 //
 // The watch also passes Gmsh's messages on to stderr as the user's verbosity asks (warnings and
-// errors at 1, information at 2), and any other line as it is; it learns which CAD face and
+// errors at 1, information at 2), and any other line as it is (at 1); it learns which CAD face and
 // edge each Gmsh entity is from the lines gmshEntityLine writes.
 #pragma once
 
@@ -35,7 +35,8 @@ class GmshProgressWatch {
 
   // What Gmsh was doing when its output ended, for a crash's message: "while meshing Gmsh's
   // surface 38 (CAD face 40), after its error: The 1D mesh seems not to be forming a closed
-  // loop", or "" when it said nothing of it.
+  // loop" (the entity it last entered, and an error said since), or "" when it said nothing of
+  // it (between entities: the volumes' meshing says which volume it enters only in 3D).
   std::string lastActivity() const;
 
  private:

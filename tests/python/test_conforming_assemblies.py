@@ -214,5 +214,9 @@ def test_balls_touching_their_races_are_imprinted_and_the_mesh_conforms(homesh_b
     m = meshio.read(msh)
     faces = tet_faces(m)
     assert all(len(s) <= 2 for s in faces.values())
-    shared = [s for s in faces.values() if len(s) == 2 and s[0] != s[1]]
-    assert len(shared) > 0
+    tris = triangles(m)
+    for interface in imprint["interfaces"]:
+        on_it = [t for t, tag in tris if tag == interface["face"]]
+        assert on_it, interface
+        for t in on_it:
+            assert sorted(faces[t]) == interface["solids"], (interface, t, faces[t])

@@ -73,6 +73,35 @@ TEST(GmshProgressWatch, ASurfaceEnteredTwelveTimesIsAStall) {
             "Gmsh's surface 4: Gmsh meshed it 12 times without finishing it");
 }
 
+// Gmsh says "1 element remain invalid" in the singular: counted too.
+TEST(GmshProgressWatch, OneInvalidElementIsCountedToo) {
+  GmshProgressWatch watch(0);
+  EXPECT_EQ(
+      firstStall(watch, {"Warning : 1 element remain invalid in surface 5",
+                         "Warning : 2 elements remain invalid in surface 5",
+                         "Warning : 3 elements remain invalid in surface 5"}),
+      "Gmsh's surface 5: its invalid elements rose from 1 to 2 to 3 as Gmsh refined its edges");
+}
+
+// What a crash's message says: the entity Gmsh entered last and an error it said since; no
+// entity once it finished that dimension, and no error said before the entity or dimension.
+TEST(GmshProgressWatch, TheLastActivityNamesTheEntityAndItsError) {
+  GmshProgressWatch watch(0);
+  watch(gmshEntityLine(2, 38, 40));
+  watch("Error   : an earlier error");
+  watch("Info    : [ 50%] Meshing surface 38 (Torus, Frontal-Delaunay)");
+  EXPECT_EQ(watch.lastActivity(), "while meshing Gmsh's surface 38 (CAD face 40)");
+  watch("Error   : The 1D mesh seems not to be forming a closed loop");
+  EXPECT_EQ(watch.lastActivity(),
+            "while meshing Gmsh's surface 38 (CAD face 40), after its error: The 1D mesh seems "
+            "not to be forming a closed loop");
+  watch("Info    : Done meshing 2D (Wall 0.1s, CPU 0.1s)");
+  watch("Info    : Meshing 3D...");
+  EXPECT_EQ(watch.lastActivity(), "");
+  watch("Error   : No tetrahedra in region 1");
+  EXPECT_EQ(watch.lastActivity(), "after Gmsh's error: No tetrahedra in region 1");
+}
+
 // The lines Gmsh 4.8 printed meshing a cylinder (radius 1, height 10, size 0.5): no stall.
 TEST(GmshProgressWatch, AnOrdinaryRunIsNoStall) {
   GmshProgressWatch watch(0);
