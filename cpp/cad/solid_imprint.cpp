@@ -23,6 +23,7 @@
 #include <set>
 #include <sstream>
 #include <utility>
+#include <vector>
 
 #include "cad/occt_access.hpp"
 #include "core/error.hpp"
@@ -81,16 +82,20 @@ TopoDS_Shape withoutContactEdges(const TopoDS_Shape& shape,
   TopExp::MapShapes(shape, TopAbs_FACE, faces);
   BRep_Builder builder;
   for (int f = 1; f <= faces.Extent(); ++f) {
-    int here = 0;
-    for (TopoDS_Iterator w(faces(f).Oriented(TopAbs_FORWARD)); w.More(); w.Next())
-      if (contactWire(w.Value(), original))
-        for (TopoDS_Iterator e(w.Value()); e.More(); e.Next()) ++here;
-    if (here == 0) continue;
-    // Rebuilt forward (the wires keep their orientation in the face), with the face's flags.
+    // Read forward, so that the wires keep their orientation in the face rebuilt from them.
     const TopoDS_Face face = TopoDS::Face(faces(f).Oriented(TopAbs_FORWARD));
+    int here = 0;
+    std::vector<TopoDS_Shape> kept;
+    for (TopoDS_Iterator w(face); w.More(); w.Next()) {
+      if (!contactWire(w.Value(), original)) {
+        kept.push_back(w.Value());
+        continue;
+      }
+      for (TopoDS_Iterator e(w.Value()); e.More(); e.Next()) ++here;
+    }
+    if (here == 0) continue;
     TopoDS_Face copy = TopoDS::Face(face.EmptyCopied());
-    for (TopoDS_Iterator w(face); w.More(); w.Next())
-      if (!contactWire(w.Value(), original)) builder.Add(copy, w.Value());
+    for (const TopoDS_Shape& wire : kept) builder.Add(copy, wire);
     builder.NaturalRestriction(copy, BRep_Tool::NaturalRestriction(face));
     reshape->Replace(face, copy);
     edges += here;

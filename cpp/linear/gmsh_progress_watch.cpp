@@ -79,11 +79,13 @@ std::string GmshProgressWatch::lastActivity() const {
 
 std::string GmshProgressWatch::seeMessage(const std::string& message) {
   static const char* const kEntered[] = {"Meshing curve ", "Meshing surface ", "Meshing volume "};
+  long enteredSurface = 0;
   for (int dim = 1; dim <= 3; ++dim) {
     const long tag = numberAfter(message, kEntered[dim - 1]);
     if (tag > 0) {
       current_ = {dim, static_cast<int>(tag)};
       lastError_.clear();  // an error said before is not this entity's
+      if (dim == 2) enteredSurface = tag;
     }
   }
   // Between entities ("Done meshing 2D", "Meshing 3D...", the optimisation): none is current,
@@ -93,9 +95,8 @@ std::string GmshProgressWatch::seeMessage(const std::string& message) {
     current_ = {-1, 0};
     lastError_.clear();
   }
-  const long entered = numberAfter(message, "Meshing surface ");
-  if (entered > 0 && ++entries_[static_cast<int>(entered)] >= kStallEntries)
-    return name(2, static_cast<int>(entered)) + ": Gmsh meshed it " +
+  if (enteredSurface > 0 && ++entries_[static_cast<int>(enteredSurface)] >= kStallEntries)
+    return name(2, static_cast<int>(enteredSurface)) + ": Gmsh meshed it " +
            std::to_string(kStallEntries) + " times without finishing it";
   // "16 elements remain invalid in surface 1", "1 element remain invalid in surface 1"
   const std::string key = " remain invalid in surface ";
