@@ -75,6 +75,8 @@ class NodeStep {
   bool facetTermActive(std::int64_t node) const;
   // Per element (global index), its validity at the last evaluation; read by facetTermActive.
   void setValidity(const std::vector<Validity>* validity) { validity_ = validity; }
+  // Whether the node slides on the CAD (its steps are in the CAD's parameters).
+  bool slides(std::int64_t node) const { return sliding_.parameters(node) != 0; }
   // Whether the node is a vertex of a boundary facet of the term (after buildFacets).
   bool touchesFacet(std::int64_t node) const;
   // The facet term's total at the current positions, 0 until it has joined (facetsOn()).

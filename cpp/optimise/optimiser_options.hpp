@@ -56,6 +56,17 @@ struct OptimiserOptions {
   // against 1e-4: on nine test cases (sphere in a box, NekMesh's 3d_sphere, 3d_bl_cyl, T106)
   // the same validity verdicts, worst values within 0.007, and 1.2x to 2.5x less time.
   double activeTolerance = 1e-3;
+  // With settledQuality <= 1: a node inside the domain (one that does not slide on the CAD)
+  // whose elements all have a certified scaled Jacobian of at least settledQuality rests below
+  // settledTolerance of its element size instead. Such elements no longer limit the mesh, and
+  // polishing them costs most of a run over a mesh that is valid from the start; nodes on the
+  // CAD keep activeTolerance, their small moves being the boundary's fidelity. Off by default
+  // (`homesh optimise` runs the sweeps it is asked for on every node that moves); the pipeline
+  // uses 0.7 (pipeline/curve_stage.cpp). The values are the elements' certified lower bounds, so
+  // a run given the caller's start quality (every bound refined) may settle an element near
+  // settledQuality that a run measuring its own (refined only where it matters) does not.
+  double settledQuality = 2.0;
+  double settledTolerance = 1e-2;
   int threads = defaultOf<int>("threads");
   // Work only around elements whose certified scaled Jacobian is below this (in (0, 1]).
   std::optional<double> regionThreshold;

@@ -7,8 +7,9 @@
 //
 // Every node is active in the first sweep; later, a node is active once it or a node of one of
 // its elements moved by more than options.activeTolerance of its element size since its last
-// visit. A node is never marked by another of its own colour (they share no element), so the
-// result does not depend on the thread count.
+// visit (options.settledTolerance for a node inside the domain whose elements are all at least
+// options.settledQuality). A node is never marked by another of its own colour (they share no
+// element), so the result does not depend on the thread count.
 //
 // A cancel request (OptimiserObserver) or the time limit is honoured between colour groups: the
 // sweep then throws CancelledError, and what its passes moved so far stays in interrupted().
@@ -88,6 +89,7 @@ class Sweeper {
   static constexpr std::uint8_t kStale = 1, kDrifted = 2;
 
   void record(std::int64_t node, double relative);
+  bool settled(std::int64_t node) const;
   Moves relax(const std::vector<std::int64_t>& nodes, const std::vector<std::size_t>& starts,
               bool onlyActive);
   std::vector<std::size_t> take(std::uint8_t flag);
