@@ -31,7 +31,8 @@ void OptimiserOptions::validate() const {
     throw ParameterError("active tolerance must be a finite number >= 0");
   if (!(settledQuality >= 0.0) || !std::isfinite(settledQuality))
     throw ParameterError("settled quality must be a finite number >= 0");
-  if (!(settledTolerance >= activeTolerance) || !std::isfinite(settledTolerance))
+  if (settledQuality <= 1.0 &&
+      (!(settledTolerance >= activeTolerance) || !std::isfinite(settledTolerance)))
     throw ParameterError("settled tolerance must be finite and at least the active tolerance");
   if (!(focusMargin >= 0.0) || !std::isfinite(focusMargin))
     throw ParameterError("focus margin must be a finite number >= 0");

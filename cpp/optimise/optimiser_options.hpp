@@ -57,14 +57,16 @@ struct OptimiserOptions {
   // the same validity verdicts, worst values within 0.007, and 1.2x to 2.5x less time.
   double activeTolerance = 1e-3;
   // With settledQuality <= 1: a node inside the domain (one that does not slide on the CAD)
-  // whose elements all have a certified scaled Jacobian of at least settledQuality rests below
-  // settledTolerance of its element size instead. Such elements no longer limit the mesh, and
-  // polishing them costs most of a run over a mesh that is valid from the start; nodes on the
-  // CAD keep activeTolerance, their small moves being the boundary's fidelity. Off by default
-  // (`homesh optimise` runs the sweeps it is asked for on every node that moves); the pipeline
-  // uses 0.7 (pipeline/curve_stage.cpp). The values are the elements' certified lower bounds, so
-  // a run given the caller's start quality (every bound refined) may settle an element near
-  // settledQuality that a run measuring its own (refined only where it matters) does not.
+  // whose elements all have a certified scaled Jacobian of at least settledQuality, and more
+  // than focusMargin above the mesh's worst at the sweep's start, rests below settledTolerance
+  // of its element size instead (and its moves below that wake no neighbour). Such elements no
+  // longer limit the mesh, and polishing them costs most of a run over a mesh that is valid from
+  // the start; a node on the CAD keeps activeTolerance for its own moves, which are the
+  // boundary's fidelity. Off by default (`homesh optimise` has no settled rule); the pipeline
+  // uses 0.7 (pipeline/curve_stage.cpp). The values are the elements' certified lower bounds,
+  // refined only near the worst and the region threshold (certified_quality.hpp), so an element
+  // somewhat above settledQuality may not count as settled, and a run given the caller's start
+  // quality (every bound refined) may settle one that a run measuring its own does not.
   double settledQuality = 2.0;
   double settledTolerance = 1e-2;
   int threads = defaultOf<int>("threads");

@@ -21,20 +21,23 @@ void Sweeper<D>::resetMarks() {
   for (std::size_t i = 0; i < mesh_.mesh.numNodes(); ++i) active_[i].store(1);
 }
 
-// Whether the node is inside the domain and its elements all at least options_.settledQuality
-// (their certified values of the last evaluation: constant during a pass).
+// Whether the node is inside the domain and its elements all at least settledFloor_ (their
+// certified values of the last evaluation: constant during a pass).
 template <int D>
 bool Sweeper<D>::settled(std::int64_t node) const {
   if (step_.slides(node)) return false;
   const std::vector<double>& scaled = quality_.scaled();
-  for (std::size_t k = mesh_.incidenceStart[node]; k < mesh_.incidenceStart[node + 1]; ++k)
-    if (!(scaled[mesh_.globalIndex(mesh_.incidence[k])] >= options_.settledQuality)) return false;
+  for (std::size_t k = mesh_.incidenceStart[node]; k < mesh_.incidenceStart[node + 1]; ++k) {
+    const double q = scaled[mesh_.globalIndex(mesh_.incidence[k])];
+    if (!(q >= settledFloor_ && q > 0.0)) return false;
+  }
   return true;
 }
 
 // After a node's visit: mark the elements it moved, and decide which nodes the next sweep
 // visits. A node that did not move by more than activeTolerance of its element size (a settled
-// one: settledTolerance) rests until a node of one of its elements moves by more.
+// one: settledTolerance) rests until a node of one of its elements moves by more; a move that
+// leaves the node resting wakes none of them either.
 template <int D>
 void Sweeper<D>::record(std::int64_t node, double relative) {
   const bool moved = relative > 0.0;
@@ -144,6 +147,13 @@ Moves Sweeper<D>::relax(const std::vector<std::int64_t>& nodes,
 template <int D>
 Moves Sweeper<D>::sweep() {
   interrupted_ = Moves{};
+  // The elements within focusMargin of the worst still limit the mesh: they never settle.
+  settledFloor_ = options_.settledQuality;
+  if (settledFloor_ <= 1.0) {
+    const std::vector<double>& scaled = quality_.scaled();
+    const double worst = scaled.empty() ? 0.0 : *std::min_element(scaled.begin(), scaled.end());
+    settledFloor_ = std::max(settledFloor_, worst + options_.focusMargin);
+  }
   Moves moved = relax(free_, colouring_.colourStart(), true);
   interrupted_ = moved;  // a focused pass the limit stops adds its own
   writeBack();

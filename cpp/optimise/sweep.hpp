@@ -7,9 +7,10 @@
 //
 // Every node is active in the first sweep; later, a node is active once it or a node of one of
 // its elements moved by more than options.activeTolerance of its element size since its last
-// visit (options.settledTolerance for a node inside the domain whose elements are all at least
-// options.settledQuality). A node is never marked by another of its own colour (they share no
-// element), so the result does not depend on the thread count.
+// visit (options.settledTolerance for a node inside the domain whose own elements are all at
+// least options.settledQuality and above the worst plus options.focusMargin). A node is never
+// marked by another of its own colour (they share no element), so the result does not depend on the
+// thread count.
 //
 // A cancel request (OptimiserObserver) or the time limit is honoured between colour groups: the
 // sweep then throws CancelledError, and what its passes moved so far stays in interrupted().
@@ -107,6 +108,9 @@ class Sweeper {
   // Per node: visit it in the next sweep (it or a neighbour moved by more than
   // options_.activeTolerance of its element size since its last visit).
   std::unique_ptr<std::atomic<std::uint8_t>[]> active_;
+  // The quality at and above which an element counts as settled in this sweep:
+  // options.settledQuality, or the worst plus options.focusMargin where that is higher.
+  double settledFloor_ = 2.0;
   Moves interrupted_;
 };
 

@@ -33,16 +33,15 @@ constexpr double kBudgetReserve = 4.0;
 // rounds (the optimiser alone waits 10).
 constexpr int kPipelineStuckWindow = 5;
 
-// Interior nodes whose elements are all at least this good rest below 1e-2 of their element
-// size rather than 1e-3 (OptimiserOptions::settledQuality). Against no such rule, on twelve
-// cases (NekMesh's 3d_sphere at orders 4 and 6, 3d_bl_cyl, T106 and the aerofoil, the sphere in a
-// box at sizes 1.2 and 0.8, the bracket, OpenCASCADE's bottle, a long, a thin and a bent
-// cylinder): the same verdicts, worst values within 0.006, the largest normal angles within
-// 0.14 degrees, 1.07x to 2.1x fewer node visits (the long cylinder 9.6 to 6.7 million, the bottle
-// 6.6 to 5.0 million). Resting the nodes on the CAD of such elements below 3e-3 too took the
-// long cylinder from 69 to 42 s but the bottle's worst from 0.196 to 0.170 and the bracket's
-// largest normal angle from 0.78 to 1.58 degrees; 0 instead of 0.7 lowered the sphere in a box's
-// worst at size 0.8 from 0.398 to 0.383 and T106's from 0.106 to 0.094.
+// Interior nodes whose elements are all at least this good (and 0.05 above the worst) rest below
+// 1e-2 of their element size rather than 1e-3 (OptimiserOptions::settledQuality). Against no
+// such rule, on twelve cases (NekMesh's 3d_sphere at orders 4 and 6, 3d_bl_cyl, T106 and the
+// aerofoil, the sphere in a box at sizes 1.2 and 0.8, the bracket, OpenCASCADE's bottle, a long,
+// a thin and a bent cylinder): the same verdicts, worst values within 0.006, the largest normal
+// angles within 0.14 degrees, 1.03x to 2.1x fewer node visits (the long cylinder 9.6 to 6.7
+// million, the bottle 6.6 to 5.0 million). Resting the nodes on the CAD of such elements below
+// 3e-3 too took the long cylinder from 69 to 42 s but the bottle's worst from 0.196 to 0.170 and
+// the bracket's largest normal angle from 0.78 to 1.58 degrees.
 constexpr double kPipelineSettledQuality = 0.7;
 
 // Layers of neighbours around a repair round's new elements that the optimiser moves too. One

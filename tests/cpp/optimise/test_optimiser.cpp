@@ -709,7 +709,8 @@ TEST(Optimiser, RestingNodesAreVisitedOnlyWhenTheirNeighboursMove) {
 
 // A node inside the domain whose elements are all good (settledQuality) rests below the larger
 // settledTolerance. These meshes have no CAD, so every free node is inside the domain: with
-// settledQuality 0 every node whose elements are valid settles, and the run visits fewer nodes
+// settledQuality 0 every node whose elements are valid and more than focusMargin above the
+// worst settles, and the run visits fewer nodes
 // than with the rule off (and may end early, nothing left to move), still improving the mesh;
 // the rule's two values are checked.
 TEST(Optimiser, SettledNodesRestBelowTheLargerTolerance) {
@@ -724,7 +725,7 @@ TEST(Optimiser, SettledNodesRestBelowTheLargerTolerance) {
     options.tolerance = 0.0;        // (settled, a sweep may move nothing)
     options.settledQuality = 2.0;   // none settles (the default)
     const OptimiserResult plain = optimiseMesh(off, options);
-    options.settledQuality = 0.0;  // every node of valid elements does
+    options.settledQuality = 0.0;  // every node of valid elements away from the worst does
     const OptimiserResult settled = optimiseMesh(on, options);
     ASSERT_EQ(plain.history.size(), 6U);
     // Up to six: a run whose nodes all rest moves nothing and ends ("displacement").
@@ -744,6 +745,7 @@ TEST(Optimiser, SettledNodesRestBelowTheLargerTolerance) {
         plain.worstAfter);
   }
   OptimiserOptions bad;
+  bad.settledQuality = 0.7;
   bad.settledTolerance = 0.5 * bad.activeTolerance;
   EXPECT_THROW(bad.validate(), ParameterError);
   bad = OptimiserOptions();
