@@ -710,9 +710,8 @@ TEST(Optimiser, RestingNodesAreVisitedOnlyWhenTheirNeighboursMove) {
 // A node inside the domain whose elements are all good (settledQuality) rests below the larger
 // settledTolerance. These meshes have no CAD, so every free node is inside the domain: with
 // settledQuality 0 every node whose elements are valid and more than focusMargin above the
-// worst settles, and the run visits fewer nodes
-// than with the rule off (and may end early, nothing left to move), still improving the mesh;
-// the rule's two values are checked.
+// worst settles, and the run visits fewer nodes than with the rule off (and may end early,
+// nothing left to move), still improving the mesh; the rule's two values are checked.
 TEST(Optimiser, SettledNodesRestBelowTheLargerTolerance) {
   for (const Input& in : cubeSpheres()) {
     SCOPED_TRACE(in.name);
