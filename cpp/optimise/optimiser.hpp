@@ -7,8 +7,8 @@
 // are exact), then `focusPasses` more steps on the nodes of the worst elements only. Every node
 // is active in the first sweep; later, a node is active once it or a node of one of its elements
 // moved by more than `activeTolerance` of its element size since its last visit
-// (`settledTolerance` for a node inside the domain whose own elements are all at least
-// `settledQuality`: see optimiser_options.hpp). Per point the
+// (`settledTolerance`, or `settledSlidingTolerance` on the CAD, for a node whose own elements
+// are all at least `settledQuality`: see optimiser_options.hpp). Per point the
 // deformation gradient F and J = det F are kept and updated by the rank-one change of each
 // accepted move, so a Newton step costs O(quadrature points of the node's elements). Each step
 // shifts the Hessian to be positive definite and uses a backtracking Armijo line search that

@@ -32,8 +32,9 @@ void OptimiserOptions::validate() const {
   if (!(settledQuality >= 0.0) || !std::isfinite(settledQuality))
     throw ParameterError("settled quality must be a finite number >= 0");
   if (settledQuality <= 1.0 &&
-      (!(settledTolerance >= activeTolerance) || !std::isfinite(settledTolerance)))
-    throw ParameterError("settled tolerance must be finite and at least the active tolerance");
+      (!(settledTolerance >= activeTolerance) || !std::isfinite(settledTolerance) ||
+       !(settledSlidingTolerance >= activeTolerance) || !std::isfinite(settledSlidingTolerance)))
+    throw ParameterError("settled tolerances must be finite and at least the active tolerance");
   if (!(focusMargin >= 0.0) || !std::isfinite(focusMargin))
     throw ParameterError("focus margin must be a finite number >= 0");
 }

@@ -22,7 +22,9 @@ struct OptimiserOptions {
   //    element (its straight-sided volume to the power 1/d);
   //  "energy": every element is proven valid and the sweep lowered the total energy by less
   //    than `energyTolerance` of it (an invalid mesh keeps going: untangling can follow a
-  //    plateau of the energy);
+  //    plateau of the energy); with `stall` > 0, only if the sweep also raised the worst scaled
+  //    Jacobian by less than `stall` (where most nodes rest, the few moving around the worst
+  //    element lower the total energy by little while they still raise the worst);
   //  "stalled" (only with `stall` > 0): every element is proven valid, the last sweep's worst
   //    scaled Jacobian is less than `stall` above its lowest value in the state before the last
   //    `stallWindow` sweeps and in those sweeps, and the last sweep lowered the energy by less
@@ -56,19 +58,21 @@ struct OptimiserOptions {
   // against 1e-4: on nine test cases (sphere in a box, NekMesh's 3d_sphere, 3d_bl_cyl, T106)
   // the same validity verdicts, worst values within 0.007, and 1.2x to 2.5x less time.
   double activeTolerance = 1e-3;
-  // With settledQuality <= 1: a node inside the domain (one that does not slide on the CAD)
-  // whose elements all have a certified scaled Jacobian of at least settledQuality, and more
-  // than focusMargin above the mesh's worst at the sweep's start, rests below settledTolerance
-  // of its element size instead (and its moves below that wake no neighbour). Such elements no
+  // With settledQuality <= 1: a node whose elements all have a certified scaled Jacobian of at
+  // least settledQuality, and more than focusMargin above the mesh's worst at the sweep's start,
+  // rests below settledTolerance of its element size instead (settledSlidingTolerance for a
+  // node sliding on the CAD), and its moves below that wake no neighbour. Such elements no
   // longer limit the mesh, and polishing them costs most of a run over a mesh that is valid from
-  // the start; a node on the CAD keeps activeTolerance for its own moves, which are the
-  // boundary's fidelity. Off by default (`homesh optimise` has no settled rule); the pipeline
-  // uses 0.7 (pipeline/curve_stage.cpp). The values are the elements' certified lower bounds,
-  // refined only near the worst and the region threshold (certified_quality.hpp), so an element
-  // somewhat above settledQuality may not count as settled, and a run given the caller's start
-  // quality (every bound refined) may settle one that a run measuring its own does not.
+  // the start. A node on the CAD has a tolerance of its own because its small moves are the
+  // boundary's fidelity: the pipeline rests it below 3e-3 where the inside rests below 1e-2
+  // (pipeline/curve_stage.cpp). Off by default (`homesh optimise` has no settled rule); the
+  // pipeline uses 0.7. The values are the elements' certified lower bounds, refined only near
+  // the worst and the region threshold (certified_quality.hpp), so an element somewhat above
+  // settledQuality may not count as settled, and a run given the caller's start quality (every
+  // bound refined) may settle one that a run measuring its own does not.
   double settledQuality = 2.0;
   double settledTolerance = 1e-2;
+  double settledSlidingTolerance = 1e-3;
   int threads = defaultOf<int>("threads");
   // Work only around elements whose certified scaled Jacobian is below this (in (0, 1]).
   std::optional<double> regionThreshold;

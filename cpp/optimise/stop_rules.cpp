@@ -23,6 +23,9 @@ bool displacementRule(const IterationRecord& r, const OptimiserOptions& options)
 
 bool energyRule(const IterationRecord& r, const IterationRecord& previous,
                 const OptimiserOptions& options) {
+  // In stall mode a sweep that still raises the worst is progress, however little the energy
+  // falls (most nodes rest around a mesh that is good elsewhere).
+  if (options.stall > 0.0 && r.worst - previous.worst >= options.stall) return false;
   return provenValid(r) && energyFall(r, previous) < options.energyTolerance;
 }
 

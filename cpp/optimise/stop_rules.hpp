@@ -61,7 +61,8 @@ double energyFall(const IterationRecord& r, const IterationRecord& previous);
 // `previous` is the state before it, `input` the state before the first sweep.
 // "displacement": no node moved by more than `tolerance` times its element size.
 bool displacementRule(const IterationRecord& r, const OptimiserOptions& options);
-// "energy": proven valid, and the energy fell by less than energyTolerance of it.
+// "energy": proven valid, and the energy fell by less than energyTolerance of it (with
+// stall > 0: and the worst rose by less than `stall`).
 bool energyRule(const IterationRecord& r, const IterationRecord& previous,
                 const OptimiserOptions& options);
 // "stalled" (stall > 0): proven valid, the energy fell by less than stallEnergy, and the worst

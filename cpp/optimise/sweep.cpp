@@ -21,11 +21,10 @@ void Sweeper<D>::resetMarks() {
   for (std::size_t i = 0; i < mesh_.mesh.numNodes(); ++i) active_[i].store(1);
 }
 
-// Whether the node is inside the domain and its elements all at least settledFloor_ (their
-// certified values of the last evaluation: constant during a pass).
+// Whether the node's elements are all at least settledFloor_ (their certified values of the
+// last evaluation: constant during a pass).
 template <int D>
 bool Sweeper<D>::settled(std::int64_t node) const {
-  if (step_.slides(node)) return false;
   const std::vector<double>& scaled = quality_.scaled();
   for (std::size_t k = mesh_.incidenceStart[node]; k < mesh_.incidenceStart[node + 1]; ++k) {
     const double q = scaled[mesh_.globalIndex(mesh_.incidence[k])];
@@ -36,13 +35,15 @@ bool Sweeper<D>::settled(std::int64_t node) const {
 
 // After a node's visit: mark the elements it moved, and decide which nodes the next sweep
 // visits. A node that did not move by more than activeTolerance of its element size (a settled
-// one: settledTolerance) rests until a node of one of its elements moves by more; a move that
-// leaves the node resting wakes none of them either.
+// one: settledTolerance, or settledSlidingTolerance on the CAD) rests until a node of one of its
+// elements moves by more; a move that leaves the node resting wakes none of them either.
 template <int D>
 void Sweeper<D>::record(std::int64_t node, double relative) {
   const bool moved = relative > 0.0;
-  const bool wakes = relative > options_.activeTolerance &&
-                     (relative > options_.settledTolerance || !settled(node));
+  const double settledBelow =
+      step_.slides(node) ? options_.settledSlidingTolerance : options_.settledTolerance;
+  const bool wakes =
+      relative > options_.activeTolerance && (relative > settledBelow || !settled(node));
   // Loads before stores: the flags mostly hold their value already, and a store (even of the
   // same value) takes the cache line from the other threads working on neighbouring nodes.
   if (const std::uint8_t want = wakes ? 1 : 0;

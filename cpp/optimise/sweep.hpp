@@ -7,9 +7,10 @@
 //
 // Every node is active in the first sweep; later, a node is active once it or a node of one of
 // its elements moved by more than options.activeTolerance of its element size since its last
-// visit (options.settledTolerance for a node inside the domain whose own elements are all at
-// least options.settledQuality and above the worst plus options.focusMargin). A node is never
-// marked by another of its own colour (they share no element), so the result does not depend on the
+// visit (options.settledTolerance for a node whose own elements are all at least
+// options.settledQuality and above the worst plus options.focusMargin, or
+// options.settledSlidingTolerance where such a node slides on the CAD). A node is never marked
+// by another of its own colour (they share no element), so the result does not depend on the
 // thread count.
 //
 // A cancel request (OptimiserObserver) or the time limit is honoured between colour groups: the

@@ -71,6 +71,22 @@ TEST(StopRules, EnergyFiresOnlyOnAProvenValidMesh) {
   EXPECT_DOUBLE_EQ(optimiser::energyFall(record(1, 0.6, 0, 8.0), previous), 0.25);
 }
 
+// In stall mode a sweep that raised the worst by `stall` or more is progress whatever the
+// energy did: where most nodes rest, the few around the worst element lower it by little.
+TEST(StopRules, EnergyWaitsInStallModeWhileTheWorstStillRises) {
+  OptimiserOptions o = quiet();
+  o.energyTolerance = 1e-3;
+  o.stall = 1e-3;
+  o.stallEnergy = 0.0;  // the stalled rule itself stays quiet
+  const IterationRecord previous = record(0, 0.5, 0, 10.0);
+  const double flat = 10.0 / (1.0 + 1e-4);  // a fall below energyTolerance
+  EXPECT_EQ(stopRule({record(1, 0.502, 0, flat)}, previous, previous, o), "");
+  EXPECT_EQ(stopRule({record(1, 0.5005, 0, flat)}, previous, previous, o), "energy");
+  EXPECT_EQ(stopRule({record(1, 0.4, 0, flat)}, previous, previous, o), "energy");
+  o.stall = 0.0;  // without stall mode the energy alone decides
+  EXPECT_EQ(stopRule({record(1, 0.502, 0, flat)}, previous, previous, o), "energy");
+}
+
 TEST(StopRules, StalledMeasuresTheLastSweepAgainstTheWindowsLowestWorst) {
   OptimiserOptions o = quiet();
   o.stall = 1e-3;
