@@ -265,6 +265,22 @@ int NumberingMap::finalCount(int dim) const {
   return finalCount_.at(static_cast<std::size_t>(dim));
 }
 
+std::string NumberingMap::givenNames(int dim, int index) const {
+  if (!changed(dim)) return "";
+  const std::vector<int> given =
+      index >= 1 && index <= finalCount(dim) ? originals(dim, index) : std::vector<int>{};
+  if (given.empty()) {
+    static const char* const kinds[] = {"vertex", "edge", "face", "solid"};
+    return std::string("no numbered ") + kinds[std::clamp(dim, 0, 3)] + " of the model as given";
+  }
+  std::string text;
+  for (std::size_t i = 0; i < given.size(); ++i) {
+    if (i > 0) text += i + 1 == given.size() ? " and " : ", ";
+    text += cadEntityName(dim, given[i]);
+  }
+  return text;
+}
+
 std::vector<int> NumberingMap::originals(int dim, int index) const {
   std::vector<int> out;
   const auto& images = images_.at(static_cast<std::size_t>(dim));

@@ -45,9 +45,10 @@ std::string GmshProgressWatch::name(int dim, int tag) const {
   static const char* const kCad[] = {"vertex", "edge", "face", "solid"};
   std::string text = std::string("Gmsh's ") + kGmsh[dim] + " " + std::to_string(tag);
   const auto it = cad_.find({dim, tag});
-  if (it != cad_.end())
-    text += std::string(" (CAD ") + kCad[dim] + " " + std::to_string(it->second) + ")";
-  return text;
+  if (it == cad_.end()) return text;
+  text += std::string(" (CAD ") + kCad[dim] + " " + std::to_string(it->second);
+  const std::string given = givenNames_ ? givenNames_(dim, it->second) : std::string();
+  return text + (given.empty() ? ")" : ", " + given + " as given)");
 }
 
 std::string GmshProgressWatch::operator()(const std::string& line) {

@@ -14,6 +14,7 @@
 // edge each Gmsh entity is from the lines gmshEntityLine writes.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <string>
 #include <utility>
@@ -26,11 +27,15 @@ class GmshProgressWatch {
   // Entries of one surface taken as a stall (twice the most seen in a successful run).
   static constexpr int kStallEntries = 12;
 
-  explicit GmshProgressWatch(int verbosity) : verbosity_(verbosity) {}
+  // `givenNames`: as LinearMeshOptions::givenNames, added to the CAD entity a message names.
+  explicit GmshProgressWatch(int verbosity,
+                             std::function<std::string(int dim, int index)> givenNames = {})
+      : verbosity_(verbosity), givenNames_(std::move(givenNames)) {}
 
   // One line of the run's output (without its newline). Returns "" while the run progresses;
   // once it stalls, what it stalled on: "Gmsh's surface 1 (CAD face 3): its invalid elements
-  // rose from 16 to 56 to 234 as Gmsh refined its edges".
+  // rose from 16 to 56 to 234 as Gmsh refined its edges" ("(CAD face 3, Face7 as given)" where
+  // the model was numbered afresh).
   std::string operator()(const std::string& line);
 
   // What Gmsh was doing when its output ended, for a crash's message: "while meshing Gmsh's
@@ -44,6 +49,7 @@ class GmshProgressWatch {
   std::string seeMessage(const std::string& message);
 
   int verbosity_;
+  std::function<std::string(int dim, int index)> givenNames_;
   std::map<std::pair<int, int>, int> cad_;    // Gmsh (dim, tag) -> CAD number
   std::map<int, int> entries_;                // Gmsh surface tag -> times entered
   std::map<int, std::vector<long>> invalid_;  // Gmsh surface tag -> invalid counts so far

@@ -372,7 +372,8 @@ Mesh generateLinearMesh(const CadModel& cad, const LinearMeshOptions& options) {
     }
     GmshRun told = r;
     told.tellEntities = o.isolate;
-    const auto watch = o.isolate ? std::make_shared<GmshProgressWatch>(o.verbosity) : nullptr;
+    const auto watch =
+        o.isolate ? std::make_shared<GmshProgressWatch>(o.verbosity, o.givenNames) : nullptr;
     const std::string bytes = withGmsh(
         o, "Gmsh's meshing of " + cad.sourceName(),
         [&](GmshSession&) {

@@ -40,6 +40,11 @@ struct LinearMeshOptions {
   std::string timeLimitName;
   std::function<bool()> cancelRequested;
   std::function<void(const std::string&)> note;
+  // The names the user knows a sub-shape of the model meshed by (dimension 0..3, its 1-based
+  // number), where healing or imprinting numbered the model afresh (NumberingMap::givenNames:
+  // "Face7"); empty or "": the model's own numbers are the user's. A message naming a CAD
+  // entity (a stalled or crashed Gmsh run) adds it.
+  std::function<std::string(int dim, int index)> givenNames;
 
   static LinearMeshOptions uniform(double size) {
     LinearMeshOptions o;

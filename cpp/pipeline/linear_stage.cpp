@@ -30,6 +30,10 @@ LinearStage::LinearStage(MeshResult& result, const MeshingOptions& options, JobB
   if (observer != nullptr)
     base_.cancelRequested = [observer] { return observer->cancelRequested(); };
   base_.note = [&result](const std::string& note) { result.notes.push_back(note); };
+  // Read when a message is written: a fallback that meshes the solids apart maps them anew.
+  base_.givenNames = [&result](int dim, int index) {
+    return result.healing.numbering.givenNames(dim, index);
+  };
 }
 
 void LinearStage::limitGmsh(LinearMeshOptions& o, const std::string& stage) {

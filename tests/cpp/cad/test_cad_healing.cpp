@@ -153,6 +153,25 @@ TEST(CadHealing, SewingNumbersAfreshAndTheRecordMapsTheFilesNumbers) {
                 dim == 2 ? 1 : faceOf.FindFromKey(after(k)).Extent())
           << dim << " " << k;
   }
+  // A message about a sub-shape of the model meshed names it as the file does: a face by its
+  // one original, an edge two faces shared by the two copies sewn into it (the hole's seam,
+  // which one face uses twice, by its one).
+  for (int i = 1; i <= map.originalCount(2); ++i)
+    EXPECT_EQ(map.givenNames(2, map.finalNumbers(2, i)[0]), "Face" + std::to_string(i));
+  int sewn = 0;
+  for (int k = 1; k <= map.finalCount(1); ++k) {
+    const std::vector<int> copies = map.originals(1, k);
+    ASSERT_FALSE(copies.empty()) << k;
+    ASSERT_LE(copies.size(), 2U) << k;
+    const std::string first = "Edge" + std::to_string(copies[0]);
+    EXPECT_EQ(map.givenNames(1, k),
+              copies.size() == 1 ? first : first + " and Edge" + std::to_string(copies[1]));
+    sewn += copies.size() == 2 ? 1 : 0;
+  }
+  EXPECT_GT(sewn, 0);
+  // The solid sewing made is none of the file's; a number the model lacks is named so too.
+  EXPECT_EQ(map.givenNames(3, 1), "no numbered solid of the model as given");
+  EXPECT_EQ(map.givenNames(2, map.finalCount(2) + 1), "no numbered face of the model as given");
 }
 
 // Two closed shells whose bounding boxes nest: one inside the other's material is a void and

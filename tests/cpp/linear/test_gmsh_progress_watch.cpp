@@ -51,6 +51,18 @@ TEST(GmshProgressWatch, InvalidElementsGrowingTwiceInARowIsAStallOnTheCadFace) {
             "Gmsh refined its edges");
 }
 
+// Where healing or imprinting numbered the model afresh, the stall also names the face as the
+// user knows it (LinearMeshOptions::givenNames).
+TEST(GmshProgressWatch, AStallNamesTheFaceAsGivenToo) {
+  GmshProgressWatch watch(0, [](int dim, int index) {
+    return dim == 2 && index == 3 ? std::string("Face7") : std::string();
+  });
+  watch(gmshEntityLine(2, 1, 3));
+  EXPECT_EQ(firstStall(watch, growingRounds(3)),
+            "Gmsh's surface 1 (CAD face 3, Face7 as given): its invalid elements rose from 16 to "
+            "56 to 234 as Gmsh refined its edges");
+}
+
 TEST(GmshProgressWatch, FewerInvalidElementsAfterARoundIsProgress) {
   GmshProgressWatch watch(0);
   const std::vector<std::string> lines = {
