@@ -534,6 +534,15 @@ TEST(Optimiser, ResultDoesNotDependOnTheNumberOfThreadsWithTheFacetTerm) {
   EXPECT_NE(one.xyz, off.xyz) << "the facet term changed nothing";
 }
 
+// The box with a hole at order 3, size 1, curved and not optimised, with its CAD: nodes that
+// slide.
+MeshResult curvedBoxWithHole() {
+  MeshingOptions meshing;
+  meshing.order = 3;
+  meshing.size = 1.0;
+  return runMeshPipeline(CadSource::brepText(test::brepText(test::boxWithHole())), meshing);
+}
+
 // The sweeps run on the mesh renumbered along a space-filling curve (OptimiserOptions::
 // spatialOrder), for locality only: every choice made in sequence follows the caller's numbers,
 // so the result is the one without the renumbering, bit for bit: in 3D and 2D, with the mesh's
@@ -599,11 +608,7 @@ TEST(Optimiser, TheSpatialOrderChangesNoResult) {
   naca.functional = Functional::LinearElastic;
   naca.threads = 1;
   for (const Input& in : nacas()) cases.push_back({in.name + " 2D", in.mesh, naca});
-  MeshingOptions meshing;
-  meshing.order = 3;
-  meshing.size = 1.0;
-  const MeshResult hole =
-      runMeshPipeline(CadSource::brepText(test::brepText(test::boxWithHole())), meshing);
+  const MeshResult hole = curvedBoxWithHole();
   cases.push_back({"box with a hole, sliding on the CAD", hole.mesh, plain, hole.cad.get()});
   OptimiserOptions facets = plain;
   facets.facetWeight = 1.0;
@@ -761,11 +766,7 @@ TEST(Optimiser, SettledNodesRestBelowTheLargerTolerance) {
 // a larger tolerance for the sliding ones leaves fewer of their visits (the first sweep visits
 // every node either way) and still improves the mesh.
 TEST(Optimiser, SettledNodesOnTheCadRestBelowTheirOwnTolerance) {
-  MeshingOptions meshing;
-  meshing.order = 3;
-  meshing.size = 1.0;
-  const MeshResult hole =
-      runMeshPipeline(CadSource::brepText(test::brepText(test::boxWithHole())), meshing);
+  const MeshResult hole = curvedBoxWithHole();
   OptimiserOptions options;
   options.maxIterations = 6;
   options.focusPasses = 0;
