@@ -677,15 +677,22 @@ TEST(Optimiser, AFailedRunLeavesTheCallersMeshAndNumbers) {
   EXPECT_EQ(flat.blocks[0].nodes, given.blocks[0].nodes);
 }
 
+// Six sweeps each (no energy rule), without focused passes, on 2 threads: the runs the
+// resting and settled tests compare.
+OptimiserOptions sixPlainSweeps() {
+  OptimiserOptions options;
+  options.maxIterations = 6;
+  options.focusPasses = 0;
+  options.threads = 2;
+  options.energyTolerance = 0.0;
+  return options;
+}
+
 TEST(Optimiser, RestingNodesAreVisitedOnlyWhenTheirNeighboursMove) {
   for (const Input& in : cubeSpheres()) {
     SCOPED_TRACE(in.name);
     Mesh every = in.mesh, active = in.mesh;
-    OptimiserOptions options;
-    options.maxIterations = 6;
-    options.focusPasses = 0;
-    options.threads = 2;
-    options.energyTolerance = 0.0;  // six sweeps each
+    OptimiserOptions options = sixPlainSweeps();
     // Every free node in every sweep, where each moves in each (a node whose step is exactly
     // zero rests until a neighbour moves: on a straight-sided patch, hence the made mesh's
     // perturbation).
@@ -721,13 +728,9 @@ TEST(Optimiser, SettledNodesRestBelowTheLargerTolerance) {
   for (const Input& in : cubeSpheres()) {
     SCOPED_TRACE(in.name);
     Mesh off = in.mesh, on = in.mesh;
-    OptimiserOptions options;
-    options.maxIterations = 6;
-    options.focusPasses = 0;
-    options.threads = 2;
-    options.energyTolerance = 0.0;  // six sweeps each
-    options.tolerance = 0.0;        // (settled, a sweep may move nothing)
-    options.settledQuality = 2.0;   // none settles (the default)
+    OptimiserOptions options = sixPlainSweeps();
+    options.tolerance = 0.0;       // (settled, a sweep may move nothing)
+    options.settledQuality = 2.0;  // none settles (the default)
     const OptimiserResult plain = optimiseMesh(off, options);
     options.settledQuality = 0.0;  // every node of valid elements away from the worst does
     const OptimiserResult settled = optimiseMesh(on, options);
@@ -767,11 +770,7 @@ TEST(Optimiser, SettledNodesRestBelowTheLargerTolerance) {
 // every node either way) and still improves the mesh.
 TEST(Optimiser, SettledNodesOnTheCadRestBelowTheirOwnTolerance) {
   const MeshResult hole = curvedBoxWithHole();
-  OptimiserOptions options;
-  options.maxIterations = 6;
-  options.focusPasses = 0;
-  options.threads = 2;
-  options.energyTolerance = 0.0;
+  OptimiserOptions options = sixPlainSweeps();
   options.tolerance = 0.0;
   options.settledQuality = 0.0;
   options.settledSlidingTolerance = options.activeTolerance;  // as inside a node's own move
