@@ -101,8 +101,14 @@ class TetDisplacement {
   }
 
   // E(l) plus the F_f(l) of the four faces.
-  Eigen::Vector3d cell(const Bary& l) const {
+  Eigen::Vector3d cell(const Bary& l) {
     const int p = l_.order;
+    if (residual_.empty()) {  // what each face node adds to E: the same for every cell node
+      residual_.assign(d_.size(), Eigen::Vector3d::Zero());
+      for (std::size_t n = 0; n < d_.size(); ++n)
+        if (l_.interiorCoordinates(static_cast<int>(n)) == 3)
+          residual_[n] = d_[n] - edges(l_.bary(static_cast<int>(n)));
+    }
     Eigen::Vector3d sum = edges(l);
     for (int o = 0; o < 4; ++o) {
       const double w = 1.0 - l[o];
@@ -114,7 +120,7 @@ class TetDisplacement {
         double basis = 1.0;
         for (int m = 0; m < 4; ++m)
           if (m != o) basis *= silvester(b[m], p * l[m] / w);
-        r += basis * (d_[static_cast<std::size_t>(n)] - edges(l_.bary(n)));
+        r += basis * residual_[static_cast<std::size_t>(n)];
       }
       sum += w * w * w * r;
     }
@@ -130,6 +136,7 @@ class TetDisplacement {
   const Mesh& mesh_;
   std::array<Eigen::Vector3d, 4> v_;
   std::vector<Eigen::Vector3d> d_;
+  std::vector<Eigen::Vector3d> residual_;  // per face node, once cell() is first asked
 };
 
 }  // namespace
