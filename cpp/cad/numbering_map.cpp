@@ -271,7 +271,7 @@ std::string NumberingMap::givenNames(int dim, int index) const {
       index >= 1 && index <= finalCount(dim) ? originals(dim, index) : std::vector<int>{};
   if (given.empty()) {
     static const char* const kinds[] = {"vertex", "edge", "face", "solid"};
-    return std::string("no numbered ") + kinds[std::clamp(dim, 0, 3)] + " of the model as given";
+    return std::string("no numbered ") + kinds[std::clamp(dim, 0, 3)];
   }
   std::string text;
   for (std::size_t i = 0; i < given.size(); ++i) {

@@ -70,8 +70,8 @@ class NumberingMap {
 
   // originals() as a user names them, for a message about final sub-shape `index` of the
   // model meshed: "Face7", "Face7 and Face9", "Face3, Face4 and Face8"; "" where the numbers of
-  // dimension `dim` did not change (the final name is the user's), and "no numbered <kind> of
-  // the model as given" for one no original became (or an index the final model lacks).
+  // dimension `dim` did not change (the final name is the user's), and "no numbered <kind>"
+  // ("no numbered solid") for one no original became (or an index the final model lacks).
   std::string givenNames(int dim, int index) const;
 
   // What removed original number `index` of dimension `dim` ("" when it was not removed, or

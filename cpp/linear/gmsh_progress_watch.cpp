@@ -48,7 +48,7 @@ std::string GmshProgressWatch::name(int dim, int tag) const {
   if (it == cad_.end()) return text;
   text += std::string(" (CAD ") + kCad[dim] + " " + std::to_string(it->second);
   const std::string given = givenNames_ ? givenNames_(dim, it->second) : std::string();
-  return text + (given.empty() ? ")" : ", " + given + " as given)");
+  return text + (given.empty() ? ")" : "; as given: " + given + ")");
 }
 
 std::string GmshProgressWatch::operator()(const std::string& line) {

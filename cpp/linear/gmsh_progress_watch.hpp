@@ -34,7 +34,7 @@ class GmshProgressWatch {
 
   // One line of the run's output (without its newline). Returns "" while the run progresses;
   // once it stalls, what it stalled on: "Gmsh's surface 1 (CAD face 3): its invalid elements
-  // rose from 16 to 56 to 234 as Gmsh refined its edges" ("(CAD face 3, Face7 as given)" where
+  // rose from 16 to 56 to 234 as Gmsh refined its edges" ("(CAD face 3; as given: Face7)" where
   // the model was numbered afresh).
   std::string operator()(const std::string& line);
 

@@ -170,8 +170,8 @@ TEST(CadHealing, SewingNumbersAfreshAndTheRecordMapsTheFilesNumbers) {
   }
   EXPECT_GT(sewn, 0);
   // The solid sewing made is none of the file's; a number the model lacks is named so too.
-  EXPECT_EQ(map.givenNames(3, 1), "no numbered solid of the model as given");
-  EXPECT_EQ(map.givenNames(2, map.finalCount(2) + 1), "no numbered face of the model as given");
+  EXPECT_EQ(map.givenNames(3, 1), "no numbered solid");
+  EXPECT_EQ(map.givenNames(2, map.finalCount(2) + 1), "no numbered face");
 }
 
 // Two closed shells whose bounding boxes nest: one inside the other's material is a void and

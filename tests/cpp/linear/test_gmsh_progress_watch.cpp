@@ -59,7 +59,7 @@ TEST(GmshProgressWatch, AStallNamesTheFaceAsGivenToo) {
   });
   watch(gmshEntityLine(2, 1, 3));
   EXPECT_EQ(firstStall(watch, growingRounds(3)),
-            "Gmsh's surface 1 (CAD face 3, Face7 as given): its invalid elements rose from 16 to "
+            "Gmsh's surface 1 (CAD face 3; as given: Face7): its invalid elements rose from 16 to "
             "56 to 234 as Gmsh refined its edges");
 }
 
