@@ -57,6 +57,13 @@ inline CadModel toModel(const TopoDS_Shape& shape) {
   return CadModel::fromBrepText(brepText(shape));
 }
 
+// The 1-based index of the model's vertex at p (to 1e-9), or 0 where there is none.
+inline int vertexAt(const CadModel& cad, const Eigen::Vector3d& p) {
+  for (int v = 1; v <= cad.numVertices(); ++v)
+    if ((cad.vertexPoint(v) - p).norm() < 1e-9) return v;
+  return 0;
+}
+
 inline TopoDS_Shape sphere(double r) {
   return BRepPrimAPI_MakeSphere(r).Shape();
 }

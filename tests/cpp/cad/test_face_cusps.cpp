@@ -12,17 +12,11 @@
 namespace homesh {
 namespace {
 
-int vertexAt(const CadModel& cad, const Eigen::Vector3d& p) {
-  for (int v = 1; v <= cad.numVertices(); ++v)
-    if ((cad.vertexPoint(v) - p).norm() < 1e-9) return v;
-  return 0;
-}
-
 TEST(FaceCusps, TheTangentCornerOfTheTopAndBottomFacesIsACusp) {
   const CadModel cad = test::toModel(test::cuspPrism());
   const std::vector<FaceCusp> cusps = findFaceCusps(cad);
   ASSERT_EQ(cusps.size(), 2u);
-  const std::set<int> corners = {vertexAt(cad, {0, 0, 0}), vertexAt(cad, {0, 0, 1})};
+  const std::set<int> corners = {test::vertexAt(cad, {0, 0, 0}), test::vertexAt(cad, {0, 0, 1})};
   std::set<int> found;
   for (const FaceCusp& c : cusps) {
     found.insert(c.vertex);
