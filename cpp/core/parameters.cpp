@@ -37,12 +37,13 @@ std::vector<ParameterDefinition> meshAndCadRows() {
        "as they slide, so the curved boundary stays on the CAD between them (0: off; 1 is a "
        "good start)"},
       {"fidelity_weight", "FidelityWeight", "--fidelity-weight", "", "fidelity weight",
-       ParameterKind::Real, 0, 1000, false, 0, false, false, "mesh",
-       "Weight of the boundary's fidelity to the CAD in the optimiser's energy (3D meshes): at "
-       "the boundary facets' quadrature points, the squared distance off the CAD's tangent "
-       "plane (relative to the facet) and the squared sine of the angle between the facet's and "
-       "the CAD's normals, so that sliding nodes keep the curved boundary on the CAD between "
-       "them; a node takes it once its own elements are proven valid (0: off)"},
+       ParameterKind::Real, 0, 1000, false, 2, false, false, "mesh",
+       "Weight of the boundary's fidelity to the CAD in the optimiser's energy (3D meshes), added "
+       "once every element is proven valid: at the boundary facets' quadrature points, the "
+       "squared distance off the CAD's tangent plane (relative to the facet) and the squared "
+       "sine of the angle between the facet's and the CAD's normals, so that sliding nodes keep "
+       "the curved boundary on the CAD between them (0: off; higher follows the CAD closer at "
+       "some cost to the worst element)"},
       {"linear_seconds", "LinearTimeLimit", "--linear-time-limit", "", "linear meshing time limit",
        ParameterKind::Real, 0, kNoLimit, false, 600, false, false, "mesh",
        "Seconds Gmsh's linear meshing may take (each run, in its own process); it is then "

@@ -3,9 +3,12 @@
 #include <omp.h>
 
 #include <Eigen/Dense>
+#include <map>
 #include <optional>
 #include <string>
+#include <utility>
 
+#include "cad/face_apexes.hpp"
 #include "core/error.hpp"
 #include "core/first_failure.hpp"
 #include "element/quadrature.hpp"
@@ -130,7 +133,10 @@ double FacetEnergy::facetEnergy(const Facet& f, const std::vector<Vec>& position
     const double c1 = follows ? m.col(0).dot(normal) : 0.0;
     const double c2 = follows ? m.col(1).dot(normal) : 0.0;
     const double wd = scale_[k] * (weight_ * f.size), wf = scale_[k] * (fidelity_ * f.size);
-    if (follows) energy += wf * (rq * rq + c1 * c1 + c2 * c2);
+    // rho(q) = q / (1 + q / s): q for small deviations, at most s for large ones (see the
+    // header); rho' = 1 / bend^2, rho'' = -2 / (s bend^3).
+    const double q0 = rq * rq + c1 * c1 + c2 * c2, bend = 1.0 + q0 / kFidelitySaturation;
+    if (follows) energy += wf * q0 / bend;
     if (patch == nullptr) {
       if (distortion) energy += wd * facet_detail::density<double>(m.col(0), m.col(1));
       continue;
@@ -143,8 +149,10 @@ double FacetEnergy::facetEnergy(const Facet& f, const std::vector<Vec>& position
       const double l = s.values[at] / f.size;
       const double slope = 2.0 * (rq * l + c1 * a[0] + c2 * a[1]);
       const double curvature = 2.0 * (l * l + a[0] * a[0] + a[1] * a[1]);
-      *g += wf * slope * normal;
-      *h += wf * curvature * normal * normal.transpose();
+      const double first = 1.0 / (bend * bend);
+      const double second = -2.0 / (kFidelitySaturation * bend * bend * bend);
+      *g += wf * first * slope * normal;
+      *h += wf * (first * curvature + second * slope * slope) * normal * normal.transpose();
       if (size != nullptr) *size += wf * (rq * rq + c1 * c1 + c2 * c2);
       patch->normal.push_back(normal);
       patch->r.push_back(rq);
@@ -206,9 +214,35 @@ double FacetEnergy::energyAfter(const Patch& patch, const Vec& d) {
     const double s = patch.normal[i].dot(d);
     const double r = patch.r[i] + patch.l[i] * s, c1 = patch.c1[i] + patch.b1[i] * s,
                  c2 = patch.c2[i] + patch.b2[i] * s;
-    energy += patch.wf[i] * (r * r + c1 * c1 + c2 * c2);
+    const double q = r * r + c1 * c1 + c2 * c2;
+    energy += patch.wf[i] * q / (1.0 + q / kFidelitySaturation);
   }
   return energy;
+}
+
+std::size_t FacetEnergy::dropApexFacets(const Mesh& mesh, const CadModel& cad) {
+  std::map<std::pair<int, int>, bool> apex;  // (face, vertex): few vertices, each tested once
+  std::size_t dropped = 0;
+  for (Facet& f : facets_) {
+    const Shape& s = shapes_[static_cast<std::size_t>(f.shape)];
+    const std::int64_t* v = s.cells->element(f.cell);
+    const int face = s.cells->entity[f.cell];
+    if (face < 1 || face > cad.numFaces()) continue;
+    for (int n = 0; n < s.vertices && f.followsCad; ++n) {
+      const auto id = static_cast<std::size_t>(v[n]);
+      if (mesh.nodeCadDim[id] != 0 || mesh.nodeCadIndex[id] < 1) continue;
+      const std::pair<int, int> key{face, mesh.nodeCadIndex[id]};
+      auto it = apex.find(key);
+      if (it == apex.end()) it = apex.emplace(key, isFaceApex(cad, face, key.second)).first;
+      if (it->second) f.followsCad = false;
+    }
+    if (!f.followsCad) {
+      ++dropped;
+      for (int q = 0; q < s.points; ++q)
+        normal_[f.first + static_cast<std::size_t>(q)] = Vec::Zero();
+    }
+  }
+  return dropped;
 }
 
 void FacetEnergy::refreshTargets(const std::vector<Vec>& positions, const Mesh& mesh,
@@ -224,7 +258,7 @@ void FacetEnergy::refreshTargets(const std::vector<Vec>& positions, const Mesh& 
       const Shape& s = shapes_[static_cast<std::size_t>(f.shape)];
       const std::int64_t* v = s.cells->element(f.cell);
       const int face = s.cells->entity[f.cell];
-      if (face < 1 || face > cad.numFaces()) continue;
+      if (face < 1 || face > cad.numFaces() || !f.followsCad) continue;
       for (int q = 0; q < s.points; ++q) {
         const auto k = f.first + static_cast<std::size_t>(q);
         Vec x = Vec::Zero();

@@ -94,7 +94,11 @@ void NodeStep<D>::buildFacets(const std::vector<std::int64_t>& free, const CadMo
     if (!any) return;
     facetEnergy_ = std::make_unique<FacetEnergy>(mesh_.mesh, mesh_.position, movable,
                                                  options_.facetWeight, options_.fidelityWeight);
-    if (facetEnergy_->empty()) facetEnergy_.reset();
+    if (facetEnergy_->empty()) {
+      facetEnergy_.reset();
+      return;
+    }
+    if (options_.fidelityWeight > 0.0) facetEnergy_->dropApexFacets(mesh_.mesh, *cad);
   }
 }
 
@@ -103,21 +107,6 @@ void NodeStep<D>::setFacetsOn(bool on) {
   facetsOn_ = on;
   if constexpr (D == 3) {
     if (facetEnergy_ != nullptr) facetEnergy_->setDistortionOn(on);
-  }
-}
-
-template <int D>
-bool NodeStep<D>::facetTermActive(std::int64_t node) const {
-  if (!hasFacets()) return false;
-  if (facetsOn_) return true;
-  if constexpr (D == 3) {
-    if (!facetEnergy_->hasFidelity() || validity_ == nullptr) return false;
-    const auto n = static_cast<std::size_t>(node);
-    for (std::size_t k = mesh_.incidenceStart[n]; k < mesh_.incidenceStart[n + 1]; ++k)
-      if ((*validity_)[mesh_.globalIndex(mesh_.incidence[k])] != Validity::Valid) return false;
-    return true;
-  } else {
-    return false;
   }
 }
 
@@ -279,12 +268,11 @@ double NodeStep<D>::slideOn(const CadModel& cad, std::int64_t node, Patch<D>& pa
   double* param = &mesh_.mesh.nodeCadParam[2 * node];
   ++patch.slides;
   const LocalCadModel<D>& model = sliding_.currentModel(cad, node, patch.cadEvaluations);
-  // The boundary facets' term joins the volume patch's once the mesh is valid (facetsOn_),
-  // its fidelity part once the node's elements are (facetTermActive).
+  // The boundary facets' term joins the volume patch's once the mesh is valid (facetsOn_).
   double e0 = volumeEnergy;
   Vec grad = volumeGrad;
   Mat hess = volumeHess;
-  const bool facets = facetTermActive(node);
+  const bool facets = facetsOn_ && hasFacets();
   if (facets) {
     double size = 0.0;
     const double ef = facetAssemble(node, grad, hess, patch, size);

@@ -55,8 +55,7 @@ class NodeStep {
       : mesh_(mesh), sliding_(sliding), options_(options), lockedNormal_(lockedNormal) {}
 
   // The boundary facets of the free sliding nodes (3D, with CAD and options.facetWeight or
-  // fidelityWeight > 0); none otherwise. The term is off until setFacetsOn() (its fidelity
-  // part: at a node, until the node's elements are proven valid, facetTermActive).
+  // fidelityWeight > 0); none otherwise. The term is off until setFacetsOn().
   void buildFacets(const std::vector<std::int64_t>& free, const CadModel* cad);
   // The facet term's fidelity targets (the CAD's foot points and normals) at the current
   // positions (FacetEnergy::refreshTargets).
@@ -67,14 +66,6 @@ class NodeStep {
   // proven-valid mesh; untangling comes first).
   bool facetsOn() const { return facetsOn_; }
   void setFacetsOn(bool on);
-  // Whether the steps at `node` add the facet term: once its distortion part has joined; before,
-  // its fidelity part alone where the node's elements are all proven valid (validity(): the
-  // last evaluation), so that sliding untangles first and the CAD's pull joins node by node
-  // rather than only once the whole mesh is valid (a run that never gets there would not have
-  // it at all).
-  bool facetTermActive(std::int64_t node) const;
-  // Per element (global index), its validity at the last evaluation; read by facetTermActive.
-  void setValidity(const std::vector<Validity>* validity) { validity_ = validity; }
   // Whether the node slides on the CAD (its steps are in the CAD's parameters).
   bool slides(std::int64_t node) const { return sliding_.parameters(node) != 0; }
   // Whether the node is a vertex of a boundary facet of the term (after buildFacets).
@@ -111,11 +102,9 @@ class NodeStep {
   const OptimiserOptions& options_;
   const std::vector<Vec>& lockedNormal_;
   // The boundary facets' term (OptimiserOptions::facetWeight, fidelityWeight); null without
-  // them. facetsOn_: the distortion part has joined; the
-  // steps add it, once the mesh is proven valid.
+  // them. facetsOn_: the steps add it (both parts), once the mesh is proven valid.
   std::unique_ptr<FacetEnergy> facetEnergy_;
   bool facetsOn_ = false;
-  const std::vector<Validity>* validity_ = nullptr;
 };
 
 extern template class NodeStep<2>;

@@ -78,7 +78,6 @@ class Optimiser {
     result_.functional = options_.functional;
     mesh_.build();
     quality_.measureInput(startQuality_);  // certified quality of every element, before
-    step_.setValidity(&quality_.validity());
     const IterationRecord before = quality_.summarise(0, 0.0, t0);
     result_.worstBefore = before.worst;
     result_.invalidBefore = before.invalid;
@@ -101,7 +100,7 @@ class Optimiser {
     Kept best{before, {}, {}};
     // Before the energy: it counts the term.
     step_.setFacetsOn(before.invalid + before.undecided == 0);
-    step_.refreshFacetTargets();
+    if (step_.facetsOn()) step_.refreshFacetTargets();
     best.record.energy = result_.energyBefore = totalEnergy();
     Mesh& mesh = mesh_.mesh;
     const std::vector<double> input = mesh.xyz, inputParam = mesh.nodeCadParam;
@@ -197,9 +196,9 @@ class Optimiser {
       // The fidelity targets follow the sweeps (a lagged model of the distance to the CAD): the
       // last record's energy is taken again against the new ones, so that the stop rules
       // compare a sweep's start and end under one model.
-      if (it > 1 && step_.hasFidelity()) {
+      if (it > 1 && step_.hasFidelity() && step_.facetsOn()) {
         step_.refreshFacetTargets();
-        if (step_.facetsOn()) previous.energy = totalEnergy();  // before, the total has no term
+        previous.energy = totalEnergy();
       }
       const auto s0 = Clock::now();
       Moves moved;
@@ -213,8 +212,7 @@ class Optimiser {
       }
       result_.sweepSeconds += since(s0);
       IterationRecord record = sweepRecord(it, moved, t0);
-      // The facet term joins once the mesh is proven valid (its fidelity part, already on at
-      // the nodes whose elements were, joins the total): every node of a facet is visited
+      // The facet term joins once the mesh is proven valid: every node of a facet is visited
       // again (resting nodes too), and the sweep is not judged by the stop rules, whose energy
       // would compare totals with and without the term.
       const bool switching =
@@ -287,6 +285,7 @@ class Optimiser {
   // The boundary facets' term joins: every node of a facet is visited in the next sweep.
   void switchFacetsOn() {
     step_.setFacetsOn(true);
+    step_.refreshFacetTargets();  // at the positions the term starts from
     for (const std::int64_t node : free_.nodes)
       if (step_.touchesFacet(node)) sweeper_.wake(node);
   }

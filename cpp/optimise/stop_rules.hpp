@@ -92,9 +92,8 @@ bool acceptable(const IterationRecord& r, const IterationRecord& input);
 // Fewer elements not proven valid first, then the better worst value, then, with the worst
 // value unchanged to the last bit (the worst element's nodes did not move: fixed, or not
 // reached before the time limit), the lower energy: the rest of the mesh improved. Two such
-// records have the facet term alike: it joins the total energy at the first proven-valid record
-// (its fidelity part acts at valid nodes before, uncounted), and every record before it has
-// elements not proven valid.
+// records have the facet term alike: it joins the total energy at the first proven-valid record,
+// and every record before it has elements not proven valid.
 bool better(const IterationRecord& r, const IterationRecord& than);
 
 }  // namespace homesh::optimiser

@@ -381,7 +381,7 @@ def test_the_boundary_terms_reach_the_core_and_are_checked(data, key, value, nam
     # The sphere at size 0.5, order 4: the optimiser slides its nodes with and without the
     # term; both valid, and the term changes the result (it is applied, not dropped).
     text = (data / "sphere.brep").read_text()
-    plain = homesh.mesh(text, order=4, size=0.5, optimise=20)
+    plain = homesh.mesh(text, order=4, size=0.5, optimise=20, **{key: 0.0})
     term = homesh.mesh(text, order=4, size=0.5, optimise=20, **{key: value})
     for m in (plain, term):
         assert m.report()["optimiser"]["invalid_after"] == 0

@@ -50,6 +50,7 @@ std::pair<MeshResult, MeshResult> withAndWithout(const char* name, double size, 
   // The figures below were measured with the sphere and its box meshed apart on their two
   // sphere faces, as before touching solids were imprinted (cad/solid_imprint.hpp).
   options.imprint = false;
+  options.fidelityWeight = 0.0;  // "without": no boundary term (the default has the fidelity's)
   std::pair<MeshResult, MeshResult> r{runMeshPipeline(CadSource::file(sphereBox), options), {}};
   turnOn(options);
   r.second = runMeshPipeline(CadSource::file(sphereBox), options);
@@ -85,21 +86,33 @@ TEST(MeshPipeline, TheFacetTermKeepsSlidingBoundaryNodesSpreadOnTheCad) {
   EXPECT_GT(with.quality.scaled.min, 0.0);
 }
 
-// The optimiser's fidelity term (MeshingOptions::fidelityWeight) on the sphere in a box at size
-// 1.2, order 4: the boundary nodes slide along the sphere to untangle and improve the elements,
-// and without the term the curved surface between them ends 1.4e-2 off the sphere (radius 1)
-// and 14 degrees off its normal (curving alone: the interpolation's 1e-5 and 0.03 degrees).
-// With weight 10, 8.4e-4 and 1.45 degrees, the worst element 0.298 instead of 0.171
-// (2026-11-30; with the term on, no node rests sooner for being in good elements: with the
-// inside's nodes resting it was 3.9 degrees); the test asks for a quarter of the distance and
-// angle, every element proven valid both ways (with the default repair rounds, which this size
-// needs either way).
-TEST(MeshPipeline, TheFidelityTermKeepsTheSurfaceBetweenSlidingNodesOnTheCad) {
-  const auto [without, with] = withAndWithout("fidelity term", 1.2, MeshingOptions{}.repairRounds,
-                                              [](MeshingOptions& o) { o.fidelityWeight = 10.0; });
+// The optimiser's fidelity term (MeshingOptions::fidelityWeight), on by default, on the sphere
+// in a box at size 0.8, order 4 (its sphere and box imprinted, as by default): the boundary
+// nodes slide along the sphere to improve the elements, and without the term the curved surface
+// between them ends 7.2e-4 of the diagonal off the sphere and 7.0 degrees off its normal; with
+// the default weight, joining once the mesh is valid, 1.7e-4 and 1.6 degrees, the worst element
+// 0.409 instead of 0.400 (2026-11-30). The test asks for a third of the distance and angle,
+// every element proven valid both ways.
+TEST(MeshPipeline, TheDefaultFidelityTermKeepsTheSurfaceBetweenSlidingNodesOnTheCad) {
+  ASSERT_GT(MeshingOptions{}.fidelityWeight, 0.0) << "the term is on by default";
+  const std::string sphereBox = std::string(HOMESH_SOURCE_DIR) + "/examples/sphere_box.step";
+  MeshingOptions options;
+  options.order = 4;
+  options.size = 0.8;
+  options.optimiseIterations = 100;
+  options.threads = 2;
+  const MeshResult with = runMeshPipeline(CadSource::file(sphereBox), options);
+  options.fidelityWeight = 0.0;
+  const MeshResult without = runMeshPipeline(CadSource::file(sphereBox), options);
   ASSERT_TRUE(without.geometry && with.geometry);
-  EXPECT_LT(with.geometry->maxDistance, 0.25 * without.geometry->maxDistance);
-  EXPECT_LT(with.geometry->maxAngleDeg, 0.25 * without.geometry->maxAngleDeg);
+  std::printf("fidelity term: distance %.2e -> %.2e, angle %.2f -> %.2f deg, worst %.3f -> %.3f\n",
+              without.geometry->maxDistance, with.geometry->maxDistance,
+              without.geometry->maxAngleDeg, with.geometry->maxAngleDeg, without.quality.scaled.min,
+              with.quality.scaled.min);
+  for (const MeshResult* m : {&without, &with})
+    EXPECT_EQ(m->quality.invalid + m->quality.undecided, 0U);
+  EXPECT_LT(with.geometry->maxDistance, without.geometry->maxDistance / 3.0);
+  EXPECT_LT(with.geometry->maxAngleDeg, without.geometry->maxAngleDeg / 3.0);
 }
 
 TEST(MeshPipeline, RunsEveryStageAndReports) {
