@@ -111,7 +111,7 @@ double FacetEnergy::facetEnergy(const Facet& f, const std::vector<Vec>& position
                                 Vec* g, Mat* h, Patch* patch, double* size) const {
   const Shape& s = shapes_[static_cast<std::size_t>(f.shape)];
   const std::int64_t* v = s.cells->element(f.cell);
-  const bool distortion = distortionOn_ && weight_ > 0.0, fidelity = fidelity_ > 0.0;
+  const bool distortion = weight_ > 0.0, fidelity = fidelity_ > 0.0;
   double energy = 0.0;
   for (int q = 0; q < s.points; ++q) {
     const auto k = f.first + static_cast<std::size_t>(q);

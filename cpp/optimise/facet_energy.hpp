@@ -97,11 +97,12 @@ bool derivatives(const Eigen::Matrix<T, 3, 1>& m1, const Eigen::Matrix<T, 3, 1>&
 
 }  // namespace facet_detail
 
+// s above: the fidelity part's largest contribution per point, relative to its weight.
+inline constexpr double kFidelitySaturation = 0.25;
+
 // The boundary facets around the movable nodes of a 3D mesh, with their ideal shapes and
 // quadrature, and the facet energy of one node's facets (as the optimiser's node patch: value,
 // gradient and Hessian at the node's position, then values after trial moves).
-// s above: the fidelity part's largest contribution per point, relative to its weight.
-inline constexpr double kFidelitySaturation = 0.25;
 
 class FacetEnergy {
  public:
@@ -145,8 +146,6 @@ class FacetEnergy {
   void refreshTargets(const std::vector<Vec>& positions, const Mesh& mesh,
                       const std::vector<CadModel>& cads);
   bool hasFidelity() const { return fidelity_ > 0.0; }
-  // Switches the distortion part (on from construction) off and on.
-  void setDistortionOn(bool on) { distortionOn_ = on; }
 
   // The energy of `node`'s facets at `positions`, with its gradient and Hessian in the node's
   // displacement (added to g and h); fills `patch`. Infinite (g, h untouched) where a facet is
@@ -196,7 +195,6 @@ class FacetEnergy {
   std::vector<Eigen::Matrix2d> invW_;  // per facet point: W^-1
   std::vector<double> scale_;          // per facet point: quadrature weight x |det W|
   double weight_ = 0.0, fidelity_ = 0.0;
-  bool distortionOn_ = true;
   // The fidelity part's targets per facet point: the foot on the CAD, the unit normal there
   // (zero: undefined, or not refreshed yet) and its face parameters (NaN: none yet).
   std::vector<Vec> foot_, normal_;

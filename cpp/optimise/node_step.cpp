@@ -103,14 +103,6 @@ void NodeStep<D>::buildFacets(const std::vector<std::int64_t>& free, const CadMo
 }
 
 template <int D>
-void NodeStep<D>::setFacetsOn(bool on) {
-  facetsOn_ = on;
-  if constexpr (D == 3) {
-    if (facetEnergy_ != nullptr) facetEnergy_->setDistortionOn(on);
-  }
-}
-
-template <int D>
 void NodeStep<D>::refreshFacetTargets() {
   if constexpr (D == 3) {
     if (facetEnergy_ != nullptr)

@@ -65,7 +65,7 @@ class NodeStep {
   // Whether the facet term has joined the whole mesh and its total energy (it waits for a
   // proven-valid mesh; untangling comes first).
   bool facetsOn() const { return facetsOn_; }
-  void setFacetsOn(bool on);
+  void setFacetsOn(bool on) { facetsOn_ = on; }
   // Whether the node slides on the CAD (its steps are in the CAD's parameters).
   bool slides(std::int64_t node) const { return sliding_.parameters(node) != 0; }
   // Whether the node is a vertex of a boundary facet of the term (after buildFacets).
