@@ -37,6 +37,14 @@ struct SurfaceDerivatives {
     if (!(m.norm() > 1e-8 * scale)) return std::nullopt;
     return m;
   }
+  // Per parameter direction (u, v): whether r does not move along it here (a pole, a cone's
+  // apex). Such a derivative vanishes up to the rounding of the surface's own formulas
+  // (cos(pi/2) ~ 1e-16 times the radius); 1e-7 of the other leaves ample room without mistaking
+  // a merely stretched chart.
+  std::array<bool, 2> degenerate() const {
+    const double nu = du.norm(), nv = dv.norm(), scale = std::max(nu, nv);
+    return {nu <= 1e-7 * scale, nv <= 1e-7 * scale};
+  }
 };
 
 struct CurveProjection {

@@ -25,9 +25,7 @@ bool isFaceApex(const CadModel& cad, int face, int vertex) {
     const SurfaceProjection at = cad.projectOnSurface(face, p);
     if (!(at.distance <= std::max(cad.tolerance(0, vertex), 1e-7 * cad.boundingDiagonal())))
       return false;
-    const SurfaceDerivatives d = cad.evaluateSurface(face, at.u, at.v);
-    const double nu = d.du.norm(), nv = d.dv.norm(), scale = std::max(nu, nv);
-    const bool uDegenerate = nu <= 1e-7 * scale, vDegenerate = nv <= 1e-7 * scale;
+    const auto [uDegenerate, vDegenerate] = cad.evaluateSurface(face, at.u, at.v).degenerate();
     if (uDegenerate == vDegenerate) return false;  // regular (or no derivative at all)
     const SurfaceBounds b = cad.faceBounds(face);
     // Around the vertex: the degenerate parameter over its whole range, the other one stepped

@@ -53,11 +53,7 @@ FaceParameter FaceChart::wrap(FaceParameter uv) const {
 }
 
 std::array<bool, 2> FaceChart::singular(const FaceParameter& uv) const {
-  const SurfaceDerivatives s = cad_.evaluateSurface(face_, uv[0], uv[1]);
-  const double nu = s.du.norm(), nv = s.dv.norm(), scale = std::max(nu, nv);
-  // A pole's derivative vanishes up to rounding of the surface's own formulas (cos(pi/2) ~ 1e-16
-  // times the radius); 1e-7 leaves ample room without mistaking a merely stretched chart.
-  return {nu <= 1e-7 * scale, nv <= 1e-7 * scale};
+  return cad_.evaluateSurface(face_, uv[0], uv[1]).degenerate();
 }
 
 bool FaceChart::contains(const FaceParameter& uv) const {
