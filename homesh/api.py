@@ -149,8 +149,8 @@ class HighOrderMesh:
         return json.loads(record)["optimiser"]
 
     def geometry(self):
-        """How closely the boundary follows the CAD, for a mesh made from CAD (None for a mesh
-        read from a file): the report's "geometry" record as a dict, with ``max_distance`` (and
+        """How closely the boundary follows the CAD, for a mesh made from CAD or read with
+        ``cad=`` (None for a mesh read from a file without it): the report's "geometry" record as a dict, with ``max_distance`` (and
         ``max_distance_relative`` to the model's diagonal) of boundary sample points to their
         CAD face or curve, ``max_normal_angle_deg`` and ``mean_normal_angle_deg`` between mesh
         and CAD normals, ``samples`` and the worst entity and point."""
@@ -232,13 +232,21 @@ def parameters():
     return [dict(p) for p in _PARAMETERS]
 
 
-def read(path, **options):
+def read(path, cad=None, **options):
     """Reads a mesh file: .msh (Gmsh 2.2 or 4.1, ASCII or binary), .xml (Nektar++, plain or
     compressed), or FreeCAD FEM's .unv (I-DEAS), .vtk (legacy VTK) and .vtu (VTK XML), linear or
     quadratic, and evaluates its quality. Solids a FEM file lists left-handed (FreeCAD's VTK
     export) are read mirrored: ``report()["notes"]`` says so. Raises FileError naming the file,
-    the line or data array and the element."""
-    return HighOrderMesh(_core.read_mesh(os.fspath(path), options))
+    the line or data array and the element.
+
+    With ``cad`` (the path of the CAD file the mesh was made from, as ``homesh quality --cad``
+    takes it), ``geometry()`` measures how closely the boundary follows it: each boundary cell
+    the file holds is put on the CAD face or curve its corners lie on (within
+    ``classify_tolerance``), and a corner on no CAD entity raises MeshingError naming it."""
+    if cad is None and "classify_tolerance" in options:
+        raise ParameterError("read: classify_tolerance needs cad, the CAD file to measure against")
+    return HighOrderMesh(_core.read_mesh(os.fspath(path), os.fspath(cad) if cad else "",
+                                         options))
 
 
 def load(path):

@@ -304,7 +304,11 @@ QualityCommand parseQuality(const std::vector<std::string>& args) {
   OptionTable table;
   addCommon(table, cmd.common, false, true);
   table.flag({"--strict"}, [&cmd] { cmd.strict = true; });
+  table.value({"--cad"}, [&cmd](const std::string&, const std::string& v) { cmd.cad = v; });
+  addTableOptions(table, cmd.options, {"classify_tolerance"});
   cmd.input = onlyInput(table.parse(args, 1, "quality"), "quality", "an INPUT mesh file");
+  if (cmd.cad.empty() && !cmd.options.empty())
+    throw UsageError{"'homesh quality': --classify-tolerance needs --cad CAD"};
   return cmd;
 }
 
@@ -547,10 +551,18 @@ FEM's .unv, .vtk and .vtu, linear or quadratic): per element type, the certified
 (Bezier bounds, as Gmsh's AnalyseMeshQuality) and the distortion against the straight-sided
 elements, worst, mean and histogram, and the number of invalid elements.
 
+With --cad, also how closely the mesh's boundary follows the CAD it was made from, measured as
+'homesh mesh' measures its own (the report's "geometry"): each boundary cell the file holds is
+put on the CAD face or curve its corners lie on, and sampled at quadrature points for its
+distance to the CAD and the angle between its normal and the CAD's. Meshes from Gmsh, NekMesh or
+HOMesh compare on one measure.
+
 options:
       --report FILE   write the JSON report ("-" for standard output)
       --strict        exit with status 3 if any element is invalid or not proven valid
-)" + commonHelp();
+      --cad CAD       the CAD file (STEP, IGES, BRep; a NekMesh .mcf reads its CAD in metres)
+)" + tableHelp({"classify_tolerance"}) +
+         commonHelp();
 }
 
 std::string convertHelp() {

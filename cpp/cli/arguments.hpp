@@ -51,6 +51,8 @@ struct MeshCommand {
 struct QualityCommand {
   std::string input;
   bool strict = false;  // exit status 3 if an element is invalid or undecided
+  std::string cad;      // with --cad: the boundary's distance and normal angle to this CAD
+  OptionMap options;    // classify_tolerance (with --cad)
   CommonOptions common;
 };
 

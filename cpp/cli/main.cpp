@@ -22,6 +22,7 @@
 #include "io/mesh_writers.hpp"
 #include "optimise/optimiser.hpp"
 #include "pipeline/case_setup.hpp"
+#include "pipeline/geometry_check.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/mesh_summary.hpp"
 #include "pipeline/nektar_read_back.hpp"
@@ -262,16 +263,46 @@ homesh::Mesh readMeshFile(const std::string& path, bool quiet, std::vector<std::
   return mesh;
 }
 
+// How closely the boundary follows the CAD (homesh quality --cad).
+void printGeometry(std::FILE* out, const homesh::FileGeometry& g) {
+  const homesh::GeometryAccuracy& a = g.accuracy;
+  std::fprintf(out, "  against %s:\n", g.cad.c_str());
+  std::fprintf(out,
+               "    distance to the CAD: max %.3g (%.3g of the diagonal, at %s), mean %.3g of "
+               "the diagonal, %zu samples\n",
+               a.maxDistance, a.maxDistanceRelative(),
+               a.worstEntity.empty() ? "-" : a.worstEntity.c_str(), a.meanDistanceRelative(),
+               a.samples);
+  std::fprintf(out, "    normal angle to the CAD: max %.3g deg (at %s), mean %.3g deg",
+               a.maxAngleDeg, a.worstAngleEntity.empty() ? "-" : a.worstAngleEntity.c_str(),
+               a.meanAngleDeg);
+  if (a.undefinedNormals > 0)
+    std::fprintf(out, ", %zu samples where the CAD has no normal", a.undefinedNormals);
+  std::fprintf(out, "\n");
+}
+
 int runQuality(const homesh::QualityCommand& cmd) {
-  checkOutputs(cmd.common, {cmd.input});
+  checkOutputs(cmd.common, {cmd.input, cmd.cad});
   std::vector<std::string> notes;
   const homesh::Mesh mesh = readMeshFile(cmd.input, cmd.common.quiet, notes);
   const homesh::QualitySummary q = homesh::evaluateQuality(mesh, cmd.common.threads);
-  if (!cmd.common.quiet)
-    printQuality(cmd.common.report && *cmd.common.report == "-" ? stderr : stdout, cmd.input, mesh,
-                 q);
+  std::optional<homesh::FileGeometry> geometry;
+  if (!cmd.cad.empty()) {
+    homesh::MeshingOptions options;
+    options.apply(cmd.options);
+    geometry = homesh::FileGeometry{
+        cmd.cad, homesh::checkGeometryAgainstCad(mesh, cmd.cad, cmd.common.threads,
+                                                 options.classifyTolerance)
+                     .accuracy};
+  }
+  std::FILE* out = cmd.common.report && *cmd.common.report == "-" ? stderr : stdout;
+  if (!cmd.common.quiet) {
+    printQuality(out, cmd.input, mesh, q);
+    if (geometry) printGeometry(out, *geometry);
+  }
   if (cmd.common.report)
-    writeReport(*cmd.common.report, homesh::qualityReportJson(mesh, q, cmd.input, notes));
+    writeReport(*cmd.common.report, homesh::qualityReportJson(mesh, q, cmd.input, notes,
+                                                              geometry ? &*geometry : nullptr));
   return cmd.strict && (q.invalid > 0 || q.undecided > 0) ? 3 : 0;
 }
 

@@ -60,9 +60,9 @@ std::vector<ParameterDefinition> meshAndCadRows() {
        "around them, curve, optimise and check again)"},
       {"classify_tolerance", "", "--classify-tolerance", "", "classification tolerance",
        ParameterKind::Real, 0, 0.01, true, 1e-5, false, false, "mesh",
-       "How far a boundary node of a mesh made elsewhere (homesh curve) may lie from the CAD "
-       "vertex, edge or face it is put on, relative to the CAD's bounding diagonal; the node is "
-       "then moved onto it"},
+       "How far a boundary node of a mesh made elsewhere may lie from the CAD vertex, edge or "
+       "face it is put on, relative to the CAD's bounding diagonal: homesh curve then moves the "
+       "node onto it; homesh quality --cad places boundary cells by their corners"},
       {"threads", "Threads", "--threads", "-j", "threads", ParameterKind::Integer, 1, 1024, false,
        0, true, false, "mesh",
        "Threads the sizing, the optimiser and the quality checks use (0: every core this "

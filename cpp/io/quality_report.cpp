@@ -38,7 +38,8 @@ void appendMeasure(JsonWriter& json, const std::string& key, const MeasureSummar
 // record when there is one.
 std::string fileReportJson(const Mesh& mesh, const QualitySummary& quality,
                            const OptimiserResult* optimiser, const std::string& input,
-                           const std::vector<std::string>& notes) {
+                           const std::vector<std::string>& notes,
+                           const FileGeometry* geometry = nullptr) {
   JsonWriter json;
   json.beginObject();
   json.value("input", input);
@@ -48,6 +49,10 @@ std::string fileReportJson(const Mesh& mesh, const QualitySummary& quality,
   appendCounts(json, mesh);
   appendQuality(json, mesh, quality);
   if (optimiser != nullptr) appendOptimiser(json, *optimiser);
+  if (geometry != nullptr) {
+    json.value("cad", geometry->cad);
+    appendGeometry(json, geometry->accuracy);
+  }
   appendStrings(json, "notes", notes);
   json.endObject();
   return json.str();
@@ -199,8 +204,9 @@ void appendGeometry(JsonWriter& json, const GeometryAccuracy& g) {
 }
 
 std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
-                              const std::string& input, const std::vector<std::string>& notes) {
-  return fileReportJson(mesh, quality, nullptr, input, notes);
+                              const std::string& input, const std::vector<std::string>& notes,
+                              const FileGeometry* geometry) {
+  return fileReportJson(mesh, quality, nullptr, input, notes, geometry);
 }
 
 void appendOptimiser(JsonWriter& json, const OptimiserResult& r, const std::string& key) {

@@ -45,10 +45,17 @@ void appendCounts(JsonWriter& json, const Mesh& mesh);
 // CAD normals, the sample counts and where the worst distance and angle were found.
 void appendGeometry(JsonWriter& json, const GeometryAccuracy& geometry);
 
-// The report of `homesh quality`: input, order, counts, quality, and "notes" (what reading the
-// file changed, from readMesh).
+// A mesh file's geometry measured against a CAD file (`homesh quality --cad`).
+struct FileGeometry {
+  std::string cad;  // the CAD file's path
+  GeometryAccuracy accuracy;
+};
+
+// The report of `homesh quality`: input, order, counts, quality, with `geometry` "cad" and
+// "geometry", and "notes" (what reading the file changed, from readMesh).
 std::string qualityReportJson(const Mesh& mesh, const QualitySummary& quality,
-                              const std::string& input, const std::vector<std::string>& notes = {});
+                              const std::string& input, const std::vector<std::string>& notes = {},
+                              const FileGeometry* geometry = nullptr);
 
 // Appends "optimiser": {functional, iterations, worst_before, worst_after, invalid_before,
 // invalid_after, seconds, ...} with the per-sweep history.

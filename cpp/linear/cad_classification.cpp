@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "cad/point_classifier.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "core/parameters.hpp"
@@ -20,121 +21,6 @@ namespace homesh {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// A box around sampled points of an entity, grown by `margin`: points farther out cannot lie on
-// the entity (the margin covers the bulge between samples).
-struct Box {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
-  Eigen::Vector3d hi = Eigen::Vector3d::Constant(std::numeric_limits<double>::lowest());
-  void add(const Eigen::Vector3d& p) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  void grow(double fraction, double absolute) {
-    const double m = fraction * (hi - lo).norm() + absolute;
-    lo.array() -= m;
-    hi.array() += m;
-  }
-  bool contains(const Eigen::Vector3d& p) const {
-    return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all();
-  }
-};
-
-// Where a boundary node lies.
-struct Place {
-  int dim = -1, index = 0;
-  double u = kNaN, v = kNaN;
-  Eigen::Vector3d point;
-  double distance = 0.0;
-};
-
-class Classifier {
- public:
-  Classifier(const CadModel& cad, double tolerance) : cad_(cad), tol_(tolerance) {
-    const int kSamples = 9;
-    edgeBoxes_.resize(cad.numEdges() + 1);
-    faceBoxes_.resize(cad.numFaces() + 1);
-    vertexEdges_.resize(cad.numVertices() + 1);
-    edgeFaces_.resize(cad.numEdges() + 1);
-    for (int e = 1; e <= cad.numEdges(); ++e) {
-      for (const int v : cad.subShapeIndices(1, e, 0)) vertexEdges_[v].push_back(e);
-      if (cad.isDegenerated(e)) continue;
-      const ParameterRange r = cad.edgeRange(e);
-      for (int k = 0; k <= 2 * kSamples; ++k)
-        edgeBoxes_[e].add(
-            cad.evaluateCurve(e, r.first + (r.last - r.first) * k / (2 * kSamples)).point);
-      edgeBoxes_[e].grow(0.25, tol_);
-    }
-    for (int f = 1; f <= cad.numFaces(); ++f) {
-      for (const int e : cad.subShapeIndices(2, f, 1)) edgeFaces_[e].push_back(f);
-      const SurfaceBounds b = cad.faceBounds(f);
-      for (int i = 0; i <= kSamples; ++i)
-        for (int j = 0; j <= kSamples; ++j)
-          faceBoxes_[f].add(cad.evaluateSurface(f, b.uMin + (b.uMax - b.uMin) * i / kSamples,
-                                                b.vMin + (b.vMax - b.vMin) * j / kSamples)
-                                .point);
-      faceBoxes_[f].grow(0.25, tol_);
-    }
-  }
-
-  // The lowest-dimensional entity `p` lies on, or dim -1 (with the nearest face's distance in
-  // `nearestFace`).
-  Place classify(const Eigen::Vector3d& p, std::pair<int, double>& nearestFace) const {
-    Place best;
-    for (int v = 1; v <= cad_.numVertices(); ++v) {
-      const Eigen::Vector3d q = cad_.vertexPoint(v);
-      const double d = (q - p).norm();
-      if (d <= tol_ + cad_.tolerance(0, v) && (best.dim < 0 || d < best.distance)) {
-        best = Place{0, v, kNaN, kNaN, q, d};
-      }
-    }
-    if (best.dim >= 0) return best;
-    for (int e = 1; e <= cad_.numEdges(); ++e) {
-      if (cad_.isDegenerated(e) || !edgeBoxes_[e].contains(p)) continue;
-      const CurveProjection c = cad_.projectOnCurve(e, p);
-      if (c.distance <= tol_ + cad_.tolerance(1, e) && (best.dim < 0 || c.distance < best.distance))
-        best = Place{1, e, c.t, kNaN, c.point, c.distance};
-    }
-    if (best.dim >= 0) return best;
-    nearestFace = {0, std::numeric_limits<double>::infinity()};
-    for (int f = 1; f <= cad_.numFaces(); ++f) {
-      if (!faceBoxes_[f].contains(p)) continue;
-      const SurfaceProjection s = cad_.projectOnSurface(f, p);
-      if (s.distance < nearestFace.second) nearestFace = {f, s.distance};
-      if (s.distance > tol_ + cad_.tolerance(2, f)) continue;
-      if (!cad_.faceContains(f, cad_.wrapIntoPeriod(f, s.u, 0), cad_.wrapIntoPeriod(f, s.v, 1)))
-        continue;
-      if (best.dim < 0 || s.distance < best.distance)
-        best = Place{2, f, s.u, s.v, s.point, s.distance};
-    }
-    return best;
-  }
-
-  // The CAD faces a node on entity (dim, index) may belong to.
-  std::set<int> facesOf(int dim, int index) const {
-    std::set<int> out;
-    if (dim == 2) out.insert(index);
-    if (dim == 1) out.insert(edgeFaces_[index].begin(), edgeFaces_[index].end());
-    if (dim == 0)
-      for (const int e : vertexEdges_[index])
-        out.insert(edgeFaces_[e].begin(), edgeFaces_[e].end());
-    return out;
-  }
-
-  // The CAD edges a node on entity (dim, index) may belong to.
-  std::set<int> edgesOf(int dim, int index) const {
-    std::set<int> out;
-    if (dim == 1) out.insert(index);
-    if (dim == 0) out.insert(vertexEdges_[index].begin(), vertexEdges_[index].end());
-    return out;
-  }
-
- private:
-  const CadModel& cad_;
-  double tol_;
-  std::vector<Box> edgeBoxes_, faceBoxes_;
-  std::vector<std::vector<int>> vertexEdges_, edgeFaces_;
-};
 
 // A boundary face: 3 corners (a triangle, last entry -1) or 4 (a quadrilateral), pointing out.
 using Face = std::array<std::int64_t, 4>;
@@ -226,7 +112,7 @@ Mesh nodesInSolid(const Mesh& linear) {
 std::pair<double, double> enclosedVolume(const Mesh& mesh, const std::int64_t* c,
                                          const CellFaces& faces, int corners) {
   const Eigen::Vector3d origin = nodePoint(mesh, c[0]);
-  Box box;
+  PointBox box;
   for (int k = 0; k < corners; ++k) box.add(nodePoint(mesh, c[k]) - origin);
   double v = 0.0;
   for (const std::vector<int>& f : faces.faces)
@@ -324,7 +210,7 @@ MeshingError offCad(const std::string& what, std::size_t i, const Eigen::Vector3
 }
 
 // Node i moved onto where it lies on the CAD, with its records.
-void setPlace(Mesh& mesh, std::size_t i, const Place& place) {
+void setPlace(Mesh& mesh, std::size_t i, const CadPlace& place) {
   mesh.nodeCadDim[i] = static_cast<std::uint8_t>(place.dim);
   mesh.nodeCadIndex[i] = place.index;
   mesh.nodeCadParam[2 * i] = place.u;
@@ -334,7 +220,8 @@ void setPlace(Mesh& mesh, std::size_t i, const Place& place) {
 
 // Boundary nodes on the CAD (snapped onto it: within the tolerance of where they were).
 CadClassificationStats placeBoundaryNodes(Mesh& mesh, const std::vector<Face>& boundary,
-                                          const Classifier& classifier, const CadModel& cad) {
+                                          const CadPointClassifier& classifier,
+                                          const CadModel& cad) {
   const std::size_t n = mesh.numNodes();
   std::vector<char> onBoundary(n, 0);
   for (const Face& f : boundary)
@@ -344,7 +231,7 @@ CadClassificationStats placeBoundaryNodes(Mesh& mesh, const std::vector<Face>& b
     if (onBoundary[i] == 0) continue;
     const Eigen::Vector3d p = nodePoint(mesh, static_cast<std::int64_t>(i));
     std::pair<int, double> nearest{0, 0.0};
-    const Place place = classifier.classify(p, nearest);
+    const CadPlace place = classifier.classify(p, nearest);
     if (place.dim < 0) throw offCad("boundary node", i, p, cad, 2, nearest.first, nearest.second);
     setPlace(mesh, i, place);
     ++s.boundaryNodes;
@@ -356,58 +243,31 @@ CadClassificationStats placeBoundaryNodes(Mesh& mesh, const std::vector<Face>& b
 
 // The CAD face a boundary face lies on: the one its nodes share (nearest its centroid when
 // several do).
-int faceOfBoundaryFace(const Face& f, const Mesh& mesh, const Classifier& classifier,
+int faceOfBoundaryFace(const Face& f, const Mesh& mesh, const CadPointClassifier& classifier,
                        const CadModel& cad) {
   const int nf = faceSize(f);
-  std::set<int> common = classifier.facesOf(mesh.nodeCadDim[f[0]], mesh.nodeCadIndex[f[0]]);
-  Eigen::Vector3d centroid = nodePoint(mesh, f[0]);
-  for (int k = 1; k < nf; ++k) {
-    const std::set<int> other = classifier.facesOf(mesh.nodeCadDim[f[k]], mesh.nodeCadIndex[f[k]]);
-    std::set<int> both;
-    std::set_intersection(common.begin(), common.end(), other.begin(), other.end(),
-                          std::inserter(both, both.begin()));
-    common = std::move(both);
+  std::vector<std::pair<int, int>> places;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (int k = 0; k < nf; ++k) {
+    places.emplace_back(mesh.nodeCadDim[f[k]], mesh.nodeCadIndex[f[k]]);
     centroid += nodePoint(mesh, f[k]);
   }
   centroid /= nf;
-  if (common.empty())
+  const int face = classifier.sharedFace(places, centroid);
+  if (face == 0)
     throw MeshingError("the boundary " + std::string(nf == 3 ? "triangle" : "quadrilateral") +
                        " of nodes " + nodeList(f) + " near " + describe(centroid) +
                        " spans more than one face of " + cad.sourceName() +
                        ": the mesh does not follow the CAD's faces");
-  int face = *common.begin();
-  if (common.size() > 1) {
-    double nearest = std::numeric_limits<double>::infinity();
-    for (const int c : common) {
-      const double d = cad.projectOnSurface(c, centroid).distance;
-      if (d < nearest) nearest = d, face = c;
-    }
-  }
   return face;
 }
 
 // The CAD edge the segment (a, b) lies on, or 0 when it lies on none.
-int edgeOfSegment(std::int64_t a, std::int64_t b, const Mesh& mesh, const Classifier& classifier,
-                  const CadModel& cad, double tolerance) {
-  const std::set<int> ea = classifier.edgesOf(mesh.nodeCadDim[a], mesh.nodeCadIndex[a]);
-  const std::set<int> eb = classifier.edgesOf(mesh.nodeCadDim[b], mesh.nodeCadIndex[b]);
-  std::vector<int> shared;
-  std::set_intersection(ea.begin(), ea.end(), eb.begin(), eb.end(), std::back_inserter(shared));
-  if (shared.empty()) return 0;
-  // A chord of its edge bulges from it by at most 0.29 of its length for arcs up to 120
-  // degrees; a segment across a face between two vertices of one edge (a cap of two
-  // half circles) lies 0.5 of its length away: not on the edge.
-  const Eigen::Vector3d pa = nodePoint(mesh, a), pb = nodePoint(mesh, b);
-  const Eigen::Vector3d mid = 0.5 * (pa + pb);
-  int edge = 0;
-  double nearest = std::numeric_limits<double>::infinity();
-  for (const int e : shared) {
-    if (cad.isDegenerated(e)) continue;
-    const double d = cad.projectOnCurve(e, mid).distance;
-    if (d < nearest) nearest = d, edge = e;
-  }
-  if (edge == 0 || nearest > 0.3 * (pb - pa).norm() + tolerance) return 0;
-  return edge;
+int edgeOfSegment(std::int64_t a, std::int64_t b, const Mesh& mesh,
+                  const CadPointClassifier& classifier) {
+  return classifier.sharedEdge({mesh.nodeCadDim[a], mesh.nodeCadIndex[a]},
+                               {mesh.nodeCadDim[b], mesh.nodeCadIndex[b]}, nodePoint(mesh, a),
+                               nodePoint(mesh, b));
 }
 
 // The boundary's cells: triangles and quadrilaterals on the CAD face their nodes share, segments
@@ -417,7 +277,7 @@ struct BoundaryCells {
 };
 
 BoundaryCells boundaryCells(const Mesh& mesh, const std::vector<Face>& boundary,
-                            const Classifier& classifier, const CadModel& cad, double tolerance) {
+                            const CadPointClassifier& classifier, const CadModel& cad) {
   BoundaryCells out;
   out.tris.type = CellType::Triangle;
   out.quads.type = CellType::Quadrilateral;
@@ -431,7 +291,7 @@ BoundaryCells boundaryCells(const Mesh& mesh, const std::vector<Face>& boundary,
     for (int k = 0; k < nf; ++k) {
       const std::int64_t a = f[k], b = f[(k + 1) % nf];
       if (!seen.insert({std::min(a, b), std::max(a, b)}).second) continue;
-      const int edge = edgeOfSegment(a, b, mesh, classifier, cad, tolerance);
+      const int edge = edgeOfSegment(a, b, mesh, classifier);
       if (edge == 0) continue;
       out.lines.nodes.insert(out.lines.nodes.end(), {a, b});
       out.lines.entity.push_back(edge);
@@ -445,7 +305,7 @@ BoundaryCells boundaryCells(const Mesh& mesh, const std::vector<Face>& boundary,
 std::pair<double, double> signedArea(const Mesh& mesh, const std::int64_t* c, int corners,
                                      const Eigen::Vector3d& normal) {
   const Eigen::Vector3d a = nodePoint(mesh, c[0]);
-  Box box;
+  PointBox box;
   for (int k = 0; k < corners; ++k) box.add(nodePoint(mesh, c[k]) - a);
   const Eigen::Vector3d d1 = nodePoint(mesh, c[corners == 3 ? 1 : 2]) - a;
   const Eigen::Vector3d d2 = corners == 3
@@ -532,13 +392,13 @@ Mesh classifyPlanarOnCad(const Mesh& linear, const CadModel& cad, double toleran
     mesh.blocks.push_back(std::move(cells));
   }
   if (mesh.blocks.empty()) throw ParameterError("the mesh has no 2D cells to put on the CAD");
-  const Classifier classifier(cad, tolerance);
+  const CadPointClassifier classifier(cad, tolerance);
   CadClassificationStats s;
   for (std::size_t i = 0; i < n; ++i) {
     if (used[i] == 0) continue;
     const Eigen::Vector3d p = nodePoint(mesh, static_cast<std::int64_t>(i));
     std::pair<int, double> nearest{0, 0.0};
-    const Place place = classifier.classify(p, nearest);
+    const CadPlace place = classifier.classify(p, nearest);
     if (place.dim < 0) {
       // In the plane a node off the faces lies beyond their edges: the nearest edge says how far
       // (a face's own distance, that of its untrimmed plane, would be 0).
@@ -569,7 +429,7 @@ Mesh classifyPlanarOnCad(const Mesh& linear, const CadModel& cad, double toleran
       Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
       for (int k = 0; k < nv; ++k) centroid += nodePoint(mesh, b.element(e)[k]);
       std::pair<int, double> nearest{0, 0.0};
-      const Place inside = classifier.classify(centroid / nv, nearest);
+      const CadPlace inside = classifier.classify(centroid / nv, nearest);
       if (inside.dim == 2) {
         b.entity[e] = inside.index;
         continue;
@@ -590,7 +450,7 @@ Mesh classifyPlanarOnCad(const Mesh& linear, const CadModel& cad, double toleran
     // is curved on the curve as `homesh mesh` curves it.
     const bool inner = use.count == 2;
     if (inner && (mesh.nodeCadDim[use.from] > 1 || mesh.nodeCadDim[use.to] > 1)) continue;
-    const int edge = edgeOfSegment(use.from, use.to, mesh, classifier, cad, tolerance);
+    const int edge = edgeOfSegment(use.from, use.to, mesh, classifier);
     if (edge == 0 && inner) continue;
     if (edge == 0)
       throw MeshingError("the boundary side of nodes " + std::to_string(use.from + 1) + ", " +
@@ -628,9 +488,9 @@ Mesh classifyOnCad(const Mesh& linear, const CadModel& cad, double tolerance,
     mesh.blocks.push_back(std::move(cells));
   }
   const std::vector<Face> boundary = boundaryFaces(uses);
-  const Classifier classifier(cad, tolerance);
+  const CadPointClassifier classifier(cad, tolerance);
   CadClassificationStats s = placeBoundaryNodes(mesh, boundary, classifier, cad);
-  BoundaryCells cells = boundaryCells(mesh, boundary, classifier, cad, tolerance);
+  BoundaryCells cells = boundaryCells(mesh, boundary, classifier, cad);
   s.boundaryTriangles = cells.tris.count();
   s.boundaryQuadrilaterals = cells.quads.count();
   s.boundarySegments = cells.lines.count();

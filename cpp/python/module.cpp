@@ -28,6 +28,7 @@
 #include "element/reference_element.hpp"
 #include "io/mesh_readers.hpp"
 #include "pipeline/case_setup.hpp"
+#include "pipeline/geometry_check.hpp"
 #include "pipeline/mesh_pipeline.hpp"
 #include "pipeline/mesh_summary.hpp"
 #include "pipeline/nektar_read_back.hpp"
@@ -477,7 +478,7 @@ const std::vector<std::string> kCurveKeys = [] {
 const std::vector<std::string> kSizingKeys = {"threads",   "heal",      "solids_only",
                                               "surface",   "auto",      "imprint",
                                               "min_delta", "max_delta", "eps"};
-const std::vector<std::string> kReadKeys = {"threads"};
+const std::vector<std::string> kReadKeys = {"threads", "classify_tolerance"};
 
 // The table keys the front-end function `function` ("mesh", "curve", "sizing": predict and
 // size_field, "read", "optimise": HighOrderMesh.optimise) takes, in the table's order, for
@@ -751,14 +752,18 @@ PyMesh meshFromArrays(int dim, int order, const bp::object& nodes, const bp::obj
 }
 
 // Reads a mesh file (.msh, .xml) and evaluates its quality.
-PyMesh readMeshFile(const std::string& path, const bp::dict& given) {
-  const int threads = MeshingOptions::fromMap(optionMapFrom(given), kReadKeys).threads;
+PyMesh readMeshFile(const std::string& path, const std::string& cad, const bp::dict& given) {
+  const MeshingOptions options = MeshingOptions::fromMap(optionMapFrom(given), kReadKeys);
   CurvedMesh curved;
   StageRecords records;
   {
     const ReleaseGil nogil;
     curved.mesh = readMesh(path, &records.notes);
-    curved.quality = evaluateQuality(curved.mesh, threads);
+    curved.quality = evaluateQuality(curved.mesh, options.threads);
+    if (!cad.empty())
+      records.geometry =
+          checkGeometryAgainstCad(curved.mesh, cad, options.threads, options.classifyTolerance)
+              .accuracy;
   }
   records.options.order = curved.mesh.order;
   return {std::move(curved), std::move(records)};
@@ -884,7 +889,7 @@ BOOST_PYTHON_MODULE(_core) {
           (bp::arg("path"), bp::arg("nodes"), bp::arg("cells"), bp::arg("options"),
            bp::arg("progress") = bp::object(), bp::arg("cancel") = bp::object()));
   bp::def("size_field", &sizeField, (bp::arg("text"), bp::arg("name"), bp::arg("options")));
-  bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("options") = bp::dict()));
+  bp::def("read_mesh", &readMeshFile, (bp::arg("path"), bp::arg("cad"), bp::arg("options")));
   bp::def("quadrature_rule", &quadrature, (bp::arg("type"), bp::arg("degree")));
   bp::def("reference_nodes", &referenceNodes, (bp::arg("type"), bp::arg("order")));
   bp::def("lagrange_basis", &lagrangeBasis, (bp::arg("type"), bp::arg("order"), bp::arg("points")));

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from conftest import PEER_CASES, needs_peer_files, run
+import homesh
 from homesh import HighOrderMesh, _core, read
 
 PEERS = PEER_CASES / "optimiser"
@@ -111,6 +112,92 @@ def test_quality_report_of_a_made_mesh(homesh_bin, tmp_path, made):
     assert quality["flagged_elements"] == []
     r = run([homesh_bin, "quality", path, "--report", "-", "-q", "-j", "2"])
     assert r.returncode == 0 and json.loads(r.stdout)["quality"] == quality
+
+
+def test_quality_against_the_cad_measures_as_the_mesh_command(homesh_bin, tmp_path, made, data):
+    """`homesh quality --cad` on the mesh `homesh mesh` wrote: its boundary, put back on the CAD
+    by the corners of its cells, is measured as the mesh command measured it: the same samples,
+    distances to the projections' precision (1e-9 of the diagonal) and angles to that over the
+    radius (1)."""
+    path, mesh_report = made
+    report = tmp_path / "q.json"
+    r = run([homesh_bin, "quality", path, "--cad", data / "sphere.brep", "--report", report])
+    assert r.returncode == 0, r.stderr
+    assert "normal angle to the CAD: max" in r.stdout
+    q = json.loads(report.read_text())
+    got, expected = q["geometry"], mesh_report["geometry"]
+    assert q["cad"].endswith("sphere.brep")
+    for key in ("samples", "angle_samples", "undefined_normals", "worst_angle_entity"):
+        assert got[key] == expected[key], key
+    precision = 1e-9 * expected["diagonal"]
+    assert got["max_distance"] == pytest.approx(expected["max_distance"], abs=precision)
+    assert got["max_normal_angle_deg"] == pytest.approx(expected["max_normal_angle_deg"],
+                                                        abs=np.degrees(precision))
+    assert q["quality"] == json.loads(run([homesh_bin, "quality", path, "--report", "-", "-q"])
+                                      .stdout)["quality"]
+
+
+def test_quality_against_the_cad_of_a_gmsh_mesh(homesh_bin, tmp_path, data):
+    """Gmsh's linear mesh of the unit sphere, its boundary triangles tagged by Gmsh's own numbers:
+    each flat triangle's normal n is off the sphere's x / |x| by an angle that is largest at a
+    vertex (the directions within an angle of n form a convex cone), and the measure samples the
+    vertices, so its largest angle is the largest over the triangles' vertices (the poles, where
+    the CAD has no normal, left out). The distance lies between the flat triangle and the sphere:
+    at most 1 - (the distance from the centre to the triangle)."""
+    path = tmp_path / "gmsh.msh"
+    r = run(["gmsh", data / "sphere.brep", "-3", "-setnumber", "Mesh.MeshSizeMax", "0.4",
+             "-setnumber", "Mesh.SaveAll", "1", "-format", "msh41", "-o", path, "-v", "1"])
+    assert r.returncode == 0 and path.exists(), r.stderr
+    report = tmp_path / "q.json"
+    r = run([homesh_bin, "quality", path, "--cad", data / "sphere.brep", "--report", report, "-q"])
+    assert r.returncode == 0, r.stderr
+    g = json.loads(report.read_text())["geometry"]
+    mesh = meshio.read(path)
+    x = mesh.points
+    triangles = np.concatenate([c.data for c in mesh.cells if c.type == "triangle"])
+    assert np.allclose(np.linalg.norm(x[np.unique(triangles)], axis=1), 1.0, atol=1e-9)
+    angle, nearest = 0.0, 1.0
+    for t in triangles:
+        a, b, c = x[t]
+        n = np.cross(b - a, c - a)
+        n /= np.linalg.norm(n)
+        for v in (a, b, c):
+            if np.hypot(v[0], v[1]) > 1e-6:  # not a pole
+                angle = max(angle, np.degrees(np.arccos(min(1.0, abs(n @ v) / np.linalg.norm(v)))))
+        nearest = min(nearest, abs(n @ a))  # the triangle's plane: no nearer than it
+    assert g["max_normal_angle_deg"] == pytest.approx(angle, abs=1e-6)
+    assert 0.0 < g["max_distance"] <= 1.0 - nearest + 1e-9
+    assert g["worst_angle_entity"] == "Face1"
+
+
+def test_quality_against_the_cad_errors_name_the_problem(homesh_bin, tmp_path, made, data):
+    path, _ = made
+    r = run([homesh_bin, "quality", path, "--classify-tolerance", "1e-4"])
+    assert r.returncode == 2 and "--classify-tolerance needs --cad" in r.stderr
+    r = run([homesh_bin, "quality", path, "--cad", data / "box_hole.step", "--report",
+             tmp_path / "q.json"])
+    assert r.returncode != 0 and "is the mesh of this shape?" in r.stderr
+    assert "boundary node" in r.stderr and not (tmp_path / "q.json").exists()
+    tets = tmp_path / "tets.msh"
+    two_tetrahedra(2).write(tets)
+    r = run([homesh_bin, "quality", tets, "--cad", data / "sphere.brep"])
+    assert r.returncode != 0 and "no boundary cells" in r.stderr
+
+
+def test_python_read_with_the_cad_measures_its_geometry(made, data):
+    """homesh.read(path, cad=...) gives geometry() as `homesh quality --cad` reports it, and
+    names the problem as the command does."""
+    path, mesh_report = made
+    assert read(path).geometry() is None
+    g = read(path, cad=data / "sphere.brep", threads=1).geometry()
+    expected = mesh_report["geometry"]
+    assert g["samples"] == expected["samples"]
+    assert g["max_distance"] == pytest.approx(expected["max_distance"],
+                                              abs=1e-9 * expected["diagonal"])
+    with pytest.raises(homesh.ParameterError, match="classify_tolerance needs cad"):
+        read(path, classify_tolerance=1e-4)
+    with pytest.raises(homesh.MeshingError, match="is the mesh of this shape"):
+        read(path, cad=data / "box_hole.step")
 
 
 def test_strict_fails_on_a_certified_invalid_mesh(homesh_bin, tmp_path):
