@@ -3,11 +3,17 @@
 #include <algorithm>
 #include <iterator>
 
+#include "core/format.hpp"
+
 namespace homesh {
 
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }  // namespace
+
+std::string describePoint(const Eigen::Vector3d& p) {
+  return "(" + formatNumber(p.x()) + ", " + formatNumber(p.y()) + ", " + formatNumber(p.z()) + ")";
+}
 
 CadPointClassifier::CadPointClassifier(const CadModel& cad, double tolerance)
     : cad_(cad), tol_(tolerance) {

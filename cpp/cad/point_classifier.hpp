@@ -12,12 +12,16 @@
 #include <Eigen/Core>
 #include <limits>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "cad/cad_model.hpp"
 
 namespace homesh {
+
+// "(x, y, z)" with formatNumber's digits: where a point is, for messages about points off the CAD.
+std::string describePoint(const Eigen::Vector3d& p);
 
 // An axis-aligned box around points, grown by a margin.
 struct PointBox {

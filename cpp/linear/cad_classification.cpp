@@ -8,7 +8,6 @@
 #include <map>
 #include <optional>
 #include <set>
-#include <sstream>
 
 #include "cad/point_classifier.hpp"
 #include "core/error.hpp"
@@ -27,13 +26,6 @@ using Face = std::array<std::int64_t, 4>;
 
 int faceSize(const Face& f) {
   return f[3] < 0 ? 3 : 4;
-}
-
-std::string describe(const Eigen::Vector3d& p) {
-  std::ostringstream s;
-  s << "(" << formatNumber(p.x()) << ", " << formatNumber(p.y()) << ", " << formatNumber(p.z())
-    << ")";
-  return s.str();
 }
 
 std::string nodeList(const std::int64_t* nodes, int count) {
@@ -201,7 +193,7 @@ std::vector<Face> boundaryFaces(const FaceUses& uses) {
 // position and the nearest entity of dimension `dim` (0: none found) at `distance`.
 MeshingError offCad(const std::string& what, std::size_t i, const Eigen::Vector3d& p,
                     const CadModel& cad, int dim, int nearest, double distance) {
-  return MeshingError{what + " " + std::to_string(i + 1) + " at " + describe(p) +
+  return MeshingError{what + " " + std::to_string(i + 1) + " at " + describePoint(p) +
                       " lies on no face of " + cad.sourceName() +
                       (nearest > 0 ? " (nearest: " + cadEntityName(dim, nearest) + " at distance " +
                                          formatNumber(distance) + ")"
@@ -256,7 +248,7 @@ int faceOfBoundaryFace(const Face& f, const Mesh& mesh, const CadPointClassifier
   const int face = classifier.sharedFace(places, centroid);
   if (face == 0)
     throw MeshingError("the boundary " + std::string(nf == 3 ? "triangle" : "quadrilateral") +
-                       " of nodes " + nodeList(f) + " near " + describe(centroid) +
+                       " of nodes " + nodeList(f) + " near " + describePoint(centroid) +
                        " spans more than one face of " + cad.sourceName() +
                        ": the mesh does not follow the CAD's faces");
   return face;
@@ -453,11 +445,11 @@ Mesh classifyPlanarOnCad(const Mesh& linear, const CadModel& cad, double toleran
     const int edge = edgeOfSegment(use.from, use.to, mesh, classifier);
     if (edge == 0 && inner) continue;
     if (edge == 0)
-      throw MeshingError("the boundary side of nodes " + std::to_string(use.from + 1) + ", " +
-                         std::to_string(use.to + 1) + " near " +
-                         describe(0.5 * (nodePoint(mesh, use.from) + nodePoint(mesh, use.to))) +
-                         " lies on no edge of " + cad.sourceName() +
-                         ": the mesh does not follow the CAD's edges");
+      throw MeshingError(
+          "the boundary side of nodes " + std::to_string(use.from + 1) + ", " +
+          std::to_string(use.to + 1) + " near " +
+          describePoint(0.5 * (nodePoint(mesh, use.from) + nodePoint(mesh, use.to))) +
+          " lies on no edge of " + cad.sourceName() + ": the mesh does not follow the CAD's edges");
     lines.nodes.insert(lines.nodes.end(), {use.from, use.to});
     lines.entity.push_back(edge);
   }

@@ -23,10 +23,6 @@ Eigen::Vector3d pointOf(const Mesh& mesh, std::int64_t i) {
   return Eigen::Vector3d::Map(&mesh.xyz[3 * static_cast<std::size_t>(i)]);
 }
 
-std::string describe(const Eigen::Vector3d& p) {
-  return "(" + formatNumber(p.x()) + ", " + formatNumber(p.y()) + ", " + formatNumber(p.z()) + ")";
-}
-
 // Whether a block's cells are boundary cells the geometry measure samples (as it selects them):
 // faces of a volume or a surface mesh's cells (on CAD faces), lines (on CAD curves).
 bool onCad(const Mesh& mesh, const ElementBlock& block) {
@@ -79,7 +75,7 @@ class Attacher {
     std::pair<int, double> nearest{0, 0.0};
     place = classifier_.classify(p, nearest);
     if (place.dim < 0)
-      throw MeshingError("boundary node " + std::to_string(i + 1) + " at " + describe(p) +
+      throw MeshingError("boundary node " + std::to_string(i + 1) + " at " + describePoint(p) +
                          " lies on no face of " + cad_.sourceName() +
                          (nearest.first > 0
                               ? " (nearest: " + cadEntityName(2, nearest.first) + " at distance " +
@@ -143,10 +139,10 @@ class Attacher {
     }
     const bool face = cellDimension(block.type) == 2;
     return MeshingError{"the boundary " + cellShortName(block.type) + " " + std::to_string(e + 1) +
-                        " of its block (corner nodes " + corners + ") near " + describe(centroid) +
-                        " lies on no single " + (face ? "face" : "curve") + " of " +
-                        cad_.sourceName() + ": its corners lie on " + on +
-                        "; is the mesh of this shape?"};
+                        " of its block (corner nodes " + corners + ") near " +
+                        describePoint(centroid) + " lies on no single " +
+                        (face ? "face" : "curve") + " of " + cad_.sourceName() +
+                        ": its corners lie on " + on + "; is the mesh of this shape?"};
   }
 
   Mesh& mesh_;
