@@ -292,8 +292,7 @@ int runQuality(const homesh::QualityCommand& cmd) {
     options.apply(cmd.options);
     geometry = homesh::FileGeometry{
         cmd.cad, homesh::checkGeometryAgainstCad(mesh, cmd.cad, cmd.common.threads,
-                                                 options.classifyTolerance)
-                     .accuracy};
+                                                 options.classifyTolerance)};
   }
   std::FILE* out = cmd.common.report && *cmd.common.report == "-" ? stderr : stdout;
   if (!cmd.common.quiet) {

@@ -10,22 +10,15 @@
 
 #include <string>
 
-#include "quality/boundary_on_cad.hpp"
 #include "quality/geometry_accuracy.hpp"
 
 namespace homesh {
-
-struct GeometryCheck {
-  GeometryAccuracy accuracy;
-  BoundaryOnCadStats attachment;
-  double seconds = 0.0;  // reading, healing, attaching and measuring
-};
 
 // `relativeTolerance`: how far a boundary cell's corner may lie from the CAD, relative to the
 // model's bounding diagonal (<= 0: the parameter table's classify_tolerance). Throws IoError,
 // CadError or ParameterError for the CAD file, and what boundaryOnCad and
 // measureGeometryAccuracy throw.
-GeometryCheck checkGeometryAgainstCad(const Mesh& mesh, const std::string& cadPath, int threads,
-                                      double relativeTolerance = 0.0);
+GeometryAccuracy checkGeometryAgainstCad(const Mesh& mesh, const std::string& cadPath, int threads,
+                                         double relativeTolerance = 0.0);
 
 }  // namespace homesh

@@ -762,8 +762,7 @@ PyMesh readMeshFile(const std::string& path, const std::string& cad, const bp::d
     curved.quality = evaluateQuality(curved.mesh, options.threads);
     if (!cad.empty())
       records.geometry =
-          checkGeometryAgainstCad(curved.mesh, cad, options.threads, options.classifyTolerance)
-              .accuracy;
+          checkGeometryAgainstCad(curved.mesh, cad, options.threads, options.classifyTolerance);
   }
   records.options.order = curved.mesh.order;
   return {std::move(curved), std::move(records)};
