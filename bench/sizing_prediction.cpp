@@ -8,12 +8,16 @@
 //   Without cases: the five NekMesh meshgen peer cases (../shared/peer-cases/nekmesh/meshgen).
 //
 // Prints one line per case and, with --calibrate, the fitted densities of the prediction model
-// (see cpp/sizing/element_count.hpp) by least squares over all cases.
+// (see cpp/sizing/element_count.hpp) by least squares over all cases (of one dimension; the 3D
+// densities in use were fitted on FreeCAD-built shapes by bench/prediction_shapes --calibrate,
+// and --gradient-term applies to 2D).
 #include <Eigen/Dense>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -80,7 +84,8 @@ int main(int argc, char** argv) {
            {"3d_sphere", "3d_bl_cyl", "2d_bl_aerofoil", "2d_bl_t106", "2d_bl_naca0012"})
         cases.push_back(parseCase(std::string(HOMESH_SOURCE_DIR) +
                                   "/../shared/peer-cases/nekmesh/meshgen/" + peer + ".mcf"));
-    std::vector<Eigen::Vector3d> rows;
+    std::vector<Eigen::VectorXd> rows;  // the model's terms (element_count.hpp) per case
+    std::vector<int> dims;
     std::vector<double> actual;
     std::printf("%-28s %8s %8s %9s %9s %9s %7s %7s\n", "case", "leaves", "octree_s", "predict_s",
                 "mesh_s", "predicted", "actual", "ratio");
@@ -90,7 +95,7 @@ int main(int argc, char** argv) {
       const homesh::SizingOctree tree = homesh::SizingOctree::build(cad, c.params, threads);
       const double octreeSeconds = seconds(t0);
       t0 = std::chrono::steady_clock::now();
-      const homesh::ElementCountPrediction p = homesh::predictElementCount(tree, threads);
+      const homesh::ElementCountPrediction p = homesh::predictElementCount(tree, cad, threads);
       const double predictSeconds = seconds(t0);
       homesh::LinearMeshOptions options;
       options.sizeField = [&tree](const Eigen::Vector3d& x) { return tree.delta(x); };
@@ -103,25 +108,48 @@ int main(int argc, char** argv) {
       std::printf("%-28s %8zu %8.3f %9.3f %9.3f %9.0f %7.0f %7.3f  (octree+predict / mesh %.3f)\n",
                   c.name.c_str(), tree.numLeaves(), octreeSeconds, predictSeconds, meshSeconds,
                   p.elements, n, p.elements / n, (octreeSeconds + predictSeconds) / meshSeconds);
-      std::printf(
-          "    volume integral %.6g, boundary integral %.6g, gradient integral %.6g, domain %.6g\n",
-          p.volumeIntegral, p.boundaryIntegral, p.gradientIntegral, p.domainMeasure);
-      rows.emplace_back(p.volumeIntegral, p.boundaryIntegral, p.gradientIntegral);
+      if (p.dim == 3) {
+        std::printf(
+            "    core integral %.6g, boundary integral %.6g, curve integral %.6g, convexity "
+            "integral %.6g, gradient integral %.6g, volume integral %.6g, domain %.6g\n",
+            p.coreIntegral, p.boundaryIntegral, p.curveIntegral, p.convexityIntegral,
+            p.gradientIntegral, p.volumeIntegral, p.domainMeasure);
+        Eigen::VectorXd terms(5);
+        terms << p.coreIntegral, p.boundaryIntegral, p.curveIntegral, p.convexityIntegral,
+            p.gradientIntegral;
+        rows.push_back(terms);
+      } else {
+        std::printf(
+            "    volume integral %.6g, boundary integral %.6g, gradient integral %.6g, domain "
+            "%.6g\n",
+            p.volumeIntegral, p.boundaryIntegral, p.gradientIntegral, p.domainMeasure);
+        Eigen::VectorXd terms(gradientTerm ? 3 : 2);
+        terms << p.volumeIntegral, p.boundaryIntegral;
+        if (gradientTerm) terms[2] = p.gradientIntegral;
+        rows.push_back(terms);
+      }
+      dims.push_back(p.dim);
       actual.push_back(n);
     }
     if (calibrate && rows.size() >= 2) {
-      // Relative least squares: minimise sum ((a V + b B) / N - 1)^2.
-      const int terms = gradientTerm ? 3 : 2;
+      if (std::adjacent_find(dims.begin(), dims.end(), std::not_equal_to<>()) != dims.end())
+        throw std::runtime_error("--calibrate needs cases of one dimension (2D or 3D)");
+      // Relative least squares: minimise sum ((terms . densities) / N - 1)^2.
+      const auto terms = static_cast<Eigen::Index>(rows[0].size());
       Eigen::MatrixXd A(rows.size(), terms);
-      Eigen::VectorXd y = Eigen::VectorXd::Ones(rows.size());
+      Eigen::VectorXd y = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(rows.size()));
       for (std::size_t i = 0; i < rows.size(); ++i)
-        A.row(i) = rows[i].head(terms).transpose() / actual[i];
-      const Eigen::VectorXd ab = A.colPivHouseholderQr().solve(y);
-      std::printf("fit: volume density %.4f, boundary density %.4f, gradient density %.4f\n", ab[0],
-                  ab[1], terms == 3 ? ab[2] : 0.0);
+        A.row(static_cast<Eigen::Index>(i)) = rows[i].transpose() / actual[i];
+      const Eigen::VectorXd fit = A.colPivHouseholderQr().solve(y);
+      if (dims[0] == 3)
+        std::printf(
+            "fit: core density %.4f, boundary %.4f, curve %.4f, convexity %.4f, gradient %.4f\n",
+            fit[0], fit[1], fit[2], fit[3], fit[4]);
+      else
+        std::printf("fit: area density %.4f, boundary density %.4f, gradient density %.4f\n",
+                    fit[0], fit[1], terms == 3 ? fit[2] : 0.0);
       for (std::size_t i = 0; i < rows.size(); ++i)
-        std::printf("    case %zu: fitted/actual %.3f\n", i + 1,
-                    rows[i].head(terms).dot(ab) / actual[i]);
+        std::printf("    case %zu: fitted/actual %.3f\n", i + 1, rows[i].dot(fit) / actual[i]);
     }
     return 0;
   } catch (const std::exception& e) {

@@ -135,7 +135,7 @@ namespace {
 SizingResult buildSizing(const CadModel& cad, const SizingParameters& params, int threads) {
   SizingResult r;
   r.octree = std::make_shared<const SizingOctree>(SizingOctree::build(cad, params, threads));
-  r.prediction = predictElementCount(*r.octree, threads);
+  r.prediction = predictElementCount(*r.octree, cad, threads);
   return r;
 }
 

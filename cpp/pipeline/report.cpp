@@ -123,7 +123,10 @@ void appendSizing(JsonWriter& json, const SizingResult& sizing) {
   json.value("predicted_elements", static_cast<std::size_t>(std::llround(e.elements)));
   json.value("domain_measure", e.domainMeasure);
   json.value("volume_integral", e.volumeIntegral);
+  json.value("core_integral", e.coreIntegral);
   json.value("boundary_integral", e.boundaryIntegral);
+  json.value("curve_integral", e.curveIntegral);
+  json.value("convexity_integral", e.convexityIntegral);
   json.value("gradient_integral", e.gradientIntegral);
   json.beginObject("octree");
   json.value("leaves", s.leaves);

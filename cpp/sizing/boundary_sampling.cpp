@@ -36,15 +36,16 @@ double sizeForCurvature(double k, const SizingParameters& params) {
 }
 
 // Largest absolute principal curvature from the fundamental forms at a regular point.
-double largestCurvature(const SurfaceDerivatives& d) {
+// The mean curvature against du x dv and the largest absolute principal curvature.
+std::pair<double, double> surfaceCurvatures(const SurfaceDerivatives& d) {
   const double E = d.du.dot(d.du), F = d.du.dot(d.dv), G = d.dv.dot(d.dv);
   const double det = E * G - F * F;
-  if (!(det > 0.0)) return 0.0;
+  if (!(det > 0.0)) return {0.0, 0.0};
   const Eigen::Vector3d n = d.du.cross(d.dv) / std::sqrt(det);
   const double L = d.duu.dot(n), M = d.duv.dot(n), N = d.dvv.dot(n);
   const double mean = (E * N - 2.0 * F * M + G * L) / (2.0 * det);
   const double gauss = (L * N - M * M) / det;
-  return std::abs(mean) + std::sqrt(std::max(0.0, mean * mean - gauss));
+  return {mean, std::abs(mean) + std::sqrt(std::max(0.0, mean * mean - gauss))};
 }
 
 int samplesAlong(double length, double spacing, int atLeast) {
@@ -156,7 +157,9 @@ std::vector<BoundarySample> faceGrid(const CadModel& cad, int face, const FaceGr
       s.internal = internal;
       s.cadIndex = face;
       if (curved) {
-        s.curvature = largestCurvature(d);
+        const auto [mean, largest] = surfaceCurvatures(d);
+        s.curvature = largest;
+        s.meanCurvature = reversed ? -mean : mean;
         s.delta = sizeForCurvature(s.curvature, params);
       }
       found.push_back(s);

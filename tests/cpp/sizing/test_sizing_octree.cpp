@@ -211,9 +211,9 @@ TEST(SizingOctree, SourcesRefineTheirRegion) {
   // against 0.668: the octree grades leaf by leaf, within a leaf width of the formula).
   EXPECT_NEAR(tree.delta({3.8, 0.2, 3.8}), 0.2 + 0.2 * std::sqrt(0.09 + 0.09 + 2.3 * 2.3), 0.15);
   // Refined leaves make the prediction grow.
-  const double refined = predictElementCount(tree).elements;
+  const double refined = predictElementCount(tree, cad).elements;
   const double plain =
-      predictElementCount(SizingOctree::build(cad, params(0.1, 1.0, 0.1))).elements;
+      predictElementCount(SizingOctree::build(cad, params(0.1, 1.0, 0.1)), cad).elements;
   EXPECT_GT(refined, 1.5 * plain);  // measured 142x
 }
 
