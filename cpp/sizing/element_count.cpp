@@ -100,13 +100,15 @@ struct DomainIntegrals {
 DomainIntegrals integrateDomain(const SizingOctree& tree, int threads) {
   const int d = tree.dim();
   const std::vector<BoundarySample>& samples = tree.samples();
-  const SampleTree walls(samples, isWall);
+  // The core is 3D's alone: in 2D the tree holds nothing.
+  const SampleTree walls(samples, [d](const BoundarySample& s) { return d == 3 && isWall(s); });
   double volume = 0.0, core = 0.0, gradient = 0.0;
   const auto leaves = static_cast<std::int64_t>(tree.numLeaves());
   FirstFailure failure;  // an allocation failure must not leave the parallel region
 #pragma omp parallel num_threads(threadsToUse(threads)) reduction(+ : volume, core, gradient)
   {
     std::vector<SizingOctree::QuadraturePoint> points;
+    std::vector<double> sizes;  // delta at each point
 #pragma omp for schedule(dynamic, 256)
     for (std::int64_t i = 0; i < leaves; ++i) {
       const auto index = static_cast<std::size_t>(i);
@@ -117,32 +119,34 @@ DomainIntegrals integrateDomain(const SizingOctree& tree, int threads) {
         continue;
       }
       if (points.empty()) continue;
+      sizes.clear();
+      double leafVolume = 0.0, leafGradient = 0.0;  // of delta^-d
       for (const SizingOctree::QuadraturePoint& q : points) {
         const double h = tree.delta(q.x);
+        sizes.push_back(h);
         const double density = q.weight / (d == 3 ? h * h * h : h * h);
-        volume += density;
-        gradient += density * q.gradient;
+        leafVolume += density;
+        leafGradient += density * q.gradient;
       }
+      volume += leafVolume;
+      gradient += leafGradient;
       if (d != 3) continue;
       const SizingOctree::Leaf leaf = tree.leaf(index);
       const double diagonalHalf = std::sqrt(3.0) * leaf.halfWidth;
-      double largest = leaf.delta;  // the leaf's largest size: its own and its points'
-      for (const SizingOctree::QuadraturePoint& q : points)
-        largest = std::max(largest, tree.delta(q.x));
+      // The leaf's largest size: its own and its points'.
+      const double largest = std::max(leaf.delta, *std::max_element(sizes.begin(), sizes.end()));
       if (leaf.location == SizingOctree::Location::Inside &&
           !nearWall(walls, samples, leaf.centre, diagonalHalf + kCoreDepth * largest)) {
-        for (const SizingOctree::QuadraturePoint& q : points) {
-          const double h = tree.delta(q.x);
-          core += q.weight / (h * h * h);
-        }
+        core += leafVolume;
         continue;
       }
       // The distance r from the leaf's centre decides each point q within |q - c| of it (the
       // distance is 1-Lipschitz): only points near the core's edge are searched for.
       const double cap = 2.0 * (diagonalHalf + kCoreDepth * largest);
       const double r = wallDistance(walls, samples, leaf.centre, cap);
-      for (const SizingOctree::QuadraturePoint& q : points) {
-        const double h = tree.delta(q.x);
+      for (std::size_t k = 0; k < points.size(); ++k) {
+        const SizingOctree::QuadraturePoint& q = points[k];
+        const double h = sizes[k];
         const double depth = kCoreDepth * h, offset = (q.x - leaf.centre).norm();
         const bool inCore = r - offset > depth    ? true
                             : r + offset <= depth ? false
