@@ -203,25 +203,22 @@ ElementCountPrediction predictElementCount(const SizingOctree& tree, const CadMo
   out.gradientIntegral = domain.gradient;
   out.domainMeasure = tree.domainMeasure();
   const std::vector<BoundarySample>& samples = tree.samples();
-  double boundary = 0.0;
-#pragma omp parallel for num_threads(threadsToUse(threads)) reduction(+ : boundary) schedule(static)
+  // One pass over the samples for the boundary and (3D) convexity integrals; a face between two
+  // solids counts twice in the first and not in the second (convex on one side, concave on the
+  // other).
+  double boundary = 0.0, convexity = 0.0;
+#pragma omp parallel for num_threads(threadsToUse(threads)) reduction(+ : boundary, convexity) \
+    schedule(static)
   for (std::int64_t i = 0; i < static_cast<std::int64_t>(samples.size()); ++i) {
     const BoundarySample& s = samples[static_cast<std::size_t>(i)];
     const double h = tree.delta(s.x);
     boundary += (s.internal ? 2.0 : 1.0) * s.weight / (d == 3 ? h * h : h);
+    if (d == 3 && !s.internal && isWall(s))
+      convexity +=
+          s.weight * std::clamp(-s.meanCurvature * h, -kMostCurvature, kMostCurvature) / (h * h);
   }
   out.boundaryIntegral = boundary;
   if (d == 3) {
-    double convexity =
-        0.0;  // a face between two solids is convex on one side, concave on the other
-#pragma omp parallel for num_threads(threadsToUse(threads)) reduction(+ : convexity) schedule(static)
-    for (std::int64_t i = 0; i < static_cast<std::int64_t>(samples.size()); ++i) {
-      const BoundarySample& s = samples[static_cast<std::size_t>(i)];
-      if (s.internal || !isWall(s)) continue;
-      const double h = tree.delta(s.x);
-      convexity +=
-          s.weight * std::clamp(-s.meanCurvature * h, -kMostCurvature, kMostCurvature) / (h * h);
-    }
     out.convexityIntegral = convexity;
     out.curveIntegral = curveIntegral(cad, tree);
     out.elements = kCoreDensity3 * out.coreIntegral + kBoundaryDensity3 * boundary +
