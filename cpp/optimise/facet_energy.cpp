@@ -3,6 +3,9 @@
 #include <omp.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <map>
 #include <optional>
 #include <string>
@@ -259,6 +262,16 @@ void FacetEnergy::refreshTargets(const std::vector<Vec>& positions, const Mesh& 
       const std::int64_t* v = s.cells->element(f.cell);
       const int face = s.cells->entity[f.cell];
       if (face < 1 || face > cad.numFaces() || !f.followsCad) continue;
+      if (!refreshedAt_.empty() &&
+          std::all_of(v, v + s.nodes,
+                      [&](std::int64_t id) {
+                        return positions[static_cast<std::size_t>(id)] ==
+                               refreshedAt_[static_cast<std::size_t>(id)];
+                      }) &&
+          std::all_of(footParam_.begin() + static_cast<std::ptrdiff_t>(f.first),
+                      footParam_.begin() + static_cast<std::ptrdiff_t>(f.first) + s.points,
+                      [](const std::array<double, 2>& uv) { return std::isfinite(uv[0]); }))
+        continue;  // unmoved since its targets were found
       for (int q = 0; q < s.points; ++q) {
         const auto k = f.first + static_cast<std::size_t>(q);
         Vec x = Vec::Zero();
@@ -296,6 +309,7 @@ void FacetEnergy::refreshTargets(const std::vector<Vec>& positions, const Mesh& 
     }
   }
   failure.rethrow();
+  refreshedAt_ = positions;
 }
 
 double FacetEnergy::total(const std::vector<Vec>& positions) const {

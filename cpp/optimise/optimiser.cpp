@@ -175,6 +175,7 @@ class Optimiser {
                                        options_);
     result_.regionElements = free_.regionElements;
     result_.freeNodes = free_.nodes.size();
+    elementEnergy_.clear();  // totalEnergy computes every element's share again
     energyOrder_ =
         optimiser::energyOrder(free_.changed, mesh_.totalElements, mesh_.callersElements);
   }
@@ -291,24 +292,40 @@ class Optimiser {
   }
 
   // The energy of the elements that contain a free node (the others' is constant), from the
-  // current F, with the regularisation of a valid patch.
-  double totalEnergy() const {
-    // summed in order: the same for any thread count
-    std::vector<double> energy(free_.changed.size());
+  // current F, with the regularisation of a valid patch. Each element's share is kept and
+  // computed again only where its F changed since (the sweeper marks those): the total is the
+  // same to the last bit as from every element afresh, and a late sweep that moves a few nodes
+  // no longer pays for the whole mesh (0.12 s a sweep on the 66,899 order-4 tetrahedra of a
+  // cylinder of radius 1 and length 1000, where such sweeps took 0.1 s).
+  double totalEnergy() {
+    std::vector<std::size_t> stale;  // positions in free_.changed
+    if (elementEnergy_.size() != free_.changed.size()) {
+      elementEnergy_.assign(free_.changed.size(), 0.0);
+      stale.resize(free_.changed.size());
+      for (std::size_t i = 0; i < stale.size(); ++i) stale[i] = i;
+      sweeper_.takeChangedEnergy();
+    } else {
+      for (const std::size_t e : sweeper_.takeChangedEnergy())
+        stale.push_back(static_cast<std::size_t>(
+            std::lower_bound(free_.changed.begin(), free_.changed.end(), e) -
+            free_.changed.begin()));
+    }
+    std::vector<std::size_t> elements(stale.size());
+    for (std::size_t k = 0; k < stale.size(); ++k) elements[k] = free_.changed[stale[k]];
     functional_detail::dispatch(options_.functional, [&](auto fn) {
-      colouring_.forEachOwned(free_.changed, 64, [&](std::size_t i, int /*thread*/) {
-        const auto [bi, e] = mesh_.locate(free_.changed[i]);
+      colouring_.forEachOwned(elements, 64, [&](std::size_t k, int /*thread*/) {
+        const auto [bi, e] = mesh_.locate(elements[k]);
         const optimiser::Block<D>& b = mesh_.blocks[bi];
         double sum = 0.0;
         for (int q = 0; q < b.points; ++q) {
           const std::size_t p = e * b.points + q;
           sum += b.weights[p] * energyDensity<D, decltype(fn)::value>(b.matrixF(e, q), 1e-10);
         }
-        energy[i] = sum;
+        elementEnergy_[stale[k]] = sum;
       });
     });
-    double total = 0.0;
-    for (const std::size_t i : energyOrder_) total += energy[i];
+    double total = 0.0;  // summed in order: the same for any thread count
+    for (const std::size_t i : energyOrder_) total += elementEnergy_[i];
     total += step_.facetTotal();
     return total;
   }
@@ -321,6 +338,7 @@ class Optimiser {
   WorkingMesh<D> mesh_;
   FreeNodes<D> free_;  // its nodes grouped by colour, then by part, once coloured
   std::vector<std::size_t> energyOrder_;  // positions in free_.changed, summed in this order
+  std::vector<double> elementEnergy_;     // per position in free_.changed (totalEnergy)
   NodeColouring<D> colouring_;
   CertifiedQuality<D> quality_;
   CadSliding<D> sliding_;

@@ -50,12 +50,12 @@ void Sweeper<D>::record(std::int64_t node, double relative) {
       active_[node].load(std::memory_order_relaxed) != want)
     active_[node].store(want, std::memory_order_relaxed);
   if (!moved) return;
-  constexpr std::uint8_t both = kStale | kDrifted;
+  constexpr std::uint8_t all = kStale | kDrifted | kEnergyStale;
   for (std::size_t k = mesh_.incidenceStart[node]; k < mesh_.incidenceStart[node + 1]; ++k) {
     const Incidence& inc = mesh_.incidence[k];
     std::atomic<std::uint8_t>& mark = marks_[mesh_.globalIndex(inc)];
-    if ((mark.load(std::memory_order_relaxed) & both) != both)
-      mark.fetch_or(both, std::memory_order_relaxed);
+    if ((mark.load(std::memory_order_relaxed) & all) != all)
+      mark.fetch_or(all, std::memory_order_relaxed);
     if (!wakes) continue;
     const Block<D>& b = mesh_.blocks[inc.block];
     const std::int64_t* v = b.cells->element(inc.element);

@@ -84,11 +84,15 @@ class Sweeper {
   // Makes the node active for the next sweep.
   void wake(std::int64_t node) { active_[node].store(1, std::memory_order_relaxed); }
 
+  // The elements whose F changed since the last call (global indices, ascending), and clears
+  // that mark: their energy is out of date.
+  std::vector<std::size_t> takeChangedEnergy() { return take(kEnergyStale); }
+
  private:
   // Per element: kStale = a node moved since its quality was last computed, kDrifted = since
-  // its F was last computed from the nodes. Set by record() (atomics: threads mark shared
-  // elements), cleared by take().
-  static constexpr std::uint8_t kStale = 1, kDrifted = 2;
+  // its F was last computed from the nodes, kEnergyStale = since takeChangedEnergy(). Set by
+  // record() (atomics: threads mark shared elements), cleared by take().
+  static constexpr std::uint8_t kStale = 1, kDrifted = 2, kEnergyStale = 4;
 
   void record(std::int64_t node, double relative);
   bool settled(std::int64_t node) const;

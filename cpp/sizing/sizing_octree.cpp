@@ -28,6 +28,12 @@ constexpr int kMaxLevel = 20;  // corner keys pack 21 bits per axis
 constexpr int kMinLevel = 2;
 constexpr std::size_t kMaxCandidates = 24;
 constexpr int kGroupVotes = 15;
+// A vote counts only where the direction from the nearest boundary sample to the leaf is at
+// least this far from the sample's tangent plane (|cos| against its normal): seen past a
+// face's rim, a far leaf's nearest sample can lie on the side wall, whose normal is then
+// nearly perpendicular to the direction and its sign is chance (a cylinder of radius 0.01 and
+// length 1 had its outside counted as inside, 3.2e3 times its volume).
+constexpr double kDecidingCosine = 0.3;
 // About 1 GB of octree: sizes that need more are refused (they would also make far more
 // elements than a machine can hold).
 constexpr std::size_t kMaxNodes =
@@ -352,17 +358,25 @@ class OctreeBuilder {
   // `candidates` (DESIGN.md: the CAD normal at the nearest boundary sample).
   bool insideBySamples(const Eigen::Vector3d& q,
                        const std::vector<std::int32_t>& candidates) const {
-    double best = kInf;
-    bool inside = false;
+    return nearestSampleSide(q, candidates) < 0.0;
+  }
+
+  // The cosine between the outward normal of the nearest of `candidates` and the direction
+  // from it to q: negative inside, and near 0 where that sample does not decide (q seen past
+  // the rim of a face, the sample on its side wall).
+  double nearestSampleSide(const Eigen::Vector3d& q,
+                           const std::vector<std::int32_t>& candidates) const {
+    double best = kInf, side = 0.0;
     for (const std::int32_t i : candidates) {
       const BoundarySample& s = samples_[i];
-      const double dist = (q - s.x).squaredNorm();
+      const Eigen::Vector3d d = q - s.x;
+      const double dist = d.squaredNorm();
       if (dist < best) {
         best = dist;
-        inside = s.outward.dot(q - s.x) < 0.0;
+        side = dist > 0.0 ? s.outward.dot(d) / std::sqrt(dist) : 0.0;
       }
     }
-    return inside;
+    return side;
   }
 
   void classify() {
@@ -387,9 +401,9 @@ class OctreeBuilder {
     for (std::size_t i = 0; i < nLeaves; ++i)
       boundary[i] = onDomainBoundary(content_[t_.leaves_[i].node]);
     // Leaves off the boundary: flood-fill connected groups; classify each group by the nearest
-    // boundary samples seen from its members next to the boundary (a vote, robust against one
-    // unlucky sample at a sharp corner); OCCT's classifier only for a group that touches no
-    // boundary leaf.
+    // boundary samples seen from its members next to the boundary (a vote of the samples that
+    // decide, kDecidingCosine); OCCT's classifier for a group whose votes are split (one
+    // unlucky sample at a sharp corner) or that has none (it touches no boundary leaf).
     std::vector<std::int32_t> group(nLeaves, -1);
     std::vector<bool> groupInside;
     std::vector<std::int32_t> candidates;
@@ -399,9 +413,12 @@ class OctreeBuilder {
       int votesIn = 0, votesOut = 0;
       std::vector<std::size_t> stack{start};
       group[start] = g;
+      std::size_t largest = start;
       while (!stack.empty()) {
         const std::size_t i = stack.back();
         stack.pop_back();
+        if (t_.nodes_[t_.leaves_[i].node].half > t_.nodes_[t_.leaves_[largest].node].half)
+          largest = i;
         for (std::int64_t k = t_.neighbourStart_[i]; k < t_.neighbourStart_[i + 1]; ++k) {
           const auto j = static_cast<std::size_t>(t_.neighbours_[k]);
           if (boundary[j]) {
@@ -409,8 +426,9 @@ class OctreeBuilder {
               candidates.clear();
               for (const std::int32_t c : content_[t_.leaves_[j].node].samples)
                 if (separatesDomain(samples_[c])) candidates.push_back(c);
-              (insideBySamples(t_.nodes_[t_.leaves_[i].node].centre, candidates) ? votesIn
-                                                                                 : votesOut)++;
+              const double side =
+                  nearestSampleSide(t_.nodes_[t_.leaves_[i].node].centre, candidates);
+              if (std::abs(side) >= kDecidingCosine) (side < 0.0 ? votesIn : votesOut)++;
             }
           } else if (group[j] < 0) {
             group[j] = g;
@@ -418,9 +436,12 @@ class OctreeBuilder {
           }
         }
       }
-      groupInside.push_back(votesIn + votesOut > 0
-                                ? votesIn > votesOut
-                                : insideModel(t_.nodes_[t_.leaves_[start].node].centre));
+      // Unanimous votes decide; split or no votes, OCCT's classifier at the group's largest
+      // leaf (farthest from the boundary, where its ray casting is surest).
+      groupInside.push_back(votesIn > 0 && votesOut == 0 ? true
+                            : votesOut > 0 && votesIn == 0
+                                ? false
+                                : insideModel(t_.nodes_[t_.leaves_[largest].node].centre));
     }
     // Each leaf is judged on its own, in parallel (an allocation failure is carried out).
     FirstFailure failure;

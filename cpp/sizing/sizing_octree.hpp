@@ -106,6 +106,9 @@ class SizingOctree {
   // normal as the third; the identity in 3D.
   const Eigen::Matrix3d& axes() const { return axes_; }
 
+  // Sub-cells per axis of a boundary leaf, each classified inside or outside by its centre.
+  int subdivisions() const { return dim_ == 3 ? 3 : 6; }
+
  private:
   struct Node {
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // local coordinates
@@ -133,7 +136,6 @@ class SizingOctree {
   double interpolate(const LeafData& leaf, const Eigen::Vector3d& q) const;
   double gradientNorm(const LeafData& leaf, const Eigen::Vector3d& q) const;
   int children() const { return 1 << dim_; }
-  int subdivisions() const { return dim_ == 3 ? 3 : 6; }  // sub-cells per axis for boundary leaves
 
   friend class OctreeBuilder;
 

@@ -115,6 +115,30 @@ TEST_P(Shapes, QuadratureIsExactToItsDegree) {
   }
 }
 
+// Positive weights and interior points: an energy or a Jacobian sampled there stays inside the
+// element, and no sample can cancel another.
+TEST_P(Shapes, QuadratureWeightsArePositiveAndPointsInside) {
+  const CellType type = GetParam();
+  const int dim = cellDimension(type);
+  for (int degree = 0; degree <= 22; ++degree) {
+    const QuadratureRule rule = quadratureRule(type, degree);
+    for (int q = 0; q < rule.size(); ++q) {
+      ASSERT_GT(rule.weights[q], 0.0) << "degree " << degree << " point " << q;
+      const double* x = &rule.points[static_cast<std::size_t>(q) * dim];
+      double simplex = 0.0;  // the sum of the coordinates bound by 1 on simplices
+      for (int k = 0; k < dim; ++k) {
+        ASSERT_GT(x[k], 0.0) << "degree " << degree << " point " << q;
+        ASSERT_LT(x[k], 1.0) << "degree " << degree << " point " << q;
+      }
+      if (type == CellType::Triangle || type == CellType::Tetrahedron)
+        for (int k = 0; k < dim; ++k) simplex += x[k];
+      if (type == CellType::Prism) simplex = x[0] + x[1];
+      if (type == CellType::Pyramid) simplex = std::max(x[0], x[1]) + x[2];
+      ASSERT_LT(simplex, 1.0) << "degree " << degree << " point " << q;
+    }
+  }
+}
+
 TEST_P(Shapes, BasisReproducesItsPolynomialsAndTheirDerivatives) {
   const CellType type = GetParam();
   const int dim = cellDimension(type);
