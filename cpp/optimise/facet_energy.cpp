@@ -243,6 +243,7 @@ std::size_t FacetEnergy::dropApexFacets(const Mesh& mesh, const CadModel& cad) {
       ++dropped;
       for (int q = 0; q < s.points; ++q)
         normal_[f.first + static_cast<std::size_t>(q)] = Vec::Zero();
+      totalAt_.clear();  // total() computes every share again
     }
   }
   return dropped;
@@ -272,6 +273,7 @@ void FacetEnergy::refreshTargets(const std::vector<Vec>& positions, const Mesh& 
                       footParam_.begin() + static_cast<std::ptrdiff_t>(f.first) + s.points,
                       [](const std::array<double, 2>& uv) { return std::isfinite(uv[0]); }))
         continue;  // unmoved since its targets were found
+      if (!shareStale_.empty()) shareStale_[static_cast<std::size_t>(fi)] = 1;
       for (int q = 0; q < s.points; ++q) {
         const auto k = f.first + static_cast<std::size_t>(q);
         Vec x = Vec::Zero();
@@ -312,9 +314,26 @@ void FacetEnergy::refreshTargets(const std::vector<Vec>& positions, const Mesh& 
   refreshedAt_ = positions;
 }
 
-double FacetEnergy::total(const std::vector<Vec>& positions) const {
+double FacetEnergy::total(const std::vector<Vec>& positions) {
+  if (totalAt_.empty()) {
+    share_.assign(facets_.size(), 0.0);
+    shareStale_.assign(facets_.size(), 1);
+  }
   double energy = 0.0;
-  for (const Facet& f : facets_) energy += facetEnergy(f, positions, -1, nullptr, nullptr, nullptr);
+  for (std::size_t fi = 0; fi < facets_.size(); ++fi) {
+    const Facet& f = facets_[fi];
+    const Shape& s = shapes_[static_cast<std::size_t>(f.shape)];
+    const std::int64_t* v = s.cells->element(f.cell);
+    if (shareStale_[fi] != 0 || std::any_of(v, v + s.nodes, [&](std::int64_t id) {
+          const auto n = static_cast<std::size_t>(id);
+          return positions[n] != totalAt_[n];
+        })) {
+      share_[fi] = facetEnergy(f, positions, -1, nullptr, nullptr, nullptr);
+      shareStale_[fi] = 0;
+    }
+    energy += share_[fi];
+  }
+  totalAt_ = positions;
   return energy;
 }
 

@@ -166,8 +166,10 @@ class FacetEnergy {
   }
   // The same energy with the node moved by d from where assemble() had it.
   static double energyAfter(const Patch& patch, const Vec& d);
-  // The energy of every facet at `positions`, summed in facet order.
-  double total(const std::vector<Vec>& positions) const;
+  // The energy of every facet at `positions`, summed in facet order. Each facet's share is kept
+  // and computed again only where one of its nodes moved or its targets changed since: the
+  // same total to the last bit, without a pass over every facet after a sweep that moved few.
+  double total(const std::vector<Vec>& positions);
 
  private:
   struct Shape {  // one facet cell type and order
@@ -204,7 +206,12 @@ class FacetEnergy {
   // (zero: undefined, or not refreshed yet) and its face parameters (NaN: none yet).
   std::vector<Vec> foot_, normal_;
   std::vector<std::array<double, 2>> footParam_;
-  std::vector<Vec> refreshedAt_;    // per node: its position at the last refresh (empty: none)
+  std::vector<Vec> refreshedAt_;  // per node: its position at the last refresh (empty: none)
+  // total()'s shares: per facet its energy and whether its targets changed since (1: compute
+  // again), per node its position at the last total (empty: none).
+  std::vector<double> share_;
+  std::vector<char> shareStale_;
+  std::vector<Vec> totalAt_;
   std::vector<std::size_t> start_;  // per node: its facets in incidence_
   std::vector<Incidence> incidence_;
 };

@@ -120,7 +120,7 @@ bool NodeStep<D>::touchesFacet(std::int64_t node) const {
 }
 
 template <int D>
-double NodeStep<D>::facetTotal() const {
+double NodeStep<D>::facetTotal() {
   if constexpr (D == 3) {
     if (facetsOn_ && hasFacets()) return facetEnergy_->total(mesh_.position);
   }

@@ -71,7 +71,7 @@ class NodeStep {
   // Whether the node is a vertex of a boundary facet of the term (after buildFacets).
   bool touchesFacet(std::int64_t node) const;
   // The facet term's total at the current positions, 0 until it has joined (facetsOn()).
-  double facetTotal() const;
+  double facetTotal();
 
   // The patch of a node: F, a and the weight at every quadrature point of its elements. Returns
   // the regularisation the patch needs (DESIGN.md section 6: sizeable only where it is inverted).

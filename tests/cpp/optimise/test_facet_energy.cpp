@@ -91,7 +91,7 @@ TEST_P(FacetShapes, ARigidMotionOfTheStraightFacetCostsNothing) {
   const int order = 3;
   OneFacet f = straightFacet(order, side, type);
   const std::vector<std::uint8_t> movable(f.positions.size(), 1);
-  const FacetEnergy energy(f.mesh, f.positions, movable, weight);
+  FacetEnergy energy(f.mesh, f.positions, movable, weight);
   ASSERT_EQ(energy.size(), 1U);
   // The points' weights add up to weight x area x sqrt(area). At every point C = I to the
   // rounding of M = T W^-1 (T a sum over the nodes of |x| |grad l|, a few hundred u relative
@@ -116,7 +116,7 @@ TEST_P(FacetShapes, BunchedNodesCostAndTrialsMatchTheMovedFacet) {
   const CellType type = GetParam();
   OneFacet f = straightFacet(4, 1.0, type);
   const std::vector<std::uint8_t> movable(f.positions.size(), 1);
-  const FacetEnergy energy(f.mesh, f.positions, movable, 1.0);
+  FacetEnergy energy(f.mesh, f.positions, movable, 1.0);
   // The first node on edge 0-1 (at a quarter of it) slid towards vertex 0, along the edge.
   const std::int64_t node = firstEdgeNode(type);
   const Eigen::Vector3d along = (f.positions[1] - f.positions[0]).normalized();
@@ -131,6 +131,9 @@ TEST_P(FacetShapes, BunchedNodesCostAndTrialsMatchTheMovedFacet) {
     moved[node] += d;
     const double direct = energy.total(moved);
     EXPECT_GT(direct, e0 + 1e-6) << "bunching by " << s << " costs nothing";
+    // total() keeps each facet's share from its last call: the moved facet's is computed again,
+    // to the last bit what a term that never saw the other positions finds.
+    EXPECT_EQ(direct, FacetEnergy(f.mesh, f.positions, movable, 1.0).total(moved));
     // The trial formula (M + d a^T) and the recomputed facet agree to the rounding of the terms
     // the energy sums, sum w (|W_s| + |M|^2) (`size`, near 2 x the weights at the ideal, where
     // the energy itself is near 0), a few hundred u of them, plus that of the moved facet.
