@@ -115,6 +115,11 @@ double FacetEnergy::facetEnergy(const Facet& f, const std::vector<Vec>& position
   const Shape& s = shapes_[static_cast<std::size_t>(f.shape)];
   const std::int64_t* v = s.cells->element(f.cell);
   const bool distortion = weight_ > 0.0, fidelity = fidelity_ > 0.0;
+  // The facet's nodes side by side: every point reads all of them.
+  thread_local std::vector<Vec> nodes;
+  nodes.resize(static_cast<std::size_t>(s.nodes));
+  for (int n = 0; n < s.nodes; ++n)
+    nodes[static_cast<std::size_t>(n)] = positions[static_cast<std::size_t>(v[n])];
   double energy = 0.0;
   for (int q = 0; q < s.points; ++q) {
     const auto k = f.first + static_cast<std::size_t>(q);
@@ -123,7 +128,7 @@ double FacetEnergy::facetEnergy(const Facet& f, const std::vector<Vec>& position
     for (int n = 0; n < s.nodes; ++n) {
       const auto at = static_cast<std::size_t>(n) * s.points + q;
       const double* dn = &s.gradients[at * 2];
-      const Vec& xn = positions[static_cast<std::size_t>(v[n])];
+      const Vec& xn = nodes[static_cast<std::size_t>(n)];
       t.col(0) += xn * dn[0];
       t.col(1) += xn * dn[1];
       if (fidelity) x += xn * s.values[at];
