@@ -19,6 +19,19 @@
 
 namespace homesh {
 
+namespace {
+
+// Whether the `count` nodes `v` are where `then` had them, to the last bit.
+bool unmoved(const std::int64_t* v, int count, const std::vector<Eigen::Vector3d>& positions,
+             const std::vector<Eigen::Vector3d>& then) {
+  return std::all_of(v, v + count, [&](std::int64_t id) {
+    const auto n = static_cast<std::size_t>(id);
+    return positions[n] == then[n];
+  });
+}
+
+}  // namespace
+
 FacetEnergy::FacetEnergy(const Mesh& mesh, const std::vector<Vec>& positions,
                          const std::vector<std::uint8_t>& movable, double weight, double fidelity)
     : weight_(weight), fidelity_(fidelity) {
@@ -268,12 +281,7 @@ void FacetEnergy::refreshTargets(const std::vector<Vec>& positions, const Mesh& 
       const std::int64_t* v = s.cells->element(f.cell);
       const int face = s.cells->entity[f.cell];
       if (face < 1 || face > cad.numFaces() || !f.followsCad) continue;
-      if (!refreshedAt_.empty() &&
-          std::all_of(v, v + s.nodes,
-                      [&](std::int64_t id) {
-                        return positions[static_cast<std::size_t>(id)] ==
-                               refreshedAt_[static_cast<std::size_t>(id)];
-                      }) &&
+      if (!refreshedAt_.empty() && unmoved(v, s.nodes, positions, refreshedAt_) &&
           std::all_of(footParam_.begin() + static_cast<std::ptrdiff_t>(f.first),
                       footParam_.begin() + static_cast<std::ptrdiff_t>(f.first) + s.points,
                       [](const std::array<double, 2>& uv) { return std::isfinite(uv[0]); }))
@@ -329,10 +337,7 @@ double FacetEnergy::total(const std::vector<Vec>& positions) {
     const Facet& f = facets_[fi];
     const Shape& s = shapes_[static_cast<std::size_t>(f.shape)];
     const std::int64_t* v = s.cells->element(f.cell);
-    if (shareStale_[fi] != 0 || std::any_of(v, v + s.nodes, [&](std::int64_t id) {
-          const auto n = static_cast<std::size_t>(id);
-          return positions[n] != totalAt_[n];
-        })) {
+    if (shareStale_[fi] != 0 || !unmoved(v, s.nodes, positions, totalAt_)) {
       share_[fi] = facetEnergy(f, positions, -1, nullptr, nullptr, nullptr);
       shareStale_[fi] = 0;
     }

@@ -298,20 +298,16 @@ class Optimiser {
   // no longer pays for the whole mesh (0.12 s a sweep on the 66,899 order-4 tetrahedra of a
   // cylinder of radius 1 and length 1000, where such sweeps took 0.1 s).
   double totalEnergy() {
-    std::vector<std::size_t> stale;  // positions in free_.changed
+    std::vector<std::size_t> elements = sweeper_.takeChangedEnergy();  // global indices
     if (elementEnergy_.size() != free_.changed.size()) {
       elementEnergy_.assign(free_.changed.size(), 0.0);
-      stale.resize(free_.changed.size());
-      for (std::size_t i = 0; i < stale.size(); ++i) stale[i] = i;
-      sweeper_.takeChangedEnergy();
-    } else {
-      for (const std::size_t e : sweeper_.takeChangedEnergy())
-        stale.push_back(static_cast<std::size_t>(
-            std::lower_bound(free_.changed.begin(), free_.changed.end(), e) -
-            free_.changed.begin()));
+      elements = free_.changed;
     }
-    std::vector<std::size_t> elements(stale.size());
-    for (std::size_t k = 0; k < stale.size(); ++k) elements[k] = free_.changed[stale[k]];
+    std::vector<std::size_t> stale(elements.size());  // their positions in free_.changed
+    for (std::size_t k = 0; k < elements.size(); ++k)
+      stale[k] = static_cast<std::size_t>(
+          std::lower_bound(free_.changed.begin(), free_.changed.end(), elements[k]) -
+          free_.changed.begin());
     functional_detail::dispatch(options_.functional, [&](auto fn) {
       colouring_.forEachOwned(elements, 64, [&](std::size_t k, int /*thread*/) {
         const auto [bi, e] = mesh_.locate(elements[k]);
