@@ -233,6 +233,7 @@ void appendOptimiser(JsonWriter& json, const OptimiserResult& r, const std::stri
   json.value("cad_evaluations", r.cadEvaluations);
   json.value("colours", r.colours);
   json.value("region_elements", r.regionElements);
+  json.value("energy_rule", r.energyRule);
   json.value("seconds", r.seconds);
   json.value("setup_seconds", r.setupSeconds);
   json.value("sweep_seconds", r.sweepSeconds);

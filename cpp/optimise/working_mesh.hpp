@@ -52,9 +52,23 @@ constexpr NodeSet kWorkingSet = NodeSet::Optimal;
 // against 1).
 constexpr double kNodeShare = 0.01;
 
-// The energy's sample points of a cell type and order: the quadrature rule of degree 2P - 1 and
-// the element's equispaced nodes, weighted kNodeShare of the measure together.
-QuadratureRule energySamples(CellType type, int order, const ReferenceElement& equispaced);
+// Which samples the energy takes. Both rules are exact to degree 2P - 1; W is not a
+// polynomial, and the larger set's extra points see more of a fold:
+// - Collapsed: the collapsed Gauss-Jacobi product (quadrature.hpp), n^3 points on a
+//   tetrahedron, and every node of the element;
+// - Symmetric: on tetrahedra of orders 3 and 4, the fully symmetric rule of that degree
+//   (symmetric_quadrature.hpp: 14 and 35 points against 27 and 64) and the vertices and edge
+//   nodes only (16 and 22 of 20 and 35); the collapsed set elsewhere.
+// The optimiser takes Symmetric for an input certified valid, whose kept sweep is never worse
+// than the input; an input with elements not proven valid keeps Collapsed (optimiser.cpp says
+// what the smaller set lost there).
+enum class EnergyRule { Collapsed, Symmetric };
+
+// The energy's sample points of a cell type and order by `choice`: the quadrature rule of
+// degree 2P - 1 and the element's equispaced nodes (or some, above), weighted kNodeShare of the
+// measure together.
+QuadratureRule energySamples(CellType type, int order, const ReferenceElement& equispaced,
+                             EnergyRule choice = EnergyRule::Collapsed);
 
 template <int D>
 struct Block {
@@ -112,10 +126,14 @@ class WorkingMesh {
   // `order`: the renumbering `mesh` has been given (applied); null: the mesh's own numbers.
   WorkingMesh(Mesh& mesh, bool converting, const SpatialOrder* order = nullptr);
 
-  // The frame, the blocks, the working positions and the incidence, in that order. Throws
-  // ParameterError for a straight-sided element of zero volume (named by the caller's
-  // number) or a mesh without elements of dimension D.
+  // The frame, the blocks (without their samples), the working positions and the incidence,
+  // in that order. Throws ParameterError for a mesh without elements of dimension D.
   void build();
+
+  // After build(): each block's energy samples by `choice` (energySamples), their basis
+  // gradients, the ideal elements, the weights, room for F and J, and the node sizes. Throws
+  // ParameterError for a straight-sided element of zero volume (named by the caller's number).
+  void buildSamples(EnergyRule choice);
 
   // F and J at every quadrature point of the given elements (global indices): one matrix
   // product per element (its node coordinates times the tabulated basis gradients), each on its
@@ -178,12 +196,14 @@ class WorkingMesh {
   std::vector<std::size_t> incidenceStart;
   std::vector<Incidence> incidence;
   std::vector<double> nodeSize;  // size of each node's smallest element (volume^(1/D))
+  EnergyRule energyRule = EnergyRule::Collapsed;  // the one buildSamples took
 
  private:
   void setFrame();
   void buildBlocks();
   void convertToWorkingSet();
   void buildIncidence();
+  void buildNodeSizes();
 };
 
 extern template class WorkingMesh<2>;

@@ -25,6 +25,7 @@ struct Hole {
   std::vector<char> boundary;
   Hole() {
     working.build();
+    working.buildSamples(optimiser::EnergyRule::Collapsed);
     boundary.assign(mesh.numNodes(), 1);  // every node fixed before the CAD's say
     sliding.choose(boundary, 2);
   }

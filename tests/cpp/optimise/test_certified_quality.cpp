@@ -29,6 +29,7 @@ struct Measured {
   explicit Measured(Mesh m, bool converting = false)
       : mesh(std::move(m)), working(mesh, converting) {
     working.build();
+    working.buildSamples(optimiser::EnergyRule::Collapsed);
   }
 };
 

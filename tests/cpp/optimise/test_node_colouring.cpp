@@ -29,6 +29,7 @@ struct Cube {
   std::vector<std::size_t> changed;
   Cube() {
     working.build();
+    working.buildSamples(optimiser::EnergyRule::Collapsed);
     const std::vector<char> boundary = boundaryNodes(mesh.numNodes(), {working.blocks[0].cells});
     for (std::size_t n = 0; n < mesh.numNodes(); ++n)
       if (boundary[n] == 0) free.push_back(static_cast<std::int64_t>(n));

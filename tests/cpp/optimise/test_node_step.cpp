@@ -39,6 +39,7 @@ struct Stepper {
   Stepper(Mesh m, const CadModel* cad)
       : mesh(std::move(m)), working(mesh, cad == nullptr), sliding(working, cad) {
     working.build();
+    working.buildSamples(optimiser::EnergyRule::Collapsed);
     std::vector<char> boundary = boundaryNodes(mesh.numNodes(), {working.blocks[0].cells});
     sliding.choose(boundary, 1);
     for (std::size_t n = 0; n < mesh.numNodes(); ++n)

@@ -336,6 +336,7 @@ TEST(Optimiser, CubeSphereOrder4ConvergesAndKeepsTheBoundaryOfTheMadeMesh) {
   options.threads = 2;
   const OptimiserResult r = optimiseMesh(mesh, options);
   EXPECT_TRUE(r.converged) << r.stopReason;
+  EXPECT_EQ(r.energyRule, "symmetric");  // the input is certified valid
   EXPECT_EQ(r.invalidAfter, 0U);
   EXPECT_GT(r.worstAfter, r.worstBefore);
   EXPECT_GE(r.nodalWorstAfter, r.worstAfter);
@@ -416,6 +417,7 @@ TEST(Optimiser, UntanglesThePyramidsOfAHybridMesh) {
   options.threads = 2;
   const OptimiserResult r = optimiseMesh(mesh, options);
   EXPECT_GT(r.invalidBefore, 0U);
+  EXPECT_EQ(r.energyRule, "collapsed");  // not the symmetric rule on a tangled input
   EXPECT_EQ(r.invalidAfter, 0U);
   EXPECT_EQ(r.undecidedAfter, 0U);
   EXPECT_GT(r.worstAfter, 0.0);

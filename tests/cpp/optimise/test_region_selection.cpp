@@ -29,6 +29,7 @@ struct Cube {
   std::vector<Validity> validity;  // every element valid to start
   Cube() {
     working.build();
+    working.buildSamples(optimiser::EnergyRule::Collapsed);
     scaled.assign(working.totalElements, 0.9);
     validity.assign(working.totalElements, Validity::Valid);
   }
