@@ -87,7 +87,7 @@ class Optimiser {
     // such an input. Taken on every input (a trial), runs that untangle ended elsewhere: four
     // tests failed (a boundary layer's first height, repair rounds that must keep a flip).
     mesh_.buildSamples(certified ? EnergyRule::Symmetric : EnergyRule::Collapsed);
-    result_.energyRule = certified ? "symmetric" : "collapsed";
+    result_.energyRule = mesh_.energyRule == EnergyRule::Symmetric ? "symmetric" : "collapsed";
     result_.worstBefore = before.worst;
     result_.invalidBefore = before.invalid;
     result_.undecidedBefore = before.undecided;

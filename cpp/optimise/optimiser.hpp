@@ -80,8 +80,8 @@ struct OptimiserResult {
   std::size_t invalidBefore = 0, invalidAfter = 0;
   std::size_t undecidedBefore = 0, undecidedAfter = 0;
   std::size_t freeNodes = 0, colours = 0, regionElements = 0;
-  // The energy's quadrature (working_mesh.hpp's EnergyRule): "symmetric" on an input
-  // certified valid, else "collapsed".
+  // The energy's samples (working_mesh.hpp's EnergyRule): "symmetric" where an input
+  // certified valid holds tetrahedra of order 3 or 4, else "collapsed".
   std::string energyRule;
   std::size_t visits = 0;  // Newton steps tried in all sweeps (node updates)
   // Visits of nodes sliding on the CAD, and the CAD evaluations they made: the full Newton step

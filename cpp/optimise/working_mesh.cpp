@@ -15,15 +15,29 @@
 
 namespace homesh::optimiser {
 
+namespace {
+
+// The symmetric rule the energy of (type, order) takes with EnergyRule::Symmetric, where it has
+// fewer points than the collapsed one (tetrahedra of orders 3 and 4).
+std::optional<QuadratureRule> symmetricSamples(CellType type, int order) {
+  const int degree = std::max(1, 2 * order - 1);
+  if (type != CellType::Tetrahedron) return std::nullopt;
+  std::optional<QuadratureRule> rule = symmetricRule(type, degree);
+  if (rule && rule->size() >= quadratureRule(type, degree).size()) rule.reset();
+  return rule;
+}
+
+}  // namespace
+
+bool takesSymmetricSamples(CellType type, int order) {
+  return symmetricSamples(type, order).has_value();
+}
+
 QuadratureRule energySamples(CellType type, int order, const ReferenceElement& equispaced,
                              EnergyRule choice) {
-  const int degree = std::max(1, 2 * order - 1);
-  QuadratureRule rule = quadratureRule(type, degree);
-  std::optional<QuadratureRule> symmetric;
-  if (choice == EnergyRule::Symmetric && type == CellType::Tetrahedron)
-    symmetric = symmetricRule(type, degree);
-  if (symmetric && symmetric->size() >= rule.size()) symmetric.reset();  // orders 1 and 2
-  if (symmetric) rule = *symmetric;
+  const std::optional<QuadratureRule> symmetric =
+      choice == EnergyRule::Symmetric ? symmetricSamples(type, order) : std::nullopt;
+  QuadratureRule rule = symmetric ? *symmetric : quadratureRule(type, std::max(1, 2 * order - 1));
   double measure = 0.0;
   for (const double w : rule.weights) measure += w;
   const Eigen::MatrixXd& nodes = equispaced.nodes();
@@ -102,7 +116,7 @@ void WorkingMesh<D>::buildBlocks() {
 
 template <int D>
 void WorkingMesh<D>::buildSamples(EnergyRule choice) {
-  energyRule = choice;
+  energyRule = EnergyRule::Collapsed;
   for (std::size_t bi = 0; bi < blocks.size(); ++bi) {
     Block<D>& b = blocks[bi];
     const ElementBlock& cells = *b.cells;
@@ -111,6 +125,8 @@ void WorkingMesh<D>::buildSamples(EnergyRule choice) {
     const ReferenceElement& equi = ReferenceElement::get(cells.type, cells.order);
     const ReferenceElement& lin = ReferenceElement::get(cells.type, 1);
     const QuadratureRule rule = energySamples(cells.type, cells.order, equi, choice);
+    if (choice == EnergyRule::Symmetric && takesSymmetricSamples(cells.type, cells.order))
+      energyRule = EnergyRule::Symmetric;
     b.points = rule.size();
     const Eigen::MatrixXd points = pointRows(rule);
     const std::vector<Eigen::MatrixXd> grad = ref.derivativesAt(points);

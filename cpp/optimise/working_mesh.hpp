@@ -70,6 +70,10 @@ enum class EnergyRule { Collapsed, Symmetric };
 QuadratureRule energySamples(CellType type, int order, const ReferenceElement& equispaced,
                              EnergyRule choice = EnergyRule::Collapsed);
 
+// Whether EnergyRule::Symmetric changes the samples of (type, order) (tetrahedra of orders 3
+// and 4).
+bool takesSymmetricSamples(CellType type, int order);
+
 template <int D>
 struct Block {
   using Mat = Eigen::Matrix<double, D, D>;
@@ -196,7 +200,8 @@ class WorkingMesh {
   std::vector<std::size_t> incidenceStart;
   std::vector<Incidence> incidence;
   std::vector<double> nodeSize;  // size of each node's smallest element (volume^(1/D))
-  EnergyRule energyRule = EnergyRule::Collapsed;  // the one buildSamples took
+  // Symmetric where buildSamples took it on some block (tetrahedra of orders 3 and 4).
+  EnergyRule energyRule = EnergyRule::Collapsed;
 
  private:
   void setFrame();
