@@ -1105,5 +1105,23 @@ TEST(Optimiser, BadOptionsAreRefused) {
   EXPECT_THROW(optimiseMesh(mesh, options), ParameterError);
 }
 
+// An element whose straight-sided shape is flat (its fourth vertex in the plane of the other
+// three) has no ideal to measure distortion against: refused naming it, after the input's
+// quality is measured (the samples are built then) and before any node moves.
+TEST(Optimiser, AFlatStraightSidedElementIsRefusedByNumber) {
+  Mesh mesh = twoTetrahedra(1);
+  mesh.xyz[3 * 4] = 0.5, mesh.xyz[3 * 4 + 1] = 0.5, mesh.xyz[3 * 4 + 2] = 0.0;  // x + y + z = 1
+  mesh = elevateOrder(mesh, 2, nullptr);
+  const std::vector<double> before = mesh.xyz;
+  try {
+    optimiseMesh(mesh, OptimiserOptions{});
+    FAIL() << "a flat element was optimised";
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("element 1 "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("zero volume"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(mesh.xyz, before);
+}
+
 }  // namespace
 }  // namespace homesh
