@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cstdint>
 #include <limits>
 #include <map>
@@ -17,10 +18,12 @@ namespace homesh {
 namespace {
 
 // Writes numbers as MSH 4.1 ASCII text or as its binary encoding (int: 4 bytes, size_t: 8,
-// double: 8, native little-endian).
+// double: 8, native little-endian). Numbers gather in a buffer written out in large pieces, and
+// ASCII ones are formatted by std::to_chars: the shortest text that reads back as the same
+// double, at a fraction of a stream's cost (an order-4 mesh of 873,000 nodes spent 2.5 s here).
 class MshSink {
  public:
-  MshSink(std::ostream& os, bool binary) : os_(os), binary_(binary) { os_.precision(17); }
+  MshSink(std::ostream& os, bool binary) : os_(os), binary_(binary) {}
   bool binary() const { return binary_; }
 
   void size(std::size_t v) { put(static_cast<std::uint64_t>(v)); }
@@ -29,26 +32,40 @@ class MshSink {
   // Ends an ASCII line (nothing in binary).
   void endLine() {
     if (!binary_) {
-      os_ << '\n';
+      buffer_.push_back('\n');
       first_ = true;
     }
   }
-  std::ostream& text() { return os_; }
+  // The stream, for free text, after the numbers before it.
+  std::ostream& text() {
+    flush();
+    return os_;
+  }
+  void flush() {
+    os_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+    buffer_.clear();
+  }
 
  private:
+  static constexpr std::size_t kChunk = 1 << 16;
   template <class T>
   void put(T v) {
     if (binary_) {
-      os_.write(reinterpret_cast<const char*>(&v), sizeof v);
-      return;
+      const char* bytes = reinterpret_cast<const char*>(&v);
+      buffer_.append(bytes, sizeof v);
+    } else {
+      if (!first_) buffer_.push_back(' ');
+      std::array<char, 32> digits{};  // a double's shortest form takes at most 24
+      const std::to_chars_result r = std::to_chars(digits.data(), digits.data() + digits.size(), v);
+      buffer_.append(digits.data(), r.ptr);
+      first_ = false;
     }
-    if (!first_) os_ << ' ';
-    os_ << v;
-    first_ = false;
+    if (buffer_.size() >= kChunk) flush();
   }
   std::ostream& os_;
   bool binary_;
   bool first_ = true;
+  std::string buffer_;
 };
 
 // Gmsh entity tags must be positive; meshes without CAD have index 0.
@@ -276,6 +293,7 @@ void writeMsh41(const Mesh& mesh, const std::string& path, const std::vector<Cel
   writeNodes(out, mesh, entities.nodesOf);
   writeElements(out, groupElements(mesh));
   writeElementData(out, fields);
+  out.flush();
   file.commit();
 }
 

@@ -153,11 +153,24 @@ void orientTetrahedra(const Mesh& mesh, ElementBlock& tets) {
 }
 
 // Makes every tetrahedron positively oriented and every boundary triangle that bounds exactly one
-// tetrahedron point out of it.
+// tetrahedron point out of it. Only the triangles' faces are looked up (sorted, searched by each
+// tetrahedron's faces): a map of every tetrahedron's four faces took a second of a run of 67,000.
 void orientVolumeMesh(Mesh& mesh, ElementBlock& tets, ElementBlock& tris) {
   using Face = std::array<std::int64_t, 3>;
   orientTetrahedra(mesh, tets);
-  std::map<Face, std::vector<std::int64_t>> opposite;  // sorted face -> opposite vertices
+  std::vector<std::pair<Face, std::size_t>> faces(tris.count());  // sorted face, triangle
+  for (std::size_t e = 0; e < tris.count(); ++e) {
+    const std::int64_t* t = tris.nodes.data() + 3 * e;
+    Face f{t[0], t[1], t[2]};
+    std::sort(f.begin(), f.end());
+    faces[e] = {f, e};
+  }
+  std::sort(faces.begin(), faces.end());
+  std::vector<std::int64_t> opposite(tris.count(), -1);  // the vertex across, per triangle
+  std::vector<int> bounding(tris.count(), 0);            // how many tetrahedra it bounds
+  const auto byFace = [](const std::pair<Face, std::size_t>& a, const Face& b) {
+    return a.first < b;
+  };
   for (std::size_t e = 0; e < tets.count(); ++e) {
     const std::int64_t* t = tets.nodes.data() + 4 * e;
     for (int skip = 0; skip < 4; ++skip) {
@@ -166,18 +179,19 @@ void orientVolumeMesh(Mesh& mesh, ElementBlock& tets, ElementBlock& tris) {
       for (int k = 0; k < 4; ++k)
         if (k != skip) f[n++] = t[k];
       std::sort(f.begin(), f.end());
-      opposite[f].push_back(t[skip]);
+      for (auto it = std::lower_bound(faces.begin(), faces.end(), f, byFace);
+           it != faces.end() && it->first == f; ++it) {
+        ++bounding[it->second];
+        opposite[it->second] = t[skip];
+      }
     }
   }
   for (std::size_t e = 0; e < tris.count(); ++e) {
+    if (bounding[e] != 1) continue;
     std::int64_t* t = tris.nodes.data() + 3 * e;
-    Face f{t[0], t[1], t[2]};
-    std::sort(f.begin(), f.end());
-    const auto it = opposite.find(f);
-    if (it == opposite.end() || it->second.size() != 1) continue;
     const Eigen::Vector3d a = point(mesh, t[0]);
     const Eigen::Vector3d n = (point(mesh, t[1]) - a).cross(point(mesh, t[2]) - a);
-    if (n.dot(point(mesh, it->second[0]) - a) > 0.0) std::swap(t[1], t[2]);
+    if (n.dot(point(mesh, opposite[e]) - a) > 0.0) std::swap(t[1], t[2]);
   }
 }
 

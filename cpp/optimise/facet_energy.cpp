@@ -14,6 +14,7 @@
 #include "cad/face_apexes.hpp"
 #include "core/error.hpp"
 #include "core/first_failure.hpp"
+#include "core/vector_clones.hpp"
 #include "element/quadrature.hpp"
 #include "element/reference_element.hpp"
 
@@ -57,6 +58,12 @@ FacetEnergy::FacetEnergy(const Mesh& mesh, const std::vector<Vec>& positions,
             out[(static_cast<std::size_t>(n) * s.points + q) * 2 + k] = grad[k](q, n);
     };
     tabulate(ref, s.gradients);
+    s.byPoint.resize(s.gradients.size());
+    for (int n = 0; n < s.nodes; ++n)
+      for (int q = 0; q < s.points; ++q)
+        for (int k = 0; k < 2; ++k)
+          s.byPoint[(static_cast<std::size_t>(k) * s.nodes + n) * s.points + q] =
+              s.gradients[(static_cast<std::size_t>(n) * s.points + q) * 2 + k];
     tabulate(lin, s.linear);
     const Eigen::MatrixXd values = ref.valuesAt(points);  // points x nodes
     s.values.resize(static_cast<std::size_t>(s.nodes) * s.points);
@@ -123,28 +130,49 @@ FacetEnergy::FacetEnergy(const Mesh& mesh, const std::vector<Vec>& positions,
   }
 }
 
-double FacetEnergy::facetEnergy(const Facet& f, const std::vector<Vec>& positions, int local,
-                                Vec* g, Mat* h, Patch* patch, double* size) const {
+HOMESH_VECTOR_CLONES double FacetEnergy::facetEnergy(const Facet& f,
+                                                     const std::vector<Vec>& positions, int local,
+                                                     Vec* g, Mat* h, Patch* patch,
+                                                     double* size) const {
   const Shape& s = shapes_[static_cast<std::size_t>(f.shape)];
   const std::int64_t* v = s.cells->element(f.cell);
   const bool distortion = weight_ > 0.0, fidelity = fidelity_ > 0.0;
-  // The facet's nodes side by side: every point reads all of them.
-  thread_local std::vector<Vec> nodes;
-  nodes.resize(static_cast<std::size_t>(s.nodes));
-  for (int n = 0; n < s.nodes; ++n)
-    nodes[static_cast<std::size_t>(n)] = positions[static_cast<std::size_t>(v[n])];
+  // The tangents t = dx/dxi (and x) at every point first, node by node with the points innermost
+  // (a loop that vectorises), summed over the nodes in their order as a point-by-point loop
+  // would: [component][point] for t's first column, its second, then x.
+  const auto points = static_cast<std::size_t>(s.points);
+  thread_local std::vector<double> tx;
+  tx.assign(9 * points, 0.0);
+  for (int n = 0; n < s.nodes; ++n) {
+    const Vec& xn = positions[static_cast<std::size_t>(v[n])];
+    const double* d0 = &s.byPoint[static_cast<std::size_t>(n) * points];
+    const double* d1 = &s.byPoint[(static_cast<std::size_t>(s.nodes) + n) * points];
+    const double* l = &s.values[static_cast<std::size_t>(n) * points];
+    for (int c = 0; c < 3; ++c) {
+      const double xc = xn[c];
+      double* t0 = &tx[static_cast<std::size_t>(c) * points];
+      double* t1 = &tx[static_cast<std::size_t>(3 + c) * points];
+#pragma omp simd
+      for (std::size_t q = 0; q < points; ++q) {
+        t0[q] += xc * d0[q];
+        t1[q] += xc * d1[q];
+      }
+      if (!fidelity) continue;
+      double* xq = &tx[static_cast<std::size_t>(6 + c) * points];
+#pragma omp simd
+      for (std::size_t q = 0; q < points; ++q) xq[q] += xc * l[q];
+    }
+  }
   double energy = 0.0;
   for (int q = 0; q < s.points; ++q) {
     const auto k = f.first + static_cast<std::size_t>(q);
-    Eigen::Matrix<double, 3, 2> t = Eigen::Matrix<double, 3, 2>::Zero();
-    Vec x = Vec::Zero();
-    for (int n = 0; n < s.nodes; ++n) {
-      const auto at = static_cast<std::size_t>(n) * s.points + q;
-      const double* dn = &s.gradients[at * 2];
-      const Vec& xn = nodes[static_cast<std::size_t>(n)];
-      t.col(0) += xn * dn[0];
-      t.col(1) += xn * dn[1];
-      if (fidelity) x += xn * s.values[at];
+    const auto uq = static_cast<std::size_t>(q);
+    Eigen::Matrix<double, 3, 2> t;
+    Vec x;
+    for (int c = 0; c < 3; ++c) {
+      t(c, 0) = tx[static_cast<std::size_t>(c) * points + uq];
+      t(c, 1) = tx[static_cast<std::size_t>(3 + c) * points + uq];
+      x[c] = tx[static_cast<std::size_t>(6 + c) * points + uq];
     }
     const Eigen::Matrix2d& invW = invW_[k];
     const Eigen::Matrix<double, 3, 2> m = t * invW;
@@ -226,7 +254,7 @@ double FacetEnergy::assemble(std::int64_t node, const std::vector<Vec>& position
   return energy;
 }
 
-double FacetEnergy::energyAfter(const Patch& patch, const Vec& d) {
+HOMESH_VECTOR_CLONES double FacetEnergy::energyAfter(const Patch& patch, const Vec& d) {
   double energy = 0.0;
   for (std::size_t i = 0; i < patch.w.size(); ++i)
     energy += patch.w[i] * facet_detail::density<double>(Vec(patch.m1[i] + patch.a1[i] * d),

@@ -56,7 +56,8 @@ namespace facet_detail {
 // W_s at one point from the columns m1, m2 of M; infinite where the facet is degenerate
 // (det C <= 0). Templated on the scalar for the derivative tests (AutoDiffScalar).
 template <class T>
-T density(const Eigen::Matrix<T, 3, 1>& m1, const Eigen::Matrix<T, 3, 1>& m2) {
+[[gnu::always_inline]] inline T density(const Eigen::Matrix<T, 3, 1>& m1,
+                                        const Eigen::Matrix<T, 3, 1>& m2) {
   using std::log;
   const T c11 = m1.dot(m1), c22 = m2.dot(m2), c12 = m1.dot(m2);
   const T det = c11 * c22 - c12 * c12;
@@ -71,8 +72,10 @@ T density(const Eigen::Matrix<T, 3, 1>& m1, const Eigen::Matrix<T, 3, 1>& m2) {
 // det C is a quartic in d and its derivatives below are its own). Returns false (and leaves g,
 // h alone) where the facet is degenerate.
 template <class T>
-bool derivatives(const Eigen::Matrix<T, 3, 1>& m1, const Eigen::Matrix<T, 3, 1>& m2, T a1, T a2,
-                 T& value, Eigen::Matrix<T, 3, 1>& g, Eigen::Matrix<T, 3, 3>& h) {
+[[gnu::always_inline]] inline bool derivatives(const Eigen::Matrix<T, 3, 1>& m1,
+                                               const Eigen::Matrix<T, 3, 1>& m2, T a1, T a2,
+                                               T& value, Eigen::Matrix<T, 3, 1>& g,
+                                               Eigen::Matrix<T, 3, 3>& h) {
   using std::log;
   using V = Eigen::Matrix<T, 3, 1>;
   using M3 = Eigen::Matrix<T, 3, 3>;
@@ -177,6 +180,7 @@ class FacetEnergy {
     int nodes = 0, points = 0;
     std::vector<double> values;     // [node][point]
     std::vector<double> gradients;  // [node][point][2]
+    std::vector<double> byPoint;    // the same as [2][node][point]: loops over points vectorise
     std::vector<double> weights;    // quadrature weights
     std::vector<double> linear;     // the linear cell's basis gradients: [vertex][point][2]
     int vertices = 0;

@@ -6,8 +6,10 @@
 // The formulas are functional.hpp's (W = psi(S, J_r), F(delta) = F + delta a^T); this file only
 // lays the points out so the loops over them vectorise: one array per component of F, of a and
 // of the rank-one terms, and the transcendental (log, cube root) in a loop of its own, since a
-// libm call in a loop stops the compiler's vectoriser. The linear elastic W, quartic in delta,
-// goes point by point through functional.hpp.
+// libm call in a loop stops the compiler's vectoriser (the log is vector_log.hpp's, which
+// vectorises). The kernels are compiled for AVX2 as well as for the baseline
+// (core/vector_clones.hpp). The linear elastic W, quartic in delta, goes point by point through
+// functional.hpp.
 //
 // Sums over points are vectorised reductions: their order differs from a plain loop's, so the
 // results agree with functional.hpp's to rounding, not bit for bit (tests/cpp/optimise).
@@ -20,7 +22,9 @@
 #include <limits>
 #include <vector>
 
+#include "core/vector_clones.hpp"
 #include "optimise/functional.hpp"
+#include "optimise/vector_log.hpp"
 
 namespace homesh {
 
@@ -136,10 +140,16 @@ namespace patch_detail {
   return out;
 }
 
-// The transcendental psi needs of r (functional.hpp's transcendentalOf) at n points.
+// The transcendental psi needs of r (functional.hpp's transcendentalOf) at n points; ln r by
+// vectorLog, which vectorises (vector_log.hpp: within a unit in the last place of std::log).
 template <int D, Functional Fn>
-void transcendental(const double* r, double* t, std::size_t n) {
-  for (std::size_t i = 0; i < n; ++i) t[i] = functional_detail::transcendentalOf<D, Fn>(r[i]);
+[[gnu::always_inline]] inline void transcendental(const double* r, double* t, std::size_t n) {
+  if constexpr (Fn == Functional::Hyperelastic || Fn == Functional::LinearElastic) {
+#pragma omp simd
+    for (std::size_t i = 0; i < n; ++i) t[i] = vectorLog(r[i]);
+  } else {
+    for (std::size_t i = 0; i < n; ++i) t[i] = functional_detail::transcendentalOf<D, Fn>(r[i]);
+  }
 }
 
 // psi and its derivatives (functional.hpp's psi) from r and t = transcendental(r); the values
@@ -158,14 +168,14 @@ template <int D, Functional Fn>
 
 // J_r (and its derivatives) at n points. A run whose every J is far from inversion, the common
 // case, takes J_r = J without the square root and divisions of the general formula.
-inline bool allFar(const double* J, std::size_t n, double eps) {
+[[gnu::always_inline]] inline bool allFar(const double* J, std::size_t n, double eps) {
   double lowest = std::numeric_limits<double>::infinity();
 #pragma omp simd reduction(min : lowest)
   for (std::size_t i = 0; i < n; ++i) lowest = std::min(lowest, J[i]);
   return lowest > 1e9 * eps;
 }
-inline void regulariseAll(const double* J, std::size_t n, double eps, double* r, double* dr,
-                          double* ddr) {
+[[gnu::always_inline]] inline void regulariseAll(const double* J, std::size_t n, double eps,
+                                                 double* r, double* dr, double* ddr) {
   if (allFar(J, n, eps)) {
 #pragma omp simd
     for (std::size_t i = 0; i < n; ++i) {
@@ -188,8 +198,9 @@ inline void regulariseAll(const double* J, std::size_t n, double eps, double* r,
 // Pass 1 of assemblePatch, on one run: at every point |F|^2, J = det F, |a|^2, F a,
 // g = cof(F) a, and J_r with its derivatives into r, dr, ddr.
 template <int D>
-void rankOneTerms(NodePatch<D>& p, const typename NodePatch<D>::Run& run, double eps, double* r,
-                  double* dr, double* ddr) {
+[[gnu::always_inline]] inline void rankOneTerms(NodePatch<D>& p,
+                                                const typename NodePatch<D>::Run& run, double eps,
+                                                double* r, double* dr, double* ddr) {
   const std::size_t n = run.count, o = run.first, s = run.stride;
   double* SF = p.SF() + o;
   double* J = p.J() + o;
@@ -268,8 +279,10 @@ template <int D, Functional Fn>
 // The patch energy sum_i w_i W(F_i) and its gradient and Hessian in the node's displacement;
 // fills the patch's rank-one terms. `magnitude`, if given, receives sum_i w_i (|W_i| + |F_i|^2).
 template <int D, Functional Fn>
-double assemblePatch(NodePatch<D>& p, double eps, Eigen::Matrix<double, D, 1>& grad,
-                     Eigen::Matrix<double, D, D>& hess, double* magnitude = nullptr) {
+HOMESH_VECTOR_CLONES double assemblePatch(NodePatch<D>& p, double eps,
+                                          Eigen::Matrix<double, D, 1>& grad,
+                                          Eigen::Matrix<double, D, D>& hess,
+                                          double* magnitude = nullptr) {
   using Vec = Eigen::Matrix<double, D, 1>;
   using Mat = Eigen::Matrix<double, D, D>;
   if constexpr (Fn == Functional::LinearElastic) {
@@ -385,7 +398,8 @@ double assemblePatch(NodePatch<D>& p, double eps, Eigen::Matrix<double, D, 1>& g
 // The patch energy with the node moved by d from where F has it (after assemblePatch, whose
 // terms it reads). Infinite or NaN where a point inverts without regularisation.
 template <int D, Functional Fn>
-double patchEnergyAfter(NodePatch<D>& p, const Eigen::Matrix<double, D, 1>& d, double eps) {
+HOMESH_VECTOR_CLONES double patchEnergyAfter(NodePatch<D>& p, const Eigen::Matrix<double, D, 1>& d,
+                                             double eps) {
   if constexpr (Fn == Functional::LinearElastic) {
     double e1 = 0.0;
     for (const typename NodePatch<D>::Run& run : p.runs())

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "core/vector_clones.hpp"
 
 namespace homesh::optimiser {
 
@@ -38,7 +39,7 @@ bool newtonStep(M h, const V& g, V& step, double& slope) {
 // F += d a^T and, by the matrix determinant lemma, J += g . d at every point of the patch, in
 // the blocks' own arrays.
 template <int D>
-void applyMove(Patch<D>& patch, const Eigen::Matrix<double, D, 1>& d) {
+HOMESH_VECTOR_CLONES void applyMove(Patch<D>& patch, const Eigen::Matrix<double, D, 1>& d) {
   const NodePatch<D>& pts = patch.points;
   for (const typename Patch<D>::Run& run : patch.runs) {
     Block<D>& b = *run.block;
@@ -139,7 +140,7 @@ double NodeStep<D>::facetAssemble(std::int64_t node, Vec& grad, Mat& hess, Patch
 }
 
 template <int D>
-double NodeStep<D>::gather(std::int64_t node, Patch<D>& patch) {
+HOMESH_VECTOR_CLONES double NodeStep<D>::gather(std::int64_t node, Patch<D>& patch) {
   std::size_t total = 0;
   for (std::size_t k = mesh_.incidenceStart[node]; k < mesh_.incidenceStart[node + 1]; ++k)
     total += static_cast<std::size_t>(mesh_.blocks[mesh_.incidence[k].block].points);
