@@ -57,13 +57,14 @@ FacetEnergy::FacetEnergy(const Mesh& mesh, const std::vector<Vec>& positions,
           for (int k = 0; k < 2; ++k)
             out[(static_cast<std::size_t>(n) * s.points + q) * 2 + k] = grad[k](q, n);
     };
-    tabulate(ref, s.gradients);
-    s.byPoint.resize(s.gradients.size());
+    std::vector<double> gradients;  // [node][point][2], as tabulate writes them
+    tabulate(ref, gradients);
+    s.byPoint.resize(gradients.size());
     for (int n = 0; n < s.nodes; ++n)
       for (int q = 0; q < s.points; ++q)
         for (int k = 0; k < 2; ++k)
           s.byPoint[(static_cast<std::size_t>(k) * s.nodes + n) * s.points + q] =
-              s.gradients[(static_cast<std::size_t>(n) * s.points + q) * 2 + k];
+              gradients[(static_cast<std::size_t>(n) * s.points + q) * 2 + k];
     tabulate(lin, s.linear);
     const Eigen::MatrixXd values = ref.valuesAt(points);  // points x nodes
     s.values.resize(static_cast<std::size_t>(s.nodes) * s.points);
@@ -191,8 +192,9 @@ HOMESH_VECTOR_CLONES double FacetEnergy::facetEnergy(const Facet& f,
       continue;
     }
     const auto at = static_cast<std::size_t>(local) * s.points + q;
-    const double* dn = &s.gradients[at * 2];
-    const Eigen::Vector2d a = invW.transpose() * Eigen::Vector2d(dn[0], dn[1]);
+    const Eigen::Vector2d a =
+        invW.transpose() *
+        Eigen::Vector2d(s.byPoint[at], s.byPoint[static_cast<std::size_t>(s.nodes) * points + at]);
     if (follows) {
       // W_f as a function of s = d . n: (r + l s)^2 + (c1 + a1 s)^2 + (c2 + a2 s)^2.
       const double l = s.values[at] / f.size;

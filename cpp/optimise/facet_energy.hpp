@@ -178,11 +178,10 @@ class FacetEnergy {
   struct Shape {  // one facet cell type and order
     const ElementBlock* cells;
     int nodes = 0, points = 0;
-    std::vector<double> values;     // [node][point]
-    std::vector<double> gradients;  // [node][point][2]
-    std::vector<double> byPoint;    // the same as [2][node][point]: loops over points vectorise
-    std::vector<double> weights;    // quadrature weights
-    std::vector<double> linear;     // the linear cell's basis gradients: [vertex][point][2]
+    std::vector<double> values;   // [node][point]
+    std::vector<double> byPoint;  // basis gradients, [2][node][point]: loops over points vectorise
+    std::vector<double> weights;  // quadrature weights
+    std::vector<double> linear;   // the linear cell's basis gradients: [vertex][point][2]
     int vertices = 0;
   };
   struct Facet {
