@@ -308,6 +308,25 @@ void splitLayers(MeshResult& result, const std::vector<double>& z, LayerHeights 
   split.done();
 }
 
+// The "boundary_fit" stage (pipeline/boundary_fidelity.hpp) on the kept mesh, with the fidelity
+// term's weight above 0 (0 turns both off) and while the job's budget lasts.
+void fitBoundary(MeshResult& result, JobBudget& budget, PipelineObserver* observer) {
+  if (!(result.options.fidelityWeight > 0.0) || result.mesh.dim != 3 || result.mesh.order < 2)
+    return;
+  if (budget.spent()) {
+    budget.skip("boundary_fit");
+    return;
+  }
+  StageClock clock("boundary_fit", result.timings, observer);
+  const auto stop = [&] {
+    return (observer != nullptr && observer->cancelRequested()) || budget.spent();
+  };
+  result.boundaryFit =
+      fitBoundaryFidelity(result.mesh, result.quality, *result.cad, result.options.threads, stop);
+  if (result.boundaryFit->stopped && budget.spent()) budget.cut("boundary_fit");
+  clock.done();
+}
+
 // The closing note, the geometry stage (left out once the job's budget is spent: it only
 // measures), then the job's record.
 void finishJob(MeshResult& result, JobBudget& budget, PipelineObserver* observer,
@@ -532,6 +551,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   CurvedState best = runRepairRounds(std::move(first), budget.elapsed() - firstStart, linear,
                                      result, options, budget, observer);
   takeCurved(result, best);
+  fitBoundary(result, budget, observer);
 
   if (options.boundaryLayer) {
     LayerHeights heights{grownLayerHeights(best.linear), {}, {}, {}};
@@ -574,6 +594,7 @@ MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOp
   straightenWhereInvalid(state, result, stacks.has_value(), options.threads, budget, observer);
   result.mesh = std::move(state.mesh);
   result.quality = std::move(state.quality);
+  fitBoundary(result, budget, observer);
   result.optimiser = std::move(state.optimiser);
   result.lowOrderOptimiser = std::move(state.lowOrderOptimiser);
   if (stacks && stacks->record.layers > 1) {

@@ -138,22 +138,24 @@ class PipelineObserver {
 // from that mesh, except after a split that made the mesh worse than the best: then it refines
 // around the best mesh's offenders instead (always, with a boundary layer: its linear mesh and
 // layer are made again). The result is the best mesh seen: fewest elements not
-// proven valid, then the best worst scaled Jacobian (a round never makes the result worse); with
+// proven valid, then the best worst scaled Jacobian (a round never makes the result worse); its
+// boundary triangles are then fitted to their CAD faces ("boundary_fit",
+// pipeline/boundary_fidelity.hpp: 3D, order 2 or more, options.fidelityWeight above 0); with
 // a boundary layer, its macro prisms are then split ("split_layers") and the quality is that of
 // the split mesh. With options.jobSeconds, each Gmsh and optimiser run gets at most what is
 // left of that budget, a round starts only if what is left covers what the one before took
 // (the first: the linear mesh, curving, optimiser and quality before it), the optimiser and
-// "geometry" are left out once it is spent, and result.job (with result.notes) says so; spent
-// before the linear mesh is made, BudgetExceeded (core/isolated_call.hpp) names the stage. Throws
-// ParameterError, IoError, CadError, MeshingError or CancelledError.
+// "boundary_fit" and "geometry" are left out once it is spent, and result.job (with result.notes)
+// says so; spent before the linear mesh is made, BudgetExceeded (core/isolated_call.hpp) names the
+// stage. Throws ParameterError, IoError, CadError, MeshingError or CancelledError.
 MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
                            PipelineObserver* observer = nullptr);
 
 // Curves a linear tetrahedral mesh made elsewhere (FreeCAD FEM's Gmsh or Netgen mesher) on the
 // CAD it was made from: the mesh is put on the CAD (linear/cad_classification.hpp, stage
 // "classify"), then elevated, optimised and evaluated as runMeshPipeline does ("high_order",
-// "optimise", "quality", "geometry"; the optimiser and "geometry" under options.jobSeconds as
-// there). The mesh is the user's: no sizing, no linear meshing, no
+// "optimise", "quality", "boundary_fit", "geometry"; the optimiser, "boundary_fit" and "geometry"
+// under options.jobSeconds as there). The mesh is the user's: no sizing, no linear meshing, no
 // repair rounds and no boundary layer (ParameterError when one is asked for).
 MeshResult curveMeshOnCad(const CadSource& source, const Mesh& linear, MeshingOptions options,
                           PipelineObserver* observer = nullptr);

@@ -295,6 +295,16 @@ std::string meshReportJson(const CurvedMesh& curved, const StageRecords& records
     appendOptimiser(json, *records.lowOrderOptimiser,
                     "optimiser_order_" + std::to_string(kContinuationOrder));
   appendRepairRounds(json, records.rounds);
+  if (records.boundaryFit) {
+    json.beginObject("boundary_fit");
+    json.value("triangles", records.boundaryFit->triangles);
+    json.value("fitted", records.boundaryFit->fitted);
+    json.value("tiers", records.boundaryFit->tiers);
+    json.value("frozen_nodes", records.boundaryFit->frozenNodes);
+    json.value("remeasured_elements", records.boundaryFit->remeasured);
+    json.value("stopped", records.boundaryFit->stopped);
+    json.endObject();
+  }
   if (records.boundaryLayer) appendBoundaryLayer(json, records);
   if (records.givenLayers) appendGivenLayers(json, records);
   appendStrings(json, "notes", records.notes);

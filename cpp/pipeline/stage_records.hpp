@@ -16,6 +16,7 @@
 #include "boundary_layer/layer_stacks.hpp"
 #include "cad/cad_healing.hpp"
 #include "optimise/optimiser.hpp"
+#include "pipeline/boundary_fidelity.hpp"
 #include "pipeline/curved_mesh.hpp"
 #include "pipeline/meshing_options.hpp"
 #include "pipeline/repair.hpp"
@@ -63,6 +64,9 @@ struct StageRecords {
   std::optional<SizingResult> sizing;        // when the sizes came from the octree
   std::optional<GeometryAccuracy> geometry;  // boundary against the CAD (a mesh made from CAD)
   std::vector<RepairRound> rounds;           // the repair rounds run, in order
+  // The boundary triangles fitted to their faces once the mesh was curved and repaired
+  // (pipeline/boundary_fidelity.hpp): when the stage ran.
+  std::optional<BoundaryFitRecord> boundaryFit;
   // Tangent ears split in the linear meshes Gmsh made, before curving (tangentEarSplits in
   // pipeline/repair.hpp), over the first mesh and the refine rounds' meshes.
   std::size_t tangentEars = 0;

@@ -21,7 +21,7 @@ import homesh
 # runs); stages not listed (repair rounds) take the remainder.
 _STAGE_WEIGHTS = {"cad": 2, "classify": 3, "sizing": 3, "linear": 10, "boundary_layer": 5, "high_order": 10,
                   "optimise_low_order": 20, "raise_order": 3, "optimise": 40, "quality": 4,
-                  "split_layers": 2, "geometry": 2}
+                  "boundary_fit": 3, "split_layers": 2, "geometry": 2}
 
 _WORKER_NICENESS = 10
 

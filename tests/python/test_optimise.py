@@ -305,7 +305,9 @@ def test_mesh_command_with_optimise(homesh_bin, data, tmp_path):
     assert 1 <= rep["optimiser"]["iterations"] <= 5
     assert len(rep["optimiser"]["history"]) == rep["optimiser"]["iterations"]
     assert "optimise" in rep["timings_s"]
-    # The same double, printed twice with %.15g.
-    assert rep["quality"]["scaled_jacobian"]["min"] == rep["optimiser"]["worst_after"]
+    # The boundary fit after the optimiser keeps every element within 0.1 % of the lower of its
+    # own value and the worst before it (pipeline/boundary_fidelity.hpp): the worst may rise.
+    assert "boundary_fit" in rep
+    assert rep["quality"]["scaled_jacobian"]["min"] >= (1 - 1e-3) * rep["optimiser"]["worst_after"]
     r = run([homesh_bin, "mesh", str(data / "sphere.brep"), "-n", "5"])
     assert r.returncode == 2 and "--optimise" in r.stderr

@@ -191,7 +191,7 @@ def test_progress_reports_stages_and_can_cancel(data):
     homesh.mesh(str(data / "sphere.brep"), order=2, size=0.5,
                 progress=lambda stage, seconds: seen.append((stage, seconds)))
     assert [s for s, t in seen if t is None] == [
-        "cad", "linear", "high_order", "quality", "geometry"]
+        "cad", "linear", "high_order", "quality", "boundary_fit", "geometry"]
     assert all(t >= 0 for s, t in seen if t is not None)
 
     def stop(stage, seconds):

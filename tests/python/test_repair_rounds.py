@@ -140,7 +140,10 @@ def test_poor_elements_are_split_once_every_element_is_valid(homesh_bin, tmp_pat
     assert kept and kept[-1]["worst_after"] > first["worst"]
     quality = data["quality"]
     assert quality["invalid_elements"] == quality["undecided_elements"] == 0
-    assert quality["scaled_jacobian"]["min"] == kept[-1]["worst_after"]
+    # The boundary fit after the rounds keeps every element within 0.1 % of the lower of its own
+    # value and the worst before it (pipeline/boundary_fidelity.hpp): the worst may rise.
+    assert "boundary_fit" in data
+    assert quality["scaled_jacobian"]["min"] >= (1 - 1e-3) * kept[-1]["worst_after"]
     assert quality["scaled_jacobian"]["min"] > 0.1
     assert gmsh_worst(msh) > 0.0  # Gmsh's own Bezier-bounded verdict: valid too
 

@@ -123,7 +123,8 @@ TEST(MeshPipeline, RunsEveryStageAndReports) {
   const MeshResult result =
       runMeshPipeline(CadSource::brepText(test::brepText(test::sphere(1.0))), options, &observer);
   EXPECT_EQ(observer.started,
-            (std::vector<std::string>{"cad", "linear", "high_order", "quality", "geometry"}));
+            (std::vector<std::string>{"cad", "linear", "high_order", "quality", "boundary_fit",
+                                      "geometry"}));
   EXPECT_EQ(result.mesh.order, 3);
   EXPECT_EQ(result.quality.scaledJacobian.size(), result.mesh.numElements());
   const std::string json = meshReportJson(result, "sphere");

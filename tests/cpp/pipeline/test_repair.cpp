@@ -591,12 +591,14 @@ TEST(RepairRounds, ASpentJobBudgetEndsTheJobWithTheMeshSoFar) {
   EXPECT_FALSE(result.optimiser.has_value());
   EXPECT_TRUE(result.rounds.empty());
   EXPECT_FALSE(result.geometry.has_value());
-  for (const char* stage : {"optimise", "repair 1", "geometry"}) {
+  EXPECT_FALSE(result.boundaryFit.has_value());
+  for (const char* stage : {"optimise", "repair 1", "boundary_fit", "geometry"}) {
     EXPECT_EQ(std::count(burner.started.begin(), burner.started.end(), stage), 0) << stage;
   }
   EXPECT_EQ(result.job.timeLimit, 2.0);
   EXPECT_TRUE(result.job.cut.empty());
-  EXPECT_EQ(result.job.skipped, (std::vector<std::string>{"optimise", "repair 1", "geometry"}));
+  EXPECT_EQ(result.job.skipped,
+            (std::vector<std::string>{"optimise", "repair 1", "boundary_fit", "geometry"}));
   // The burner held the job until its budget was spent; how long the stages after it took is
   // the machine's business, not a property of the code, and is not asserted.
   EXPECT_GE(result.job.seconds, 2.0);
