@@ -44,8 +44,8 @@ std::vector<ParameterDefinition> meshAndCadRows() {
        "sine of the angle between the facet's and the CAD's normals, so that sliding nodes keep "
        "the curved boundary on the CAD between them (0: off; higher follows the CAD closer at "
        "some cost to the worst element). Above 0 the boundary_fit stage also runs once the mesh "
-       "is curved: boundary triangles on curved faces fitted to them, no element losing more "
-       "than 0.1 %"},
+       "is curved: boundary triangles on curved faces fitted to them, no element ending more "
+       "than 0.1 % below the lower of its own value and the mesh's worst"},
       {"linear_seconds", "LinearTimeLimit", "--linear-time-limit", "", "linear meshing time limit",
        ParameterKind::Real, 0, kNoLimit, false, 600, false, false, "mesh",
        "Seconds Gmsh's linear meshing may take (each run, in its own process); it is then "

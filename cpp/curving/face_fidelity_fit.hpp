@@ -1,6 +1,7 @@
 // The interior nodes of a curved boundary triangle moved on its CAD face so that the triangle's
 // polynomial surface follows the face between its nodes: the surface placed for its own
-// fidelity before the volume is optimised (issue 49).
+// fidelity (issue 49; the boundary_fit stage, pipeline/boundary_fidelity.hpp, applies it once the
+// volume is optimised, and says why then).
 //
 // Why: nodes on the CAD only say where the surface passes; between them the polynomial follows
 // it as closely as the nodes sample one smooth map of the reference triangle. The relaxed
@@ -50,11 +51,6 @@ TriangleFit fitTriangleInterior(const FaceChart& chart, int order,
                                 const std::vector<FaceParameter>& uv,
                                 const std::vector<Eigen::Vector3d>& x);
 
-struct BoundaryFitStats {
-  std::size_t triangles = 0;  // boundary triangles with interior nodes on one CAD face
-  std::size_t fitted = 0;     // those whose interior moved
-};
-
 // The fit applied to the boundary triangles of a curved 3D mesh whose interior nodes lie on one
 // curved CAD face (nodeCadDim 2; a plane's are left out, they lie in it), corners and nodes on CAD
 // curves as they are: rounds over the edges inside a face (the edge's nodes with both triangles'
@@ -76,7 +72,7 @@ class BoundaryFitter {
   std::vector<char> touching(const std::vector<char>& nodes) const;
   // Fits the patches of the triangles set in `active` (per triangle); nodes set in `frozen` (per
   // node, if given) stay.
-  BoundaryFitStats fit(const std::vector<char>& active, const std::vector<char>* frozen = nullptr);
+  void fit(const std::vector<char>& active, const std::vector<char>* frozen = nullptr);
 
  private:
   class Impl;

@@ -24,12 +24,12 @@ constexpr double kWorstLoss = 1e-3;
 constexpr int kFreezeRounds = 6;
 // A tier: the triangles not fitted yet whose largest normal angle is at least half the largest
 // among them (squared sines: a quarter). Tiers are fitted from the largest angles down, and the
-// stage stops once a triangle the volume held (one touching a frozen node) keeps an angle no tier
-// left could lower the boundary's largest below. Why tiers and that stop: the largest angle is
-// what the fit is for, and fitting every triangle costs as much as the optimiser on a boundary
-// of many alike triangles (a cylinder of radius 1 and length 1000 at order 4: 38,349 triangles
-// in 45 s, where the optimiser took 32 s) while the largest angle stays where the volume holds
-// it (0.61 -> 0.55 degrees there).
+// stage stops once a triangle next to a frozen node (the volume held it) keeps an angle at least
+// as large as any left to fit: the largest angle is held there. Why tiers and that stop: the
+// largest angle is what the fit is for, and fitting every triangle costs as much as the optimiser
+// on a boundary of many alike triangles (a cylinder of radius 1 and length 1000 at order 4: 38,349
+// triangles in 45 s, where the optimiser took 32 s) while the largest angle stays where the volume
+// holds it (0.61 -> 0.55 degrees there).
 constexpr double kTierShare = 0.25;
 // At most this many triangles a tier, or this share of the boundary's if more: on the cylinder
 // above, the first tier's 11,383 triangles took 7 s and the frozen nodes then kept the largest
@@ -37,11 +37,26 @@ constexpr double kTierShare = 0.25;
 constexpr std::size_t kTierTriangles = 64;
 constexpr double kTierFraction = 0.01;
 
-// Whether element e's new verdict keeps the stage's promise (header).
+// A verdict's rank: a change to a lower one is a worse verdict.
+int rank(Validity v) {
+  return v == Validity::Valid ? 2 : v == Validity::Undecided ? 1 : 0;
+}
+
+// Whether element e's new verdict keeps the stage's promise (header): no worse verdict, and a
+// value at most kWorstLoss of its size below the lower of its own and the mesh's worst (negative
+// values included: an element left invalid by the repair rounds may not fall either).
 bool keeps(const QualitySummary& before, const QualitySummary& after, std::size_t e) {
-  if (before.validity[e] == Validity::Valid && after.validity[e] != Validity::Valid) return false;
-  return after.scaledJacobian[e] >=
-         (1.0 - kWorstLoss) * std::min(before.scaledJacobian[e], before.scaled.min);
+  if (rank(after.validity[e]) < rank(before.validity[e])) return false;
+  const double floor = std::min(before.scaledJacobian[e], before.scaled.min);
+  return after.scaledJacobian[e] >= floor - kWorstLoss * std::abs(floor);
+}
+
+// Per node: whether its position in `now` differs from that in `reference`.
+std::vector<char> movedNodes(const std::vector<double>& now, const std::vector<double>& reference) {
+  std::vector<char> moved(now.size() / 3, 0);
+  for (std::size_t i = 0; i < now.size(); ++i)
+    if (now[i] != reference[i]) moved[i / 3] = 1;
+  return moved;
 }
 
 // The largest finite entry of `sines` among the triangles set in `which` (0 if none).
@@ -87,13 +102,14 @@ class TierFitter {
   bool fitTier(std::vector<char> active) {
     const std::vector<double> xyz = mesh_.xyz, param = mesh_.nodeCadParam;
     const std::vector<char> frozenBefore = frozen_;
+    const QualitySummary qualityBefore = quality_;
     for (int round = 0; round < kFreezeRounds; ++round) {
       fitter_.fit(active, &frozen_);
       const KnownQuality known{&mesh_, &measuredXyz_, &quality_, {}};
       QualitySummary after = evaluateQuality(mesh_, threads_, &known);
       record_.remeasured += after.scaledJacobian.size() - after.known;
       measuredXyz_ = mesh_.xyz;
-      const std::vector<char> newlyFrozen = breakers(after, xyz);
+      const std::vector<char> newlyFrozen = breakers(after, movedNodes(mesh_.xyz, xyz));
       quality_ = std::move(after);
       if (newlyFrozen.empty()) return true;
       for (std::size_t node = 0; node < mesh_.numNodes(); ++node) {
@@ -104,37 +120,37 @@ class TierFitter {
       }
       active = fitter_.touching(newlyFrozen);
     }
-    // No round kept every element: the mesh as the tier found it.
+    // No round kept every element: the mesh as the tier found it, and its quality.
     mesh_.xyz = xyz;
     mesh_.nodeCadParam = param;
     frozen_ = frozenBefore;
-    const KnownQuality known{&mesh_, &measuredXyz_, &quality_, {}};
-    quality_ = evaluateQuality(mesh_, threads_, &known);
-    measuredXyz_ = mesh_.xyz;
+    quality_ = qualityBefore;
+    measuredXyz_ = xyz;
     return false;
   }
 
  private:
-  // The nodes moved since `xyz` of every element whose verdict `after` breaks the promise
-  // against the input's; empty when none does.
-  std::vector<char> breakers(const QualitySummary& after, const std::vector<double>& xyz) const {
-    std::vector<char> nodes;
+  // The `moved` nodes of every element whose verdict `after` breaks the promise against the
+  // input's; empty when none does (an element none of whose nodes moved is not the tier's doing).
+  std::vector<char> breakers(const QualitySummary& after, const std::vector<char>& moved) const {
+    std::vector<char> nodes(mesh_.numNodes(), 0);
+    bool any = false;
     std::size_t e = 0;
     for (const ElementBlock& b : mesh_.blocks) {
       if (cellDimension(b.type) != mesh_.dim) continue;
       const auto n = static_cast<std::size_t>(b.nodesPerElement());
       for (std::size_t c = 0; c < b.count(); ++c, ++e) {
         if (keeps(inputQuality_, after, e)) continue;
-        if (nodes.empty()) nodes.assign(mesh_.numNodes(), 0);
         const std::int64_t* v = b.element(c);
         for (std::size_t k = 0; k < n; ++k) {
           const auto node = static_cast<std::size_t>(v[k]);
-          for (int i = 0; i < 3; ++i)
-            if (mesh_.xyz[3 * node + i] != xyz[3 * node + i]) nodes[node] = 1;
+          if (moved[node] == 0) continue;
+          nodes[node] = 1;
+          any = true;
         }
       }
     }
-    return nodes;
+    return any ? nodes : std::vector<char>{};
   }
 
   Mesh& mesh_;
@@ -172,7 +188,8 @@ BoundaryFitRecord fitBoundaryFidelity(Mesh& mesh, QualitySummary& quality, const
     }
     const double reach = largestOf(sines, untried);
     if (!(reach > 0.0)) break;
-    // A triangle the volume held keeps at least this: no tier left can lower the largest angle.
+    // A triangle next to a frozen node (the volume held it there) keeps an angle at least this
+    // large: the largest angle is held, and further tiers would only spend time.
     const std::vector<char> held = fitter.touching(tiers.frozen());
     if (largestOf(sines, held) >= reach) break;
     std::vector<std::size_t> candidates;
@@ -190,24 +207,16 @@ BoundaryFitRecord fitBoundaryFidelity(Mesh& mesh, QualitySummary& quality, const
       untried[candidates[k]] = 0;
     }
     const std::vector<double> before = mesh.xyz;
-    ++record.tiers;
     if (!tiers.fitTier(tier)) break;
+    ++record.tiers;
     // The triangles a node of which moved (edge patches reach the tier's neighbours): measured
     // again.
-    std::vector<char> moved(mesh.numNodes(), 0);
-    for (std::size_t node = 0; node < mesh.numNodes(); ++node)
-      for (int c = 0; c < 3; ++c)
-        if (mesh.xyz[3 * node + c] != before[3 * node + c]) moved[node] = 1;
-    const std::vector<char> touched = fitter.touching(moved);
+    const std::vector<char> touched = fitter.touching(movedNodes(mesh.xyz, before));
     const std::vector<double> again = fitter.largestSines(&touched);
     for (std::size_t t = 0; t < record.triangles; ++t)
       if (touched[t] != 0) sines[t] = again[t];
   }
-  std::vector<char> moved(mesh.numNodes(), 0);
-  for (std::size_t node = 0; node < mesh.numNodes(); ++node)
-    for (int c = 0; c < 3; ++c)
-      if (mesh.xyz[3 * node + c] != input[3 * node + c]) moved[node] = 1;
-  const std::vector<char> fitted = fitter.touching(moved);
+  const std::vector<char> fitted = fitter.touching(movedNodes(mesh.xyz, input));
   record.fitted = static_cast<std::size_t>(std::count(fitted.begin(), fitted.end(), 1));
   record.frozenNodes =
       static_cast<std::size_t>(std::count(tiers.frozen().begin(), tiers.frozen().end(), 1));

@@ -2,14 +2,15 @@
 // boundary triangles inside curved CAD faces move on them so that each triangle's surface follows
 // the face's normal between its nodes (curving/face_fidelity_fit.hpp), in tiers from the largest
 // normal angles down, and the elements they belong to are certified again after each: no element
-// proven valid may end not proven so, nor any end more than 0.1 % (kWorstLoss) below the lower of
-// its own value before the stage and the mesh's worst before. The moved nodes of an element that
-// does are frozen where they were and the tier fitted again around them (a few rounds, then the
-// tier is undone and the stage ends), so the mesh's verdict is never worse than the stage's input
-// and its worst element at most 0.1 % lower (the certified measure's resolution): the trade for
-// fidelity, made explicit. The stage ends once no tier left could lower the largest angle (a
-// triangle held by a frozen node keeps one at least as large). The nodes of prisms, pyramids and
-// hexahedra stay: a boundary layer's heights are measured from its wall.
+// may end with a worse verdict (valid, undecided, invalid), nor any end more than 0.1 %
+// (kWorstLoss) below the lower of its own value before the stage and the mesh's worst before. The
+// moved nodes of an element that does are frozen where they were and the tier fitted again around
+// them (a few rounds, then the tier is undone and the stage ends), so the mesh's verdict is never
+// worse than the stage's input and its worst element at most 0.1 % lower (the certified measure's
+// resolution): the trade for fidelity, made explicit. The stage ends once a triangle next to a
+// frozen node keeps an angle at least as large as any left to fit (the volume holds the largest
+// angle there). The nodes of prisms, pyramids and hexahedra stay: a boundary layer's heights are
+// measured from its wall.
 //
 // Why a stage of its own, after the optimiser: the optimiser's untangling slides the boundary's
 // nodes for the volume, and the facet and fidelity terms join only once the mesh is valid, where
@@ -31,7 +32,7 @@ namespace homesh {
 struct BoundaryFitRecord {
   std::size_t triangles = 0;    // boundary triangles with interior nodes on one face
   std::size_t fitted = 0;       // those with a node moved
-  std::size_t tiers = 0;        // tiers fitted (largest angles first)
+  std::size_t tiers = 0;        // tiers fitted and kept (largest angles first)
   std::size_t frozenNodes = 0;  // nodes the certification held where they were
   std::size_t remeasured = 0;   // elements certified again
   bool stopped = false;         // ended by `stop` (a cancel, the job's time budget)
