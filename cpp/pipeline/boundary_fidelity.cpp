@@ -78,8 +78,9 @@ std::vector<char> layerNodes(const Mesh& mesh) {
   return nodes;
 }
 
-// The stage's state between tiers: the mesh at its input (the promise's reference), the nodes
-// the certification froze, and the quality last measured with the positions it measured.
+// The stage's state between tiers: the quality at its input (the promise's reference), the nodes
+// that stay (layer cells') or were frozen by the certification, and the quality last measured
+// with the positions it measured.
 class TierFitter {
  public:
   TierFitter(Mesh& mesh, QualitySummary& quality, const CadModel& cad, int threads,
