@@ -67,6 +67,13 @@ double largestOf(const std::vector<double>& sines, const std::vector<char>& whic
   return largest;
 }
 
+// Per entry: 1 where `values` holds `value`, else 0.
+std::vector<char> valued(const std::vector<char>& values, char value) {
+  std::vector<char> out(values.size(), 0);
+  for (std::size_t i = 0; i < values.size(); ++i) out[i] = values[i] == value ? 1 : 0;
+  return out;
+}
+
 // Per node: 2 for the nodes of prisms, pyramids and hexahedra (a boundary layer's, whose heights
 // are measured from its wall: they stay), else 0 (1 marks the nodes the certification freezes).
 std::vector<char> layerNodes(const Mesh& mesh) {
@@ -176,9 +183,14 @@ BoundaryFitRecord fitBoundaryFidelity(Mesh& mesh, QualitySummary& quality, const
   record.triangles = fitter.triangles();
   if (record.triangles == 0) return record;
   std::vector<double> sines = fitter.largestSines();
+  // A boundary layer's wall: triangles every node of which stays (none to fit, none held by the
+  // certification), and those with a layer node (held there once tried: a far-field face's are
+  // not, so the wall's angles do not end the stage before the rest is fitted).
+  const std::vector<char> onLayer = fitter.touching(valued(tiers.frozen(), 2));
+  const std::vector<char> movable = fitter.touching(valued(tiers.frozen(), 0));
   std::vector<char> untried(record.triangles, 0);
   for (std::size_t t = 0; t < record.triangles; ++t)
-    untried[t] = std::isfinite(sines[t]) && sines[t] > 0.0 ? 1 : 0;
+    untried[t] = movable[t] != 0 && std::isfinite(sines[t]) && sines[t] > 0.0 ? 1 : 0;
   const std::size_t capacity = std::max(
       kTierTriangles,
       static_cast<std::size_t>(std::ceil(kTierFraction * static_cast<double>(record.triangles))));
@@ -191,7 +203,9 @@ BoundaryFitRecord fitBoundaryFidelity(Mesh& mesh, QualitySummary& quality, const
     if (!(reach > 0.0)) break;
     // A triangle next to a frozen node (the volume held it there) keeps an angle at least this
     // large: the largest angle is held, and further tiers would only spend time.
-    const std::vector<char> held = fitter.touching(tiers.frozen());
+    std::vector<char> held = fitter.touching(valued(tiers.frozen(), 1));
+    for (std::size_t t = 0; t < record.triangles; ++t)
+      if (onLayer[t] != 0 && movable[t] != 0 && untried[t] == 0) held[t] = 1;
     if (largestOf(sines, held) >= reach) break;
     std::vector<std::size_t> candidates;
     for (std::size_t t = 0; t < record.triangles; ++t)

@@ -10,7 +10,8 @@
 // resolution): the trade for fidelity, made explicit. The stage ends once a triangle next to a
 // frozen node keeps an angle at least as large as any left to fit (the volume holds the largest
 // angle there). The nodes of prisms, pyramids and hexahedra stay: a boundary layer's heights are
-// measured from its wall.
+// measured from its wall, and the wall's triangles, having nothing to fit, neither join a tier
+// nor count as held.
 //
 // Why a stage of its own, after the optimiser: the optimiser's untangling slides the boundary's
 // nodes for the volume, and the facet and fidelity terms join only once the mesh is valid, where

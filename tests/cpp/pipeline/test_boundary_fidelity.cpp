@@ -2,12 +2,23 @@
 // it: the boundary follows the CAD's normal closer, and no element breaks the stage's promise.
 #include <gtest/gtest.h>
 
+#include <BRepAlgoAPI_Cut.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
+#include <gp_Ax2.hxx>
+
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
+#include <vector>
 
+#include "cad/cad_model.hpp"
+#include "curving/face_fidelity_fit.hpp"
 #include "pipeline/boundary_fidelity.hpp"
 #include "pipeline/mesh_pipeline.hpp"
+#include "test_support.hpp"
 
 namespace homesh {
 namespace {
@@ -83,6 +94,87 @@ TEST(BoundaryFit, StopsBetweenTiersKeepingWhatWasCertified) {
   // What the stage returns is certified: a fresh measure agrees with it element by element.
   const QualitySummary measured = evaluateQuality(mesh, 2);
   EXPECT_EQ(measured.scaledJacobian, quality.scaledJacobian);
+  EXPECT_EQ(measured.invalid + measured.undecided, 0U);
+}
+
+// A box with two holes, a boundary layer on the narrower one's wall: the layer's nodes stay, and
+// its wall, whose angles are the mesh's largest (radius 0.08 against 0.15 at one size), does not
+// end the stage before the other hole is fitted (it did when every layer node counted as frozen
+// by the certification: the wall was "held" from the start and the stage stopped at once).
+TEST(BoundaryFit, FitsTheFacesBesideABoundaryLayersWallAndLeavesTheWall) {
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(1.0, 0.8, 0.3).Shape();
+  const auto drill = [](double x, double radius) {
+    return BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(x, 0.4, -0.1), gp_Dir(0, 0, 1)), radius, 0.5)
+        .Shape();
+  };
+  const TopoDS_Shape holed =
+      BRepAlgoAPI_Cut(BRepAlgoAPI_Cut(box, drill(0.25, 0.08)).Shape(), drill(0.65, 0.15)).Shape();
+  const std::string brep = test::brepText(holed);
+  const CadModel cad = CadModel::fromBrepText(brep);
+  BoundaryLayerParameters layer;
+  for (int f = 1; f <= cad.numFaces(); ++f) {
+    if (cad.isPlanar(f)) continue;
+    const SurfaceBounds b = cad.faceBounds(f);
+    const PrincipalCurvatures k =
+        cad.curvature(f, 0.5 * (b.uMin + b.uMax), 0.5 * (b.vMin + b.vMax));
+    if (std::abs(k.kMax) > 10.0) layer.faces.push_back(f);  // 1 / 0.08, not 1 / 0.15
+  }
+  ASSERT_FALSE(layer.faces.empty());
+  layer.thickness = "0.03";
+  layer.layers = 3;
+  layer.progression = 1.3;
+  MeshingOptions options;
+  options.order = 2;
+  options.size = 0.1;
+  options.optimiseIterations = 20;
+  options.threads = 2;
+  options.fidelityWeight = 0.0;  // neither the term nor the stage
+  options.boundaryLayer = layer;
+  const MeshResult made = runMeshPipeline(CadSource::brepText(brep, "two holes"), options);
+  ASSERT_TRUE(made.boundaryLayer.has_value());
+  ASSERT_EQ(made.quality.invalid + made.quality.undecided, 0U);
+  std::vector<char> layerNodes(made.mesh.numNodes(), 0);
+  for (const ElementBlock& b : made.mesh.blocks)
+    if (b.type == CellType::Prism)
+      for (const std::int64_t node : b.nodes) layerNodes[static_cast<std::size_t>(node)] = 1;
+  // Over the triangles on curved faces, on the wall or off it: the largest of their largest
+  // squared sines, and their sum.
+  struct Sines {
+    double largest = 0.0, sum = 0.0;
+  };
+  const auto sines = [&](const Mesh& mesh, bool onWall) {
+    Mesh copy = mesh;  // the fitter holds a mesh it may move
+    BoundaryFitter fitter(copy, *made.cad);
+    const std::vector<double> each = fitter.largestSines();
+    const std::vector<char> wall = fitter.touching(layerNodes);
+    Sines out;
+    for (std::size_t t = 0; t < each.size(); ++t) {
+      if ((wall[t] != 0) != onWall || !std::isfinite(each[t])) continue;
+      out.largest = std::max(out.largest, each[t]);
+      out.sum += each[t];
+    }
+    return out;
+  };
+  const Sines wallBefore = sines(made.mesh, true), freeBefore = sines(made.mesh, false);
+  ASSERT_GT(wallBefore.largest, freeBefore.largest);  // the case's point
+  Mesh mesh = made.mesh;
+  QualitySummary quality = made.quality;
+  const BoundaryFitRecord record = fitBoundaryFidelity(mesh, quality, *made.cad, 2);
+  const Sines wallAfter = sines(mesh, true), freeAfter = sines(mesh, false);
+  std::printf(
+      "beside a layer: %zu of %zu triangles fitted in %zu tiers; largest squared sine on "
+      "the wall %.3g; off it %.3g -> %.3g, their sum %.3g -> %.3g\n",
+      record.fitted, record.triangles, record.tiers, wallBefore.largest, freeBefore.largest,
+      freeAfter.largest, freeBefore.sum, freeAfter.sum);
+  EXPECT_GT(record.fitted, 0U);
+  EXPECT_LE(freeAfter.largest, freeBefore.largest);
+  EXPECT_LT(freeAfter.sum, freeBefore.sum);
+  EXPECT_EQ(wallAfter.sum, wallBefore.sum);
+  for (std::size_t node = 0; node < mesh.numNodes(); ++node) {
+    if (layerNodes[node] == 0) continue;
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(mesh.xyz[3 * node + c], made.mesh.xyz[3 * node + c]);
+  }
+  const QualitySummary measured = evaluateQuality(mesh, 2);
   EXPECT_EQ(measured.invalid + measured.undecided, 0U);
 }
 
