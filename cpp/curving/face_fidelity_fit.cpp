@@ -232,18 +232,19 @@ class Fit {
             feet_[t * static_cast<std::size_t>(table_.points) + static_cast<std::size_t>(q)];
         const Eigen::Vector3d target = pointAt(patch_.triangles[t], q);
         SurfaceDerivatives d{};
+        Eigen::Vector2d step = Eigen::Vector2d::Zero();
+        bool stepped = false;
         for (int s = 0; s <= steps; ++s) {
           d = chart_.cad().evaluateSurface(chart_.face(), foot.uv[0], foot.uv[1]);
-          if (s == steps) break;
-          Eigen::Matrix<double, 3, 2> j;
-          j << d.du, d.dv;
-          const Eigen::Matrix2d jtj = j.transpose() * j;
-          if (!(std::abs(jtj.determinant()) > 1e-14 * jtj.trace() * jtj.trace())) break;
-          const Eigen::Vector2d step = jtj.ldlt().solve(j.transpose() * (target - d.point));
+          stepped = tangentStep(d, target, step);
+          if (s == steps || !stepped) break;
           foot.uv = {foot.uv[0] + step[0], foot.uv[1] + step[1]};
         }
         if (!d.point.allFinite()) return false;
-        if (!settled(d, target, size_[t])) {
+        // Settled: the offset left is along the normal, to kFootSlip of the triangle's size.
+        const bool settled =
+            stepped && (d.du * step[0] + d.dv * step[1]).norm() <= kFootSlip * size_[t];
+        if (!settled) {
           try {
             const SurfaceProjection p =
                 chart_.cad().projectOnSurface(chart_.face(), target, foot.uv);
@@ -271,15 +272,16 @@ class Fit {
     return true;
   }
 
-  // Whether `target`'s offset from the point `d` describes is along the face's normal there, to
-  // kFootSlip of `size`: a foot the steps found (false where the chart degenerates).
-  static bool settled(const SurfaceDerivatives& d, const Eigen::Vector3d& target, double size) {
+  // Sets `step` to the (u, v) step that takes the point `d` describes to `target`'s foot on the
+  // tangent plane (Gauss-Newton on the distance); false, `step` unset, where the chart degenerates.
+  static bool tangentStep(const SurfaceDerivatives& d, const Eigen::Vector3d& target,
+                          Eigen::Vector2d& step) {
     Eigen::Matrix<double, 3, 2> j;
     j << d.du, d.dv;
     const Eigen::Matrix2d jtj = j.transpose() * j;
     if (!(std::abs(jtj.determinant()) > 1e-14 * jtj.trace() * jtj.trace())) return false;
-    const Eigen::Vector3d along = j * jtj.ldlt().solve(j.transpose() * (target - d.point));
-    return along.norm() <= kFootSlip * size;
+    step = jtj.ldlt().solve(j.transpose() * (target - d.point));
+    return true;
   }
 
   Eigen::Vector3d pointAt(const std::vector<int>& t, int q) const {
