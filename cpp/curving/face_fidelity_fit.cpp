@@ -60,21 +60,31 @@ struct FitTable {
   std::vector<double> weights;
 };
 
-const FitTable& fitTable(int order) {
+// `check`: the points the report's geometry samples instead (a rule of degree 2P + 2 and the
+// nodes, quality/geometry_accuracy.hpp), weights zero at the nodes: for the largest angle only.
+const FitTable& fitTable(int order, bool check = false) {
   static std::mutex lock;
-  static std::array<std::unique_ptr<FitTable>, kMaxOrder + 1> tables;
+  static std::array<std::array<std::unique_ptr<FitTable>, 2>, kMaxOrder + 1> tables;
   const std::lock_guard<std::mutex> guard(lock);
-  std::unique_ptr<FitTable>& t = tables[static_cast<std::size_t>(order)];
+  std::unique_ptr<FitTable>& t = tables[static_cast<std::size_t>(order)][check ? 1 : 0];
   if (t) return *t;
   t = std::make_unique<FitTable>();
-  const std::optional<QuadratureRule> symmetric = symmetricRule(CellType::Triangle, 2 * order);
-  const QuadratureRule rule =
-      symmetric ? *symmetric : quadratureRule(CellType::Triangle, 2 * order);
+  const int degree = check ? 2 * order + 2 : 2 * order;
+  const std::optional<QuadratureRule> symmetric = symmetricRule(CellType::Triangle, degree);
+  QuadratureRule rule = symmetric ? *symmetric : quadratureRule(CellType::Triangle, degree);
+  const ReferenceElement& ref = ReferenceElement::get(CellType::Triangle, order);
+  if (check) {
+    const Eigen::MatrixXd& nodes = ref.nodes();
+    for (Eigen::Index n = 0; n < nodes.rows(); ++n) {
+      rule.points.push_back(nodes(n, 0));
+      rule.points.push_back(nodes(n, 1));
+      rule.weights.push_back(0.0);
+    }
+  }
   Eigen::MatrixXd points(rule.size(), 2);
   for (int q = 0; q < rule.size(); ++q)
     for (int c = 0; c < 2; ++c)
       points(q, c) = rule.points[2 * static_cast<std::size_t>(q) + static_cast<std::size_t>(c)];
-  const ReferenceElement& ref = ReferenceElement::get(CellType::Triangle, order);
   const Eigen::MatrixXd values = ref.valuesAt(points);
   const std::vector<Eigen::MatrixXd> grads = ref.derivativesAt(points);
   t->nodes = ref.numNodes();
@@ -116,8 +126,9 @@ struct Patch {
 
 class Fit {
  public:
-  Fit(const FaceChart& chart, int order, Patch patch)
-      : chart_(chart), p_(order), table_(fitTable(order)), patch_(std::move(patch)) {
+  // `check`: the points are the report's (fitTable), for largestSine.
+  Fit(const FaceChart& chart, int order, Patch patch, bool check = false)
+      : chart_(chart), p_(order), table_(fitTable(order, check)), patch_(std::move(patch)) {
     for (std::size_t k = 0; k < patch_.free.size(); ++k)
       if (patch_.free[k] != 0) {
         free_.push_back(static_cast<int>(k));
@@ -168,8 +179,9 @@ class Fit {
       result.uv = patch_.uv;
       return result;
     }
-    double f = objective(nullptr);
+    double f = objective(nullptr, nullptr, &result.largestBefore);
     result.before = result.after = f;
+    result.largestAfter = result.largestBefore;
     if (!(f > kNothingToFit)) {
       result.uv = patch_.uv;
       return result;
@@ -218,6 +230,8 @@ class Fit {
       }
     }
     result.after = f;
+    result.largestAfter = 0.0;
+    objective(nullptr, nullptr, &result.largestAfter);
     result.uv = patch_.uv;
     return result;
   }
@@ -448,6 +462,58 @@ class BoundaryFitter::Impl {
     return active;
   }
 
+  std::vector<std::int64_t> starVertices() const {
+    std::vector<std::int64_t> vertices;
+    for (const auto& [vertex, star] : stars_) vertices.push_back(vertex);
+    return vertices;
+  }
+
+  std::vector<std::size_t> starOf(std::int64_t vertex) const {
+    std::vector<std::size_t> triangles;
+    const auto it = stars_.find(vertex);
+    if (it != stars_.end())
+      for (const auto& [t, c] : it->second) triangles.push_back(t);
+    return triangles;
+  }
+
+  std::vector<std::vector<std::int64_t>> fitVertices(const std::vector<std::int64_t>& vertices,
+                                                     const std::vector<char>* frozen) {
+    frozen_ = frozen;
+    std::vector<std::vector<std::int64_t>> moved(vertices.size());
+    const std::map<std::int64_t, std::vector<Dragged>> dragged = draggedNodes(vertices);
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+      const auto it = stars_.find(vertices[i]);
+      if (it == stars_.end()) continue;
+      std::vector<const BoundaryTriangle*> patch;
+      std::vector<std::int64_t> free{vertices[i]};
+      for (const auto& [t, c] : it->second) {
+        const BoundaryTriangle& tri = triangles_[t];
+        patch.push_back(&tri);
+        for (const std::int64_t n : interior(tri)) free.push_back(n);
+        // The two sides at the vertex's corner c: side c runs from it, side c + 2 to it.
+        for (const int side : {c, (c + 2) % 3})
+          for (const int k : edgeSlots(order_, side))
+            free.push_back(tri.nodes[static_cast<std::size_t>(k)]);
+      }
+      std::sort(free.begin(), free.end());
+      free.erase(std::unique(free.begin(), free.end()), free.end());
+      const Eigen::Vector3d from = point(vertices[i]);
+      if (!fit(patch, free, true)) continue;
+      moved[i] = free;
+      // The volume's nodes follow the vertex by their share of it, so that the tetrahedra
+      // around it move as their straight-sided maps would, instead of bending at the vertex.
+      const Eigen::Vector3d shift = point(vertices[i]) - from;
+      const auto around = dragged.find(vertices[i]);
+      if (around == dragged.end()) continue;
+      for (const Dragged& d : around->second) {
+        const auto n = static_cast<std::size_t>(d.node);
+        for (int c = 0; c < 3; ++c) mesh_.xyz[3 * n + c] += d.share * shift[c];
+        moved[i].push_back(d.node);
+      }
+    }
+    return moved;
+  }
+
   void fit(const std::vector<char>& active, const std::vector<char>* frozen) {
     frozen_ = frozen;
     // Rounds over the edges inside a face, each fitted with the interiors of its two
@@ -515,6 +581,36 @@ class BoundaryFitter::Impl {
         }
         triangles_.push_back(std::move(t));
       }
+    }
+    collectStars();
+  }
+
+  // The vertices inside a face whose star of triangles is closed on it (every side at the vertex
+  // shared by two of them), with each triangle's corner at the vertex.
+  void collectStars() {
+    std::map<std::int64_t, std::vector<std::pair<std::size_t, int>>> stars;
+    for (std::size_t t = 0; t < triangles_.size(); ++t)
+      for (int c = 0; c < 3; ++c)
+        stars[triangles_[t].nodes[static_cast<std::size_t>(corner(c))]].emplace_back(t, c);
+    for (auto& [vertex, star] : stars) {
+      const auto v = static_cast<std::size_t>(vertex);
+      const int face = triangles_[star.front().first].face;
+      if (mesh_.nodeCadDim[v] != 2 || mesh_.nodeCadIndex[v] != face ||
+          !std::isfinite(mesh_.nodeCadParam[2 * v]))
+        continue;
+      std::map<std::int64_t, int> spokes;  // the far end of each side at the vertex: its count
+      bool closed = true;
+      for (const auto& [t, c] : star) {
+        const BoundaryTriangle& tri = triangles_[t];
+        closed = closed && tri.face == face;
+        for (const int side : {c, (c + 2) % 3}) {
+          closed = closed && onFace(tri.nodes, edgeSlots(order_, side), face);
+          const int far = side == c ? (c + 1) % 3 : (c + 2) % 3;
+          ++spokes[tri.nodes[static_cast<std::size_t>(corner(far))]];
+        }
+      }
+      for (const auto& [w, count] : spokes) closed = closed && count == 2;
+      if (closed) stars_.emplace(vertex, std::move(star));
     }
   }
 
@@ -603,7 +699,11 @@ class BoundaryFitter::Impl {
 
   // Fits the `free` nodes of `triangles` (one face) and writes them back where F falls by
   // kKeptFall and every free node stays inside the face's trimming.
-  bool fit(const std::vector<const BoundaryTriangle*>& triangles, std::vector<std::int64_t> free) {
+  bool fit(const std::vector<const BoundaryTriangle*>& triangles, std::vector<std::int64_t> free,
+           bool holdLargest = false) {
+    if (holdLargest && frozen_ != nullptr &&
+        (*frozen_)[static_cast<std::size_t>(free.front())] != 0)
+      return false;  // a vertex patch whose vertex stays: its edges' and interiors' patches
     if (frozen_ != nullptr)
       free.erase(std::remove_if(
                      free.begin(), free.end(),
@@ -615,8 +715,17 @@ class BoundaryFitter::Impl {
     Patch patch = makePatch(triangles, free, &slot);
     const TriangleFit result = Fit(ch, order_, std::move(patch)).run();
     if (!(result.after < kKeptFall * result.before)) return false;
+    if (holdLargest && !(result.largestAfter <= result.largestBefore)) return false;
     for (const std::int64_t n : free)
       if (!ch.contains(result.uv[static_cast<std::size_t>(slot.at(n))])) return false;
+    const double largestBefore = holdLargest ? checkedLargest(triangles) : 0.0;
+    std::vector<double> xyz, param;
+    for (const std::int64_t node : free) {
+      const auto n = static_cast<std::size_t>(node);
+      xyz.insert(xyz.end(), mesh_.xyz.begin() + 3 * n, mesh_.xyz.begin() + 3 * n + 3);
+      param.insert(param.end(), mesh_.nodeCadParam.begin() + 2 * n,
+                   mesh_.nodeCadParam.begin() + 2 * n + 2);
+    }
     for (const std::int64_t node : free) {
       const FaceParameter& uv = result.uv[static_cast<std::size_t>(slot.at(node))];
       const Eigen::Vector3d x = ch.point(uv);
@@ -626,7 +735,70 @@ class BoundaryFitter::Impl {
       mesh_.nodeCadParam[2 * n] = stored[0];
       mesh_.nodeCadParam[2 * n + 1] = stored[1];
     }
+    // Where the points the report samples see a larger angle than before (its corners: a
+    // vertex patch tilts them, and the fit's rule has no point there), the patch goes back.
+    if (holdLargest && !(checkedLargest(triangles) <= largestBefore)) {
+      for (std::size_t i = 0; i < free.size(); ++i) {
+        const auto n = static_cast<std::size_t>(free[i]);
+        for (std::size_t c = 0; c < 3; ++c) mesh_.xyz[3 * n + c] = xyz[3 * i + c];
+        for (std::size_t c = 0; c < 2; ++c) mesh_.nodeCadParam[2 * n + c] = param[2 * i + c];
+      }
+      return false;
+    }
     return true;
+  }
+
+  // A node inside the volume that a vertex drags: its share of the vertex's moves (the vertex's
+  // barycentric coordinate at the node in a tetrahedron around it).
+  struct Dragged {
+    std::int64_t node = 0;
+    double share = 0.0;
+  };
+
+  // Per vertex in `vertices`: the nodes of the tetrahedra around it that lie inside the volume
+  // (nodeCadDim 3) with a share above zero. A vertex with another cell around it (a layer's
+  // prism, a pyramid) drags none.
+  std::map<std::int64_t, std::vector<Dragged>> draggedNodes(
+      const std::vector<std::int64_t>& vertices) const {
+    std::map<std::int64_t, std::map<std::int64_t, double>> shares;
+    for (const std::int64_t v : vertices) shares[v];
+    std::vector<std::int64_t> mixed;
+    for (const ElementBlock& b : mesh_.blocks) {
+      if (cellDimension(b.type) != 3) continue;
+      const auto corners = static_cast<std::size_t>(cellNumVertices(b.type));
+      const ReferenceElement* ref =
+          b.type == CellType::Tetrahedron ? &ReferenceElement::get(b.type, b.order) : nullptr;
+      const auto count = static_cast<std::size_t>(b.nodesPerElement());
+      for (std::size_t e = 0; e < b.count(); ++e) {
+        const std::int64_t* nodes = b.element(e);
+        for (std::size_t c = 0; c < corners; ++c) {
+          const auto it = shares.find(nodes[c]);
+          if (it == shares.end()) continue;
+          if (ref == nullptr) {
+            mixed.push_back(nodes[c]);
+            continue;
+          }
+          for (std::size_t k = corners; k < count; ++k) {
+            const LatticePoint& l = ref->lattice()[k];
+            const int share = c == 0 ? b.order - l[0] - l[1] - l[2] : l[c - 1];
+            const auto n = static_cast<std::size_t>(nodes[k]);
+            if (share > 0 && mesh_.nodeCadDim[n] == 3)
+              it->second[nodes[k]] = static_cast<double>(share) / b.order;
+          }
+        }
+      }
+    }
+    for (const std::int64_t v : mixed) shares.erase(v);
+    std::map<std::int64_t, std::vector<Dragged>> dragged;
+    for (const auto& [v, nodes] : shares)
+      for (const auto& [n, share] : nodes) dragged[v].push_back({n, share});
+    return dragged;
+  }
+
+  // The largest squared sine of `triangles` (one face) at the report's points.
+  double checkedLargest(const std::vector<const BoundaryTriangle*>& triangles) {
+    Patch patch = makePatch(triangles, {});
+    return Fit(chart(triangles.front()->face), order_, std::move(patch), true).largestSine();
   }
 
   Mesh& mesh_;
@@ -636,6 +808,8 @@ class BoundaryFitter::Impl {
   std::vector<BoundaryTriangle> triangles_;
   // Per edge (its corners, sorted): the triangles on it and the side it is of each.
   std::map<std::pair<std::int64_t, std::int64_t>, std::vector<std::pair<std::size_t, int>>> edges_;
+  // Per vertex inside a face with a closed star (collectStars): its triangles and their corner.
+  std::map<std::int64_t, std::vector<std::pair<std::size_t, int>>> stars_;
   std::map<int, FaceChart> charts_;
 };
 
@@ -653,6 +827,16 @@ std::vector<char> BoundaryFitter::touching(const std::vector<char>& nodes) const
 }
 void BoundaryFitter::fit(const std::vector<char>& active, const std::vector<char>* frozen) {
   impl_->fit(active, frozen);
+}
+std::vector<std::int64_t> BoundaryFitter::starVertices() const {
+  return impl_->starVertices();
+}
+std::vector<std::size_t> BoundaryFitter::starOf(std::int64_t vertex) const {
+  return impl_->starOf(vertex);
+}
+std::vector<std::vector<std::int64_t>> BoundaryFitter::fitVertices(
+    const std::vector<std::int64_t>& vertices, const std::vector<char>* frozen) {
+  return impl_->fitVertices(vertices, frozen);
 }
 
 }  // namespace homesh

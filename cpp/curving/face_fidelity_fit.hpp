@@ -38,6 +38,10 @@ struct TriangleFit {
   double before = 0.0;            // F at the start and at the end (after <= before)
   double after = 0.0;
   int steps = 0;  // Gauss-Newton steps kept
+  // The largest squared sine of the angle between the normals at the points, at the start and
+  // at the end.
+  double largestBefore = 0.0;
+  double largestAfter = 0.0;
 };
 
 // The fit of an order-P triangle's interior nodes on `chart`'s face. `uv` holds every lattice
@@ -73,6 +77,18 @@ class BoundaryFitter {
   // Fits the patches of the triangles set in `active` (per triangle); nodes set in `frozen` (per
   // node, if given) stay.
   void fit(const std::vector<char>& active, const std::vector<char>* frozen = nullptr);
+
+  // The vertices inside a face whose star of triangles (those with a corner there) is closed on
+  // it, and a vertex's star (empty for another node).
+  std::vector<std::int64_t> starVertices() const;
+  std::vector<std::size_t> starOf(std::int64_t vertex) const;
+  // Fits the patch of each of `vertices` (of starVertices; no two in one triangle), in turn: the
+  // vertex, the nodes of the sides at it and its triangles' interiors move, those set in `frozen`
+  // excepted (a frozen vertex: no patch), kept where F falls by 1 %, the patch's largest angle
+  // does not rise and every node stays inside the face's trimming. Returns per vertex the nodes
+  // written (empty where the patch was not kept).
+  std::vector<std::vector<std::int64_t>> fitVertices(const std::vector<std::int64_t>& vertices,
+                                                     const std::vector<char>* frozen = nullptr);
 
  private:
   class Impl;

@@ -36,6 +36,9 @@ constexpr double kTierShare = 0.25;
 // angle where it was.
 constexpr std::size_t kTierTriangles = 64;
 constexpr double kTierFraction = 0.01;
+// Rounds of vertex patches after the tiers (fitVertexStars) at most, and patches a round at most.
+constexpr int kVertexRounds = 8;
+constexpr std::size_t kVertexPatches = 8;
 
 // A verdict's rank: a change to a lower one is a worse verdict.
 int rank(Validity v) {
@@ -102,6 +105,7 @@ class TierFitter {
         frozen_(layerNodes(mesh)) {}
 
   BoundaryFitter& fitter() { return fitter_; }
+  Mesh& mesh() { return mesh_; }
   const std::vector<char>& frozen() const { return frozen_; }
 
   // Fits the triangles set in `tier`, certifies, freezes and fits again (kFreezeRounds); on
@@ -137,27 +141,76 @@ class TierFitter {
     return false;
   }
 
+  // Fits the patches of `vertices` (no two in one triangle), certifies, and puts back every
+  // patch with a node in an element that breaks the promise, certifying again until none does
+  // (each pass puts back at least one patch). Returns the vertices whose patch was kept.
+  std::vector<std::int64_t> fitVertices(const std::vector<std::int64_t>& vertices) {
+    const std::vector<double> xyz = mesh_.xyz, param = mesh_.nodeCadParam;
+    std::vector<std::vector<std::int64_t>> kept = fitter_.fitVertices(vertices, &frozen_);
+    std::vector<int> owner(mesh_.numNodes(), -1);
+    for (std::size_t i = 0; i < kept.size(); ++i)
+      for (const std::int64_t n : kept[i]) owner[static_cast<std::size_t>(n)] = static_cast<int>(i);
+    while (true) {
+      const KnownQuality known{&mesh_, &measuredXyz_, &quality_, {}};
+      QualitySummary after = evaluateQuality(mesh_, threads_, &known);
+      record_.remeasured += after.scaledJacobian.size() - after.known;
+      measuredXyz_ = mesh_.xyz;
+      quality_ = std::move(after);
+      std::vector<char> undo(kept.size(), 0);
+      bool any = false;
+      forEachBreaker(quality_, [&](const std::int64_t* v, std::size_t n) {
+        for (std::size_t k = 0; k < n; ++k) {
+          const int i = owner[static_cast<std::size_t>(v[k])];
+          if (i < 0) continue;
+          undo[static_cast<std::size_t>(i)] = 1;
+          any = true;
+        }
+      });
+      if (!any) break;
+      for (std::size_t i = 0; i < kept.size(); ++i) {
+        if (undo[i] == 0) continue;
+        for (const std::int64_t node : kept[i]) {
+          const auto n = static_cast<std::size_t>(node);
+          for (int c = 0; c < 3; ++c) mesh_.xyz[3 * n + c] = xyz[3 * n + c];
+          for (int c = 0; c < 2; ++c) mesh_.nodeCadParam[2 * n + c] = param[2 * n + c];
+          owner[n] = -1;
+        }
+        kept[i].clear();
+      }
+    }
+    std::vector<std::int64_t> moved;
+    for (std::size_t i = 0; i < kept.size(); ++i)
+      if (!kept[i].empty()) moved.push_back(vertices[i]);
+    return moved;
+  }
+
  private:
+  // Calls `visit(nodes, count)` for every element whose verdict in `after` breaks the promise
+  // against the input's.
+  template <typename Visit>
+  void forEachBreaker(const QualitySummary& after, Visit&& visit) const {
+    std::size_t e = 0;
+    for (const ElementBlock& b : mesh_.blocks) {
+      if (cellDimension(b.type) != mesh_.dim) continue;
+      const auto n = static_cast<std::size_t>(b.nodesPerElement());
+      for (std::size_t c = 0; c < b.count(); ++c, ++e)
+        if (!keeps(inputQuality_, after, e)) visit(b.element(c), n);
+    }
+  }
+
   // The `moved` nodes of every element whose verdict `after` breaks the promise against the
   // input's; empty when none does (an element none of whose nodes moved is not the tier's doing).
   std::vector<char> breakers(const QualitySummary& after, const std::vector<char>& moved) const {
     std::vector<char> nodes(mesh_.numNodes(), 0);
     bool any = false;
-    std::size_t e = 0;
-    for (const ElementBlock& b : mesh_.blocks) {
-      if (cellDimension(b.type) != mesh_.dim) continue;
-      const auto n = static_cast<std::size_t>(b.nodesPerElement());
-      for (std::size_t c = 0; c < b.count(); ++c, ++e) {
-        if (keeps(inputQuality_, after, e)) continue;
-        const std::int64_t* v = b.element(c);
-        for (std::size_t k = 0; k < n; ++k) {
-          const auto node = static_cast<std::size_t>(v[k]);
-          if (moved[node] == 0) continue;
-          nodes[node] = 1;
-          any = true;
-        }
+    forEachBreaker(after, [&](const std::int64_t* v, std::size_t n) {
+      for (std::size_t k = 0; k < n; ++k) {
+        const auto node = static_cast<std::size_t>(v[k]);
+        if (moved[node] == 0) continue;
+        nodes[node] = 1;
+        any = true;
       }
-    }
+    });
     return any ? nodes : std::vector<char>{};
   }
 
@@ -170,6 +223,65 @@ class TierFitter {
   std::vector<double> measuredXyz_;
   std::vector<char> frozen_;
 };
+
+// After the tiers, whose patches hold the triangles' corners: rounds of vertex patches
+// (BoundaryFitter::fitVertices) around the triangles with the largest angles left, each vertex
+// not frozen by the tiers whose star holds a triangle at least a quarter (kTierShare) of the
+// largest squared sine, largest first, no two in one triangle, at most `capacity` a round; a
+// patch that breaks the promise is put back whole, and the rounds end once one keeps none.
+// Why: an order-2 triangle's normal is set by its corners and edge nodes, and the optimiser's
+// sliding leaves corners where an edge spans far more of a curved face than its neighbours;
+// with the corners held the fit cannot shorten it. Why after the tiers, not within their
+// rounds: a vertex reshapes every element around it, and frozen there by the certification it
+// held its triangles' edge nodes too (the tiers stop at a held triangle): the thin cylinder's
+// largest angle doubled.
+void fitVertexStars(TierFitter& tiers, std::vector<double>& sines, const std::vector<char>& movable,
+                    BoundaryFitRecord& record, const std::function<bool()>& stop) {
+  BoundaryFitter& fitter = tiers.fitter();
+  std::vector<std::int64_t> vertices = fitter.starVertices();
+  for (int round = 0; round < kVertexRounds; ++round) {
+    if (stop && stop()) {
+      record.stopped = true;
+      return;
+    }
+    const double largest = largestOf(sines, movable);
+    if (!(largest > 0.0)) return;
+    std::vector<std::pair<double, std::int64_t>> candidates;
+    for (const std::int64_t v : vertices) {
+      if (tiers.frozen()[static_cast<std::size_t>(v)] != 0) continue;
+      double star = 0.0;
+      for (const std::size_t t : fitter.starOf(v))
+        if (std::isfinite(sines[t])) star = std::max(star, sines[t]);
+      if (star >= kTierShare * largest) candidates.emplace_back(star, v);
+    }
+    std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+      return a.first != b.first ? a.first > b.first : a.second < b.second;
+    });
+    // No two in one triangle, so that a patch put back takes no other's nodes with it.
+    std::vector<char> blocked(sines.size(), 0);  // per triangle
+    std::vector<std::int64_t> chosen;
+    for (const auto& [star, v] : candidates) {
+      const std::vector<std::size_t> triangles = fitter.starOf(v);
+      if (std::any_of(triangles.begin(), triangles.end(),
+                      [&](std::size_t t) { return blocked[t] != 0; }))
+        continue;
+      chosen.push_back(v);
+      if (chosen.size() == kVertexPatches) break;
+      // A neighbour's star shares a triangle with it (the two patches would share nodes).
+      for (const std::size_t t : triangles) blocked[t] = 1;
+    }
+    if (chosen.empty()) return;
+    const std::vector<double> before = tiers.mesh().xyz;
+    const std::vector<std::int64_t> moved = tiers.fitVertices(chosen);
+    record.verticesMoved += moved.size();
+    if (moved.empty()) return;
+    const std::vector<char> touched = fitter.touching(movedNodes(tiers.mesh().xyz, before));
+    const std::vector<double> again = fitter.largestSines(&touched);
+    for (std::size_t t = 0; t < sines.size(); ++t)
+      if (touched[t] != 0) sines[t] = again[t];
+    if (!(largestOf(sines, movable) < largest)) return;
+  }
+}
 
 }  // namespace
 
@@ -231,6 +343,7 @@ BoundaryFitRecord fitBoundaryFidelity(Mesh& mesh, QualitySummary& quality, const
     for (std::size_t t = 0; t < record.triangles; ++t)
       if (touched[t] != 0) sines[t] = again[t];
   }
+  if (!record.stopped) fitVertexStars(tiers, sines, movable, record, stop);
   const std::vector<char> fitted = fitter.touching(movedNodes(mesh.xyz, input));
   record.fitted = static_cast<std::size_t>(std::count(fitted.begin(), fitted.end(), 1));
   record.frozenNodes =

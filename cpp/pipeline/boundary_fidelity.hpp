@@ -9,7 +9,9 @@
 // worse than the stage's input and its worst element at most 0.1 % lower (the certified measure's
 // resolution): the trade for fidelity, made explicit. The stage ends once a triangle next to a
 // frozen node keeps an angle at least as large as any left to fit (the volume holds the largest
-// angle there). The nodes of prisms, pyramids and hexahedra stay: a boundary layer's heights are
+// angle there); then rounds of vertex patches (corners moved with their star of triangles,
+// the volume's nodes around dragged along) around the largest angles left, each patch kept only
+// if its elements keep the same promise. The nodes of prisms, pyramids and hexahedra stay: a boundary layer's heights are
 // measured from its wall, and the wall's triangles, having nothing to fit, neither join a tier
 // nor count as held.
 //
@@ -31,12 +33,13 @@
 namespace homesh {
 
 struct BoundaryFitRecord {
-  std::size_t triangles = 0;    // boundary triangles with interior nodes on one face
-  std::size_t fitted = 0;       // those with a node moved
-  std::size_t tiers = 0;        // tiers fitted and kept (largest angles first)
-  std::size_t frozenNodes = 0;  // nodes the certification held where they were
-  std::size_t remeasured = 0;   // elements certified again
-  bool stopped = false;         // ended by `stop` (a cancel, the job's time budget)
+  std::size_t triangles = 0;      // boundary triangles with interior nodes on one face
+  std::size_t fitted = 0;         // those with a node moved
+  std::size_t tiers = 0;          // tiers fitted and kept (largest angles first)
+  std::size_t frozenNodes = 0;    // nodes the certification held where they were
+  std::size_t verticesMoved = 0;  // vertex patches kept after the tiers (a vertex may count twice)
+  std::size_t remeasured = 0;     // elements certified again
+  bool stopped = false;           // ended by `stop` (a cancel, the job's time budget)
 };
 
 // The stage on `mesh` (3D, order 2 or more; otherwise nothing) whose certified quality is

@@ -301,6 +301,7 @@ std::string meshReportJson(const CurvedMesh& curved, const StageRecords& records
     json.value("fitted", records.boundaryFit->fitted);
     json.value("tiers", records.boundaryFit->tiers);
     json.value("frozen_nodes", records.boundaryFit->frozenNodes);
+    json.value("vertices_moved", records.boundaryFit->verticesMoved);
     json.value("remeasured_elements", records.boundaryFit->remeasured);
     json.value("stopped", records.boundaryFit->stopped);
     json.endObject();
