@@ -60,8 +60,8 @@ struct FitTable {
   std::vector<double> weights;
 };
 
-// `check`: the points the report's geometry samples instead (a rule of degree 2P + 2 and the
-// nodes, quality/geometry_accuracy.hpp), weights zero at the nodes: for the largest angle only.
+// `check`: the points the report's geometry samples instead (the same rule of degree 2P + 2 and
+// the nodes, quality/geometry_accuracy.cpp), weights zero at the nodes: for the largest angle.
 const FitTable& fitTable(int order, bool check = false) {
   static std::mutex lock;
   static std::array<std::array<std::unique_ptr<FitTable>, 2>, kMaxOrder + 1> tables;
@@ -70,7 +70,8 @@ const FitTable& fitTable(int order, bool check = false) {
   if (t) return *t;
   t = std::make_unique<FitTable>();
   const int degree = check ? 2 * order + 2 : 2 * order;
-  const std::optional<QuadratureRule> symmetric = symmetricRule(CellType::Triangle, degree);
+  const std::optional<QuadratureRule> symmetric =
+      check ? std::nullopt : symmetricRule(CellType::Triangle, degree);
   QuadratureRule rule = symmetric ? *symmetric : quadratureRule(CellType::Triangle, degree);
   const ReferenceElement& ref = ReferenceElement::get(CellType::Triangle, order);
   if (check) {
@@ -480,10 +481,13 @@ class BoundaryFitter::Impl {
                                                      const std::vector<char>* frozen) {
     frozen_ = frozen;
     std::vector<std::vector<std::int64_t>> moved(vertices.size());
-    const std::map<std::int64_t, std::vector<Dragged>> dragged = draggedNodes(vertices);
+    std::vector<Eigen::Vector3d> shifts(vertices.size(), Eigen::Vector3d::Zero());
     for (std::size_t i = 0; i < vertices.size(); ++i) {
       const auto it = stars_.find(vertices[i]);
-      if (it == stars_.end()) continue;
+      // A frozen vertex: its sides' and interiors' patches are the tiers'.
+      if (it == stars_.end() ||
+          (frozen != nullptr && (*frozen)[static_cast<std::size_t>(vertices[i])] != 0))
+        continue;
       std::vector<const BoundaryTriangle*> patch;
       std::vector<std::int64_t> free{vertices[i]};
       for (const auto& [t, c] : it->second) {
@@ -497,17 +501,28 @@ class BoundaryFitter::Impl {
       }
       std::sort(free.begin(), free.end());
       free.erase(std::unique(free.begin(), free.end()), free.end());
+      if (frozen != nullptr)  // as fit() would, so that `moved` names only the nodes written
+        free.erase(std::remove_if(
+                       free.begin(), free.end(),
+                       [&](std::int64_t n) { return (*frozen)[static_cast<std::size_t>(n)] != 0; }),
+                   free.end());
       const Eigen::Vector3d from = point(vertices[i]);
       if (!fit(patch, free, true)) continue;
       moved[i] = free;
-      // The volume's nodes follow the vertex by their share of it, so that the tetrahedra
-      // around it move as their straight-sided maps would, instead of bending at the vertex.
-      const Eigen::Vector3d shift = point(vertices[i]) - from;
+      shifts[i] = point(vertices[i]) - from;
+    }
+    // The volume's nodes follow each kept vertex by their share of it, so that the tetrahedra
+    // around it move as their straight-sided maps would, instead of bending at the vertex.
+    std::vector<std::int64_t> kept;
+    for (std::size_t i = 0; i < vertices.size(); ++i)
+      if (!moved[i].empty()) kept.push_back(vertices[i]);
+    const std::map<std::int64_t, std::vector<Dragged>> dragged = draggedNodes(kept);
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
       const auto around = dragged.find(vertices[i]);
-      if (around == dragged.end()) continue;
+      if (moved[i].empty() || around == dragged.end()) continue;
       for (const Dragged& d : around->second) {
         const auto n = static_cast<std::size_t>(d.node);
-        for (int c = 0; c < 3; ++c) mesh_.xyz[3 * n + c] += d.share * shift[c];
+        for (int c = 0; c < 3; ++c) mesh_.xyz[3 * n + c] += d.share * shifts[i][c];
         moved[i].push_back(d.node);
       }
     }
@@ -698,12 +713,10 @@ class BoundaryFitter::Impl {
   }
 
   // Fits the `free` nodes of `triangles` (one face) and writes them back where F falls by
-  // kKeptFall and every free node stays inside the face's trimming.
+  // kKeptFall and every free node stays inside the face's trimming; with `holdLargest`, only
+  // where the largest angle at the report's points (checkedLargest) does not rise either.
   bool fit(const std::vector<const BoundaryTriangle*>& triangles, std::vector<std::int64_t> free,
            bool holdLargest = false) {
-    if (holdLargest && frozen_ != nullptr &&
-        (*frozen_)[static_cast<std::size_t>(free.front())] != 0)
-      return false;  // a vertex patch whose vertex stays: its edges' and interiors' patches
     if (frozen_ != nullptr)
       free.erase(std::remove_if(
                      free.begin(), free.end(),
@@ -757,7 +770,8 @@ class BoundaryFitter::Impl {
 
   // Per vertex in `vertices`: the nodes of the tetrahedra around it that lie inside the volume
   // (nodeCadDim 3) with a share above zero. A vertex with another cell around it (a layer's
-  // prism, a pyramid) drags none.
+  // prism, a pyramid) drags none, and a node two of them would drag (on a tetrahedron's edge
+  // between them) stays: each patch is put back alone.
   std::map<std::int64_t, std::vector<Dragged>> draggedNodes(
       const std::vector<std::int64_t>& vertices) const {
     std::map<std::int64_t, std::map<std::int64_t, double>> shares;
@@ -779,8 +793,7 @@ class BoundaryFitter::Impl {
             continue;
           }
           for (std::size_t k = corners; k < count; ++k) {
-            const LatticePoint& l = ref->lattice()[k];
-            const int share = c == 0 ? b.order - l[0] - l[1] - l[2] : l[c - 1];
+            const int share = simplexBarycentric(ref->lattice()[k], 3, b.order)[c];
             const auto n = static_cast<std::size_t>(nodes[k]);
             if (share > 0 && mesh_.nodeCadDim[n] == 3)
               it->second[nodes[k]] = static_cast<double>(share) / b.order;
@@ -789,9 +802,13 @@ class BoundaryFitter::Impl {
       }
     }
     for (const std::int64_t v : mixed) shares.erase(v);
+    std::map<std::int64_t, int> draggers;
+    for (const auto& [v, nodes] : shares)
+      for (const auto& [n, share] : nodes) ++draggers[n];
     std::map<std::int64_t, std::vector<Dragged>> dragged;
     for (const auto& [v, nodes] : shares)
-      for (const auto& [n, share] : nodes) dragged[v].push_back({n, share});
+      for (const auto& [n, share] : nodes)
+        if (draggers[n] == 1) dragged[v].push_back({n, share});
     return dragged;
   }
 

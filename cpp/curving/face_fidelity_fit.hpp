@@ -85,8 +85,11 @@ class BoundaryFitter {
   // Fits the patch of each of `vertices` (of starVertices; no two in one triangle), in turn: the
   // vertex, the nodes of the sides at it and its triangles' interiors move, those set in `frozen`
   // excepted (a frozen vertex: no patch), kept where F falls by 1 %, the patch's largest angle
-  // does not rise and every node stays inside the face's trimming. Returns per vertex the nodes
-  // written (empty where the patch was not kept).
+  // does not rise, neither at the fit's points nor at the report's (a rule of degree 2P + 2 and
+  // the nodes), and every node stays inside the face's trimming. The volume's nodes of the
+  // tetrahedra around a kept vertex follow it by their barycentric share of it (a node two kept
+  // vertices share stays). Returns per vertex the nodes written, dragged ones included (empty
+  // where the patch was not kept).
   std::vector<std::vector<std::int64_t>> fitVertices(const std::vector<std::int64_t>& vertices,
                                                      const std::vector<char>* frozen = nullptr);
 

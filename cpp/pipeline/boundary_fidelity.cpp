@@ -147,6 +147,7 @@ class TierFitter {
   std::vector<std::int64_t> fitVertices(const std::vector<std::int64_t>& vertices) {
     const std::vector<double> xyz = mesh_.xyz, param = mesh_.nodeCadParam;
     std::vector<std::vector<std::int64_t>> kept = fitter_.fitVertices(vertices, &frozen_);
+    if (std::all_of(kept.begin(), kept.end(), [](const auto& k) { return k.empty(); })) return {};
     std::vector<int> owner(mesh_.numNodes(), -1);
     for (std::size_t i = 0; i < kept.size(); ++i)
       for (const std::int64_t n : kept[i]) owner[static_cast<std::size_t>(n)] = static_cast<int>(i);
@@ -225,15 +226,16 @@ class TierFitter {
 };
 
 // After the tiers, whose patches hold the triangles' corners: rounds of vertex patches
-// (BoundaryFitter::fitVertices) around the triangles with the largest angles left, each vertex
-// not frozen by the tiers whose star holds a triangle at least a quarter (kTierShare) of the
-// largest squared sine, largest first, no two in one triangle, at most `capacity` a round; a
-// patch that breaks the promise is put back whole, and the rounds end once one keeps none.
-// Why: an order-2 triangle's normal is set by its corners and edge nodes, and the optimiser's
-// sliding leaves corners where an edge spans far more of a curved face than its neighbours;
-// with the corners held the fit cannot shorten it. Why after the tiers, not within their
-// rounds: a vertex reshapes every element around it, and frozen there by the certification it
-// held its triangles' edge nodes too (the tiers stop at a held triangle): the thin cylinder's
+// (BoundaryFitter::fitVertices) around the triangles with the largest angles left: each vertex
+// that stays free (not a layer's) whose star holds a triangle with at least a quarter
+// (kTierShare) of the largest squared sine, largest first, no two in one triangle, at most
+// kVertexPatches a round; a patch that breaks the promise is put back whole, and the rounds end
+// after kVertexRounds, with no candidate, once one keeps none or once the largest angle does not
+// fall. Why: an order-2 triangle's normal is set by its corners and edge nodes, and the
+// optimiser's sliding leaves corners where an edge spans far more of a curved face than its
+// neighbours; with the corners held the fit cannot shorten it. Why after the tiers, not within
+// their rounds: a vertex reshapes every element around it, and frozen there by the
+// certification (alone) its triangles were held and ended the stage: the thin cylinder's
 // largest angle doubled.
 void fitVertexStars(TierFitter& tiers, std::vector<double>& sines, const std::vector<char>& movable,
                     BoundaryFitRecord& record, const std::function<bool()>& stop) {

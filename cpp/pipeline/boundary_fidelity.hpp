@@ -9,11 +9,11 @@
 // worse than the stage's input and its worst element at most 0.1 % lower (the certified measure's
 // resolution): the trade for fidelity, made explicit. The stage ends once a triangle next to a
 // frozen node keeps an angle at least as large as any left to fit (the volume holds the largest
-// angle there); then rounds of vertex patches (corners moved with their star of triangles,
-// the volume's nodes around dragged along) around the largest angles left, each patch kept only
-// if its elements keep the same promise. The nodes of prisms, pyramids and hexahedra stay: a boundary layer's heights are
-// measured from its wall, and the wall's triangles, having nothing to fit, neither join a tier
-// nor count as held.
+// angle there); then rounds of vertex patches (corners moved with their star of triangles, the
+// volume's nodes around dragged along) around the largest angles left, each patch kept only if
+// its elements keep the same promise. The nodes of prisms, pyramids and hexahedra stay: a
+// boundary layer's heights are measured from its wall, and the wall's triangles, having nothing
+// to fit, neither join a tier nor count as held.
 //
 // Why a stage of its own, after the optimiser: the optimiser's untangling slides the boundary's
 // nodes for the volume, and the facet and fidelity terms join only once the mesh is valid, where

@@ -184,13 +184,13 @@ TEST(BoundaryFit, FitsTheFacesBesideABoundaryLayersWallAndLeavesTheWall) {
   EXPECT_EQ(measured.invalid + measured.undecided, 0U);
 }
 
-// A linear mesh, and a mesh without CAD-face triangles of order 2 or more, are left alone.
 // Vertex patches (BoundaryFitter::fitVertices) on the unit sphere at order 2, where the
 // optimiser's sliding left edges spanning up to 87 degrees of arc and only the corners can
-// shorten them: some are kept, their vertices stay on the sphere (to rounding: the chart's
-// point), and no patch raises the largest angle the report measures (its points include the
-// corners, where the fit's own rule has none), so neither does the mesh's, the patches sharing
-// no triangle.
+// shorten them (the optimiser had stretched one from at most 68): some are kept, their vertices
+// stay on the sphere (to rounding: the chart's point), and no patch raises the largest angle the
+// report measures (each is checked at the report's own points, the corners included, where the
+// fit's rule has none), so neither does the mesh's, the patches sharing no triangle. The patches
+// are not certified here: the stage does that (BoundaryFit.FollowsTheSphere... above).
 TEST(BoundaryFit, VertexPatchesMoveCornersOnTheFaceWithoutRaisingTheLargestAngle) {
   const MeshResult& made = sphereInABox(2);
   ASSERT_TRUE(made.geometry.has_value());
@@ -227,6 +227,7 @@ TEST(BoundaryFit, VertexPatchesMoveCornersOnTheFaceWithoutRaisingTheLargestAngle
   EXPECT_LE(after.maxAngleDeg, made.geometry->maxAngleDeg * (1.0 + 1e-9));
 }
 
+// A linear mesh, and a mesh without CAD-face triangles of order 2 or more, are left alone.
 TEST(BoundaryFit, LeavesALinearMeshAlone) {
   MeshingOptions options;
   options.order = 1;
