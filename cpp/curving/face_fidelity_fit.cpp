@@ -72,24 +72,13 @@ const FitTable& fitTable(int order, bool check = false) {
   const int degree = check ? 2 * order + 2 : 2 * order;
   const std::optional<QuadratureRule> symmetric =
       check ? std::nullopt : symmetricRule(CellType::Triangle, degree);
-  QuadratureRule rule = symmetric ? *symmetric : quadratureRule(CellType::Triangle, degree);
+  const QuadratureRule rule = symmetric ? *symmetric : quadratureRule(CellType::Triangle, degree);
   const ReferenceElement& ref = ReferenceElement::get(CellType::Triangle, order);
-  if (check) {
-    const Eigen::MatrixXd& nodes = ref.nodes();
-    for (Eigen::Index n = 0; n < nodes.rows(); ++n) {
-      rule.points.push_back(nodes(n, 0));
-      rule.points.push_back(nodes(n, 1));
-      rule.weights.push_back(0.0);
-    }
-  }
-  Eigen::MatrixXd points(rule.size(), 2);
-  for (int q = 0; q < rule.size(); ++q)
-    for (int c = 0; c < 2; ++c)
-      points(q, c) = rule.points[2 * static_cast<std::size_t>(q) + static_cast<std::size_t>(c)];
+  const Eigen::MatrixXd points = pointRows(rule, check ? ref.nodes() : Eigen::MatrixXd());
   const Eigen::MatrixXd values = ref.valuesAt(points);
   const std::vector<Eigen::MatrixXd> grads = ref.derivativesAt(points);
   t->nodes = ref.numNodes();
-  t->points = rule.size();
+  t->points = static_cast<int>(points.rows());
   t->values.resize(t->points, t->nodes);
   t->dxi.resize(t->points, t->nodes);
   t->deta.resize(t->points, t->nodes);
@@ -101,6 +90,7 @@ const FitTable& fitTable(int order, bool check = false) {
     t->deta.col(k) = grads[1].col(n);
   }
   t->weights = rule.weights;
+  t->weights.resize(static_cast<std::size_t>(t->points), 0.0);  // the nodes': zero
   return *t;
 }
 
@@ -214,9 +204,11 @@ class Fit {
         }
         feet_ = feet0;
         if (!refreshFeet(kProjectionSteps)) break;
-        const double trial = objective(nullptr);
+        double trialLargest = 0.0;
+        const double trial = objective(nullptr, nullptr, &trialLargest);
         if (trial < f) {
           kept = true;
+          result.largestAfter = trialLargest;
           const double fall = (f - trial) / f;
           f = trial;
           ++result.steps;
@@ -231,8 +223,6 @@ class Fit {
       }
     }
     result.after = f;
-    result.largestAfter = 0.0;
-    objective(nullptr, nullptr, &result.largestAfter);
     result.uv = patch_.uv;
     return result;
   }
