@@ -397,8 +397,10 @@ def mesh(shape, progress=None, cancel=None, name=None, sources=(), boundary_laye
               a 3D boundary layer: ``{"faces": [1, 8], "thickness": 0.04, "layers": 6,
               "progression": 1.5}`` (faces as FreeCAD numbers them, FaceN; thickness a number
               or an expression of x, y, z such as ``"0.01+0.05*x"``; layers and progression
-              optional, with the defaults below). A macro prism layer is grown, curved and
-              optimised with the rest, then split (``report()["boundary_layer"]``). For a
+              optional, with the defaults below; ``"solids": [2]``, where a layer face lies
+              between two solids, names the one it grows into, SolidN). A macro prism layer is
+              grown, curved and optimised with the rest, then split
+              (``report()["boundary_layer"]``). For a
               NekMesh .mcf file, its BndLayer* keys are used when this is None.
 
     The options (keywords, from the one parameter table; None or left out: the default) are
@@ -500,7 +502,7 @@ def curve(shape, nodes, cells, progress=None, cancel=None, name=None, **options)
     return HighOrderMesh(core)
 
 
-_BOUNDARY_LAYER_KEYS = ("faces", "thickness", "layers", "progression")
+_BOUNDARY_LAYER_KEYS = ("faces", "thickness", "layers", "progression", "solids")
 
 
 def _boundary_layer(spec):
@@ -522,6 +524,11 @@ def _boundary_layer(spec):
     if isinstance(faces, numbers.Integral) and not isinstance(faces, bool):
         faces = [faces]
     out = {"faces": [_check_int("boundary_layer faces", f) for f in faces]}
+    solids = spec.get("solids", [])
+    if isinstance(solids, numbers.Integral) and not isinstance(solids, bool):
+        solids = [solids]
+    if solids:
+        out["solids"] = [_check_int("boundary_layer solids", s) for s in solids]
     thickness = spec["thickness"]
     if isinstance(thickness, bool) or not isinstance(thickness, (numbers.Real, str)):
         raise ParameterError("boundary_layer thickness must be a number or an expression of "

@@ -4,7 +4,7 @@
 #include <cstddef>
 
 #include "boundary_layer/layer_grower_2d.hpp"
-#include "boundary_layer/layer_grower_3d.hpp"
+#include "boundary_layer/layer_solids.hpp"
 #include "boundary_layer/wall_segment_split.hpp"
 
 namespace homesh {
@@ -22,7 +22,7 @@ Mesh growBoundaryLayer(const Mesh& volume, const CadModel& cad,
         static_cast<std::size_t>(layer_growth::splitTightWallSegments(planar, cad, parameters));
     mesh = layer_growth::growLayer2D(planar, cad, parameters, fill, record);
   } else {
-    mesh = layer_growth::growLayer3D(volume, cad, parameters, fill, record);
+    mesh = layer_growth::growLayerInSolids(volume, cad, parameters, fill, record);
   }
   record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return mesh;

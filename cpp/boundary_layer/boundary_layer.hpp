@@ -21,9 +21,14 @@
 // between them, with triangles (corner, top, top) between consecutive columns, appended to the
 // triangle block; they are part of the layer (layerFanTriangles in boundary_layer/layer_cells.hpp).
 //
+// In a model of several solids, each solid that a layer face bounds grows its own layer and the
+// others keep their tetrahedra (layer_solids.hpp); a layer face between two solids, or one with a
+// node that another solid shares, is refused (not made yet).
+//
 // The stage's parts: layer_parameters.hpp (what is asked), layer_record.hpp (what was made),
-// layer_grower_3d.hpp and layer_grower_2d.hpp (the growth), wall_segment_split.hpp (2D walls
-// halved first), layer_growth.hpp (what the growers share).
+// layer_grower_3d.hpp and layer_grower_2d.hpp (the growth), layer_solids.hpp (3D models of
+// several solids), wall_segment_split.hpp (2D walls halved first), layer_growth.hpp (what the
+// growers share).
 #pragma once
 
 #include "boundary_layer/layer_parameters.hpp"
@@ -34,12 +39,13 @@
 
 namespace homesh {
 
-// `volume`: a linear tetrahedral mesh of one solid with outward boundary triangles (as
-// generateLinearMesh makes). Returns the linear mesh with the macro layer: blocks tetrahedra,
-// prisms, boundary triangles, boundary quadrilaterals (the layer's sides on faces without a
-// layer), lines. `fill` gives the largest tetrahedron size. Throws ParameterError (a face that
-// does not exist, a thickness that is not positive somewhere, more than one solid) or
-// MeshingError naming the face and the place where no layer can be grown.
+// `volume`: a linear tetrahedral mesh of one or more solids with its boundary triangles (of one
+// solid: outward, as generateLinearMesh makes them). Returns the linear mesh with the macro
+// layer: blocks tetrahedra, prisms, boundary triangles, boundary quadrilaterals (the layer's sides
+// on faces without a layer), lines. `fill` gives the largest tetrahedron size. Throws
+// ParameterError (a face that does not exist, a thickness that is not positive somewhere, a layer
+// face between two solids or beside another solid) or MeshingError naming the face and the place
+// where no layer can be grown.
 Mesh growBoundaryLayer(const Mesh& volume, const CadModel& cad,
                        const BoundaryLayerParameters& parameters, const LinearMeshOptions& fill,
                        BoundaryLayerRecord& record);

@@ -467,7 +467,10 @@ class LayerGrower2D {
   }
 
   Mesh assemble(const LinearMeshOptions& fill) {
-    recordHeights(record_, p_, out_, wall_, [](const WallNode& w) { return w.curve; });
+    recordHeights(
+        record_, p_, out_, wall_, [](const WallNode& w) { return w.curve; },
+        [](const WallNode& w) { return w.full; },
+        [](const WallNode& w) { return w.clearanceCurve; });
     std::vector<std::int64_t> topId(wall_.size());
     std::vector<std::vector<std::int64_t>> fanIds(wall_.size());
     const auto addTop = [&](const Vec& x) {

@@ -164,14 +164,11 @@ class LayerGrower {
       throw ParameterError("boundary layers need a model with one solid; " + cad_.sourceName() +
                            " has " + std::to_string(solids.size()));
     solid_ = *solids.begin();
-    const int nf = cad_.numFaces();
-    std::set<int> layer;
-    for (const int f : p_.faces) {
-      if (f > nf)
-        throw ParameterError("boundary-layer face " + std::to_string(f) + " does not exist: " +
-                             cad_.sourceName() + " has " + std::to_string(nf) + " faces");
-      layer.insert(f);
-    }
+    std::set<int> meshed;
+    for (const ElementBlock& b : volume.blocks)
+      if (b.type == CellType::Triangle) meshed.insert(b.entity.begin(), b.entity.end());
+    requireLayerFaces(cad_, p_.faces, meshed);
+    const std::set<int> layer(p_.faces.begin(), p_.faces.end());
     std::vector<std::int64_t> newId(volume.numNodes(), -1);
     out_.dim = 3;
     out_.order = 1;
@@ -185,7 +182,6 @@ class LayerGrower {
       if (n < 0) throw MeshingError("a boundary element uses a node inside the solid");
       return n;
     };
-    std::set<int> seen;
     lines_.type = CellType::Line;
     for (const ElementBlock& b : volume.blocks) {
       if (b.type == CellType::Triangle) {
@@ -195,7 +191,6 @@ class LayerGrower {
           if (layer.count(b.entity[e]) != 0) {
             layerTris_.push_back(tri);
             layerFace_.push_back(b.entity[e]);
-            seen.insert(b.entity[e]);
           } else {
             sideTris_.push_back(tri);
             sideFace_.push_back(b.entity[e]);
@@ -206,11 +201,6 @@ class LayerGrower {
         lines_.entity.insert(lines_.entity.end(), b.entity.begin(), b.entity.end());
       }
     }
-    for (const int f : layer)
-      if (seen.count(f) == 0)
-        throw ParameterError("boundary-layer face " + std::to_string(f) + " of " +
-                             cad_.sourceName() +
-                             " has no boundary triangles (not a face of the solid?)");
     // Wall nodes, their facets and neighbours.
     for (std::size_t t = 0; t < layerTris_.size(); ++t)
       for (const std::int64_t v : layerTris_[t]) {
@@ -627,7 +617,10 @@ class LayerGrower {
   }
 
   Mesh assemble(const LinearMeshOptions& fill) {
-    recordHeights(record_, p_, out_, wall_, [](const WallNode& w) { return w.face; });
+    recordHeights(
+        record_, p_, out_, wall_, [](const WallNode& w) { return w.face; },
+        [](const WallNode& w) { return w.full / w.stretch; },
+        [](const WallNode& w) { return w.clearanceFace; });
     std::vector<std::int64_t> topId(wall_.size());
     for (std::size_t i = 0; i < wall_.size(); ++i) {
       const WallNode& w = wall_[i];

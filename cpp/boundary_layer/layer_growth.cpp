@@ -5,6 +5,19 @@
 
 namespace homesh::layer_growth {
 
+void requireLayerFaces(const CadModel& cad, const std::vector<int>& faces,
+                       const std::set<int>& meshed) {
+  const int nf = cad.numFaces();
+  for (const int f : faces) {
+    if (f > nf)
+      throw ParameterError("boundary-layer face " + std::to_string(f) + " does not exist: " +
+                           cad.sourceName() + " has " + std::to_string(nf) + " faces");
+    if (meshed.count(f) == 0)
+      throw ParameterError("boundary-layer face " + std::to_string(f) + " of " + cad.sourceName() +
+                           " has no boundary triangles (not a face of the solid?)");
+  }
+}
+
 std::string pointText(const Vec& x) {
   std::ostringstream s;
   s.precision(6);

@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,11 @@ constexpr double kStretchLean = 0.985;
 inline Vec at(const Mesh& m, std::int64_t i) {
   return {m.xyz[3 * i], m.xyz[3 * i + 1], m.xyz[3 * i + 2]};
 }
+
+// Throws ParameterError for a layer face (`faces`) that `cad` does not have, or that no
+// boundary triangle of the mesh lies on (`meshed`: the faces some lie on).
+void requireLayerFaces(const CadModel& cad, const std::vector<int>& faces,
+                       const std::set<int>& meshed);
 
 // "(x, y, z)" for messages.
 std::string pointText(const Vec& x);
@@ -115,10 +121,12 @@ int shrinkUntilClear(std::vector<Node>& nodes, Offenders offenders, PlaceAll pla
 }
 
 // The record's macro heights and per layer face or curve (`entity(node)`) its columns, how many
-// were shrunk, the smallest factor and where, from the grown wall nodes.
-template <class Node, class Entity>
+// were shrunk, the smallest factor and where, and the narrowest gap that held one down (Node:
+// clearance, full; `asked(node)`: the thickness asked there; `across(node)`: the face or curve
+// across), from the grown wall nodes.
+template <class Node, class Entity, class Asked, class Across>
 void recordHeights(BoundaryLayerRecord& record, const BoundaryLayerParameters& p, const Mesh& mesh,
-                   const std::vector<Node>& nodes, Entity entity) {
+                   const std::vector<Node>& nodes, Entity entity, Asked asked, Across across) {
   record.parameters = p;
   record.wallNodes = nodes.size();
   record.thicknessMin = std::numeric_limits<double>::infinity();
@@ -131,6 +139,11 @@ void recordHeights(BoundaryLayerRecord& record, const BoundaryLayerParameters& p
     LayerShrink& s = faces[entity(w)];
     s.face = entity(w);
     ++s.columns;
+    const double allowed = clearanceFactor(w.clearance, w.full);
+    if (across(w) != 0 && allowed < 1.0 && (s.gap.across == 0 || w.clearance < s.gap.width)) {
+      const Vec x = at(mesh, w.id);
+      s.gap = {w.clearance, across(w), {x.x(), x.y(), x.z()}, asked(w), allowed * asked(w)};
+    }
     if (w.factor >= 0.999) continue;
     ++s.nodes;
     if (s.nodes == 1 || w.factor < s.factor) {

@@ -17,6 +17,10 @@ void BoundaryLayerParameters::validate() const {
     if (f < 1)
       throw ParameterError("boundary-layer face " + std::to_string(f) +
                            " does not exist (faces are numbered from 1)");
+  for (const int s : solids)
+    if (s < 1)
+      throw ParameterError("boundary-layer solid " + std::to_string(s) +
+                           " does not exist (solids are numbered from 1)");
   if (thickness.empty())
     throw ParameterError("boundary layer: no thickness given (--bl-thickness, BndLayerThickness)");
   Expression::parse(thickness, "boundary-layer thickness");

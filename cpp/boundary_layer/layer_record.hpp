@@ -21,6 +21,16 @@ struct LayerShrink {
   double factor = 1.0;            // grown height / asked thickness there
   std::size_t nodes = 0;          // wall nodes of the face whose height was reduced
   std::size_t columns = 0;        // wall nodes of the face
+  // The narrowest gap that held a column of the face down (the layer keeps 2.5 of its heights
+  // clear of the wall across its normal): its width along the normal, the wall's face (2D:
+  // curve; 0: no column was held down so), where, the thickness asked there and the height it
+  // left room for.
+  struct Gap {
+    double width = 0.0;
+    int across = 0;
+    std::array<double, 3> where{};
+    double asked = 0.0, room = 0.0;
+  } gap;
   // Share of the face's columns grown to the height asked.
   double fullHeight() const {
     return columns == 0 ? 1.0 : 1.0 - static_cast<double>(nodes) / static_cast<double>(columns);

@@ -270,6 +270,8 @@ MeshCommand parseMesh(const std::vector<std::string>& args) {
   addOptimiseSwitch(table, optimise);
   table.value({"--bl-faces"},
               [&cmd](const std::string&, const std::string& v) { cmd.blFaces = v; });
+  table.value({"--bl-solids"},
+              [&cmd](const std::string&, const std::string& v) { cmd.blSolids = v; });
   table.value({"--bl-thickness"},
               [&cmd](const std::string&, const std::string& v) { cmd.blThickness = v; });
   table.value({"--bl-layers"}, [&cmd](const std::string& o, const std::string& v) {
@@ -514,6 +516,8 @@ refinement of the sizing octree:
 boundary layer (the macro layer is curved and optimised with the rest, then split):
       --bl-faces LIST     on these CAD faces (FaceN numbers: 1,8 or 11-12)
       --bl-thickness T    its total thickness: a number or an expression of x, y, z
+      --bl-solids LIST    where a layer face lies between two solids, the one it grows
+                          into (SolidN numbers)
 )" + tableHelp({"layers", "progression"}) +
          "\noutput:\n" + outputHelp() +
          R"(      --report FILE   write the JSON report ("-" for standard output)

@@ -41,8 +41,9 @@ struct MeshCommand {
   OptionMap options;
   SizingFlags sizing;
   // --bl-faces, --bl-thickness, --bl-layers, --bl-progression: a boundary layer (each
-  // overrides the .mcf's BndLayer* key).
-  std::optional<std::string> blFaces, blThickness;
+  // overrides the .mcf's BndLayer* key); --bl-solids: the solids it grows into from faces
+  // between two.
+  std::optional<std::string> blFaces, blThickness, blSolids;
   std::optional<int> blLayers;
   std::optional<double> blProgression;
   CommonOptions common;

@@ -186,10 +186,11 @@ int runMesh(const homesh::MeshCommand& cmd) {
   checkOutputs(c, {cmd.input});
   homesh::CaseSetup setup = setupWithFlags(cmd.input, cmd.options, cmd.sizing, c);
   homesh::MeshingOptions& options = setup.options;
-  if (cmd.blFaces || cmd.blThickness || cmd.blLayers || cmd.blProgression) {
+  if (cmd.blFaces || cmd.blThickness || cmd.blLayers || cmd.blProgression || cmd.blSolids) {
     homesh::BoundaryLayerParameters bl =
         options.boundaryLayer.value_or(homesh::BoundaryLayerParameters{});
     if (cmd.blFaces) bl.faces = homesh::parseIndexList(*cmd.blFaces, "--bl-faces");
+    if (cmd.blSolids) bl.solids = homesh::parseIndexList(*cmd.blSolids, "--bl-solids");
     if (cmd.blThickness) bl.thickness = *cmd.blThickness;
     if (cmd.blLayers) bl.layers = *cmd.blLayers;
     if (cmd.blProgression) bl.progression = *cmd.blProgression;

@@ -514,27 +514,66 @@ void readMeshAndBlock(const std::string& bytes, Mesh& mesh, ElementBlock& cells)
   cells = readBlockBytes(bytes, offset);
 }
 
+// The triangles of `boundary` grouped into shells (connected through shared nodes), the one
+// with the largest bounding box (the outer one, which encloses the others) first.
+std::vector<std::vector<std::size_t>> closedShells(
+    const Mesh& mesh, const std::vector<std::array<std::int64_t, 3>>& boundary) {
+  std::map<std::int64_t, std::int64_t> parent;
+  const auto root = [&](std::int64_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const auto& t : boundary)
+    for (const std::int64_t v : t) parent.emplace(v, v);
+  for (const auto& t : boundary) {
+    parent[root(t[1])] = root(t[0]);
+    parent[root(t[2])] = root(t[0]);
+  }
+  std::map<std::int64_t, std::size_t> shellOf;
+  std::vector<std::vector<std::size_t>> shells;
+  std::vector<Eigen::AlignedBox3d> boxes;
+  for (std::size_t t = 0; t < boundary.size(); ++t) {
+    const auto [it, fresh] = shellOf.emplace(root(boundary[t][0]), shells.size());
+    if (fresh) {
+      shells.emplace_back();
+      boxes.emplace_back();
+    }
+    shells[it->second].push_back(t);
+    for (const std::int64_t v : boundary[t])
+      boxes[it->second].extend(Eigen::Vector3d(mesh.xyz[3 * static_cast<std::size_t>(v)],
+                                               mesh.xyz[3 * static_cast<std::size_t>(v) + 1],
+                                               mesh.xyz[3 * static_cast<std::size_t>(v) + 2]));
+  }
+  std::size_t outer = 0;
+  for (std::size_t k = 1; k < shells.size(); ++k)
+    if (boxes[k].diagonal().norm() > boxes[outer].diagonal().norm()) outer = k;
+  std::swap(shells[0], shells[outer]);
+  return shells;
+}
+
 }  // namespace
 
 ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_t, 3>>& boundary,
                             const LinearMeshOptions& options, int solid, const FillRegion& region) {
   if (boundary.empty()) throw MeshingError("no surface to fill with tetrahedra");
+  // One discrete surface per shell, the outer one first: a single surface loop over a body's
+  // shell and the box's would have Gmsh fill the body too.
+  const std::vector<std::vector<std::size_t>> shells = closedShells(mesh, boundary);
   // Gmsh tags are the node ids + 1 (tags start at 1); its new nodes get larger tags.
   std::vector<char> used(mesh.numNodes(), 0);
-  for (const auto& t : boundary)
-    for (const std::int64_t v : t) used.at(static_cast<std::size_t>(v)) = 1;
-  std::vector<std::size_t> tags;
-  std::vector<double> coords;
-  for (std::size_t i = 0; i < used.size(); ++i) {
-    if (used[i] == 0) continue;
-    tags.push_back(i + 1);
-    coords.insert(coords.end(), mesh.xyz.begin() + static_cast<std::ptrdiff_t>(3 * i),
-                  mesh.xyz.begin() + static_cast<std::ptrdiff_t>(3 * i + 3));
-  }
-  std::vector<std::size_t> triangles;
-  triangles.reserve(3 * boundary.size());
-  for (const auto& t : boundary)
-    for (const std::int64_t v : t) triangles.push_back(static_cast<std::size_t>(v) + 1);
+  std::vector<std::vector<std::size_t>> tags(shells.size()), triangles(shells.size());
+  std::vector<std::vector<double>> coords(shells.size());
+  for (std::size_t k = 0; k < shells.size(); ++k)
+    for (const std::size_t t : shells[k])
+      for (const std::int64_t v : boundary[t]) {
+        const auto i = static_cast<std::size_t>(v);
+        triangles[k].push_back(i + 1);
+        if (used.at(i) != 0) continue;
+        used[i] = 1;
+        tags[k].push_back(i + 1);
+        coords[k].insert(coords[k].end(), mesh.xyz.begin() + static_cast<std::ptrdiff_t>(3 * i),
+                         mesh.xyz.begin() + static_cast<std::ptrdiff_t>(3 * i + 3));
+      }
 
   ElementBlock tets;
   tets.type = CellType::Tetrahedron;
@@ -543,13 +582,18 @@ ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_
       withGmsh(options, "Gmsh's filling of " + region.what, [&](GmshSession&) {
         withGmshErrors("filling " + region.what, [&] {
           gmsh::model::add("homesh-fill");
-          gmsh::model::addDiscreteEntity(2, 1);
-          gmsh::model::mesh::addNodes(2, 1, tags, coords);
-          gmsh::model::mesh::addElementsByType(1, kGmshTriangle, {}, triangles);
-          // A volume bounded by a discrete surface without parametrisation: Gmsh meshes the volume
-          // and leaves the surface mesh alone.
-          const int loop = gmsh::model::geo::addSurfaceLoop({1});
-          const int volume = gmsh::model::geo::addVolume({loop});
+          std::vector<int> surfaces, loops;
+          for (std::size_t k = 0; k < shells.size(); ++k) {
+            const int tag = static_cast<int>(k) + 1;
+            gmsh::model::addDiscreteEntity(2, tag);
+            gmsh::model::mesh::addNodes(2, tag, tags[k], coords[k]);
+            gmsh::model::mesh::addElementsByType(tag, kGmshTriangle, {}, triangles[k]);
+            surfaces.push_back(tag);
+            // A volume bounded by discrete surfaces without parametrisation: Gmsh meshes the
+            // volume and leaves the surface mesh alone.
+            loops.push_back(gmsh::model::geo::addSurfaceLoop({tag}));
+          }
+          const int volume = gmsh::model::geo::addVolume(loops);
           gmsh::model::geo::synchronize();
           generateFill(3, maxSize, region.what, region.hint);
           std::map<std::array<double, 3>, std::int64_t> known;
@@ -558,7 +602,7 @@ ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_
               known.emplace(
                   std::array<double, 3>{mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]},
                   static_cast<std::int64_t>(i));
-          readFill(mesh, known, {1}, 3, volume, kGmshTetrahedron, solid, tets, region.what);
+          readFill(mesh, known, surfaces, 3, volume, kGmshTetrahedron, solid, tets, region.what);
         });
         return meshAndBlockBytes(mesh, tets);
       });

@@ -74,7 +74,8 @@ struct FillRegion {
 };
 
 // Tetrahedra filling the volume enclosed by `boundary`, a closed surface of triangles on
-// existing nodes of `mesh`, which Gmsh keeps as it is (no node added or moved on it). New
+// existing nodes of `mesh` (one shell, or an outer shell and the shells of the holes inside it:
+// a body in a box), which Gmsh keeps as it is (no node added or moved on it). New
 // interior nodes are appended to `mesh` (CAD dimension 3, solid `solid`); the tetrahedra are
 // positively oriented. Sizes grow from the boundary's edge lengths, at most options.maxSize (or
 // options.size). Throws MeshingError when Gmsh cannot fill the surface (it is

@@ -109,6 +109,14 @@ std::vector<std::string> layerShortNotes(const BoundaryLayerRecord& layer, int d
                   dim == 3 ? "Face" : "Edge", f.face, 100.0 * f.fullHeight(), f.columns,
                   formatNumber(f.factor).c_str(), f.where[0], f.where[1], f.where[2]);
     notes.emplace_back(text);
+    if (f.gap.across == 0) continue;
+    std::snprintf(text, sizeof text,
+                  "; %s%d is %s away along the layer's normal at (%g, %g, %g): room for %s of "
+                  "the %s asked there",
+                  dim == 3 ? "Face" : "Edge", f.gap.across, formatNumber(f.gap.width).c_str(),
+                  f.gap.where[0], f.gap.where[1], f.gap.where[2], formatNumber(f.gap.room).c_str(),
+                  formatNumber(f.gap.asked).c_str());
+    notes.back() += text;
   }
   return notes;
 }

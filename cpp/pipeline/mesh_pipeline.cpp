@@ -85,6 +85,9 @@ void mapToMeshedNumbering(const HealingRecord& healing, const CadModel& cad,
     options.boundaryLayer->faces =
         numbering.map(planar ? 1 : 2, options.boundaryLayer->faces,
                       planar ? "boundary-layer curve" : "boundary-layer face", operation);
+    if (!planar)
+      options.boundaryLayer->solids =
+          numbering.map(3, options.boundaryLayer->solids, "boundary-layer solid", operation);
   }
   if (!options.sizing) return;
   std::vector<RefinementSource> sources;

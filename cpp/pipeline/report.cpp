@@ -174,6 +174,8 @@ void appendBoundaryLayer(JsonWriter& json, const StageRecords& records) {
   json.beginObject("boundary_layer");
   json.numbers("faces",
                std::vector<std::size_t>(r.parameters.faces.begin(), r.parameters.faces.end()));
+  json.numbers("solids",
+               std::vector<std::size_t>(r.parameters.solids.begin(), r.parameters.solids.end()));
   json.value("thickness", r.parameters.thickness);
   json.value("layers", static_cast<std::size_t>(r.parameters.layers));
   json.value("progression", r.parameters.progression);
@@ -211,6 +213,15 @@ void appendBoundaryLayer(JsonWriter& json, const StageRecords& records) {
     json.value("full_height", s.fullHeight());
     json.value("smallest_factor", s.factor);
     if (s.nodes > 0) json.numbers("where", std::vector<double>(s.where.begin(), s.where.end()));
+    if (s.gap.across != 0) {  // the narrowest gap that held a column down
+      json.beginObject("gap");
+      json.value("width", s.gap.width);
+      json.value("to", static_cast<std::size_t>(s.gap.across));
+      json.numbers("where", std::vector<double>(s.gap.where.begin(), s.gap.where.end()));
+      json.value("asked", s.gap.asked);
+      json.value("room", s.gap.room);
+      json.endObject();
+    }
     json.endObject();
   }
   json.endArray();

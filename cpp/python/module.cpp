@@ -33,6 +33,7 @@
 #include "pipeline/mesh_summary.hpp"
 #include "pipeline/nektar_read_back.hpp"
 #include "pipeline/report.hpp"
+#include "python/dict_options.hpp"
 #include "sizing/sizing_octree.hpp"
 
 namespace bp = boost::python;
@@ -188,36 +189,6 @@ CellType cellTypeFromName(const std::string& name) {
         CellType::Prism, CellType::Pyramid, CellType::Hexahedron})
     if (cellShortName(t) == name) return t;
   throw ParameterError("unknown element type '" + name + "'");
-}
-
-// A Python value for parameter `key` as the core takes it (a bool, a real number or text);
-// core/parameters.hpp's checkedOption judges it and names the parameter when it does not fit.
-OptionValue optionValueFrom(const bp::object& value) {
-  PyObject* o = value.ptr();
-  if (PyBool_Check(o) != 0) return o == Py_True;
-  if (PyUnicode_Check(o) != 0) return std::string(bp::extract<std::string>(value));
-  if (PyNumber_Check(o) != 0 && PyComplex_Check(o) == 0) {
-    PyObject* real = PyNumber_Float(o);
-    if (real != nullptr) {
-      const double x = PyFloat_AsDouble(real);
-      Py_DECREF(real);
-      return x;
-    }
-    PyErr_Clear();
-  }
-  // Not a number, on/off or text (a list, an array): its repr, which every kind refuses.
-  return std::string(bp::extract<std::string>(bp::str(value.attr("__repr__")())));
-}
-
-// The entries of an options dict keyed as the parameter table, None left out (not given).
-OptionMap optionMapFrom(const bp::dict& d) {
-  OptionMap values;
-  const bp::list keys = d.keys();
-  for (bp::ssize_t i = 0; i < bp::len(keys); ++i) {
-    const bp::object value = d[keys[i]];
-    if (!value.is_none()) values[bp::extract<std::string>(keys[i])] = optionValueFrom(value);
-  }
-  return values;
 }
 
 // The Python-visible mesh: the curved mesh a job made (or a mesh read from a file or rebuilt from
@@ -382,58 +353,6 @@ class PyMesh {
   std::shared_ptr<const CurvedMesh> curved_;
   std::shared_ptr<const StageRecords> records_;
 };
-
-Eigen::Vector3d pointFrom(const bp::object& p, const std::string& what) {
-  if (bp::len(p) != 3) throw ParameterError(what + " must be three numbers");
-  return {bp::extract<double>(p[0]), bp::extract<double>(p[1]), bp::extract<double>(p[2])};
-}
-
-// Refinement sources from a list of dicts [{"kind": "segment" | "sphere" | "box" | "curve", "a",
-// "b", "radius", "delta", "edge"}, ...] (homesh/api.py checks their fields first).
-std::vector<RefinementSource> sourcesFrom(const bp::object& list) {
-  std::vector<RefinementSource> out;
-  for (bp::ssize_t i = 0; i < bp::len(list); ++i) {
-    const bp::dict src = bp::extract<bp::dict>(list[i]);
-    const std::string kind = bp::extract<std::string>(src.get("kind", ""));
-    const std::string which = "source " + std::to_string(i + 1);
-    const double radius = bp::extract<double>(src.get("radius", 0.0));
-    const double delta = bp::extract<double>(src.get("delta", 0.0));
-    if (kind == "segment")
-      out.push_back(RefinementSource::segment(pointFrom(src["a"], which + " a"),
-                                              pointFrom(src["b"], which + " b"), radius, delta));
-    else if (kind == "sphere")
-      out.push_back(
-          RefinementSource::sphere(pointFrom(src["a"], which + " centre"), radius, delta));
-    else if (kind == "box")
-      out.push_back(RefinementSource::box(pointFrom(src["a"], which + " a"),
-                                          pointFrom(src["b"], which + " b"), delta));
-    else if (kind == "curve")
-      out.push_back(RefinementSource::curve(bp::extract<int>(src.get("edge", 0)), radius, delta));
-    else {
-      std::string message = which;
-      message += ": kind must be segment, sphere, box or curve, got '";
-      message += kind;
-      message += "'";
-      throw ParameterError(message);
-    }
-  }
-  return out;
-}
-
-// The boundary layer of a dict the Python layer checked for its keys (homesh/api.py
-// _boundary_layer): "faces" (list of int), "thickness" (text), "layers", "progression" (checked
-// here against the parameter table).
-BoundaryLayerParameters boundaryLayerFrom(const bp::dict& d) {
-  BoundaryLayerParameters p;
-  const bp::object faces = d["faces"];
-  for (bp::ssize_t i = 0; i < bp::len(faces); ++i) p.faces.push_back(bp::extract<int>(faces[i]));
-  p.thickness = bp::extract<std::string>(d["thickness"]);
-  if (d.has_key("layers"))
-    p.layers = static_cast<int>(checkedOption("layers", optionValueFrom(d["layers"])));
-  if (d.has_key("progression"))
-    p.progression = checkedOption("progression", optionValueFrom(d["progression"]));
-  return p;
-}
 
 // What each front-end function of homesh/api.py takes besides the table's own keys: refinement
 // sources (a list of dicts) and a boundary layer (a dict).

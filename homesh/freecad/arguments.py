@@ -141,8 +141,12 @@ def boundary_layer_arguments(obj, part=None):
         thickness = float(text)
     except ValueError:
         thickness = text  # an expression of x, y, z: the core parses it and names any error
-    return {"faces": sorted(set(faces)), "thickness": thickness, "layers": int(obj.Layers),
-            "progression": float(obj.Progression)}
+    out = {"faces": sorted(set(faces)), "thickness": thickness, "layers": int(obj.Layers),
+           "progression": float(obj.Progression)}
+    solids = list(getattr(obj, "Solids", []) or [])
+    if solids:
+        out["solids"] = sorted(set(int(s) for s in solids))
+    return out
 
 
 def _sub_names(obj):

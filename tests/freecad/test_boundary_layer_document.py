@@ -88,5 +88,42 @@ class BoundaryLayerObject(unittest.TestCase):
         self.assertEqual(mesh.InvalidElements, 0)
 
 
+class BoundaryLayerBetweenSolids(unittest.TestCase):
+    """A ball inside a box with its hole (two solids of one compound, imprinted by the core so
+    that the ball's face lies between them): the layer on it grows into the solid its Solids
+    property names, and without one the mesh fails with a message that says how to name it."""
+
+    def setUp(self):
+        self.doc = FreeCAD.newDocument("HOMeshLayerBetweenSolids")
+        import Part
+        ball = Part.makeSphere(1, FreeCAD.Vector(2, 2, 2))
+        self.part = self.doc.addObject("Part::Feature", "BallInBox")
+        self.part.Shape = Part.makeCompound([Part.makeBox(4, 4, 4).cut(ball), ball])
+        self.doc.recompute()
+        (self.face,) = [i + 1 for i, f in enumerate(self.part.Shape.Solids[0].Faces)
+                        if f.Surface.__class__.__name__ == "Sphere"]
+
+    def tearDown(self):
+        FreeCAD.closeDocument(self.doc.Name)
+
+    def test_the_layer_grows_into_the_solid_named(self):
+        layer = homesh.freecad.make_boundary_layer(self.doc, self.part, [self.face],
+                                                   thickness=0.1, layers=2)
+        mesh = homesh.freecad.make_high_order_mesh(self.doc, self.part, order=2, size=0.8,
+                                                   boundary_layer=layer)
+        self.doc.recompute()
+        self.assertFalse(mesh.isValid())
+        self.assertIn("name the one the layer grows into", mesh.Status)
+        layer.Solids = [1]  # the box around the ball
+        self.doc.recompute()
+        self.assertTrue(mesh.isValid(), mesh.Status)
+        report = homesh.freecad.get_mesh(mesh).report()
+        self.assertEqual(report["boundary_layer"]["solids"], [1])
+        self.assertEqual(report["elements"]["prism"],
+                         2 * report["boundary_layer"]["macro_cells"])
+        self.assertGreater(report["elements"]["prism"], 0)
+        self.assertEqual(mesh.InvalidElements, 0)
+
+
 if __name__ == "__main__":
     unittest.main()

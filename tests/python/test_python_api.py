@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import homesh
-from conftest import DATA, PEER_CASES, needs_peer_files
+from conftest import DATA, PEER_CASES, ROOT, needs_peer_files
 from homesh import tessellation
 
 
@@ -328,6 +328,21 @@ def layer_cad(request):
     return BOX_HOLE
 
 
+def test_boundary_layer_grows_into_the_solid_named():
+    """examples/sphere_box.step: a sphere in a box, imprinted so that the sphere's face lies
+    between the two solids; the layer on it grows into the solid named (the box around, as for
+    the flow past the sphere), and needs one named."""
+    sphere_box = ROOT / "examples" / "sphere_box.step"
+    spec = {"faces": [1], "thickness": 0.05, "layers": 2}
+    with pytest.raises(homesh.ParameterError, match="name the one the layer grows into"):
+        homesh.mesh(str(sphere_box), order=2, boundary_layer=spec)
+    m = homesh.mesh(str(sphere_box), order=2, boundary_layer=dict(spec, solids=[2]))
+    layer = m.report()["boundary_layer"]
+    assert layer["solids"] == [2] and layer["macro_cells"] > 0
+    assert m.report()["elements"]["prism"] == 2 * layer["macro_cells"]
+    assert m.quality()["invalid_elements"] == 0
+
+
 @pytest.mark.parametrize("spec, message", [
     ({"faces": [1]}, "needs 'thickness'"),
     ({"faces": [1], "thickness": 40, "layer": 3}, "unknown key 'layer'"),
@@ -336,6 +351,8 @@ def layer_cad(request):
     ({"faces": [1], "thickness": True}, "must be a number or an expression"),
     ({"faces": [1], "thickness": 1, "layers": 0}, "layers must be an integer from 1 to 100"),
     (5, "must be a dict"),
+    ({"faces": [1], "thickness": 1, "solids": [2]}, "boundary-layer solid 2 does not exist"),
+    ({"faces": [1], "thickness": 1, "solids": ["a"]}, "solids must be an integer"),
 ])
 def test_bad_boundary_layers_are_named(layer_cad, spec, message):
     with pytest.raises(homesh.ParameterError, match=message):

@@ -12,11 +12,12 @@ from .base import GuardedProxy
 
 
 def make_boundary_layer(doc, part, faces, thickness, layers=None, progression=None,
-                        name="BoundaryLayer"):
+                        name="BoundaryLayer", solids=None):
     """Adds a BoundaryLayer object on ``faces`` of ``part`` (FreeCAD's numbers, 1 for Face1, or
     names "Face1"; for a planar shape edges, named "Edge1"): ``thickness`` a length in the model's units or an expression of x, y, z
     (text), split into ``layers`` layers whose heights grow by ``progression`` from the wall
-    (left out: the parameter table's defaults).
+    (left out: the parameter table's defaults); ``solids`` (1 for Solid1), where a layer face
+    lies between two solids of the shape, names the one it grows into.
     Link it from a HighOrderMesh's BoundaryLayer property. The caller recomputes.
     """
     obj = doc.addObject("App::FeaturePython", name)
@@ -27,6 +28,8 @@ def make_boundary_layer(doc, part, faces, thickness, layers=None, progression=No
         obj.Layers = layers
     if progression is not None:
         obj.Progression = progression
+    if solids:
+        obj.Solids = [int(s) for s in solids]
     return obj
 
 
@@ -48,6 +51,10 @@ class BoundaryLayerProxy(GuardedProxy):
             obj.addProperty("App::PropertyString", "Thickness", "Layer",
                             "Total thickness in the model's units, or an expression of x, y, z "
                             "such as 0.01+0.05*x")
+        if "Solids" not in have:
+            obj.addProperty("App::PropertyIntegerList", "Solids", "Layer",
+                            "Where a layer face lies between two solids of the shape: the one "
+                            "it grows into (1 for Solid1)")
         add_parameter_property(obj, "layers", "Layer")
         add_parameter_property(obj, "progression", "Layer")
         for prop, kind, doc in (

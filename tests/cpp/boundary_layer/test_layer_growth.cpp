@@ -14,6 +14,7 @@
 
 #include "boundary_layer/boundary_layer.hpp"
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "layer_case_checks.hpp"
 #include "linear/linear_mesher.hpp"
 #include "pipeline/mesh_pipeline.hpp"
@@ -92,6 +93,18 @@ TEST(BoundaryLayer, ALayerThickerThanTheSolidShrinksToFitAndTheRecordSaysSo) {
   EXPECT_EQ(face.fullHeight(), 0.0);
   EXPECT_LE(face.factor * 1e9, 1.0 / 2.5);  // the ray rule: 2.5 heights within the side
   EXPECT_NEAR(face.where[0], 0.0, 1e-12);
+  // Why: the narrowest gap across the cube along the layer's normal, the wall across named, the
+  // thickness asked there and the room the ray rule left (2.5 heights within the gap).
+  const LayerShrink::Gap& gap = face.gap;
+  EXPECT_NE(gap.across, 0);
+  EXPECT_NE(gap.across, 1);
+  EXPECT_GE(gap.width, 1.0 - 1e-9);             // no point of the cube nearer across x
+  EXPECT_LE(gap.width, std::sqrt(3.0) + 1e-9);  // nor farther than its diagonal
+  EXPECT_NEAR(gap.where[0], 0.0, 1e-12);
+  EXPECT_EQ(gap.asked, 1e9);
+  EXPECT_GT(gap.room, 0.0);
+  EXPECT_LE(gap.room, gap.width / 2.5 * (1.0 + 1e-12));
+  EXPECT_GT(gap.room, 0.7 * gap.width / 2.5);  // the largest power of 0.7 that fits
   EXPECT_LE(record.thicknessMax, 1.0 / 2.5);
   EXPECT_GT(record.thicknessMin, 0.0);
   EXPECT_EQ(record.shrunk().size(), 1U);
@@ -124,6 +137,14 @@ TEST(BoundaryLayer, APlanarLayerThickerThanTheFaceShrinksToFitAndIsCertified) {
   const std::string said = "the boundary layer on Edge1 reaches its thickness on 0 % of its";
   EXPECT_TRUE(std::any_of(r.notes.begin(), r.notes.end(), [&](const std::string& n) {
     return n.find(said) != std::string::npos;
+  })) << (r.notes.empty() ? "no notes" : r.notes.front());
+  // ... and why: the curve across the square, its distance and the room it leaves.
+  ASSERT_NE(curve.gap.across, 0);
+  const std::string why = "; Edge" + std::to_string(curve.gap.across) + " is " +
+                          formatNumber(curve.gap.width) + " away along the layer's normal at (";
+  const std::string room = "room for " + formatNumber(curve.gap.room) + " of the 1e+09 asked";
+  EXPECT_TRUE(std::any_of(r.notes.begin(), r.notes.end(), [&](const std::string& n) {
+    return n.find(why) != std::string::npos && n.find(room) != std::string::npos;
   })) << (r.notes.empty() ? "no notes" : r.notes.front());
 }
 
