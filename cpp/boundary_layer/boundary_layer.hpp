@@ -21,9 +21,10 @@
 // between them, with triangles (corner, top, top) between consecutive columns, appended to the
 // triangle block; they are part of the layer (layerFanTriangles in boundary_layer/layer_cells.hpp).
 //
-// In a model of several solids, each solid that a layer face bounds grows its own layer and the
-// others keep their tetrahedra (layer_solids.hpp); a layer face between two solids, or one with a
-// node that another solid shares, is refused (not made yet).
+// In a model of several solids, each solid that a layer face grows into (the one it bounds; of the
+// two it lies between, the one named) grows its own layer and the others keep their tetrahedra
+// (layer_solids.hpp); a layer grown into both sides of a face, or whose side would change what
+// another solid touches, is refused (not made yet).
 //
 // The stage's parts: layer_parameters.hpp (what is asked), layer_record.hpp (what was made),
 // layer_grower_3d.hpp and layer_grower_2d.hpp (the growth), layer_solids.hpp (3D models of

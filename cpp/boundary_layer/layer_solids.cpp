@@ -17,32 +17,26 @@
 #include "boundary_layer/layer_grower_3d.hpp"
 #include "boundary_layer/layer_growth.hpp"
 #include "core/error.hpp"
+#include "linear/edge_split.hpp"
 
 namespace homesh::layer_growth {
 namespace {
 
 using Tri = std::array<std::int64_t, 3>;
-using Segment = std::array<std::int64_t, 2>;
 
 Tri sortedTri(Tri t) {
   std::sort(t.begin(), t.end());
   return t;
 }
 
-Segment sortedSegment(std::int64_t a, std::int64_t b) {
-  return a < b ? Segment{a, b} : Segment{b, a};
-}
-
 std::string solidName(int solid) {
-  return "Solid" + std::to_string(solid);
+  return cadEntityName(3, solid);
 }
 
 // "Face7", "Edge3", "Vertex2": the CAD entity a surface node lies on.
 std::string entityName(const Mesh& mesh, std::int64_t node) {
   const auto i = static_cast<std::size_t>(node);
-  const int dim = mesh.nodeCadDim[i];
-  const char* kind = dim == 0 ? "Vertex" : dim == 1 ? "Edge" : "Face";
-  return kind + std::to_string(mesh.nodeCadIndex[i]);
+  return cadEntityName(mesh.nodeCadDim[i], mesh.nodeCadIndex[i]);
 }
 
 // Whether node i of `a` and node j of `b` are the same point on the same CAD entity.
@@ -96,8 +90,6 @@ class SolidLayers {
   const BoundaryLayerParameters& p_;
   std::vector<Facet> facets_;
   std::map<int, std::set<int>> faceSolids_;  // face -> the solids it bounds
-  // Per node: the solid whose tetrahedra use it, -1 where several do, 0 where none.
-  std::vector<int> nodeSolid_;
 
   void findFacets() {
     std::map<Tri, std::size_t> index;
@@ -112,15 +104,12 @@ class SolidLayers {
         facets_.push_back(f);
       }
     }
-    nodeSolid_.assign(volume_.numNodes(), 0);
     for (const ElementBlock& b : volume_.blocks) {
       if (b.type != CellType::Tetrahedron) continue;
       for (std::size_t e = 0; e < b.count(); ++e) {
         const std::int64_t* t = b.element(e);
         const int solid = b.entity[e];
         for (int k = 0; k < 4; ++k) {
-          int& s = nodeSolid_[static_cast<std::size_t>(t[k])];
-          s = s == 0 || s == solid ? solid : -1;
           const Tri face{t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]};
           const auto it = index.find(sortedTri(face));
           if (it != index.end()) facets_[it->second].sides.emplace_back(solid, t[k]);
@@ -160,30 +149,40 @@ class SolidLayers {
 
   // Refuses a layer in `solid` on `faces` that would change what another solid touches, since
   // that solid's tetrahedra are kept: its side climbing a face between two solids, or a wall
-  // node that another solid shares other than on a layer face between them (where the wall
-  // stays and only its own side climbs this solid's faces).
+  // node that the tetrahedra of a solid use other than this one and those across the layer faces
+  // between two solids through it (there the wall stays and only the side climbs this solid's
+  // own faces).
   void requireOwnSides(int solid, const std::vector<int>& faces) const {
     const auto isLayer = [&](int f) {
       return std::find(faces.begin(), faces.end(), f) != faces.end();
     };
-    // Per wall node: whether it lies on a layer face between two solids, and the faces without
-    // a layer (of this solid) through it.
-    std::map<std::int64_t, std::pair<bool, std::set<int>>> wall;
+    // Per wall node: the solids it may touch, the faces without a layer (of this solid) through
+    // it, and the solids whose tetrahedra use it.
+    struct WallNode {
+      std::set<int> allowed, sides, users;
+    };
+    std::map<std::int64_t, WallNode> wall;
     for (const Facet& f : facets_)
       if (isLayer(f.face))
-        for (const std::int64_t v : f.nodes) {
-          bool& shared = wall[v].first;
-          shared = shared || faceSolids_.at(f.face).size() > 1;
-        }
+        for (const std::int64_t v : f.nodes)
+          wall[v].allowed.insert(faceSolids_.at(f.face).begin(), faceSolids_.at(f.face).end());
     for (const Facet& f : facets_) {
       if (isLayer(f.face) || faceSolids_.at(f.face).count(solid) == 0) continue;
       for (const std::int64_t v : f.nodes) {
         const auto it = wall.find(v);
-        if (it != wall.end()) it->second.second.insert(f.face);
+        if (it != wall.end()) it->second.sides.insert(f.face);
       }
     }
-    for (const auto& [v, onShared] : wall) {
-      for (const int side : onShared.second) {
+    for (const ElementBlock& b : volume_.blocks) {
+      if (b.type != CellType::Tetrahedron) continue;
+      for (std::size_t e = 0; e < b.count(); ++e)
+        for (int k = 0; k < 4; ++k) {
+          const auto it = wall.find(b.element(e)[k]);
+          if (it != wall.end()) it->second.users.insert(b.entity[e]);
+        }
+    }
+    for (const auto& [v, w] : wall) {
+      for (const int side : w.sides) {
         const std::set<int>& s = faceSolids_.at(side);
         if (s.size() < 2) continue;
         throw ParameterError("the boundary layer in " + solidName(solid) + " would climb Face" +
@@ -192,33 +191,25 @@ class SolidLayers {
                              pointText(at(volume_, v)) +
                              ": a layer beside a face between two solids is not made yet");
       }
-      if (nodeSolid_[static_cast<std::size_t>(v)] == solid || onShared.first) continue;
-      throw ParameterError("the boundary layer in " + solidName(solid) + " meets " +
-                           otherSolid(v, solid) + " at " + pointText(at(volume_, v)) + " on " +
-                           entityName(volume_, v) +
-                           ": a layer beside a face, curve or corner that another solid shares "
-                           "is not made yet");
+      for (const int other : w.users)
+        if (w.allowed.count(other) == 0)
+          throw ParameterError("the boundary layer in " + solidName(solid) + " meets " +
+                               solidName(other) + " at " + pointText(at(volume_, v)) + " on " +
+                               entityName(volume_, v) +
+                               ": a layer beside a face, curve or corner that another solid "
+                               "shares is not made yet");
     }
-  }
-
-  // A solid other than `solid` whose tetrahedra use node v (for the message).
-  std::string otherSolid(std::int64_t v, int solid) const {
-    for (const ElementBlock& b : volume_.blocks) {
-      if (b.type != CellType::Tetrahedron) continue;
-      for (std::size_t e = 0; e < b.count(); ++e) {
-        if (b.entity[e] == solid) continue;
-        const std::int64_t* t = b.element(e);
-        if (std::find(t, t + 4, v) != t + 4) return solidName(b.entity[e]);
-      }
-    }
-    return "another solid";
   }
 
   // The solid's part of the volume mesh: its tetrahedra, its boundary triangles turned outward
   // of it, and the lines along their edges (every node kept, so that the surface nodes keep
   // their order).
   Mesh solidMesh(int solid) const {
-    Mesh part = volume_;
+    Mesh part;
+    part.xyz = volume_.xyz;
+    part.nodeCadDim = volume_.nodeCadDim;
+    part.nodeCadIndex = volume_.nodeCadIndex;
+    part.nodeCadParam = volume_.nodeCadParam;
     ElementBlock tets, tris, lines;
     tets.type = CellType::Tetrahedron;
     tris.type = CellType::Triangle;
@@ -232,7 +223,7 @@ class SolidLayers {
         tets.entity.push_back(solid);
       }
     }
-    std::set<Segment> edges;
+    std::set<MeshEdge> edges;
     for (const Facet& f : facets_) {
       const auto side = std::find_if(f.sides.begin(), f.sides.end(),
                                      [&](const auto& s) { return s.first == solid; });
@@ -243,13 +234,13 @@ class SolidLayers {
       if (n.dot(at(volume_, side->second) - a) > 0.0) std::swap(t[1], t[2]);
       tris.nodes.insert(tris.nodes.end(), t.begin(), t.end());
       tris.entity.push_back(f.face);
-      for (int k = 0; k < 3; ++k) edges.insert(sortedSegment(t[k], t[(k + 1) % 3]));
+      for (int k = 0; k < 3; ++k) edges.insert(meshEdge(t[k], t[(k + 1) % 3]));
     }
     for (const ElementBlock& b : volume_.blocks) {
       if (b.type != CellType::Line) continue;
       for (std::size_t e = 0; e < b.count(); ++e) {
         const std::int64_t* l = b.element(e);
-        if (edges.count(sortedSegment(l[0], l[1])) == 0) continue;
+        if (edges.count(meshEdge(l[0], l[1])) == 0) continue;
         lines.nodes.insert(lines.nodes.end(), l, l + 2);
         lines.entity.push_back(b.entity[e]);
       }
@@ -265,10 +256,13 @@ class SolidLayers {
     out.dim = 3;
     out.order = 1;
     std::vector<std::int64_t> id(volume_.numNodes(), -1);
+    std::vector<std::size_t> surfaceNode;  // the volume's node of each surface node
     for (std::size_t i = 0; i < volume_.numNodes(); ++i)
-      if (volume_.nodeCadDim[i] < 3)
+      if (volume_.nodeCadDim[i] < 3) {
         id[i] = out.addNode(&volume_.xyz[3 * i], volume_.nodeCadDim[i], volume_.nodeCadIndex[i],
                             volume_.nodeCadParam[2 * i], volume_.nodeCadParam[2 * i + 1]);
+        surfaceNode.push_back(i);
+      }
     const std::size_t surface = out.numNodes();
     ElementBlock tets, prisms, tris, quads, lines;
     tets.type = CellType::Tetrahedron;
@@ -283,29 +277,36 @@ class SolidLayers {
         to.nodes.push_back(map[static_cast<std::size_t>(v[k])]);
       to.entity.push_back(from.entity[e]);
     };
-    // Per curve, its lines where a solid's layer climbed it; per face, the solid that owns it.
-    std::map<int, std::vector<Segment>> original = curveSegments(volume_, id);
-    std::set<int> climbed;
+    // Per face, the solid that owns it; the curves a layer climbed (their lines use its new
+    // nodes) and the surface nodes it moved (its side faces' relaxed nodes).
     std::map<int, int> owner;
     for (const auto& [face, solids] : faceSolids_)
       if (solids.size() == 1) owner[face] = *solids.begin();
+    std::set<int> climbed;
+    std::vector<char> moved(surface, 0);
     for (const auto& [solid, mesh] : grown) {
       std::vector<std::int64_t> map(mesh.numNodes());
       for (std::size_t j = 0; j < mesh.numNodes(); ++j) {
-        if (j < surface) {
-          map[j] = static_cast<std::int64_t>(j);
-          if (!sameNode(out, j, mesh, j)) copyNode(mesh, j, out, j);
-        } else {
+        if (j >= surface) {
           map[j] = out.addNode(&mesh.xyz[3 * j], mesh.nodeCadDim[j], mesh.nodeCadIndex[j],
                                mesh.nodeCadParam[2 * j], mesh.nodeCadParam[2 * j + 1]);
+          continue;
         }
+        map[j] = static_cast<std::int64_t>(j);
+        if (sameNode(volume_, surfaceNode[j], mesh, j)) continue;
+        if (moved[j] != 0)  // (requireOwnSides keeps each solid's moves on its own faces)
+          throw MeshingError("two solids' boundary layers move the node at " +
+                             pointText(at(mesh, static_cast<std::int64_t>(j))));
+        moved[j] = 1;
+        copyNode(mesh, j, out, j);
       }
-      std::set<int> changed;  // the curves this layer climbed
-      for (const auto& [curve, list] : curveSegments(mesh, map))
-        if (list != original[curve]) changed.insert(curve);
-      for (const int curve : changed)
-        if (!climbed.insert(curve).second)
-          throw MeshingError("two solids' boundary layers climb Edge" + std::to_string(curve));
+      std::set<int> changed;
+      for (const ElementBlock& b : mesh.blocks)
+        if (b.type == CellType::Line)
+          for (std::size_t e = 0; e < b.count(); ++e)
+            if (static_cast<std::size_t>(std::max(b.element(e)[0], b.element(e)[1])) >= surface)
+              changed.insert(b.entity[e]);
+      climbed.insert(changed.begin(), changed.end());
       for (const ElementBlock& b : mesh.blocks)
         for (std::size_t e = 0; e < b.count(); ++e) {
           if (b.type == CellType::Tetrahedron) append(tets, b, map, e);
@@ -343,22 +344,6 @@ class SolidLayers {
     out.blocks.push_back(std::move(lines));
     out.checkConsistency();
     return out;
-  }
-
-  // Per curve, its line segments (sorted, their ends sorted) with the nodes mapped by `map`.
-  static std::map<int, std::vector<Segment>> curveSegments(const Mesh& mesh,
-                                                           const std::vector<std::int64_t>& map) {
-    std::map<int, std::vector<Segment>> segments;
-    for (const ElementBlock& b : mesh.blocks) {
-      if (b.type != CellType::Line) continue;
-      for (std::size_t e = 0; e < b.count(); ++e) {
-        const std::int64_t* l = b.element(e);
-        segments[b.entity[e]].push_back(sortedSegment(map[static_cast<std::size_t>(l[0])],
-                                                      map[static_cast<std::size_t>(l[1])]));
-      }
-    }
-    for (auto& [curve, list] : segments) std::sort(list.begin(), list.end());
-    return segments;
   }
 
   static void copyNode(const Mesh& from, std::size_t i, Mesh& to, std::size_t j) {
@@ -402,7 +387,7 @@ Mesh growLayerInSolids(const Mesh& volume, const CadModel& cad, const BoundaryLa
       throw ParameterError("boundary-layer solid " + std::to_string(s) + " does not exist: " +
                            cad.sourceName() + " has " + std::to_string(cad.numSolids()) +
                            (cad.numSolids() == 1 ? " solid" : " solids"));
-  if (volume.dim != 3 || solids.size() <= 1) return growLayer3D(volume, cad, p, fill, record);
+  if (solids.size() <= 1) return growLayer3D(volume, cad, p, fill, record);
   return SolidLayers(volume, cad, p).grow(fill, record);
 }
 

@@ -516,7 +516,7 @@ void readMeshAndBlock(const std::string& bytes, Mesh& mesh, ElementBlock& cells)
 
 // The triangles of `boundary` grouped into shells (connected through shared nodes), the one
 // with the largest bounding box (the outer one, which encloses the others) first.
-std::vector<std::vector<std::size_t>> closedShells(
+std::vector<std::vector<std::size_t>> connectedShells(
     const Mesh& mesh, const std::vector<std::array<std::int64_t, 3>>& boundary) {
   std::map<std::int64_t, std::int64_t> parent;
   const auto root = [&](std::int64_t v) {
@@ -558,7 +558,7 @@ ElementBlock fillTetrahedra(Mesh& mesh, const std::vector<std::array<std::int64_
   if (boundary.empty()) throw MeshingError("no surface to fill with tetrahedra");
   // One discrete surface per shell, the outer one first: a single surface loop over a body's
   // shell and the box's would have Gmsh fill the body too.
-  const std::vector<std::vector<std::size_t>> shells = closedShells(mesh, boundary);
+  const std::vector<std::vector<std::size_t>> shells = connectedShells(mesh, boundary);
   // Gmsh tags are the node ids + 1 (tags start at 1); its new nodes get larger tags.
   std::vector<char> used(mesh.numNodes(), 0);
   std::vector<std::vector<std::size_t>> tags(shells.size()), triangles(shells.size());

@@ -10,6 +10,8 @@
 #include <BRepBuilderAPI_Transform.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
+#include <BRep_Builder.hxx>
+#include <TopoDS_Compound.hxx>
 #include <gp_Pnt.hxx>
 #include <gp_Trsf.hxx>
 #include <gp_Vec.hxx>
@@ -289,6 +291,46 @@ TEST(BoundaryLayerInSolids, TheFaceBetweenTwoSolidsGrowsIntoTheOneNamed) {
   EXPECT_GT(record.sideQuadrilaterals, 0U);  // climbing the second box's four sides
   EXPECT_EQ(tetrahedraOf(mesh, solids[0]), tetrahedraOf(volume, solids[0]));
   expectConforming(mesh, true);
+  const QualitySummary q = evaluateQuality(mesh);
+  EXPECT_EQ(q.invalid + q.undecided, 0U);
+}
+
+// Two boxes apart, a layer on each top: both solids grow, and each keeps the nodes its layer
+// relaxed on its side faces (a second solid's growth once put the first's back where the volume
+// mesh had them, under the first's fill).
+TEST(BoundaryLayerInSolids, TwoSolidsGrowingBothKeepTheirSideFacesRelaxed) {
+  TopoDS_Compound two;
+  BRep_Builder builder;
+  builder.MakeCompound(two);
+  builder.Add(two, BRepPrimAPI_MakeBox(1.0, 1.0, 1.0).Shape());
+  builder.Add(two, BRepPrimAPI_MakeBox(gp_Pnt(2.0, 0.0, 0.0), 1.0, 1.0, 1.0).Shape());
+  const CadModel cad = test::toModel(two);
+  ASSERT_EQ(cad.numSolids(), 2);
+  const LinearMeshOptions fill = LinearMeshOptions::uniform(0.2);
+  const Mesh volume = generateLinearMesh(cad, fill);
+  BoundaryLayerParameters p;
+  p.faces = {faceNear(volume, {0.5, 0.5, 1.0}), faceNear(volume, {2.5, 0.5, 1.0})};
+  std::sort(p.faces.begin(), p.faces.end());
+  p.thickness = "0.1";
+  BoundaryLayerRecord record;
+  const Mesh mesh = growBoundaryLayer(volume, cad, p, fill, record);
+  EXPECT_EQ(record.faces.size(), 2U);
+  // The grown mesh keeps the volume's surface nodes first, in order: count, per box, the nodes
+  // inside its side faces that moved.
+  std::array<std::size_t, 2> relaxed{0, 0};
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < volume.numNodes(); ++i) {
+    if (volume.nodeCadDim[i] == 3) continue;
+    const auto k = static_cast<std::int64_t>(j++);
+    const bool side =
+        volume.nodeCadDim[i] == 2 &&
+        std::find(p.faces.begin(), p.faces.end(), volume.nodeCadIndex[i]) == p.faces.end();
+    const Eigen::Vector3d before = point(volume, static_cast<std::int64_t>(i));
+    if (side && (point(mesh, k) - before).norm() > 1e-9) ++relaxed[before.x() < 1.5 ? 0 : 1];
+  }
+  EXPECT_GT(relaxed[0], 0U);
+  EXPECT_GT(relaxed[1], 0U);
+  expectConforming(mesh, false);
   const QualitySummary q = evaluateQuality(mesh);
   EXPECT_EQ(q.invalid + q.undecided, 0U);
 }
