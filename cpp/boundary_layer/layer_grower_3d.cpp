@@ -709,8 +709,10 @@ class LayerGrower {
       }
     record_.cells = prisms.count();
     record_.sideQuadrilaterals = quads.count();
-    for (const WallNode& w : wall_)
+    for (const WallNode& w : wall_) {
       if (w.stretch > 1.0) record_.lengthened[w.id] = w.stretch;
+      if (w.stretch > 1.0 && w.sharp) record_.sharpColumns.insert(w.id);
+    }
 
     ElementBlock tets = fillTetrahedra(out_, closure, fill, solid_);
     out_.blocks = {std::move(tets), std::move(prisms), std::move(tris)};

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <set>
 #include <vector>
 
 #include "boundary_layer/layer_parameters.hpp"
@@ -63,6 +64,10 @@ struct BoundaryLayerRecord {
   // between the layer faces and is lengthened so that its top lies at the thickness from each
   // (the split then measures its first level the same way: LayerHeights::lengthened).
   std::map<std::int64_t, double> lengthened;
+  // 3D: the wall nodes among them where layer faces meet at a sharp edge or corner (their columns
+  // lean between the faces by design; blendLayerInteriors raises the top beside them along the
+  // wall's normal). The others were lengthened for leaning from their face's normal.
+  std::set<std::int64_t> sharpColumns;
   int shrinkPasses = 0;
   // The optimiser keeps the macro layer as grown unless elements stay invalid; then it lets the
   // layer's top move around them, first parallel to the wall (the heights stay; its nodes on

@@ -368,6 +368,7 @@ class SolidLayers {
       record.sideQuadrilaterals += r.sideQuadrilaterals;
       record.wallNodes += r.wallNodes;
       record.lengthened.insert(r.lengthened.begin(), r.lengthened.end());
+      record.sharpColumns.insert(r.sharpColumns.begin(), r.sharpColumns.end());
       record.shrinkPasses = std::max(record.shrinkPasses, r.shrinkPasses);
     }
     std::sort(record.faces.begin(), record.faces.end(),

@@ -39,9 +39,10 @@ struct LayerSplitStats {
   // 2P), the distance to where the normal line meets the layer's top: its range over the points
   // measured and, with grown heights, the worst relative deviation from z_1 times the grown height
   // interpolated there (0 without them), on the smooth wall and in the cells with a vertex at a
-  // sharp corner (where the walls' normals spread by more than 30 degrees: there the column follows
-  // the corner's bisector, and the height along each wall's normal falls towards the corner by
-  // design).
+  // sharp corner (where the walls' normals spread by more than 30 degrees: a column there leans
+  // between the walls, lengthened so that its top is at the height from each, or where no
+  // lengthening was made (a 2D fan's cells, a column held down), follows their bisector, and
+  // the height along each wall's normal falls towards the corner).
   std::size_t firstHeightMeasured = 0, cornerCells = 0;
   // Quadrature points whose normal line leaves the cell's top through a neighbour's: measured
   // there as the top point's component along the normal instead (heightAlongNormal).

@@ -62,10 +62,12 @@ inline NodeKey makeKey(std::array<std::pair<std::int64_t, int>, 4> w, std::int64
 // first layer has the height asked for even where the optimiser has moved the top; the
 // others keep their progression in what remains. s_1 is kept within [z_1 / 2, 2 z_1] (and
 // below the second level's share) so the levels stay ordered. Where the top has also slid
-// sideways (T - W not along n), the first level's node is moved by `shift` onto the normal
-// through W (its tangential offset, s_1 times that of the top, would otherwise change the
-// height measured between the nodes), the shift fading linearly to 0 at wall and top. A node
-// shared by neighbours takes the column of the first cell that reaches it.
+// sideways (T - W not along n) beyond the lean its lengthening gives it by design, the first
+// level's node is moved by `shift` back by that excess, towards the normal through W (its
+// tangential offset, s_1 times that of the top, would otherwise change the height measured
+// between the nodes); at a sharp edge or corner, to the first layer's height from every wall;
+// the shift fades linearly to 0 at wall and top. A node shared by neighbours takes the column
+// of the first cell that reaches it.
 struct Column {
   std::vector<double> levels;
   Eigen::Vector3d shift = Eigen::Vector3d::Zero();
@@ -197,6 +199,11 @@ class LayerSplitter {
   // The column above lattice point `c` of cell `v` (Column): made by the first cell reaching it.
   const Column& column(const ElementBlock& b, const std::map<LatticePoint, int>& index,
                        const std::int64_t* v, LatticePoint c);
+  // The least move, within the span of `normals`, that brings the offset `x` to the height `h`
+  // along each of them (the least-squares, least-norm solution of N s = h 1 - N x): at a sharp
+  // edge or corner, what puts a level's node at one height from every wall.
+  static Eigen::Vector3d towardsHeight(const NormalSum& normals, const Eigen::Vector3d& x,
+                                       double h);
   // Sets the column's levels from its first, `wanted` kept within [s_1 / 2, 2 s_1] (and below the
   // second level's share), s its levels as they are: the others keep their progression in what
   // remains. Returns it.

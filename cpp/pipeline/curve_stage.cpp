@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <set>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -292,6 +293,11 @@ std::optional<OptimiserResult> optimiseAt(CurveRun& run, int order, Mesh& mesh, 
   return r;
 }
 
+// The layer's columns at sharp edges and corners (blendLayerInteriors), if any.
+const std::set<std::int64_t>* sharpColumns(const CurveRun& run) {
+  return run.state.layer ? &run.state.layer->sharpColumns : nullptr;
+}
+
 // Above kContinuationOrder with the optimiser: elevation to that order ("high_order"), the
 // optimiser there ("optimise_low_order"), then the raise to the final order ("raise_order").
 void elevateThroughContinuation(CurveRun& run) {
@@ -301,7 +307,7 @@ void elevateThroughContinuation(CurveRun& run) {
   run.startClock(clock, "high_order");
   run.elevationStart = std::chrono::steady_clock::now();
   state.lowOrder = elevateOrder(state.linear, kContinuationOrder, &run.cad, nullptr, run.layered);
-  if (run.layered) blendLayerInteriors(state.lowOrder, &run.cad);
+  if (run.layered) blendLayerInteriors(state.lowOrder, &run.cad, true, sharpColumns(run));
   // Until the final order is made: scaled by the nodes per simplex of the two orders.
   const CellType simplex = state.linear.dim == 3 ? CellType::Tetrahedron : CellType::Triangle;
   reserveAfterElevation(run, static_cast<double>(cellNumNodes(simplex, options.order)) /
@@ -328,7 +334,7 @@ void elevateThroughContinuation(CurveRun& run) {
   // was the top's edges on the end faces, which the raise placed afresh, straight; it keeps
   // their shape now, and the first layer is within 0.01 %.)
   if (run.layered && state.layerRelease != LayerRelease::Free)
-    blendLayerInteriors(state.mesh, &run.cad, /*tops=*/state.mesh.dim == 2);
+    blendLayerInteriors(state.mesh, &run.cad, /*tops=*/state.mesh.dim == 2, sharpColumns(run));
   reserveAfterElevation(run, 1.0);
   if (clock) clock->done();
 }
@@ -340,7 +346,7 @@ void elevateDirectly(CurveRun& run) {
   run.elevationStart = std::chrono::steady_clock::now();
   run.state.mesh =
       elevateOrder(run.state.linear, run.options.order, &run.cad, nullptr, run.layered);
-  if (run.layered) blendLayerInteriors(run.state.mesh, &run.cad);
+  if (run.layered) blendLayerInteriors(run.state.mesh, &run.cad, true, sharpColumns(run));
   reserveAfterElevation(run, 1.0);
   if (clock) clock->done();
 }
@@ -365,13 +371,14 @@ void evaluateCurved(CurveRun& run) {
 CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& cad,
                   StageTimings& timings, PipelineObserver* observer, bool clocked,
                   JobBudget& budget, const std::string& round, const CurvedState* previous,
-                  bool givenLayer) {
+                  bool givenLayer, std::optional<BoundaryLayerRecord> layer) {
   CurveRun run{options,  cad,      timings,
                observer, clocked,  budget,
                round,    previous, options.boundaryLayer.has_value() || givenLayer,
                {},       {},       {},
                {}};
   run.state.linear = std::move(linear);
+  run.state.layer = std::move(layer);
   checkHighOrderMemory(run.state.linear, options.order);
   if (options.optimiseIterations > 0 && options.order > kContinuationOrder)
     elevateThroughContinuation(run);

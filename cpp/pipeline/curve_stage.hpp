@@ -55,10 +55,13 @@ struct CurvedState {
 // measured time for the stages that always run. Throws ParameterError (memory), MeshingError,
 // CadError or CancelledError. The prisms of `linear` are a macro boundary layer (wall 0-1-2,
 // top 3-4-5: blended after elevation, kept while the rest is optimised) when options ask for a
-// layer or `givenLayer` says a given mesh's stacks were agglomerated into them (layer_stacks.hpp).
+// layer or `givenLayer` says a given mesh's stacks were agglomerated into them (layer_stacks.hpp);
+// `layer`, the record of the layer grown in `linear`, becomes the state's (its columns
+// lengthened at sharp edges shape the blend).
 CurvedState curve(Mesh linear, const MeshingOptions& options, const CadModel& cad,
                   StageTimings& timings, PipelineObserver* observer, bool clocked,
                   JobBudget& budget, const std::string& round,
-                  const CurvedState* previous = nullptr, bool givenLayer = false);
+                  const CurvedState* previous = nullptr, bool givenLayer = false,
+                  std::optional<BoundaryLayerRecord> layer = std::nullopt);
 
 }  // namespace homesh

@@ -547,8 +547,7 @@ MeshResult runMeshPipeline(const CadSource& source, MeshingOptions options,
   LinearStage& linear = *stage;
 
   CurvedState first = curve(std::move(linearMesh), options, *result.cad, result.timings, observer,
-                            true, budget, "");
-  first.layer = linear.layer();
+                            true, budget, "", nullptr, false, linear.layer());
   // A repair round starts only if what is left of the budget covers what the one before took:
   // for the first, the linear mesh and curving just measured.
   CurvedState best = runRepairRounds(std::move(first), budget.elapsed() - firstStart, linear,

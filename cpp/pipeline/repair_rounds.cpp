@@ -257,8 +257,7 @@ void RepairRounds::recordFailedRound(Round& r, const MeshingError& e, StageClock
 // than the best; the flags that steer the next round follow from the outcome.
 void RepairRounds::curveAndKeep(Round& r, StageClock& clock) {
   CurvedState state = curve(std::move(r.next), options_, *result_.cad, result_.timings, observer_,
-                            false, budget_, r.name, &r.from);
-  state.layer = linear_.layer();
+                            false, budget_, r.name, &r.from, false, linear_.layer());
   RepairRound& record = r.record;
   record.budgetStopped =
       budget_.cutStages().size() + budget_.skippedStages().size() != r.budgetEvents;
