@@ -135,10 +135,13 @@ class LayerGrower {
   std::map<std::int64_t, std::size_t> wallIndex_;  // node -> wall_ index
   // Nodes inside the faces without a layer, near the layer's foot: relaxed (each the mean of
   // its neighbours on the face, projected onto it) so that the face's triangles make room for
-  // the nodes that climb it instead of folding.
+  // the nodes that climb it instead of folding. Nodes on a curve between such faces (a
+  // cylinder's seam, the edge between two of them) slide along it the same way: held, they
+  // fold the triangles beside them where the layer climbs a face a few elements tall (a stilt).
   struct SideNode {
     std::int64_t id = 0;
-    int face = 0;
+    int face = 0;   // the face it lies inside, or 0 on a curve
+    int curve = 0;  // the curve it lies on, or 0 inside a face
     std::vector<std::int64_t> neighbours;
     Vec at = Vec::Zero();
     double u = kNaN, v = kNaN;
@@ -248,7 +251,8 @@ class LayerGrower {
     }
   }
 
-  // The side faces' inner nodes within kSideRings edges of a wall node that climbs them.
+  // The side faces' inner nodes, and those of the curves between them, within kSideRings edges
+  // of a wall node that climbs them.
   void findSideNodes() {
     std::map<std::int64_t, std::set<std::int64_t>> adjacent;
     for (const Tri& t : sideTris_)
@@ -256,6 +260,13 @@ class LayerGrower {
         for (int j = 0; j < 3; ++j)
           if (j != k)
             adjacent[t[static_cast<std::size_t>(k)]].insert(t[static_cast<std::size_t>(j)]);
+    // A curve that also bounds a face this solid's mesh does not hold (another solid's) stays:
+    // that face's triangles are not checked here.
+    std::set<int> held(layerFace_.begin(), layerFace_.end()), foreign;
+    held.insert(sideFace_.begin(), sideFace_.end());
+    for (int f = 1; f <= cad_.numFaces(); ++f)
+      if (held.count(f) == 0)
+        for (const int c : cad_.subShapeIndices(2, f, 1)) foreign.insert(c);
     std::set<std::int64_t> front, reached;
     for (const WallNode& w : wall_)
       if (!w.sideFaces.empty()) front.insert(w.id);
@@ -264,8 +275,9 @@ class LayerGrower {
       for (const std::int64_t v : front)
         for (const std::int64_t n : adjacent[v]) {
           const auto i = static_cast<std::size_t>(n);
-          if (out_.nodeCadDim[i] != 2 || wallIndex_.count(n) != 0 || !reached.insert(n).second)
-            continue;
+          const int dim = out_.nodeCadDim[i];
+          const bool slides = dim == 2 || (dim == 1 && foreign.count(out_.nodeCadIndex[i]) == 0);
+          if (!slides || wallIndex_.count(n) != 0 || !reached.insert(n).second) continue;
           next.insert(n);
         }
       front = std::move(next);
@@ -273,7 +285,8 @@ class LayerGrower {
     for (const std::int64_t n : reached) {
       SideNode s;
       s.id = n;
-      s.face = out_.nodeCadIndex[static_cast<std::size_t>(n)];
+      const auto i = static_cast<std::size_t>(n);
+      (out_.nodeCadDim[i] == 2 ? s.face : s.curve) = out_.nodeCadIndex[i];
       s.neighbours.assign(adjacent[n].begin(), adjacent[n].end());
       sideIndex_[n] = side_.size();
       side_.push_back(std::move(s));
@@ -294,6 +307,14 @@ class LayerGrower {
         Vec mean = Vec::Zero();
         for (const std::int64_t n : s.neighbours) mean += moved(n);
         mean /= static_cast<double>(s.neighbours.size());
+        if (s.curve != 0) {
+          std::optional<double> guess;
+          if (std::isfinite(s.u)) guess = s.u;
+          const CurveProjection proj = cad_.projectOnCurve(s.curve, mean, guess);
+          s.at = proj.point;
+          s.u = proj.t;
+          continue;
+        }
         std::optional<std::array<double, 2>> guess;
         if (std::isfinite(s.u) && std::isfinite(s.v)) guess = std::array<double, 2>{s.u, s.v};
         const SurfaceProjection proj = cad_.projectOnSurface(s.face, mean, guess);
